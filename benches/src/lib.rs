@@ -1,0 +1,1 @@
+//! Criterion benches (benches/benches/) and the per-cycle budget gate.

@@ -1,0 +1,1 @@
+//! Characteristic diagram (restraint LUT): file format and allocation-free multilinear interpolation.

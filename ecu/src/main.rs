@@ -1,0 +1,2 @@
+//! The fixed-rate restraint ECU process.
+fn main() {}

@@ -1,0 +1,1 @@
+//! iceoryx2 zero-copy payload types and service names shared by the bench processes.

@@ -1,0 +1,2 @@
+//! Restraint optimiser, characteristic-diagram builder and the method's studies.
+fn main() {}

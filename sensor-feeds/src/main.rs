@@ -1,0 +1,2 @@
+//! Scenario player: object, vehicle, occupant and crash-accelerometer feeds.
+fn main() {}
