@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Installs everything the bench and its test suite need on a fresh Debian/Ubuntu machine
+# with Rust: Debian packages (idempotent: only what is missing) and a Python venv with
+# cantools (fresh Debian/Ubuntu Pythons refuse system-wide pip installs, PEP 668).
+# Prints the venv's bin directory on its last line so callers can put it on PATH.
+set -euo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+
+# can-utils: candump/cansend/cangen; kmod+iproute2: vcan; user-mode-linux: vcan where the
+# host kernel has no SocketCAN; rt-tests: cyclictest; valgrind: instruction-count gate.
+pkgs=(can-utils kmod iproute2 user-mode-linux rt-tests valgrind python3-venv)
+missing=()
+for p in "${pkgs[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+    sudo=""; [ "$(id -u)" -eq 0 ] || sudo="sudo"
+    echo "setup: installing ${missing[*]}" >&2
+    $sudo apt-get update -qq >&2
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${missing[@]}" >&2
+fi
+
+venv="$here/target/pyenv"
+if ! "$venv/bin/python3" -c "import cantools" 2>/dev/null; then
+    echo "setup: creating $venv with cantools" >&2
+    python3 -m venv "$venv" >&2
+    "$venv/bin/pip" install -q --disable-pip-version-check "cantools>=39" >&2
+fi
+echo "$venv/bin"
