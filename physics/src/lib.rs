@@ -1,1 +1,49 @@
 //! Crash-pulse and occupant physics of the situation-adaptive restraint method (no_std core).
+//!
+//! * [`stiffness`] — piecewise-linear force-deflection curves, series combination, the six mass
+//!   classes (generated at build time from `data/stiffness-classes.toml`).
+//! * [`collision`] — two masses joined by one combined non-linear spring with restitution-exact
+//!   unloading; writes the compartment pulses into a caller-owned fixed buffer.
+//! * [`occupant`] — one rigid occupant body with belt, airbag + column, seat friction,
+//!   bottoming-out detection, and the ideal constant-force bound a*.
+//! * [`j211`] — SAE J211 CFC filter (phaseless, in place, no allocation).
+//! * [`derive`] (feature `std`) — force-deflection curve from a rigid-barrier accelerometer trace.
+//! * [`defaults`] — every modelling default in one place.
+//! * [`paper`] — the published numbers we calibrate against (typed from SPEC.md).
+//!
+//! Units: SI internally (m, s, kg, N); names carry the unit suffix. Nothing here allocates or
+//! panics on input (property-tested); invalid input returns [`PhysicsError`].
+#![cfg_attr(not(feature = "std"), no_std)]
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod collision;
+pub mod defaults;
+#[cfg(feature = "std")]
+pub mod derive;
+mod error;
+pub mod j211;
+pub mod occupant;
+pub mod paper;
+pub mod stiffness;
+
+pub use collision::{
+    simulate_collision, CollisionInput, CollisionSummary, CompartmentPulse, DefaultPulseBuffer,
+    PulseBuffer, VehicleResult,
+};
+pub use error::PhysicsError;
+pub use occupant::{
+    ideal_constant_force_decel_mps2, simulate_occupant, OccupantInput, OccupantOutcome,
+    RestraintHardware, RestraintSettings,
+};
+pub use stiffness::{class_for_mass_kg, CombinedSpring, Curve, MassClass};
+
+/// Convert an acceleration in m/s² to multiples of standard gravity.
+pub fn mps2_to_g(accel_mps2: f64) -> f64 {
+    accel_mps2 / defaults::STANDARD_GRAVITY_MPS2
+}
+
+/// Convert km/h to m/s.
+pub fn kph_to_mps(speed_kph: f64) -> f64 {
+    speed_kph / 3.6
+}
