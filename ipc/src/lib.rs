@@ -450,6 +450,9 @@ pub struct StaleCleanup {
 /// `try_cleanup_dead_nodes` removes them so a restarted bench does not hit
 /// "service in use / too many publishers" errors.
 pub fn create_node(name: &str, handle_signals: bool) -> Result<(IpcNode, StaleCleanup), IpcError> {
+    // iceoryx2 warns on every start that no config file exists (defaults are what the
+    // bench wants); keep warnings quiet unless IOX2_LOG_LEVEL asks for them.
+    set_log_level_from_env_or(LogLevel::Error);
     let node_name = NodeName::new(name).map_err(|e| setup_err("node name", name, e))?;
     let mode = if handle_signals {
         SignalHandlingMode::HandleTerminationRequests

@@ -1,0 +1,190 @@
+//! Wiring of the ECU process: config → CAN decision → iceoryx2 → RT settings → loop →
+//! report. Kept in the library so tests can run the whole process in-process.
+
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use ipc::ServiceNames;
+
+use super::activity::Activity;
+use super::clock::MonotonicClock;
+use super::com::{CanPort, IceoryxIo};
+use super::config::EcuConfig;
+use super::report::{CanStatus, IpcStatus, TimingReport};
+use super::rt;
+use super::run::{run_activity, LoopConfig, LoopStats};
+
+static STOP: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_stop_signal(_: nix::libc::c_int) {
+    // Async-signal-safe: a single atomic store, nothing else.
+    STOP.store(true, Ordering::Relaxed);
+}
+
+/// Installs SIGINT/SIGTERM handlers that only set the returned flag.
+pub fn install_stop_signals() -> anyhow::Result<&'static AtomicBool> {
+    use nix::sys::signal::{sigaction, SaFlags, SigAction, SigHandler, SigSet, Signal};
+    let action = SigAction::new(
+        SigHandler::Handler(on_stop_signal),
+        SaFlags::empty(), // no SA_RESTART: interrupt clock_nanosleep so we stop promptly
+        SigSet::empty(),
+    );
+    for sig in [Signal::SIGINT, Signal::SIGTERM] {
+        // SAFETY: the handler only performs an atomic store (async-signal-safe).
+        unsafe { sigaction(sig, &action) }?;
+    }
+    Ok(&STOP)
+}
+
+/// Decides whether the CAN side runs. `Err` when CAN is requested but the interface is
+/// missing (the operator must bring up vcan0 or pass `--no-can`: never silently off).
+pub fn can_decision(cfg: &EcuConfig, can_port_available: bool) -> anyhow::Result<CanStatus> {
+    let interface = cfg.can.interface.clone();
+    if !cfg.can.enabled {
+        return Ok(CanStatus {
+            enabled: false,
+            interface,
+            reason: "switched off by --no-can / can.enabled = false".into(),
+        });
+    }
+    if !Path::new("/sys/class/net").join(&interface).exists() {
+        anyhow::bail!(
+            "CAN interface {interface} does not exist on this host (no SocketCAN/vcan?): \
+             bring it up with vcan-setup.sh or run with --no-can"
+        );
+    }
+    Ok(if can_port_available {
+        CanStatus {
+            enabled: true,
+            interface,
+            reason: "SocketCAN port open".into(),
+        }
+    } else {
+        CanStatus {
+            enabled: false,
+            interface,
+            reason: "interface present but no SocketCAN port is wired into this build yet \
+                     (bus crate integration point)"
+                .into(),
+        }
+    })
+}
+
+/// The finished run.
+pub struct RunOutcome {
+    /// Text report.
+    pub text: String,
+    /// JSON report.
+    pub json: String,
+    /// Loop statistics.
+    pub stats: LoopStats,
+}
+
+/// Runs the ECU process body with `activity` until `stop` or `cfg.cycles`.
+pub fn run_ecu(
+    cfg: &EcuConfig,
+    activity: &mut dyn Activity,
+    can_port: Option<Box<dyn CanPort>>,
+    stop: &AtomicBool,
+    verbose: bool,
+) -> anyhow::Result<RunOutcome> {
+    let can = can_decision(cfg, can_port.is_some())?;
+    let can_port = if can.enabled { can_port } else { None };
+    let names = ServiceNames::with_prefix(&cfg.ipc.service_prefix);
+    let (node, cleanup) = ipc::create_node(&cfg.ipc.node_name, false)?;
+    let mut io = IceoryxIo::new(&node, &names, can_port)?;
+
+    // Preallocate everything the loop writes before locking memory and going RT.
+    let mut stats = LoopStats::default();
+    let rt_state = rt::apply(&cfg.rt);
+    if verbose {
+        eprintln!(
+            "ecu: period {} µs, activity {}, services {}/…, node {}",
+            cfg.period_us,
+            activity.name(),
+            cfg.ipc.service_prefix,
+            cfg.ipc.node_name
+        );
+        if cleanup.cleaned + cleanup.failed > 0 {
+            eprintln!(
+                "ecu: iceoryx2 stale resources: {} dead node(s) cleaned, {} failed",
+                cleanup.cleaned, cleanup.failed
+            );
+        }
+        for l in rt_state.summary_lines() {
+            eprintln!("ecu: {l}");
+        }
+        eprintln!(
+            "ecu: can          {:<6} {} ({})",
+            if can.enabled { "ON" } else { "off" },
+            can.interface,
+            can.reason
+        );
+    }
+    for o in [
+        &rt_state.sched.outcome,
+        &rt_state.mlockall,
+        &rt_state.cpu_affinity,
+        &rt_state.pm_qos,
+    ] {
+        if o.requested && !o.granted {
+            eprintln!("ecu: warning: {} — continuing without it", o.detail);
+        }
+    }
+
+    let loop_cfg = LoopConfig {
+        period_ns: cfg.period_us.saturating_mul(1_000),
+        max_cycles: cfg.cycles,
+    };
+    run_activity(
+        &mut MonotonicClock,
+        activity,
+        &mut io,
+        &loop_cfg,
+        stop,
+        &mut stats,
+    )?;
+
+    let mut counters = Vec::new();
+    activity.report_counters(&mut counters);
+    let (o, a, d) = (
+        io.object_counters(),
+        io.accel_counters(),
+        io.diagnostics_counters(),
+    );
+    let ipc_status = IpcStatus {
+        service_prefix: cfg.ipc.service_prefix.clone(),
+        stale_nodes_cleaned: cleanup.cleaned,
+        stale_nodes_failed: cleanup.failed,
+        object_rx: o.received,
+        object_rx_errors: o.errors,
+        accel_rx: a.received,
+        accel_rx_errors: a.errors,
+        diagnostics_tx: d.sent,
+        diagnostics_tx_errors: d.errors,
+    };
+    let stop_reason = if stop.load(Ordering::Relaxed) {
+        "signal"
+    } else {
+        "cycles"
+    };
+    let report = TimingReport::new(
+        &stats,
+        loop_cfg.period_ns,
+        activity.name(),
+        &counters,
+        &rt_state,
+        can,
+        Some(ipc_status),
+        stop_reason,
+    );
+    let text = report.to_text();
+    let json = report.to_json()?;
+    if let Some(path) = &cfg.report_json {
+        std::fs::write(path, &json)
+            .map_err(|e| anyhow::anyhow!("cannot write report {}: {e}", path.display()))?;
+    }
+    drop(report);
+    drop(rt_state);
+    Ok(RunOutcome { text, json, stats })
+}

@@ -1,0 +1,134 @@
+//! `ecu monitor`: live view of the ECU diagnostics service.
+
+use std::io::Write;
+use std::time::Duration;
+
+use ipc::{degraded, DiagnosticsSubscriber, EcuDiagnostics, EcuMode, ServiceNames};
+
+use super::config::{EcuConfig, MonitorArgs};
+
+/// Names of the set bits of a degraded-reason word.
+pub fn degraded_names(bits: u32) -> String {
+    const NAMES: [(u32, &str); 9] = [
+        (degraded::OBJECT_STALE, "object-stale"),
+        (degraded::OBJECT_INVALID, "object-invalid"),
+        (degraded::ACCEL_STALE, "accel-stale"),
+        (degraded::ACCEL_INVALID, "accel-invalid"),
+        (degraded::CAN_STALE, "can-stale"),
+        (degraded::E2E_FAILURE, "e2e"),
+        (degraded::LUT_INVALID, "lut-invalid"),
+        (degraded::CAN_DISABLED, "can-off"),
+        (degraded::IPC_ERROR, "ipc-error"),
+    ];
+    let v: Vec<&str> = NAMES
+        .iter()
+        .filter(|(b, _)| bits & b != 0)
+        .map(|(_, n)| *n)
+        .collect();
+    if v.is_empty() {
+        "-".into()
+    } else {
+        v.join(",")
+    }
+}
+
+/// One status line for a diagnostics record.
+pub fn format_line(d: &EcuDiagnostics, rx_rate_hz: f64) -> String {
+    let mode = EcuMode::from_u8(d.mode).map_or("?", EcuMode::name);
+    format!(
+        "cycle {:>9} {:>7.0} Hz | mode {:<10} | Δv {:>5.1} m/s a_max {:>6.1} m/s² | belt {:>6.0} N pt {:>6.3}s bag st{} {:>6.3}s | wake {:>6.1} µs exec {:>6.1} µs overruns {} | obj#{} acc#{} | degraded {}",
+        d.cycle_count,
+        rx_rate_hz,
+        mode,
+        d.predicted_delta_v_mps,
+        d.predicted_a_max_mps2,
+        d.belt_force_limit_n,
+        d.pretensioner_time_s,
+        d.airbag_stage,
+        d.airbag_time_s,
+        d.wake_latency_ns as f64 / 1e3,
+        d.last_exec_ns as f64 / 1e3,
+        d.overrun_count,
+        d.last_object_sequence,
+        d.last_accel_sequence,
+        degraded_names(d.degraded_reasons),
+    )
+}
+
+/// Runs the monitor until Ctrl-C (iceoryx2's node handles SIGINT/SIGTERM here) or
+/// `--count` refreshes.
+pub fn run(args: &MonitorArgs) -> anyhow::Result<()> {
+    let mut prefix = match &args.config {
+        Some(p) => EcuConfig::load(p)?.ipc.service_prefix,
+        None => ipc::DEFAULT_SERVICE_PREFIX.to_owned(),
+    };
+    if let Some(p) = &args.service_prefix {
+        prefix.clone_from(p);
+    }
+    anyhow::ensure!(
+        args.rate_hz.is_finite() && args.rate_hz > 0.0 && args.rate_hz <= 1_000.0,
+        "--rate-hz must be in (0, 1000]"
+    );
+    let names = ServiceNames::with_prefix(&prefix);
+    let node_name = format!("ecu-monitor-{}", std::process::id());
+    let (node, _) = ipc::create_node(&node_name, true)?;
+    let mut sub = DiagnosticsSubscriber::new(&node, &names)?;
+    let period = Duration::from_secs_f64(1.0 / args.rate_hz);
+    eprintln!("monitoring {} (Ctrl-C to exit)", names.diagnostics);
+    let mut refreshes = 0u64;
+    let mut last_cycle: Option<u64> = None;
+    let mut out = std::io::stdout();
+    while node.wait(period).is_ok() {
+        let latest = sub.latest();
+        let line = match latest {
+            Some(d) => {
+                let rate = last_cycle.map_or(0.0, |c| {
+                    d.cycle_count.saturating_sub(c) as f64 * args.rate_hz
+                });
+                last_cycle = Some(d.cycle_count);
+                format_line(&d, rate)
+            }
+            None => "waiting for ECU diagnostics …".to_owned(),
+        };
+        if args.lines {
+            writeln!(out, "{line}")?;
+        } else {
+            write!(out, "\r\x1b[2K{line}")?;
+        }
+        out.flush()?;
+        refreshes += 1;
+        if args.count.is_some_and(|c| refreshes >= c) {
+            break;
+        }
+    }
+    if !args.lines {
+        writeln!(out)?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn degraded_bits_are_named() {
+        assert_eq!(degraded_names(0), "-");
+        assert_eq!(
+            degraded_names(degraded::OBJECT_STALE | degraded::CAN_DISABLED),
+            "object-stale,can-off"
+        );
+    }
+
+    #[test]
+    fn line_shows_mode_and_timing() {
+        let mut d = EcuDiagnostics::ZERO;
+        d.mode = EcuMode::PreCrash as u8;
+        d.wake_latency_ns = 12_300;
+        d.overrun_count = 4;
+        let l = format_line(&d, 1000.0);
+        assert!(l.contains("pre-crash"), "{l}");
+        assert!(l.contains("wake   12.3 µs"), "{l}");
+        assert!(l.contains("overruns 4"), "{l}");
+    }
+}
