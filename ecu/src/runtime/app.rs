@@ -92,7 +92,12 @@ pub fn run_ecu(
     let can_port = if can.enabled { can_port } else { None };
     let names = ServiceNames::with_prefix(&cfg.ipc.service_prefix);
     let (node, cleanup) = ipc::create_node(&cfg.ipc.node_name, false)?;
-    let mut io = IceoryxIo::new(&node, &names, can_port)?;
+    let mut io = IceoryxIo::new(
+        &node,
+        &names,
+        can_port,
+        std::time::Duration::from_micros(cfg.period_us),
+    )?;
 
     // Preallocate everything the loop writes before locking memory and going RT.
     let mut stats = LoopStats::default();
@@ -145,6 +150,7 @@ pub fn run_ecu(
         &mut stats,
     )?;
 
+    io.shutdown(); // sends the final diagnostics record
     let mut counters = Vec::new();
     activity.report_counters(&mut counters);
     let (o, a, d) = (
@@ -160,6 +166,7 @@ pub fn run_ecu(
         object_rx_errors: o.errors,
         accel_rx: a.received,
         accel_rx_errors: a.errors,
+        diagnostics_written: io.diagnostics_written(),
         diagnostics_tx: d.sent,
         diagnostics_tx_errors: d.errors,
     };
