@@ -119,7 +119,7 @@ fn steady_state_loop_with_iceoryx2_allocates_nothing() {
                         a.accel_mps2 = [-9.81; 8];
                     })
                     .unwrap();
-                if seq % 4 == 0 {
+                if seq.is_multiple_of(4) {
                     objects
                         .publish_with(ObjectState::INVALID, |o| {
                             o.sequence = seq / 4;

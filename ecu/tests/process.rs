@@ -1,0 +1,208 @@
+//! The `ecu` binary as a real process: CLI, config errors, `--cycles`, SIGTERM, JSON
+//! report and `ecu monitor` against a running ECU. No assertion depends on wall-clock
+//! timing (only generous "eventually" bounds for functional failures).
+
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use ipc::{DiagnosticsSubscriber, ObjectPublisher, ObjectState, ServiceNames, VALID};
+use nix::sys::signal::{kill, Signal};
+use nix::unistd::Pid;
+
+const ECU: &str = env!("CARGO_BIN_EXE_ecu");
+const PATIENCE: Duration = Duration::from_secs(30);
+
+fn tmpdir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("ecu-proc-{}-{tag}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn prefix(tag: &str) -> String {
+    format!("ecu-proc-{}-{tag}", std::process::id())
+}
+
+#[test]
+fn help_lists_the_flags() {
+    let out = Command::new(ECU).arg("--help").output().unwrap();
+    assert!(out.status.success());
+    let s = String::from_utf8_lossy(&out.stdout);
+    for flag in [
+        "--config",
+        "--period-us",
+        "--cycles",
+        "--report-json",
+        "--sched-fifo",
+        "--mlockall",
+        "--cpu",
+        "--pm-qos",
+        "--no-can",
+        "monitor",
+    ] {
+        assert!(s.contains(flag), "{flag} missing in --help:\n{s}");
+    }
+}
+
+#[test]
+fn bad_config_exits_with_file_and_line() {
+    let dir = tmpdir("badcfg");
+    let path = dir.join("bad.toml");
+    std::fs::write(&path, "period_us = 1000\n[rt]\nmlockall = maybe\n").unwrap();
+    let out = Command::new(ECU)
+        .arg("--config")
+        .arg(&path)
+        .arg("--no-can")
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains(&format!("{}:3:", path.display())), "{err}");
+}
+
+#[test]
+fn missing_can_interface_is_an_error_unless_no_can() {
+    let out = Command::new(ECU)
+        .args(["--cycles", "1", "--can-interface", "nocan-test0"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("nocan-test0") && err.contains("--no-can"),
+        "{err}"
+    );
+}
+
+#[test]
+fn cycles_run_writes_json_report_and_monitor_shows_it() {
+    let dir = tmpdir("cycles");
+    let report = dir.join("report.json");
+    let pfx = prefix("cycles");
+    let mut ecu = Command::new(ECU)
+        .args([
+            "--cycles",
+            "4000",
+            "--period-us",
+            "500",
+            "--no-can",
+            "--quiet",
+        ])
+        .args([
+            "--service-prefix",
+            &pfx,
+            "--node-name",
+            &format!("{pfx}-ecu"),
+        ])
+        .arg("--report-json")
+        .arg(&report)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+
+    // Wait for the ECU's diagnostics, then feed a few object states.
+    let names = ServiceNames::with_prefix(&pfx);
+    let (node, _) = ipc::create_node("ecu-proc-feed", false).unwrap();
+    let mut diag = DiagnosticsSubscriber::new(&node, &names).unwrap();
+    let mut objects = ObjectPublisher::new(&node, &names).unwrap();
+    let t0 = Instant::now();
+    while diag.latest().is_none() {
+        assert!(
+            t0.elapsed() < PATIENCE,
+            "no diagnostics from the ecu process"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let monitor = Command::new(ECU)
+        .args([
+            "monitor",
+            "--count",
+            "3",
+            "--lines",
+            "--rate-hz",
+            "50",
+            "--service-prefix",
+            &pfx,
+        ])
+        .output()
+        .unwrap();
+    for seq in 1..=10u64 {
+        objects
+            .publish_with(ObjectState::INVALID, |o| {
+                o.sequence = seq;
+                o.valid = VALID;
+            })
+            .unwrap();
+        std::thread::sleep(Duration::from_millis(2));
+    }
+
+    let status = ecu.wait().unwrap();
+    let mut stdout = String::new();
+    std::io::Read::read_to_string(ecu.stdout.as_mut().unwrap(), &mut stdout).unwrap();
+    assert!(status.success(), "ecu failed: {stdout}");
+    assert!(stdout.contains("cycles 4000"), "{stdout}");
+    assert!(stdout.contains("stopped by cycles"), "{stdout}");
+
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(v["cycles"], 4000);
+    assert!(v["overruns"].is_u64());
+    for h in ["wake_latency_us", "exec_us"] {
+        for k in ["p50", "p99", "p999", "max"] {
+            let x = v[h][k].as_f64().unwrap_or(-1.0);
+            assert!(x >= 0.0, "{h}.{k} = {x}");
+        }
+        assert!(v[h]["p50"].as_f64() <= v[h]["max"].as_f64());
+    }
+    assert_eq!(v["can"]["enabled"], false);
+    assert!(v["can"]["reason"].as_str().unwrap().contains("--no-can"));
+    for s in ["sched", "mlockall", "cpu_affinity", "pm_qos"] {
+        assert_eq!(v["rt"][s]["requested"], false, "{s}");
+    }
+    assert!(v["ipc"]["object_rx"].as_u64().unwrap() >= 1, "{v}");
+
+    assert!(monitor.status.success());
+    let mon = String::from_utf8_lossy(&monitor.stdout);
+    assert_eq!(mon.lines().count(), 3, "{mon}");
+    assert!(mon.contains("mode monitoring"), "{mon}");
+    assert!(mon.contains("can-off"), "{mon}");
+}
+
+#[test]
+fn sigterm_stops_cleanly_with_report() {
+    let pfx = prefix("sigterm");
+    let ecu = Command::new(ECU)
+        .args(["--no-can", "--quiet", "--period-us", "1000"])
+        .args([
+            "--service-prefix",
+            &pfx,
+            "--node-name",
+            &format!("{pfx}-ecu"),
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let names = ServiceNames::with_prefix(&pfx);
+    let (node, _) = ipc::create_node("ecu-proc-sigterm", false).unwrap();
+    let mut diag = DiagnosticsSubscriber::new(&node, &names).unwrap();
+    let t0 = Instant::now();
+    while diag.latest().is_none_or(|d| d.cycle_count < 10) {
+        assert!(
+            t0.elapsed() < PATIENCE,
+            "no diagnostics from the ecu process"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    kill(Pid::from_raw(ecu.id() as i32), Signal::SIGTERM).unwrap();
+    let out = ecu.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("stopped by signal"), "{stdout}");
+    assert!(stdout.contains("p99.9"), "{stdout}");
+}
