@@ -1,0 +1,88 @@
+//! `lut study ...`: the paper's parameter studies.
+
+use crate::{cmd_simulate::vehicle_json, plot};
+use anyhow::Result;
+use clap::{Args, Subcommand};
+use physics::{
+    collision::{simulate_collision, CollisionInput, DefaultPulseBuffer},
+    kph_to_mps, mps2_to_g, paper, stiffness, CombinedSpring,
+};
+use serde_json::json;
+use std::path::PathBuf;
+
+#[derive(Subcommand, Debug)]
+pub enum StudyCommand {
+    /// Table 5: symmetric 1785 kg vs 1785 kg at 108 km/h for each stiffness class, beside the
+    /// paper's published vehicle results.
+    Stiffness(StiffnessStudyArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct StiffnessStudyArgs {
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Plot the vehicle pulses of all classes (SVG if .svg, else PNG).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+}
+
+pub fn run(cmd: &StudyCommand) -> Result<()> {
+    match cmd {
+        StudyCommand::Stiffness(args) => stiffness_study(args),
+    }
+}
+
+fn pct(model: f64, paper: f64) -> f64 {
+    100.0 * (model / paper - 1.0)
+}
+
+fn stiffness_study(args: &StiffnessStudyArgs) -> Result<()> {
+    let mut rows = Vec::new();
+    let mut pulses: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
+    let mut buf = Box::new(DefaultPulseBuffer::new());
+    for (i, p) in paper::TABLE5.iter().enumerate() {
+        let curve = if i < 6 { &stiffness::CLASS_CURVES[i] } else { &stiffness::COMBINED_CURVE };
+        let spring = CombinedSpring::series(curve, Some(curve))?;
+        let input = CollisionInput::with_defaults(&spring, paper::TABLE5_MASS_KG, paper::TABLE5_MASS_KG, kph_to_mps(paper::TABLE5_CLOSING_KPH));
+        let s = simulate_collision(&input, &mut buf)?;
+        let v = &s.vehicle;
+        rows.push(json!({
+            "class": p.class,
+            "vehicle": vehicle_json(v, s.contact_duration_s),
+            "paper": { "vehicle": { "crush_mm": p.crush_mm, "a_max_g": p.a_max_g, "a_mean_g": p.a_mean_g } },
+            "error_pct": {
+                "crush_mm": pct(v.crush_m * 1e3, p.crush_mm),
+                "a_max_g": pct(mps2_to_g(v.a_max_mps2), p.a_max_g),
+                "a_mean_g": pct(mps2_to_g(v.a_mean_mps2), p.a_mean_g),
+            },
+        }));
+        let t: Vec<f64> = (0..buf.len()).map(|k| k as f64 * buf.step_s() * 1e3).collect();
+        let a: Vec<f64> = buf.ego_accel_mps2().iter().map(|x| mps2_to_g(*x)).collect();
+        pulses.push((format!("class {}", p.class), t, a));
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+    } else {
+        println!("Table 5 case: {} kg vs {} kg, {} km/h, e = {}", paper::TABLE5_MASS_KG, paper::TABLE5_MASS_KG, paper::TABLE5_CLOSING_KPH, physics::defaults::RESTITUTION);
+        println!("{:<6} {:>22} {:>22} {:>22}", "class", "crush mm (paper, %)", "a_max g (paper, %)", "a_mean g (paper, %)");
+        for (r, p) in rows.iter().zip(paper::TABLE5.iter()) {
+            let v = &r["vehicle"];
+            let e = &r["error_pct"];
+            let f = |x: &serde_json::Value| x.as_f64().unwrap_or(f64::NAN);
+            println!(
+                "{:<6} {:>7.1} ({:>6.1},{:+5.1}) {:>7.2} ({:>6.2},{:+5.1}) {:>7.2} ({:>6.2},{:+5.1})",
+                p.class,
+                f(&v["crush_mm"]), p.crush_mm, f(&e["crush_mm"]),
+                f(&v["a_max_g"]), p.a_max_g, f(&e["a_max_g"]),
+                f(&v["a_mean_g"]), p.a_mean_g, f(&e["a_mean_g"]),
+            );
+        }
+    }
+    if let Some(path) = &args.plot {
+        let series = pulses.iter().map(|(l, t, a)| plot::Series { label: l.clone(), x: t, y: a }).collect();
+        plot::draw(path, &[plot::Panel { title: "Table 5 case: vehicle pulse per stiffness class".into(), x_label: "t [ms]", y_label: "a [g]", series }])?;
+        eprintln!("plot written to {}", path.display());
+    }
+    Ok(())
+}
