@@ -108,7 +108,10 @@ fn generate_meta(dbc: &Dbc) -> String {
         let MessageId::Standard(id) = msg.id else {
             panic!("{}: only 11-bit ids are used on this bus", msg.name);
         };
-        assert!(ids.insert(id, msg.name.clone()).is_none(), "duplicate id {id:#x}");
+        assert!(
+            ids.insert(id, msg.name.clone()).is_none(),
+            "duplicate id {id:#x}"
+        );
         assert!(msg.size <= 8, "{}: classic CAN frames only", msg.name);
         let ty = msg.name.to_pascal_case();
         let cycle = int_attr(dbc, msg.id, "GenMsgCycleTime").filter(|c| *c > 0);
@@ -117,7 +120,11 @@ fn generate_meta(dbc: &Dbc) -> String {
 
         // E2E layout, taken from the signals themselves.
         let e2e = data_id.map(|data_id| {
-            assert!((0..=0xFFFF).contains(&data_id), "{}: E2EDataId is 16 bit", msg.name);
+            assert!(
+                (0..=0xFFFF).contains(&data_id),
+                "{}: E2EDataId is 16 bit",
+                msg.name
+            );
             let crc = msg
                 .signals
                 .iter()
@@ -129,7 +136,9 @@ fn generate_meta(dbc: &Dbc) -> String {
                 .find(|s| s.name == COUNTER_SIGNAL)
                 .unwrap_or_else(|| panic!("{}: has E2EDataId but no {COUNTER_SIGNAL}", msg.name));
             assert!(
-                crc.size == 8 && crc.start_bit % 8 == 0 && crc.byte_order == ByteOrder::LittleEndian,
+                crc.size == 8
+                    && crc.start_bit % 8 == 0
+                    && crc.byte_order == ByteOrder::LittleEndian,
                 "{}: the CRC must be one whole byte",
                 msg.name
             );
@@ -175,7 +184,11 @@ fn generate_meta(dbc: &Dbc) -> String {
                 crc = CRC_SIGNAL.to_snake_case(),
             )
             .unwrap();
-            writeln!(e2e_arms, "        Messages::{ty}(m) => Some(E2eView::of(m)),").unwrap();
+            writeln!(
+                e2e_arms,
+                "        Messages::{ty}(m) => Some(E2eView::of(m)),"
+            )
+            .unwrap();
         } else {
             writeln!(e2e_arms, "        Messages::{ty}(_) => None,").unwrap();
         }
@@ -206,7 +219,11 @@ fn generate_meta(dbc: &Dbc) -> String {
             if scaled {
                 writeln!(dyn_dec, "            out[{idx}] = f64::from(m.{field}());").unwrap();
             } else {
-                writeln!(dyn_dec, "            out[{idx}] = m.{field}_raw_val() as f64;").unwrap();
+                writeln!(
+                    dyn_dec,
+                    "            out[{idx}] = m.{field}_raw_val() as f64;"
+                )
+                .unwrap();
             }
             let is_e2e_field = e2e.is_some() && (s.name == CRC_SIGNAL || s.name == COUNTER_SIGNAL);
             let msg_name = &msg.name;
@@ -324,14 +341,26 @@ fn generate_meta(dbc: &Dbc) -> String {
         if checks.is_empty() {
             writeln!(range_arms, "        Messages::{ty}(_) => None,").unwrap();
         } else {
-            writeln!(range_arms, "        Messages::{ty}(m) => {{\n{checks}            None\n        }}").unwrap();
+            writeln!(
+                range_arms,
+                "        Messages::{ty}(m) => {{\n{checks}            None\n        }}"
+            )
+            .unwrap();
         }
     }
 
     let mut head = String::new();
-    writeln!(head, "/// Every frame of `restraint.dbc`, in file order (generated).").unwrap();
+    writeln!(
+        head,
+        "/// Every frame of `restraint.dbc`, in file order (generated)."
+    )
+    .unwrap();
     writeln!(head, "pub const MESSAGES: &[MessageInfo] = &[\n{table}];").unwrap();
-    writeln!(head, "/// Number of E2E-protected messages (size of the per-message counter state).").unwrap();
+    writeln!(
+        head,
+        "/// Number of E2E-protected messages (size of the per-message counter state)."
+    )
+    .unwrap();
     writeln!(head, "pub const E2E_MESSAGE_COUNT: usize = {e2e_slot};").unwrap();
     writeln!(
         head,

@@ -116,7 +116,11 @@ pub struct EncodeError {
 
 impl core::fmt::Display for EncodeError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(f, "cannot encode {}.{}: {:?}", self.message, self.signal, self.kind)
+        write!(
+            f,
+            "cannot encode {}.{}: {:?}",
+            self.message, self.signal, self.kind
+        )
     }
 }
 
@@ -126,7 +130,13 @@ impl std::error::Error for EncodeError {}
 /// Physical → raw with rounding to the nearest step; `None` for NaN/inf or outside
 /// `[raw_min, raw_max]` (a half step of tolerance absorbs float noise such as 11.9999 kN).
 #[must_use]
-pub(crate) fn raw_from_f64(v: f64, raw_min: i128, raw_max: i128, factor: f64, offset: f64) -> Option<i128> {
+pub(crate) fn raw_from_f64(
+    v: f64,
+    raw_min: i128,
+    raw_max: i128,
+    factor: f64,
+    offset: f64,
+) -> Option<i128> {
     if !v.is_finite() || factor == 0.0 {
         return None;
     }
@@ -135,7 +145,11 @@ pub(crate) fn raw_from_f64(v: f64, raw_min: i128, raw_max: i128, factor: f64, of
     if x < raw_min as f64 - 0.5 || x > raw_max as f64 + 0.5 {
         return None;
     }
-    let r = if x >= 0.0 { (x + 0.5) as i128 } else { (x - 0.5) as i128 };
+    let r = if x >= 0.0 {
+        (x + 0.5) as i128
+    } else {
+        (x - 0.5) as i128
+    };
     Some(r.clamp(raw_min, raw_max))
 }
 
@@ -166,7 +180,11 @@ impl RawFrame {
         for (d, b) in data.iter_mut().zip(bytes.iter()) {
             *d = *b;
         }
-        Self { id, len: len as u8, data }
+        Self {
+            id,
+            len: len as u8,
+            data,
+        }
     }
 
     /// The valid payload bytes.
@@ -274,7 +292,9 @@ impl E2eProtector {
     /// All counters start at 0.
     #[must_use]
     pub const fn new() -> Self {
-        Self { next_counter: [0; E2E_MESSAGE_COUNT] }
+        Self {
+            next_counter: [0; E2E_MESSAGE_COUNT],
+        }
     }
 
     /// Writes the next alive counter and the CRC into `msg` (call after setting all signals).
@@ -399,10 +419,15 @@ impl core::fmt::Display for RxError {
             Self::UnknownId(id) => write!(f, "unknown CAN id {id:#x}"),
             Self::WrongDlc { expected, got } => write!(f, "wrong DLC {got} (expected {expected})"),
             Self::CrcMismatch { computed, received } => {
-                write!(f, "E2E CRC mismatch: received {received:#04x}, computed {computed:#04x}")
+                write!(
+                    f,
+                    "E2E CRC mismatch: received {received:#04x}, computed {computed:#04x}"
+                )
             }
             Self::CounterRepeated { counter } => write!(f, "E2E alive counter {counter} repeated"),
-            Self::CounterSkipped { lost } => write!(f, "E2E alive counter skipped: {lost} frame(s) lost"),
+            Self::CounterSkipped { lost } => {
+                write!(f, "E2E alive counter skipped: {lost} frame(s) lost")
+            }
             Self::OutOfRange(signal) => write!(f, "signal {signal} out of range"),
         }
     }
@@ -427,16 +452,20 @@ pub fn decode(id: u32, data: &[u8]) -> Result<Messages, RxError> {
 fn decode_layout(id: u32, data: &[u8]) -> Result<Messages, RxError> {
     let info = message_info(id).ok_or(RxError::UnknownId(id))?;
     if data.len() != info.size {
-        return Err(RxError::WrongDlc { expected: info.size, got: data.len() });
+        return Err(RxError::WrongDlc {
+            expected: info.size,
+            got: data.len(),
+        });
     }
     let sid = u16::try_from(id)
         .ok()
         .and_then(embedded_can::StandardId::new)
         .ok_or(RxError::UnknownId(id))?;
     Messages::from_can_message(embedded_can::Id::Standard(sid), data).map_err(|e| match e {
-        codec::CanError::InvalidPayloadSize => {
-            RxError::WrongDlc { expected: info.size, got: data.len() }
-        }
+        codec::CanError::InvalidPayloadSize => RxError::WrongDlc {
+            expected: info.size,
+            got: data.len(),
+        },
         _ => RxError::UnknownId(id),
     })
 }
@@ -446,7 +475,10 @@ fn check_crc(v: &E2eView<'_>) -> Result<(), RxError> {
     if computed == v.crc {
         Ok(())
     } else {
-        Err(RxError::CrcMismatch { computed, received: v.crc })
+        Err(RxError::CrcMismatch {
+            computed,
+            received: v.crc,
+        })
     }
 }
 
@@ -505,7 +537,11 @@ impl E2eChecker {
         Self {
             last_counter: [NO_COUNTER; E2E_MESSAGE_COUNT],
             max_lost,
-            stats: RxStats { accepted: 0, rejected: [0; RejectReason::COUNT], lost_frames: 0 },
+            stats: RxStats {
+                accepted: 0,
+                rejected: [0; RejectReason::COUNT],
+                lost_frames: 0,
+            },
         }
     }
 
@@ -586,16 +622,24 @@ mod tests {
         // generated constants of the codec (two generators, one DBC).
         let abg = message_info(0x30).expect("airbag frame");
         assert_eq!(abg.name, "AirbagStageCmd");
-        assert_eq!(Some(AirbagStageCmd::MESSAGE_CYCLE_TIME_MS), abg.cycle_time_ms);
+        assert_eq!(
+            Some(AirbagStageCmd::MESSAGE_CYCLE_TIME_MS),
+            abg.cycle_time_ms
+        );
         assert_eq!(AirbagStageCmd::MESSAGE_SIZE, abg.size);
-        assert_eq!(Some(<AirbagStageCmd as E2eMessage>::DATA_ID), abg.e2e_data_id);
+        assert_eq!(
+            Some(<AirbagStageCmd as E2eMessage>::DATA_ID),
+            abg.e2e_data_id
+        );
         assert!(message_info(0x31).expect("auth").e2e_data_id.is_none());
         // Safety outputs outrank everything else on the bus (lower id wins arbitration).
         let max_cmd = [AirbagStageCmd::MESSAGE_ID, BeltLimiterCmd::MESSAGE_ID];
         for m in MESSAGES {
             if m.transmitter != "RestraintEcu" {
                 for c in max_cmd {
-                    let embedded_can::Id::Standard(c) = c else { panic!() };
+                    let embedded_can::Id::Standard(c) = c else {
+                        panic!()
+                    };
                     assert!(u32::from(c.as_raw()) < m.id);
                 }
             }

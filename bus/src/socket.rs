@@ -66,7 +66,12 @@ impl BusSocket {
         })?;
         let filters: Vec<CanFilter> = rx_ids
             .iter()
-            .map(|id| CanFilter::new(*id & CAN_SFF_MASK, CAN_SFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG))
+            .map(|id| {
+                CanFilter::new(
+                    *id & CAN_SFF_MASK,
+                    CAN_SFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG,
+                )
+            })
             .collect();
         if filters.is_empty() {
             sock.set_filter_drop_all()?;
@@ -89,7 +94,11 @@ impl BusSocket {
         sock.set_error_filter_accept_all()?;
         sock.set_recv_timestamp(true)?;
         sock.set_nonblocking(true)?;
-        Ok(Self { sock, iface: iface.to_owned(), stats: SocketStats::default() })
+        Ok(Self {
+            sock,
+            iface: iface.to_owned(),
+            stats: SocketStats::default(),
+        })
     }
 
     /// The interface name.
@@ -118,7 +127,11 @@ impl BusSocket {
             match frame {
                 CanFrame::Data(d) => {
                     self.stats.frames_rx = self.stats.frames_rx.saturating_add(1);
-                    let id = if d.is_extended() { d.raw_id() | CAN_EFF_FLAG } else { d.raw_id() };
+                    let id = if d.is_extended() {
+                        d.raw_id() | CAN_EFF_FLAG
+                    } else {
+                        d.raw_id()
+                    };
                     return Ok(Some(RxFrame {
                         frame: RawFrame::new(id, d.data()),
                         kernel_time: ts.socket,

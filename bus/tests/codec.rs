@@ -19,7 +19,11 @@ fn crc8_j1850_bitwise(bytes: &[u8]) -> u8 {
     for b in bytes {
         crc ^= b;
         for _ in 0..8 {
-            crc = if crc & 0x80 != 0 { (crc << 1) ^ 0x1D } else { crc << 1 };
+            crc = if crc & 0x80 != 0 {
+                (crc << 1) ^ 0x1D
+            } else {
+                crc << 1
+            };
         }
     }
     crc ^ 0xFF
@@ -28,7 +32,13 @@ fn crc8_j1850_bitwise(bytes: &[u8]) -> u8 {
 /// Independent CRC over data id + payload without the CRC byte.
 fn oracle_crc(data_id: u16, crc_byte: usize, payload: &[u8]) -> u8 {
     let mut v = data_id.to_le_bytes().to_vec();
-    v.extend(payload.iter().enumerate().filter(|(i, _)| *i != crc_byte).map(|(_, b)| *b));
+    v.extend(
+        payload
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != crc_byte)
+            .map(|(_, b)| *b),
+    );
     crc8_j1850_bitwise(&v)
 }
 
@@ -59,14 +69,19 @@ fn bitwise_crc_oracle_matches_published_check_value() {
 /// Raw values for every signal of a message, anywhere in its valid range.
 fn raw_vectors(id: u32) -> impl Strategy<Value = Vec<i64>> {
     let sigs = signals_of(id).unwrap();
-    sigs.iter().map(|s| s.raw_min..=s.raw_max).collect::<Vec<_>>()
+    sigs.iter()
+        .map(|s| s.raw_min..=s.raw_max)
+        .collect::<Vec<_>>()
 }
 
 fn frame_for(id: u32, raws: &[i64]) -> (RawFrame, Vec<f64>) {
     let sigs = signals_of(id).unwrap();
     let info = bus::message_info(id).unwrap();
-    let mut phys: Vec<f64> =
-        sigs.iter().zip(raws).map(|(s, r)| *r as f64 * s.factor + s.offset).collect();
+    let mut phys: Vec<f64> = sigs
+        .iter()
+        .zip(raws)
+        .map(|(s, r)| *r as f64 * s.factor + s.offset)
+        .collect();
     let mut frame = encode_values(id, &phys).unwrap();
     if let Some(did) = info.e2e_data_id {
         let ci = idx(sigs, "Crc");
@@ -224,7 +239,10 @@ fn belt(level_kn: f32) -> BeltLimiterCmd {
 fn protector_crc_matches_independent_oracle() {
     let mut tx = E2eProtector::new();
     let f = tx.seal(belt(4.0));
-    assert_eq!(f.data[BeltLimiterCmd::CRC_BYTE], oracle_crc(BeltLimiterCmd::DATA_ID, 0, &f.data));
+    assert_eq!(
+        f.data[BeltLimiterCmd::CRC_BYTE],
+        oracle_crc(BeltLimiterCmd::DATA_ID, 0, &f.data)
+    );
     // The data id matters: the same payload with another message's id fails its CRC.
     let wrong = oracle_crc(AirbagStageCmd::DATA_ID, 0, &f.data);
     assert_ne!(wrong, f.data[0]);
@@ -236,7 +254,10 @@ fn repeated_counter_is_rejected() {
     let mut rx = E2eChecker::new();
     let f = tx.seal(belt(4.0));
     assert!(rx.check_frame(&f).is_ok());
-    assert_eq!(rx.check_frame(&f).unwrap_err(), RxError::CounterRepeated { counter: 0 });
+    assert_eq!(
+        rx.check_frame(&f).unwrap_err(),
+        RxError::CounterRepeated { counter: 0 }
+    );
     assert_eq!(rx.stats().rejected_for(RejectReason::CounterRepeated), 1);
     // the stream continues normally after a replay
     assert!(rx.check_frame(&tx.seal(belt(4.0))).is_ok());
@@ -255,7 +276,10 @@ fn skipped_counter_reports_lost_frames_and_resyncs() {
             let _dropped = tx.seal(belt(1.0));
         }
         let after_gap = tx.seal(belt(1.0));
-        assert_eq!(strict.check_frame(&after_gap).unwrap_err(), RxError::CounterSkipped { lost });
+        assert_eq!(
+            strict.check_frame(&after_gap).unwrap_err(),
+            RxError::CounterSkipped { lost }
+        );
         assert!(tolerant.check_frame(&after_gap).is_ok());
         assert_eq!(tolerant.stats().lost_frames, u64::from(lost));
         // resynchronised: the next frame is fine for both
@@ -287,7 +311,10 @@ fn wrong_dlc_and_unknown_ids_are_rejected() {
     for len in 0..8 {
         assert_eq!(
             rx.check(f.id, &f.data[..len]).unwrap_err(),
-            RxError::WrongDlc { expected: 8, got: len }
+            RxError::WrongDlc {
+                expected: 8,
+                got: len
+            }
         );
     }
     let known: Vec<u32> = MESSAGES.iter().map(|m| m.id).collect();
@@ -308,16 +335,25 @@ fn out_of_range_raw_values_are_rejected_by_name() {
         let mut v: Vec<f64> = sigs.iter().map(|_| 0.0).collect();
         let mut f = encode_values(0x30, &v).unwrap();
         f.data[3] = raw; // ForceLevel byte per the DBC (start bit 24), checked by the oracle:
-        assert_eq!(extract_raw(&f.data, &sigs[idx(sigs, "ForceLevel")]), i64::from(raw));
+        assert_eq!(
+            extract_raw(&f.data, &sigs[idx(sigs, "ForceLevel")]),
+            i64::from(raw)
+        );
         v[idx(sigs, "Crc")] = f64::from(oracle_crc(AirbagStageCmd::DATA_ID, 0, &f.data));
         f.data[0] = v[idx(sigs, "Crc")] as u8;
-        assert_eq!(E2eChecker::new().check_frame(&f).unwrap_err(), RxError::OutOfRange("ForceLevel"));
+        assert_eq!(
+            E2eChecker::new().check_frame(&f).unwrap_err(),
+            RxError::OutOfRange("ForceLevel")
+        );
     }
     // PretensionerCmd raw 3 has no meaning
     let mut f = E2eProtector::new().seal(belt(1.0));
     f.data[1] |= 0b0011_0000;
     f.data[0] = oracle_crc(BeltLimiterCmd::DATA_ID, 0, &f.data);
-    assert_eq!(decode(f.id, &f.data).unwrap_err(), RxError::OutOfRange("PretensionerCmd"));
+    assert_eq!(
+        decode(f.id, &f.data).unwrap_err(),
+        RxError::OutOfRange("PretensionerCmd")
+    );
 }
 
 #[test]
@@ -329,7 +365,10 @@ fn encoder_rejects_nan_and_out_of_range_by_name() {
         0.0,
     )
     .unwrap_err();
-    assert_eq!((e.signal, e.kind), ("LoadLimiterLevel", EncodeErrorKind::NotFinite));
+    assert_eq!(
+        (e.signal, e.kind),
+        ("LoadLimiterLevel", EncodeErrorKind::NotFinite)
+    );
     let e = BeltLimiterCmd::encode(
         BeltLimiterCmdPretensionerCmd::Idle,
         BeltLimiterCmdCmdSource::Adaptive,
@@ -337,7 +376,10 @@ fn encoder_rejects_nan_and_out_of_range_by_name() {
         0.0,
     )
     .unwrap_err();
-    assert_eq!((e.signal, e.kind), ("LoadLimiterLevel", EncodeErrorKind::OutOfRange));
+    assert_eq!(
+        (e.signal, e.kind),
+        ("LoadLimiterLevel", EncodeErrorKind::OutOfRange)
+    );
     let e = EgoVehicleState::encode(EgoVehicleStateBrakeState::Released, -1.0, 0.0).unwrap_err();
     assert_eq!(e.signal, "EgoSpeed");
     // Rounding, not truncation: 6.5 kN is exactly raw 130 (dbc-codegen's own setter would give
@@ -350,7 +392,11 @@ fn encoder_rejects_nan_and_out_of_range_by_name() {
 fn cycle_times_and_ids_come_from_the_dbc() {
     let dbc = bus::DBC_TEXT;
     for m in MESSAGES {
-        assert!(dbc.contains(&format!("BO_ {} {}:", m.id, m.name)), "{}", m.name);
+        assert!(
+            dbc.contains(&format!("BO_ {} {}:", m.id, m.name)),
+            "{}",
+            m.name
+        );
         if let Some(c) = m.cycle_time_ms {
             assert!(dbc.contains(&format!("BA_ \"GenMsgCycleTime\" BO_ {} {c};", m.id)));
         }

@@ -10,16 +10,17 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant, SystemTime};
 
 use bus::socket::{interface_usable, BusSocket};
-use bus::{
-    encode_values, message_info, signal_values, signals_of, E2eChecker, RawFrame, MESSAGES,
-};
+use bus::{encode_values, message_info, signal_values, signals_of, E2eChecker, RawFrame, MESSAGES};
 
 fn iface() -> String {
     std::env::var("VCAN").unwrap_or_else(|_| "vcan0".into())
 }
 
 fn repo_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
 }
 
 #[test]
@@ -35,11 +36,20 @@ fn real_bus_candump_cantools_cansend() {
     );
     let script = repo_root().join("vcan-setup.sh");
     let exe = std::env::current_exe().unwrap();
-    eprintln!("host has no usable {}; re-running the worker inside user-mode Linux", iface());
+    eprintln!(
+        "host has no usable {}; re-running the worker inside user-mode Linux",
+        iface()
+    );
     let out = Command::new(&script)
         .args(["--iface", &iface(), "--run", "--"])
         .arg(&exe)
-        .args(["--exact", "inner_real_bus_worker", "--ignored", "--nocapture", "--test-threads=1"])
+        .args([
+            "--exact",
+            "inner_real_bus_worker",
+            "--ignored",
+            "--nocapture",
+            "--test-threads=1",
+        ])
         .stdin(Stdio::null())
         .output()
         .expect("run vcan-setup.sh");
@@ -51,7 +61,10 @@ fn real_bus_candump_cantools_cansend() {
         "real-bus worker failed (neither host vcan nor a working UML guest?): {:?}",
         out.status
     );
-    assert!(stdout.contains("1 passed"), "the worker did not run inside the guest");
+    assert!(
+        stdout.contains("1 passed"),
+        "the worker did not run inside the guest"
+    );
 }
 
 #[test]
@@ -93,7 +106,11 @@ fn build(id: u32, k: u64) -> (RawFrame, Vec<f64>) {
         let ai = sigs.iter().position(|s| s.name == "AliveCounter").unwrap();
         phys[ai] = (k % 16) as f64;
         let f = encode_values(id, &phys).unwrap();
-        phys[ci] = f64::from(bus::e2e_crc(did, (sigs[ci].start_bit / 8) as usize, f.payload()));
+        phys[ci] = f64::from(bus::e2e_crc(
+            did,
+            (sigs[ci].start_bit / 8) as usize,
+            f.payload(),
+        ));
     }
     (encode_values(id, &phys).unwrap(), phys)
 }
@@ -130,18 +147,27 @@ fn real_bus_worker_body() {
         .expect("spawn candump");
     let mut tx = BusSocket::open(&iface, &[]).expect("open tx socket");
     // our rx socket with a kernel filter for the ECU's inputs only
-    let input_ids: Vec<u32> =
-        MESSAGES.iter().filter(|m| m.transmitter != "RestraintEcu").map(|m| m.id).collect();
+    let input_ids: Vec<u32> = MESSAGES
+        .iter()
+        .filter(|m| m.transmitter != "RestraintEcu")
+        .map(|m| m.id)
+        .collect();
     let mut rx = BusSocket::open(&iface, &input_ids).expect("open rx socket");
     // Wait until candump is listening: send a probe frame (unknown id) until it shows up.
     let t0 = Instant::now();
     loop {
         tx.send(&RawFrame::new(0x7FF, &[0xAA])).unwrap();
         std::thread::sleep(Duration::from_millis(100));
-        if std::fs::read_to_string(&log).unwrap_or_default().contains("7FF#AA") {
+        if std::fs::read_to_string(&log)
+            .unwrap_or_default()
+            .contains("7FF#AA")
+        {
             break;
         }
-        assert!(t0.elapsed() < Duration::from_secs(20), "candump never saw the probe frame");
+        assert!(
+            t0.elapsed() < Duration::from_secs(20),
+            "candump never saw the probe frame"
+        );
     }
     let mut expected = Vec::new();
     for k in 0..24u64 {
@@ -169,7 +195,11 @@ fn real_bus_worker_body() {
         .arg(&log)
         .output()
         .expect("run python3 cantools helper");
-    assert!(out.status.success(), "cantools decode failed: {}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "cantools decode failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let decoded: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let decoded: Vec<_> = decoded
         .as_array()
@@ -177,20 +207,37 @@ fn real_bus_worker_body() {
         .iter()
         .filter(|d| d["id"].as_u64() != Some(0x7FF))
         .collect();
-    assert_eq!(decoded.len(), expected.len(), "candump captured a different number of frames");
+    assert_eq!(
+        decoded.len(),
+        expected.len(),
+        "candump captured a different number of frames"
+    );
     for (d, (id, phys)) in decoded.iter().zip(&expected) {
         assert_eq!(d["id"].as_u64().unwrap(), u64::from(*id));
         let info = message_info(*id).unwrap();
         assert_eq!(d["name"].as_str().unwrap(), info.name);
         if info.e2e_data_id.is_some() {
-            assert_eq!(d["crc_ok"].as_bool(), Some(true), "python's CRC check of {}", info.name);
+            assert_eq!(
+                d["crc_ok"].as_bool(),
+                Some(true),
+                "python's CRC check of {}",
+                info.name
+            );
         }
         for (s, want) in signals_of(*id).unwrap().iter().zip(phys) {
             let got = d["signals"][s.name].as_f64().unwrap();
-            assert!(close(got, *want, s.factor), "{}.{}: cantools {got}, we sent {want}", info.name, s.name);
+            assert!(
+                close(got, *want, s.factor),
+                "{}.{}: cantools {got}, we sent {want}",
+                info.name,
+                s.name
+            );
         }
     }
-    eprintln!("cantools decoded {} frames written by us to the same values", decoded.len());
+    eprintln!(
+        "cantools decoded {} frames written by us to the same values",
+        decoded.len()
+    );
 
     // Kernel filter: only input ids reached rx (plus the error frame, counted not returned).
     let mut checker = E2eChecker::new();
@@ -199,19 +246,31 @@ fn real_bus_worker_body() {
     while Instant::now() < deadline {
         match rx.recv().unwrap() {
             Some(f) => {
-                assert!(input_ids.contains(&f.frame.id), "filter let {:#x} through", f.frame.id);
+                assert!(
+                    input_ids.contains(&f.frame.id),
+                    "filter let {:#x} through",
+                    f.frame.id
+                );
                 let ts = f.kernel_time.expect("kernel receive timestamp");
                 let age = SystemTime::now().duration_since(ts).unwrap_or_default();
                 assert!(age < Duration::from_secs(60), "timestamp {age:?} old");
-                checker.check_frame(&f.frame).expect("our own frames pass our checker");
+                checker
+                    .check_frame(&f.frame)
+                    .expect("our own frames pass our checker");
                 got_inputs += 1;
             }
-            None if got_inputs == 24 * input_ids.len() && rx.stats().error_frames > errs_before => break,
+            None if got_inputs == 24 * input_ids.len() && rx.stats().error_frames > errs_before => {
+                break
+            }
             None => std::thread::sleep(Duration::from_millis(10)),
         }
     }
     assert_eq!(got_inputs, 24 * input_ids.len());
-    assert_eq!(rx.stats().error_frames, errs_before + 1, "error frame not counted");
+    assert_eq!(
+        rx.stats().error_frames,
+        errs_before + 1,
+        "error frame not counted"
+    );
 
     // ---------- cantools encodes → cansend → our decoder
     let mut reqs = Vec::new();
@@ -242,19 +301,32 @@ fn real_bus_worker_body() {
         .arg(&req_path)
         .output()
         .unwrap();
-    assert!(out.status.success(), "cantools encode failed: {}", String::from_utf8_lossy(&out.stderr));
-    let lines: Vec<String> =
-        String::from_utf8(out.stdout).unwrap().lines().map(str::to_owned).collect();
+    assert!(
+        out.status.success(),
+        "cantools encode failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines: Vec<String> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(str::to_owned)
+        .collect();
     assert_eq!(lines.len(), want.len());
     for (line, (id, phys)) in lines.iter().zip(&want) {
-        let st = Command::new("cansend").args([&iface, line]).status().unwrap();
+        let st = Command::new("cansend")
+            .args([&iface, line])
+            .status()
+            .unwrap();
         assert!(st.success(), "cansend {line}");
         let t = Instant::now();
         let f = loop {
             if let Some(f) = rx.recv().unwrap() {
                 break f;
             }
-            assert!(t.elapsed() < Duration::from_secs(5), "frame {line} never arrived");
+            assert!(
+                t.elapsed() < Duration::from_secs(5),
+                "frame {line} never arrived"
+            );
             std::thread::sleep(Duration::from_millis(2));
         };
         assert_eq!(f.frame.id, *id);
@@ -263,11 +335,19 @@ fn real_bus_worker_body() {
             .unwrap_or_else(|e| panic!("our decoder rejected cansend {line}: {e}"));
         let mut vals = [0f64; 16];
         let n = signal_values(&msg, &mut vals).unwrap();
-        for (s, (got, w)) in signals_of(*id).unwrap().iter().zip(vals[..n].iter().zip(phys)) {
+        for (s, (got, w)) in signals_of(*id)
+            .unwrap()
+            .iter()
+            .zip(vals[..n].iter().zip(phys))
+        {
             if s.name == "Crc" {
                 continue; // python computed it; the checker accepted it
             }
-            assert!(close(*got, *w, s.factor), "{line}: {} = {got}, cantools encoded {w}", s.name);
+            assert!(
+                close(*got, *w, s.factor),
+                "{line}: {} = {got}, cantools encoded {w}",
+                s.name
+            );
         }
     }
     eprintln!(
