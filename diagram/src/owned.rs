@@ -318,7 +318,7 @@ pub fn lut_id_of(checksum: u32) -> u16 {
 pub(crate) fn validate_data(d: &DiagramData) -> Result<(), Problem> {
     let ego = &d.header.ego;
     let (lo, hi) = limits::EGO_MASS_KG;
-    if !(ego.mass_kg >= lo && ego.mass_kg <= hi) || !(1..=6).contains(&ego.class) {
+    if !(ego.mass_kg >= lo && ego.mass_kg <= hi && (1..=6).contains(&ego.class)) {
         return Err(Problem::EgoVehicle {
             mass_kg: ego.mass_kg,
             class: ego.class,

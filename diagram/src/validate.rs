@@ -13,12 +13,8 @@ pub mod limits {
     /// Inclusive plausible range `(min, max)` of each axis, storage order:
     /// closing speed 0–250 km/h, opponent mass 100–60 000 kg,
     /// occupant mass 1–300 kg, seat distance 0–1500 mm.
-    pub const AXIS_RANGE: [(f32, f32); AXIS_COUNT] = [
-        (0.0, 250.0),
-        (100.0, 60_000.0),
-        (1.0, 300.0),
-        (0.0, 1500.0),
-    ];
+    pub const AXIS_RANGE: [(f32, f32); AXIS_COUNT] =
+        [(0.0, 250.0), (100.0, 60_000.0), (1.0, 300.0), (0.0, 1500.0)];
 
     /// Maximum points on one axis (keeps binary search and memory bounded).
     pub const MAX_AXIS_LEN: usize = 4096;

@@ -67,6 +67,36 @@ impl Lookup {
     }
 }
 
+/// Weighted sum over the corner cells of one lookup.
+struct Accumulator<'a> {
+    /// Weighted sum of the corner cells' fields.
+    sum: [f32; CELL_FIELDS],
+    bottoming: bool,
+    cells: &'a [Cell],
+    /// Weights of the lower / upper neighbour on the last axis.
+    w3: [f32; 2],
+}
+
+impl Accumulator<'_> {
+    /// Add the two adjacent cells `start`, `start + 1` (differing only in the
+    /// last axis) with total weight `w`.
+    #[inline(always)]
+    fn pair(&mut self, start: usize, w: f32) {
+        let (w_lo, w_hi) = (w * self.w3[0], w * self.w3[1]);
+        // In range by the view's invariants (lower ≤ len-2 on every axis);
+        // `get` keeps a violated invariant from panicking.
+        let Some([lo, hi]) = self.cells.get(start..start.wrapping_add(2)) else {
+            return;
+        };
+        let (a, b) = (lo.to_array(), hi.to_array());
+        for ((acc, x), y) in self.sum.iter_mut().zip(a.iter()).zip(b.iter()) {
+            *acc += w_lo * x + w_hi * y;
+        }
+        self.bottoming |=
+            ((w_lo > 0.0) & (lo.bottoming_out > 0.5)) | ((w_hi > 0.0) & (hi.bottoming_out > 0.5));
+    }
+}
+
 /// Where a query coordinate falls on one axis.
 #[derive(Clone, Copy)]
 struct Located {
@@ -77,6 +107,26 @@ struct Located {
     used: f32,
     out_of_range: bool,
     nan: bool,
+}
+
+/// Index of the last axis point `<= x`, for `axis[0] <= x` (else 0).
+///
+/// Branchless binary search: the comparison feeds a conditional move, not
+/// a branch, so the time does not depend on the data and there are no
+/// mispredictions; `core`'s `partition_point` cost ~3x the instructions here.
+#[inline(always)]
+fn last_le(axis: &[f32], x: f32) -> usize {
+    let mut base = 0usize;
+    let mut size = axis.len();
+    while size > 1 {
+        let half = size / 2;
+        let mid = base + half;
+        // mid < base + size <= len: `get` never fails, it only avoids a panic path.
+        let le = axis.get(mid).is_some_and(|&a| a <= x);
+        base = if le { mid } else { base };
+        size -= half;
+    }
+    base
 }
 
 /// Locate `x` on a validated axis (≥ 2 increasing finite points).
@@ -106,12 +156,9 @@ fn locate(axis: &[f32], x: f32, nan_fallback: f32) -> Located {
             nan,
         };
     }
-    // first < x < last: the number of points <= x is in 1..=n-1, so the
-    // interval [p, p+1] with p = count-1 is inside the axis.
-    let lower = axis
-        .partition_point(|&a| a <= x)
-        .saturating_sub(1)
-        .min(last_interval);
+    // first < x < last: the interval [lower, lower+1] with
+    // a[lower] <= x < a[lower+1] lies inside the axis.
+    let lower = last_le(axis, x).min(last_interval);
     let a0 = axis.get(lower).copied().unwrap_or(first);
     let a1 = axis.get(lower + 1).copied().unwrap_or(last);
     // a1 > a0 (strictly increasing), x in [a0, a1): t in [0, 1). The clamp is
@@ -235,27 +282,28 @@ impl<'a> DiagramView<'a> {
         let w = |l: &Located| [1.0 - l.t, l.t];
         let (w0, w1, w2, w3) = (w(&l0), w(&l1), w(&l2), w(&l3));
 
-        let mut acc = [0.0f32; CELL_FIELDS];
-        let mut bottoming = false;
-        for corner in 0..16usize {
-            let b0 = (corner >> 3) & 1;
-            let b1 = (corner >> 2) & 1;
-            let b2 = (corner >> 1) & 1;
-            let b3 = corner & 1;
-            let weight = w0[b0] * w1[b1] * w2[b2] * w3[b3];
-            let offset = b0 * s0 + b1 * s1 + b2 * s2 + b3 * s3;
-            // In range by the view's invariants (lower ≤ len-2 on each axis);
-            // `get` keeps a violated invariant from panicking.
-            let Some(cell) = self.cells.get(base + offset) else {
-                continue;
-            };
-            let v = cell.to_array();
-            for (a, x) in acc.iter_mut().zip(v.iter()) {
-                *a += weight * x;
-            }
-            bottoming |= (weight > 0.0) & (cell.bottoming_out > 0.5);
-        }
-        let values = Cell::from_array(acc);
+        // The last axis has stride 1, so the two corners that differ only in
+        // it are adjacent in memory: 8 two-cell windows instead of 16
+        // scattered cells, explicitly unrolled (a loop with computed indices
+        // into the weight arrays costs ~2x the instructions).
+        let mut acc = Accumulator {
+            sum: [0.0f32; CELL_FIELDS],
+            bottoming: false,
+            cells: self.cells,
+            w3,
+        };
+        let (w0l, w0h, w1l, w1h) = (w0[0], w0[1], w1[0], w1[1]);
+        let (w01ll, w01lh, w01hl, w01hh) = (w0l * w1l, w0l * w1h, w0h * w1l, w0h * w1h);
+        acc.pair(base, w01ll * w2[0]);
+        acc.pair(base + s2, w01ll * w2[1]);
+        acc.pair(base + s1, w01lh * w2[0]);
+        acc.pair(base + s1 + s2, w01lh * w2[1]);
+        acc.pair(base + s0, w01hl * w2[0]);
+        acc.pair(base + s0 + s2, w01hl * w2[1]);
+        acc.pair(base + s0 + s1, w01hh * w2[0]);
+        acc.pair(base + s0 + s1 + s2, w01hh * w2[1]);
+        let Accumulator { sum, bottoming, .. } = acc;
+        let values = Cell::from_array(sum);
         Lookup {
             values,
             bottoming_out: bottoming,

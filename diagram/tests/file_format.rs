@@ -43,13 +43,19 @@ fn binary_round_trip_is_identical() {
     let back = load(&bytes).unwrap();
     assert_eq!(back, d);
     assert_eq!(back.to_bytes(), bytes);
-    assert_eq!(back.checksum(), u32::from_le_bytes(bytes[16..20].try_into().unwrap()));
+    assert_eq!(
+        back.checksum(),
+        u32::from_le_bytes(bytes[16..20].try_into().unwrap())
+    );
 }
 
 #[test]
 fn encoding_is_deterministic() {
     assert_eq!(sample().to_bytes(), sample().to_bytes());
-    assert_ne!(sample().to_bytes(), random_diagram(small_axes(), 12).to_bytes());
+    assert_ne!(
+        sample().to_bytes(),
+        random_diagram(small_axes(), 12).to_bytes()
+    );
     assert_ne!(sample().lut_id(), random_diagram(small_axes(), 12).lut_id());
 }
 
@@ -57,7 +63,10 @@ fn encoding_is_deterministic() {
 fn lut_id_folds_the_checksum_halves() {
     assert_eq!(lut_id_of(0x1234_5678), 0x1234 ^ 0x5678);
     let d = sample();
-    assert_eq!(d.lut_id(), ((d.checksum() >> 16) ^ (d.checksum() & 0xFFFF)) as u16);
+    assert_eq!(
+        d.lut_id(),
+        ((d.checksum() >> 16) ^ (d.checksum() & 0xFFFF)) as u16
+    );
 }
 
 #[test]
@@ -93,7 +102,10 @@ fn json_edits_are_checked() {
     let mut v: serde_json::Value = serde_json::from_str(&json).unwrap();
     v["cells"][0]["a_max_g"] = serde_json::json!(12.5);
     let e = Diagram::from_json_str("t.json", &v.to_string()).unwrap_err();
-    assert!(matches!(e.problem, FileProblem::ChecksumMismatch { .. }), "{e}");
+    assert!(
+        matches!(e.problem, FileProblem::ChecksumMismatch { .. }),
+        "{e}"
+    );
     // A deliberate hand edit drops crc32c and lut_id.
     v.as_object_mut().unwrap().remove("crc32c");
     v.as_object_mut().unwrap().remove("lut_id");
@@ -102,34 +114,75 @@ fn json_edits_are_checked() {
     // Wrong LUT id.
     let mut w: serde_json::Value = serde_json::from_str(&json).unwrap();
     w["lut_id"] = serde_json::json!(d.lut_id().wrapping_add(1));
-    assert!(matches!(Diagram::from_json_str("t.json", &w.to_string()).unwrap_err().problem, FileProblem::LutIdMismatch { .. }));
+    assert!(matches!(
+        Diagram::from_json_str("t.json", &w.to_string())
+            .unwrap_err()
+            .problem,
+        FileProblem::LutIdMismatch { .. }
+    ));
     // Wrong version, wrong format, NaN (serialised as null), validation.
     let mut x: serde_json::Value = serde_json::from_str(&json).unwrap();
     x["format_version"] = serde_json::json!(2);
-    assert!(matches!(Diagram::from_json_str("t.json", &x.to_string()).unwrap_err().problem, FileProblem::UnsupportedVersion { found: 2, .. }));
+    assert!(matches!(
+        Diagram::from_json_str("t.json", &x.to_string())
+            .unwrap_err()
+            .problem,
+        FileProblem::UnsupportedVersion { found: 2, .. }
+    ));
     let mut y: serde_json::Value = serde_json::from_str(&json).unwrap();
     y["format"] = serde_json::json!("something-else");
-    assert!(matches!(Diagram::from_json_str("t.json", &y.to_string()).unwrap_err().problem, FileProblem::JsonFormat { .. }));
+    assert!(matches!(
+        Diagram::from_json_str("t.json", &y.to_string())
+            .unwrap_err()
+            .problem,
+        FileProblem::JsonFormat { .. }
+    ));
     let mut z: serde_json::Value = serde_json::from_str(&json).unwrap();
     z["cells"][3]["excursion_mm"] = serde_json::Value::Null;
-    assert!(matches!(Diagram::from_json_str("t.json", &z.to_string()).unwrap_err().problem, FileProblem::Json(_)));
+    assert!(matches!(
+        Diagram::from_json_str("t.json", &z.to_string())
+            .unwrap_err()
+            .problem,
+        FileProblem::Json(_)
+    ));
     let mut u: serde_json::Value = serde_json::from_str(&json).unwrap();
     u.as_object_mut().unwrap().remove("crc32c");
     u["axes"]["seat_distance_mm"] = serde_json::json!([200.0, 450.0, 300.0]);
     let e = Diagram::from_json_str("t.json", &u.to_string()).unwrap_err();
-    assert!(matches!(e.problem, FileProblem::Invalid(Problem::AxisNotIncreasing { axis: AxisId::SeatDistance, index: 2, .. })), "{e}");
+    assert!(
+        matches!(
+            e.problem,
+            FileProblem::Invalid(Problem::AxisNotIncreasing {
+                axis: AxisId::SeatDistance,
+                index: 2,
+                ..
+            })
+        ),
+        "{e}"
+    );
 }
 
 #[test]
 fn flipped_payload_byte_is_a_checksum_mismatch() {
     let bytes = sample().to_bytes();
-    for at in [PREAMBLE_LEN, PREAMBLE_LEN + 1, bytes.len() / 2, bytes.len() - 1] {
+    for at in [
+        PREAMBLE_LEN,
+        PREAMBLE_LEN + 1,
+        bytes.len() / 2,
+        bytes.len() - 1,
+    ] {
         let mut b = bytes.clone();
         b[at] ^= 0x01;
         let e = load(&b).unwrap_err();
-        assert!(matches!(e.problem, FileProblem::ChecksumMismatch { .. }), "byte {at}: {e}");
+        assert!(
+            matches!(e.problem, FileProblem::ChecksumMismatch { .. }),
+            "byte {at}: {e}"
+        );
         let msg = e.to_string();
-        assert!(msg.starts_with("default.lut: checksum mismatch (stored 0x"), "{msg}");
+        assert!(
+            msg.starts_with("default.lut: checksum mismatch (stored 0x"),
+            "{msg}"
+        );
         assert!(msg.contains(", computed 0x"), "{msg}");
     }
     // A flipped bit in the stored CRC itself.
@@ -149,17 +202,30 @@ fn truncation_and_trailing_bytes_are_named() {
     let bytes = sample().to_bytes();
     for len in [0, 7, PREAMBLE_LEN - 1] {
         let e = load(&bytes[..len]).unwrap_err();
-        assert!(matches!(e.problem, FileProblem::TruncatedPreamble { len: l, .. } if l == len), "{e}");
+        assert!(
+            matches!(e.problem, FileProblem::TruncatedPreamble { len: l, .. } if l == len),
+            "{e}"
+        );
         assert!(e.to_string().starts_with("default.lut: truncated"), "{e}");
     }
     for len in [PREAMBLE_LEN, PREAMBLE_LEN + 10, bytes.len() - 1] {
         let e = load(&bytes[..len]).unwrap_err();
-        assert!(matches!(e.problem, FileProblem::TruncatedPayload { actual, .. } if actual == len - PREAMBLE_LEN), "{e}");
-        assert!(e.to_string().starts_with("default.lut: truncated: preamble declares"), "{e}");
+        assert!(
+            matches!(e.problem, FileProblem::TruncatedPayload { actual, .. } if actual == len - PREAMBLE_LEN),
+            "{e}"
+        );
+        assert!(
+            e.to_string()
+                .starts_with("default.lut: truncated: preamble declares"),
+            "{e}"
+        );
     }
     let mut long = bytes.clone();
     long.extend_from_slice(&[0, 0, 0]);
-    assert!(matches!(problem(&long), FileProblem::TrailingBytes { extra: 3, .. }));
+    assert!(matches!(
+        problem(&long),
+        FileProblem::TrailingBytes { extra: 3, .. }
+    ));
 }
 
 #[test]
@@ -170,12 +236,24 @@ fn magic_version_and_reserved_are_checked() {
     assert!(matches!(problem(&b), FileProblem::BadMagic { .. }));
     let v2 = sample().into_data().to_bytes_with_version(2);
     let e = load(&v2).unwrap_err();
-    assert!(matches!(e.problem, FileProblem::UnsupportedVersion { found: 2, supported: 1 }));
-    assert_eq!(e.to_string(), "default.lut: unsupported format version 2 (this build reads version 1)");
+    assert!(matches!(
+        e.problem,
+        FileProblem::UnsupportedVersion {
+            found: 2,
+            supported: 1
+        }
+    ));
+    assert_eq!(
+        e.to_string(),
+        "default.lut: unsupported format version 2 (this build reads version 1)"
+    );
     let mut b = bytes.clone();
     b[10] = 1;
     assert!(matches!(problem(&b), FileProblem::Reserved { found: 1 }));
-    assert!(matches!(problem(b"{not binary at all, but long enough}"), FileProblem::BadMagic { .. }));
+    assert!(matches!(
+        problem(b"{not binary at all, but long enough}"),
+        FileProblem::BadMagic { .. }
+    ));
 }
 
 #[test]
@@ -193,7 +271,11 @@ fn payload_that_passes_the_crc_but_does_not_decode() {
     dg.update(&b[..16]);
     dg.update(&garbage);
     b[16..20].copy_from_slice(&dg.finalize().to_le_bytes());
-    assert!(matches!(problem(&b), FileProblem::Decode(_)), "{:?}", problem(&b));
+    assert!(
+        matches!(problem(&b), FileProblem::Decode(_)),
+        "{:?}",
+        problem(&b)
+    );
 }
 
 fn invalid(bytes: &[u8]) -> Problem {
@@ -206,38 +288,137 @@ fn invalid(bytes: &[u8]) -> Problem {
 #[test]
 fn each_semantic_validator_fires() {
     // Non-monotonic axis.
-    let p = invalid(&crafted(|d| d.axes.opponent_mass_kg[2] = d.axes.opponent_mass_kg[1]));
-    assert!(matches!(p, Problem::AxisNotIncreasing { axis: AxisId::OpponentMass, index: 2, .. }), "{p}");
+    let p = invalid(&crafted(|d| {
+        d.axes.opponent_mass_kg[2] = d.axes.opponent_mass_kg[1]
+    }));
+    assert!(
+        matches!(
+            p,
+            Problem::AxisNotIncreasing {
+                axis: AxisId::OpponentMass,
+                index: 2,
+                ..
+            }
+        ),
+        "{p}"
+    );
     // Too short.
     let p = invalid(&crafted(|d| {
         d.axes.seat_distance_mm.truncate(1);
         d.cells.truncate(d.cells.len() / 3);
     }));
-    assert!(matches!(p, Problem::AxisTooShort { axis: AxisId::SeatDistance, len: 1 }), "{p}");
+    assert!(
+        matches!(
+            p,
+            Problem::AxisTooShort {
+                axis: AxisId::SeatDistance,
+                len: 1
+            }
+        ),
+        "{p}"
+    );
     // Non-finite axis.
     let p = invalid(&crafted(|d| d.axes.closing_speed_kph[3] = f32::INFINITY));
-    assert!(matches!(p, Problem::AxisNotFinite { axis: AxisId::ClosingSpeed, index: 3, .. }), "{p}");
+    assert!(
+        matches!(
+            p,
+            Problem::AxisNotFinite {
+                axis: AxisId::ClosingSpeed,
+                index: 3,
+                ..
+            }
+        ),
+        "{p}"
+    );
     // Implausible axis (m/s typed as km/h would pass; mass in g would not).
-    let p = invalid(&crafted(|d| d.axes.occupant_mass_kg = vec![30_000.0, 75_000.0, 125_000.0]));
-    assert!(matches!(p, Problem::AxisImplausible { axis: AxisId::OccupantMass, .. }), "{p}");
+    let p = invalid(&crafted(|d| {
+        d.axes.occupant_mass_kg = vec![30_000.0, 75_000.0, 125_000.0]
+    }));
+    assert!(
+        matches!(
+            p,
+            Problem::AxisImplausible {
+                axis: AxisId::OccupantMass,
+                ..
+            }
+        ),
+        "{p}"
+    );
     // Cell count.
-    let p = invalid(&crafted(|d| { d.cells.pop(); }));
-    assert!(matches!(p, Problem::CellCount { expected: 180, found: 179 }), "{p}");
+    let p = invalid(&crafted(|d| {
+        d.cells.pop();
+    }));
+    assert!(
+        matches!(
+            p,
+            Problem::CellCount {
+                expected: 180,
+                found: 179
+            }
+        ),
+        "{p}"
+    );
     // NaN value in a cell.
     let p = invalid(&crafted(|d| d.cells[17].a_mean_g = f32::NAN));
-    assert!(matches!(p, Problem::CellNotFinite { index: 17, field: "a_mean_g", .. }), "{p}");
-    let msg = load(&crafted(|d| d.cells[17].a_mean_g = f32::NAN)).unwrap_err().to_string();
-    assert!(msg.starts_with("default.lut: cell 17 [0, 1, 2, 2]: a_mean_g is not finite"), "{msg}");
+    assert!(
+        matches!(
+            p,
+            Problem::CellNotFinite {
+                index: 17,
+                field: "a_mean_g",
+                ..
+            }
+        ),
+        "{p}"
+    );
+    let msg = load(&crafted(|d| d.cells[17].a_mean_g = f32::NAN))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.starts_with("default.lut: cell 17 [0, 1, 2, 2]: a_mean_g is not finite"),
+        "{msg}"
+    );
     // Out of plausible range, and a non-0/1 bottoming flag.
     let p = invalid(&crafted(|d| d.cells[5].belt_limiter_kn = -1.0));
-    assert!(matches!(p, Problem::CellImplausible { index: 5, field: "belt_limiter_kn", .. }), "{p}");
+    assert!(
+        matches!(
+            p,
+            Problem::CellImplausible {
+                index: 5,
+                field: "belt_limiter_kn",
+                ..
+            }
+        ),
+        "{p}"
+    );
     let p = invalid(&crafted(|d| d.cells[5].bottoming_out = 0.5));
-    assert!(matches!(p, Problem::CellImplausible { index: 5, field: "bottoming_out", .. }), "{p}");
+    assert!(
+        matches!(
+            p,
+            Problem::CellImplausible {
+                index: 5,
+                field: "bottoming_out",
+                ..
+            }
+        ),
+        "{p}"
+    );
     // NaN fallback outside the axis.
     let p = invalid(&crafted(|d| d.axes.nan_fallback.occupant_mass_kg = 200.0));
-    assert!(matches!(p, Problem::FallbackOutsideAxis { axis: AxisId::OccupantMass, .. }), "{p}");
+    assert!(
+        matches!(
+            p,
+            Problem::FallbackOutsideAxis {
+                axis: AxisId::OccupantMass,
+                ..
+            }
+        ),
+        "{p}"
+    );
     // Thresholds out of order.
-    let p = invalid(&crafted(|d| d.header.airbag_thresholds.no_fire_below_kn = 7.0));
+    let p = invalid(&crafted(|d| {
+        d.header.airbag_thresholds.no_fire_below_kn = 7.0
+    }));
     assert!(matches!(p, Problem::Thresholds { .. }), "{p}");
     // Ego vehicle.
     let p = invalid(&crafted(|d| d.header.ego.class = 9));
@@ -263,5 +444,14 @@ fn shards_in_any_order_rebuild_the_same_table() {
     let mut dup = pieces.clone();
     dup.push(pieces[0]);
     let e = Diagram::from_indexed_cells(header(), small_axes(), dup).unwrap_err();
-    assert!(matches!(e, Problem::CellIndexInvalid { index: 120, count: 180 }), "{e}");
+    assert!(
+        matches!(
+            e,
+            Problem::CellIndexInvalid {
+                index: 120,
+                count: 180
+            }
+        ),
+        "{e}"
+    );
 }

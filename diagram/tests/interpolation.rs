@@ -3,19 +3,23 @@
 mod common;
 
 use common::{header, random_cell, random_diagram, small_axes};
-use diagram::{AirbagStage, AxisId, Axes, Cell, Diagram, Query, AXIS_COUNT, CELL_FIELDS};
+use diagram::{AirbagStage, Axes, AxisId, Cell, Diagram, Query, AXIS_COUNT, CELL_FIELDS};
 use proptest::prelude::*;
 
 /// Strictly increasing axis: start + cumulative positive steps.
 fn axis(start: (f32, f32), step: (f32, f32)) -> impl Strategy<Value = Vec<f32>> {
-    (start.0..start.1, prop::collection::vec(step.0..step.1, 1..5)).prop_map(|(s, steps)| {
-        let mut v = vec![s];
-        for d in steps {
-            let next = v[v.len() - 1] + d;
-            v.push(next);
-        }
-        v
-    })
+    (
+        start.0..start.1,
+        prop::collection::vec(step.0..step.1, 1..5),
+    )
+        .prop_map(|(s, steps)| {
+            let mut v = vec![s];
+            for d in steps {
+                let next = v[v.len() - 1] + d;
+                v.push(next);
+            }
+            v
+        })
 }
 
 fn axes_strategy() -> impl Strategy<Value = Axes> {
@@ -237,7 +241,12 @@ fn default_nan_fallback_is_most_severe_crash_and_reference_occupant() {
     assert_eq!(fb.occupant_mass_kg, 75.0);
     assert_eq!(fb.seat_distance_mm, 300.0);
     // Clamped into axes that do not contain the reference values.
-    let narrow = Axes::new(vec![20.0, 30.0], vec![900.0, 1000.0], vec![90.0, 100.0], vec![350.0, 400.0]);
+    let narrow = Axes::new(
+        vec![20.0, 30.0],
+        vec![900.0, 1000.0],
+        vec![90.0, 100.0],
+        vec![350.0, 400.0],
+    );
     assert_eq!(narrow.nan_fallback.occupant_mass_kg, 90.0);
     assert_eq!(narrow.nan_fallback.seat_distance_mm, 350.0);
 }
@@ -246,14 +255,24 @@ fn default_nan_fallback_is_most_severe_crash_and_reference_occupant() {
 /// per-axis linear weights times the corner values.
 #[test]
 fn hand_computed_midpoint() {
-    let axes = Axes::new(vec![20.0, 60.0], vec![1000.0, 2000.0], vec![50.0, 100.0], vec![200.0, 400.0]);
+    let axes = Axes::new(
+        vec![20.0, 60.0],
+        vec![1000.0, 2000.0],
+        vec![50.0, 100.0],
+        vec![200.0, 400.0],
+    );
     // Only corner (1,1,1,1) has a_max 16 g, the rest 0.
     let d = Diagram::from_fn(header(), axes, |p| Cell {
         a_max_g: if p.coords == [1, 1, 1, 1] { 16.0 } else { 0.0 },
         ..Cell::default()
     })
     .unwrap();
-    let q = Query { closing_speed_kph: 30.0, opponent_mass_kg: 1500.0, occupant_mass_kg: 75.0, seat_distance_mm: 350.0 };
+    let q = Query {
+        closing_speed_kph: 30.0,
+        opponent_mass_kg: 1500.0,
+        occupant_mass_kg: 75.0,
+        seat_distance_mm: 350.0,
+    };
     // weights 0.25 * 0.5 * 0.5 * 0.75 = 0.046875 → 0.75 g
     let got = d.lookup(&q).values.a_max_g;
     assert!((got - 0.75).abs() < 1e-6, "{got}");
@@ -261,7 +280,12 @@ fn hand_computed_midpoint() {
 
 #[test]
 fn bottoming_out_reported_if_any_weighted_corner_has_it() {
-    let axes = Axes::new(vec![20.0, 60.0, 100.0], vec![1000.0, 2000.0], vec![50.0, 100.0], vec![200.0, 400.0]);
+    let axes = Axes::new(
+        vec![20.0, 60.0, 100.0],
+        vec![1000.0, 2000.0],
+        vec![50.0, 100.0],
+        vec![200.0, 400.0],
+    );
     // Bottoming out only at the top speed 100 km/h.
     let d = Diagram::from_fn(header(), axes, |p| Cell {
         bottoming_out: if p.coords[0] == 2 { 1.0 } else { 0.0 },
@@ -269,7 +293,14 @@ fn bottoming_out_reported_if_any_weighted_corner_has_it() {
     })
     .unwrap();
     let v = d.view();
-    let at = |speed| v.lookup(&Query { closing_speed_kph: speed, opponent_mass_kg: 1500.0, occupant_mass_kg: 75.0, seat_distance_mm: 300.0 });
+    let at = |speed| {
+        v.lookup(&Query {
+            closing_speed_kph: speed,
+            opponent_mass_kg: 1500.0,
+            occupant_mass_kg: 75.0,
+            seat_distance_mm: 300.0,
+        })
+    };
     assert!(!at(20.0).bottoming_out);
     assert!(!at(59.0).bottoming_out);
     // Exactly at 60 km/h the upper corner's weight is 0: feasible.
@@ -284,13 +315,25 @@ fn bottoming_out_reported_if_any_weighted_corner_has_it() {
 #[test]
 fn airbag_stage_is_derived_after_interpolation() {
     // Airbag level 0 kN at 20 km/h, 12 kN at 68 km/h: level = (v - 20) / 4 kN.
-    let axes = Axes::new(vec![20.0, 68.0], vec![1000.0, 2000.0], vec![50.0, 100.0], vec![200.0, 400.0]);
+    let axes = Axes::new(
+        vec![20.0, 68.0],
+        vec![1000.0, 2000.0],
+        vec![50.0, 100.0],
+        vec![200.0, 400.0],
+    );
     let d = Diagram::from_fn(header(), axes, |p| Cell {
         airbag_level_kn: if p.coords[0] == 1 { 12.0 } else { 0.0 },
         ..Cell::default()
     })
     .unwrap();
-    let at = |speed: f32| d.lookup(&Query { closing_speed_kph: speed, opponent_mass_kg: 1500.0, occupant_mass_kg: 75.0, seat_distance_mm: 300.0 });
+    let at = |speed: f32| {
+        d.lookup(&Query {
+            closing_speed_kph: speed,
+            opponent_mass_kg: 1500.0,
+            occupant_mass_kg: 75.0,
+            seat_distance_mm: 300.0,
+        })
+    };
     // Default thresholds: no fire below 1 kN, stage 2 from 6 kN.
     assert_eq!(at(23.0).airbag_stage, AirbagStage::NoFire); // 0.75 kN
     assert_eq!(at(23.0).airbag_command_kn(), 0.0);
@@ -312,9 +355,25 @@ fn view_and_owned_lookup_agree_and_cells_are_addressable() {
     assert_eq!(v.cell_at(idx), Some(&d.cells()[i]));
     assert_eq!(d.axes().cell_coords(i), Some(idx));
     let p = d.axes().point(i).unwrap();
-    assert_eq!(p.query, Query { closing_speed_kph: 80.0, opponent_mass_kg: 2400.0, occupant_mass_kg: 75.0, seat_distance_mm: 200.0 });
+    assert_eq!(
+        p.query,
+        Query {
+            closing_speed_kph: 80.0,
+            opponent_mass_kg: 2400.0,
+            occupant_mass_kg: 75.0,
+            seat_distance_mm: 200.0
+        }
+    );
     assert_eq!(random_cell(p, 7), d.cells()[i]);
-    let q = Query { closing_speed_kph: 55.0, opponent_mass_kg: 1300.0, occupant_mass_kg: 80.0, seat_distance_mm: 310.0 };
+    let q = Query {
+        closing_speed_kph: 55.0,
+        opponent_mass_kg: 1300.0,
+        occupant_mass_kg: 80.0,
+        seat_distance_mm: 310.0,
+    };
     assert_eq!(d.lookup(&q), v.lookup(&q));
-    assert_eq!(AxisId::ALL.map(|a| d.lookup(&q).out_of_range.get(a)), [false; 4]);
+    assert_eq!(
+        AxisId::ALL.map(|a| d.lookup(&q).out_of_range.get(a)),
+        [false; 4]
+    );
 }

@@ -78,6 +78,11 @@ fn ten_thousand_lookups_allocate_nothing() {
         checksum += r.values.a_max_g + r.values.belt_limiter_kn;
     }
     let after = count();
-    assert_eq!(after - before, 0, "lookup allocated {} times", after - before);
+    assert_eq!(
+        after - before,
+        0,
+        "lookup allocated {} times",
+        after - before
+    );
     assert!(checksum.is_finite());
 }

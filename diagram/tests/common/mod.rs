@@ -15,7 +15,9 @@ pub fn header() -> Header {
             optimiser_seed: 42,
             restitution: 0.1,
             defaults_hash: "deadbeef".into(),
-            extra: [("grid".to_string(), "test".to_string())].into_iter().collect(),
+            extra: [("grid".to_string(), "test".to_string())]
+                .into_iter()
+                .collect(),
         },
         airbag_thresholds: AirbagThresholds::DEFAULT,
     }
