@@ -20,8 +20,9 @@
 //! * Seat friction μ m g, regularised over a small relative speed.
 //!
 //! Time 0 is first contact (pulse sample 0). Integration: semi-implicit Euler at the pulse step;
-//! after the pulse ends the compartment is taken as unaccelerated, and the simulation runs until
-//! the occupant has reached its maximum forward excursion.
+//! after the pulse ends the compartment is taken as unaccelerated. The simulation stops once the
+//! compartment acceleration is over (last non-zero sample) and the occupant moves rearward, i.e.
+//! after its maximum forward excursion.
 //!
 //! Mean occupant deceleration definition: the occupant's velocity change from restraint onset
 //! (first instant with belt or airbag force) until the instant of maximum forward excursion,
@@ -218,7 +219,10 @@ pub fn simulate_occupant(
     let airbag_fires = set.airbag_force_n > 0.0;
     let belt_force_cap = set.load_limiter_n;
     let k_belt = hw.belt_stiffness_n_per_m;
-    let n_pulse = pulse.accel_mps2.len();
+    // After the last non-zero compartment sample nothing can push the occupant further forward
+    // once it moves rearward (restraint forces are dissipative or restoring), so the simulation
+    // may stop there: this halves the cost for predicted pulses, which end at separation.
+    let n_active = pulse.accel_mps2.iter().rposition(|a| *a != 0.0).map_or(0, |i| i + 1);
     let max_steps = (hw.max_sim_s / dt) as usize;
 
     let (mut x, mut v, mut payout) = (0.0f64, 0.0f64, 0.0f64);
@@ -287,7 +291,7 @@ pub fn simulate_occupant(
                 mean_at_max = if span > 0.0 { decel_integral / span } else { 0.0 };
             }
         }
-        if i >= n_pulse && v <= 0.0 {
+        if i >= n_active && v <= 0.0 {
             break;
         }
     }

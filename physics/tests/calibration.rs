@@ -35,6 +35,12 @@ fn every_class_reproduces_table5_within_tolerance() {
         let s = simulate_collision(&input, &mut buf).unwrap();
         let got = (s.vehicle.crush_m * 1e3, mps2_to_g(s.vehicle.a_max_mps2), mps2_to_g(s.vehicle.a_mean_mps2));
         let err = |a: f64, b: f64| (a / b - 1.0).abs();
+        eprintln!(
+            "| {class} | {:.1} / {crush_mm} ({:+.2} %) | {:.2} / {a_max_g} ({:+.2} %) | {:.2} / {a_mean_g} ({:+.2} %) |",
+            got.0, 100.0 * (got.0 / crush_mm - 1.0),
+            got.1, 100.0 * (got.1 / a_max_g - 1.0),
+            got.2, 100.0 * (got.2 / a_mean_g - 1.0)
+        );
         assert!(err(got.0, crush_mm) <= 0.08, "class {class}: crush {} vs {crush_mm}", got.0);
         assert!(err(got.1, a_max_g) <= 0.15, "class {class}: a_max {} vs {a_max_g}", got.1);
         assert!(err(got.2, a_mean_g) <= 0.10, "class {class}: a_mean {} vs {a_mean_g}", got.2);
