@@ -448,7 +448,11 @@ pub struct StaleCleanup {
 /// handlers, so the ECU's handler (which only sets a flag) stays in charge.
 /// A killed process (SIGKILL, crash) leaves its node and port records in shared memory;
 /// `try_cleanup_dead_nodes` removes them so a restarted bench does not hit
-/// "service in use / too many publishers" errors.
+/// "service in use / too many publishers" errors. With iceoryx2 0.10's default config
+/// (`cleanup_dead_nodes_on_creation = true`) node creation already did this, so the
+/// explicit call usually reports 0; it still catches nodes that died in between and
+/// configs that turn the automatic cleanup off. (Verified: ECU SIGKILLed and restarted
+/// with the same names — the dead nodes are detected and removed at creation.)
 pub fn create_node(name: &str, handle_signals: bool) -> Result<(IpcNode, StaleCleanup), IpcError> {
     // iceoryx2 warns on every start that no config file exists (defaults are what the
     // bench wants); keep warnings quiet unless IOX2_LOG_LEVEL asks for them.
