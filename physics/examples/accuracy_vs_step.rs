@@ -23,7 +23,10 @@ fn main() {
     let k = 1.5e6;
     let linear = CombinedSpring::linear(k).unwrap();
     let mu = 1785.0 / 2.0;
-    let (f_exact, t_exact) = (30.0 * (k * mu).sqrt(), std::f64::consts::PI * (mu / k).sqrt());
+    let (f_exact, t_exact) = (
+        30.0 * (k * mu).sqrt(),
+        std::f64::consts::PI * (mu / k).sqrt(),
+    );
     println!("| step [ms] | crush err | a_max err | a_mean err | contact err | linear: peak err | linear: duration err |");
     println!("|---|---|---|---|---|---|---|");
     for step_ms in [1.0, 0.5, 0.2, 0.1, 0.05, 0.02] {

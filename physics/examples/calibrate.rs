@@ -67,8 +67,12 @@ fn table5_case(d_mm: &[f64], f_kn: &[f64], buf: &mut DefaultPulseBuffer) -> Opti
 }
 
 fn cost(p: &[f64; 3], row: &paper::Table5Row, buf: &mut DefaultPulseBuffer) -> f64 {
-    let Some((d, f)) = curve(p, peak_kn(row)) else { return 1e9 };
-    let Some(r) = table5_case(&d, &f, buf) else { return 1e9 };
+    let Some((d, f)) = curve(p, peak_kn(row)) else {
+        return 1e9;
+    };
+    let Some(r) = table5_case(&d, &f, buf) else {
+        return 1e9;
+    };
     let e = [
         (r[0] / row.crush_mm - 1.0) / paper::TOLERANCE_CRUSH,
         (r[1] / row.a_max_g - 1.0) / paper::TOLERANCE_A_MAX,
@@ -77,6 +81,7 @@ fn cost(p: &[f64; 3], row: &paper::Table5Row, buf: &mut DefaultPulseBuffer) -> f
     e.iter().map(|v| v * v).sum()
 }
 
+#[allow(clippy::needless_range_loop)] // index loops mirror the textbook algorithm
 fn nelder_mead(start: [f64; 3], row: &paper::Table5Row, buf: &mut DefaultPulseBuffer) -> [f64; 3] {
     let steps = [40.0, 60.0, 0.8];
     let mut simplex: Vec<([f64; 3], f64)> = Vec::new();
@@ -140,11 +145,31 @@ fn fmt_list(v: &[f64]) -> String {
 
 const RANGES: [(f64, f64, &str); 6] = [
     (0.0, 1200.0, "Smart, Polo (paper: 963-1100 kg)"),
-    (1200.0, 1400.0, "Yaris, Rio, Mini, Neon, Corolla, Focus, Civic (paper: 1245-1398 kg)"),
-    (1400.0, 1750.0, "Prius, Impreza, Z4, Accord, Saab 9-3, Forester, Jetta, 350Z, S60 (paper: 1515-1732 kg)"),
-    (1750.0, 2000.0, "Passat, Taurus, 325i, A4, S80, Aura, C300, Sebring, 528i (paper: 1765-1924 kg)"),
-    (2000.0, 2500.0, "Journey, XC90, H3, ML350, X5 (paper: 2136-2458 kg)"),
-    (2500.0, f64::INFINITY, "Q7, Touareg, Sequoia, Tundra, F250 (paper: 2582-3054 kg)"),
+    (
+        1200.0,
+        1400.0,
+        "Yaris, Rio, Mini, Neon, Corolla, Focus, Civic (paper: 1245-1398 kg)",
+    ),
+    (
+        1400.0,
+        1750.0,
+        "Prius, Impreza, Z4, Accord, Saab 9-3, Forester, Jetta, 350Z, S60 (paper: 1515-1732 kg)",
+    ),
+    (
+        1750.0,
+        2000.0,
+        "Passat, Taurus, 325i, A4, S80, Aura, C300, Sebring, 528i (paper: 1765-1924 kg)",
+    ),
+    (
+        2000.0,
+        2500.0,
+        "Journey, XC90, H3, ML350, X5 (paper: 2136-2458 kg)",
+    ),
+    (
+        2500.0,
+        f64::INFINITY,
+        "Q7, Touareg, Sequoia, Tundra, F250 (paper: 2582-3054 kg)",
+    ),
 ];
 
 fn main() {
@@ -189,7 +214,11 @@ fn main() {
         let f: Vec<f64> = f.iter().map(|v| (v * 10.0).round() / 10.0).collect();
         if i < 6 {
             let (lo, hi, ex) = RANGES[i];
-            let hi = if hi.is_infinite() { "inf".to_string() } else { format!("{hi:.1}") };
+            let hi = if hi.is_infinite() {
+                "inf".to_string()
+            } else {
+                format!("{hi:.1}")
+            };
             out.push_str(&format!(
                 "\n# class {}: fitted plateau {:.1} kN, stiffening from {:.1} mm at {:.3} kN/mm up to 1.1 x published peak\n[[class]]\nid = {}\nlower_kg = {lo:.1}\nupper_kg = {hi}\nexamples = \"{ex}\"\ndeflection_mm = {}\nforce_kn = {}\n",
                 row.class, p[0], p[1], p[2], i + 1, fmt_list(&d), fmt_list(&f)
@@ -202,7 +231,10 @@ fn main() {
         }
     }
     if write {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../data/stiffness-classes.toml");
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../data/stiffness-classes.toml"
+        );
         std::fs::write(path, &out).expect("write data file");
         eprintln!("wrote {path}");
     } else {

@@ -184,11 +184,17 @@ impl<const N: usize> PulseBuffer<N> {
     }
     /// The ego compartment pulse as input of the occupant model.
     pub fn ego_pulse(&self) -> CompartmentPulse<'_> {
-        CompartmentPulse { step_s: self.step_s, accel_mps2: self.ego_accel_mps2() }
+        CompartmentPulse {
+            step_s: self.step_s,
+            accel_mps2: self.ego_accel_mps2(),
+        }
     }
     /// The opponent compartment pulse.
     pub fn opp_pulse(&self) -> CompartmentPulse<'_> {
-        CompartmentPulse { step_s: self.step_s, accel_mps2: self.opp_accel_mps2() }
+        CompartmentPulse {
+            step_s: self.step_s,
+            accel_mps2: self.opp_accel_mps2(),
+        }
     }
 
     #[inline(always)]
@@ -251,28 +257,42 @@ struct Sample {
 
 fn validate(input: &CollisionInput<'_>) -> Result<(), PhysicsError> {
     if !(input.ego_mass_kg.is_finite() && input.ego_mass_kg > 0.0) {
-        return Err(PhysicsError::InvalidInput("ego mass must be finite and > 0"));
+        return Err(PhysicsError::InvalidInput(
+            "ego mass must be finite and > 0",
+        ));
     }
     if !(input.opp_mass_kg > 0.0) {
-        return Err(PhysicsError::InvalidInput("opponent mass must be > 0 (∞ = barrier)"));
+        return Err(PhysicsError::InvalidInput(
+            "opponent mass must be > 0 (∞ = barrier)",
+        ));
     }
     if !(input.closing_speed_mps.is_finite() && input.closing_speed_mps >= 0.0) {
-        return Err(PhysicsError::InvalidInput("closing speed must be finite and ≥ 0"));
+        return Err(PhysicsError::InvalidInput(
+            "closing speed must be finite and ≥ 0",
+        ));
     }
     if input.closing_speed_mps > 200.0 {
         return Err(PhysicsError::InvalidInput("closing speed above 200 m/s"));
     }
     if !defaults::RESTITUTION_BOUNDS.contains(input.restitution) {
-        return Err(PhysicsError::InvalidInput("restitution must be within 0..=1"));
+        return Err(PhysicsError::InvalidInput(
+            "restitution must be within 0..=1",
+        ));
     }
     if !defaults::STEP_BOUNDS_S.contains(input.step_s) {
-        return Err(PhysicsError::InvalidInput("step must be within 1 µs..=5 ms"));
+        return Err(PhysicsError::InvalidInput(
+            "step must be within 1 µs..=5 ms",
+        ));
     }
     if !(input.duration_s.is_finite() && input.duration_s >= 0.0 && input.duration_s <= 10.0) {
-        return Err(PhysicsError::InvalidInput("duration must be within 0..=10 s"));
+        return Err(PhysicsError::InvalidInput(
+            "duration must be within 0..=10 s",
+        ));
     }
     if input.spring.len < 2 {
-        return Err(PhysicsError::InvalidCurve("combined spring has fewer than 2 points"));
+        return Err(PhysicsError::InvalidCurve(
+            "combined spring has fewer than 2 points",
+        ));
     }
     Ok(())
 }
@@ -288,7 +308,11 @@ pub fn simulate_collision<const N: usize>(
     let spring = input.spring;
     let dt = input.step_s;
     let inv_m_ego = 1.0 / input.ego_mass_kg;
-    let inv_m_opp = if input.opp_mass_kg.is_infinite() { 0.0 } else { 1.0 / input.opp_mass_kg };
+    let inv_m_opp = if input.opp_mass_kg.is_infinite() {
+        0.0
+    } else {
+        1.0 / input.opp_mass_kg
+    };
     let mu = 1.0 / (inv_m_ego + inv_m_opp);
     let inv_mu = inv_m_ego + inv_m_opp;
     // Share of the relative velocity change that each vehicle takes (momentum conservation).
@@ -320,7 +344,10 @@ pub fn simulate_collision<const N: usize>(
         for k in 0..n_out {
             out.write(k, &zero);
         }
-        return Ok(CollisionSummary { samples_written: n_out, ..CollisionSummary::default() });
+        return Ok(CollisionSummary {
+            samples_written: n_out,
+            ..CollisionSummary::default()
+        });
     }
 
     let max_steps = libm::ceil(defaults::MAX_CONTACT_S / dt) as usize;
@@ -362,7 +389,11 @@ pub fn simulate_collision<const N: usize>(
     let _ = x_new;
 
     // ---- reversal inside step k → k+1: closing speed falls from u > 0 to u_new ≤ 0.
-    let tau = if u - u_new > 0.0 { dt * u / (u - u_new) } else { 0.0 };
+    let tau = if u - u_new > 0.0 {
+        dt * u / (u - u_new)
+    } else {
+        0.0
+    };
     let t_rev = k as f64 * dt + tau;
     let x_rev = x + 0.5 * u * tau;
     let f_rev = spring.force_at_n(x_rev);
@@ -374,7 +405,12 @@ pub fn simulate_collision<const N: usize>(
         let delta = (mu * v_sep * v_sep / f_rev).min(x_rev);
         let k_u = f_rev / delta;
         let omega = libm::sqrt(k_u * inv_mu);
-        (delta, omega, t_rev + core::f64::consts::FRAC_PI_2 / omega, k_u)
+        (
+            delta,
+            omega,
+            t_rev + core::f64::consts::FRAC_PI_2 / omega,
+            k_u,
+        )
     } else {
         (0.0, 0.0, t_rev, f64::INFINITY)
     };
@@ -387,7 +423,15 @@ pub fn simulate_collision<const N: usize>(
             let phase = omega * (t - t_rev);
             let (s, c) = (libm::sin(phase), libm::cos(phase));
             let y = x_perm + delta * c;
-            out.write(kk, &sample(f_rev * c, -delta * omega * s, ego_frac * y, (1.0 - ego_frac) * y));
+            out.write(
+                kk,
+                &sample(
+                    f_rev * c,
+                    -delta * omega * s,
+                    ego_frac * y,
+                    (1.0 - ego_frac) * y,
+                ),
+            );
         } else {
             out.write(kk, &final_sample);
         }

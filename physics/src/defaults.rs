@@ -47,18 +47,30 @@ pub const PULSE_CAPACITY: usize = 2048;
 /// Admissible restitution coefficients.
 pub const RESTITUTION_BOUNDS: Bounds = Bounds { min: 0.0, max: 1.0 };
 /// Admissible integration steps [s] (1 µs … 5 ms).
-pub const STEP_BOUNDS_S: Bounds = Bounds { min: 1.0e-6, max: 5.0e-3 };
+pub const STEP_BOUNDS_S: Bounds = Bounds {
+    min: 1.0e-6,
+    max: 5.0e-3,
+};
 /// Longest contact phase we integrate before declaring the input unphysical [s].
 pub const MAX_CONTACT_S: f64 = 2.0;
 
 // ---------------------------------------------------------------- published ranges (SPEC Table 2)
 
 /// Closing speed per vehicle the method is meant for [km/h]; below: no-fire, above: no crush data.
-pub const SPEED_PER_VEHICLE_KPH: Bounds = Bounds { min: 20.0, max: 54.0 };
+pub const SPEED_PER_VEHICLE_KPH: Bounds = Bounds {
+    min: 20.0,
+    max: 54.0,
+};
 /// Opponent mass range of the paper [kg].
-pub const OPPONENT_MASS_KG: Bounds = Bounds { min: 800.0, max: 3000.0 };
+pub const OPPONENT_MASS_KG: Bounds = Bounds {
+    min: 800.0,
+    max: 3000.0,
+};
 /// Occupant mass range of the paper [kg].
-pub const OCCUPANT_MASS_KG: Bounds = Bounds { min: 30.0, max: 125.0 };
+pub const OCCUPANT_MASS_KG: Bounds = Bounds {
+    min: 30.0,
+    max: 125.0,
+};
 /// Reference occupant of the paper's studies and FMVSS 208 [kg].
 pub const OCCUPANT_MASS_REFERENCE_KG: f64 = 75.0;
 
@@ -67,7 +79,10 @@ pub const OCCUPANT_MASS_REFERENCE_KG: f64 = 75.0;
 /// Chest to steering wheel / airbag module distance D [m] (seat position). SPEC default 300 mm.
 pub const CHEST_TO_WHEEL_M: f64 = 0.300;
 /// Admissible chest-to-wheel distances [m] (SPEC 200–450 mm).
-pub const CHEST_TO_WHEEL_BOUNDS_M: Bounds = Bounds { min: 0.200, max: 0.450 };
+pub const CHEST_TO_WHEEL_BOUNDS_M: Bounds = Bounds {
+    min: 0.200,
+    max: 0.450,
+};
 /// Compressed airbag module thickness [m]: available ride-down = D − this. SPEC default 60 mm.
 pub const MODULE_THICKNESS_M: f64 = 0.060;
 /// Belt slack before engagement [m] (SPEC default 25 mm).
@@ -97,12 +112,24 @@ pub const OCCUPANT_MAX_SIM_S: f64 = 0.300;
 // ---------------------------------------------------------------- optimisation variables
 
 /// Belt load-limiter level, lumped [N] (SPEC range 1–12 kN).
-pub const LOAD_LIMITER_BOUNDS_N: Bounds = Bounds { min: 1.0e3, max: 12.0e3 };
+pub const LOAD_LIMITER_BOUNDS_N: Bounds = Bounds {
+    min: 1.0e3,
+    max: 12.0e3,
+};
 /// Airbag + column force level [N] (SPEC range 0 = no fire … 12 kN).
-pub const AIRBAG_FORCE_BOUNDS_N: Bounds = Bounds { min: 0.0, max: 12.0e3 };
+pub const AIRBAG_FORCE_BOUNDS_N: Bounds = Bounds {
+    min: 0.0,
+    max: 12.0e3,
+};
 /// Pretensioner trigger time relative to first contact [s] (pre-crash allowed).
-pub const PRETENSIONER_TIME_BOUNDS_S: Bounds = Bounds { min: -0.100, max: 0.020 };
+pub const PRETENSIONER_TIME_BOUNDS_S: Bounds = Bounds {
+    min: -0.100,
+    max: 0.020,
+};
 /// Airbag trigger time relative to first contact [s] (not before crash confirmation).
-pub const AIRBAG_TIME_BOUNDS_S: Bounds = Bounds { min: 0.003, max: 0.040 };
+pub const AIRBAG_TIME_BOUNDS_S: Bounds = Bounds {
+    min: 0.003,
+    max: 0.040,
+};
 /// Fire time of the conventional reference restraint after contact [s] (paper: 10 ms).
 pub const REFERENCE_FIRE_TIME_S: f64 = 0.010;

@@ -64,19 +64,30 @@ pub fn parse_trace_csv(text: &str) -> Result<BarrierTrace, String> {
         .map(|(i, l)| (i + 1, l.trim()))
         .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
     let (_, header) = lines.next().ok_or("empty trace file")?;
-    let cols: Vec<String> = header.split(',').map(|c| c.trim().to_ascii_lowercase()).collect();
+    let cols: Vec<String> = header
+        .split(',')
+        .map(|c| c.trim().to_ascii_lowercase())
+        .collect();
     if cols.len() < 2 {
         return Err(format!("header must name two columns, got `{header}`"));
     }
     let time_scale = match cols[0].as_str() {
         "time_s" | "t_s" => 1.0,
         "time_ms" | "t_ms" => 1.0e-3,
-        other => return Err(format!("first column must be time_s or time_ms, got `{other}`")),
+        other => {
+            return Err(format!(
+                "first column must be time_s or time_ms, got `{other}`"
+            ))
+        }
     };
     let accel_scale = match cols[1].as_str() {
         "accel_g" | "a_g" => crate::defaults::STANDARD_GRAVITY_MPS2,
         "accel_mps2" | "a_mps2" => 1.0,
-        other => return Err(format!("second column must be accel_g or accel_mps2, got `{other}`")),
+        other => {
+            return Err(format!(
+                "second column must be accel_g or accel_mps2, got `{other}`"
+            ))
+        }
     };
     let mut times = Vec::new();
     let mut accel = Vec::new();
@@ -84,7 +95,9 @@ pub fn parse_trace_csv(text: &str) -> Result<BarrierTrace, String> {
         let mut it = line.split(',');
         let parse = |s: Option<&str>| -> Result<f64, String> {
             let s = s.ok_or(format!("line {line_no}: missing column"))?.trim();
-            let v: f64 = s.parse().map_err(|_| format!("line {line_no}: not a number: `{s}`"))?;
+            let v: f64 = s
+                .parse()
+                .map_err(|_| format!("line {line_no}: not a number: `{s}`"))?;
             if v.is_finite() {
                 Ok(v)
             } else {
@@ -95,7 +108,10 @@ pub fn parse_trace_csv(text: &str) -> Result<BarrierTrace, String> {
         accel.push(parse(it.next())? * accel_scale);
     }
     if times.len() < 16 {
-        return Err(format!("trace has {} samples, need at least 16", times.len()));
+        return Err(format!(
+            "trace has {} samples, need at least 16",
+            times.len()
+        ));
     }
     let step_s = (times[times.len() - 1] - times[0]) / (times.len() - 1) as f64;
     if !(step_s > 0.0) {
@@ -106,16 +122,26 @@ pub fn parse_trace_csv(text: &str) -> Result<BarrierTrace, String> {
             return Err(format!("non-uniform time step at sample {}", i + 2));
         }
     }
-    Ok(BarrierTrace { step_s, accel_mps2: accel })
+    Ok(BarrierTrace {
+        step_s,
+        accel_mps2: accel,
+    })
 }
 
 /// Derive a force-deflection curve from a barrier trace.
-pub fn derive_curve(trace: &BarrierTrace, opts: &DeriveOptions) -> Result<DerivedCurve, PhysicsError> {
+pub fn derive_curve(
+    trace: &BarrierTrace,
+    opts: &DeriveOptions,
+) -> Result<DerivedCurve, PhysicsError> {
     if !(opts.mass_kg.is_finite() && opts.mass_kg > 0.0) {
-        return Err(PhysicsError::InvalidInput("test mass must be finite and > 0"));
+        return Err(PhysicsError::InvalidInput(
+            "test mass must be finite and > 0",
+        ));
     }
     if !(opts.impact_speed_mps.is_finite() && opts.impact_speed_mps > 0.0) {
-        return Err(PhysicsError::InvalidInput("impact speed must be finite and > 0"));
+        return Err(PhysicsError::InvalidInput(
+            "impact speed must be finite and > 0",
+        ));
     }
     if !(3..=16).contains(&opts.points) {
         return Err(PhysicsError::InvalidInput("points must be within 3..=16"));
@@ -140,7 +166,11 @@ pub fn derive_curve(trace: &BarrierTrace, opts: &DeriveOptions) -> Result<Derive
         let v_next = v + 0.5 * (w[0] + w[1]) * dt;
         if v_next <= 0.0 {
             // Stop inside this step: add the remaining travel and stop.
-            let frac = if v - v_next > 0.0 { v / (v - v_next) } else { 0.0 };
+            let frac = if v - v_next > 0.0 {
+                v / (v - v_next)
+            } else {
+                0.0
+            };
             x += 0.5 * v * frac * dt;
             raw_crush_m.push(x);
             raw_force_n.push(opts.mass_kg * (-w[1]).max(0.0));
@@ -177,19 +207,33 @@ pub fn derive_curve(trace: &BarrierTrace, opts: &DeriveOptions) -> Result<Derive
                 c += 1;
             }
         }
-        let f = if c > 0 { s / c as f64 } else { interp(&raw_crush_m, &raw_force_n, centre) };
+        let f = if c > 0 {
+            s / c as f64
+        } else {
+            interp(&raw_crush_m, &raw_force_n, centre)
+        };
         dm[k] = centre;
         fm[k] = f.max(fm[k - 1] + 1.0);
     }
     let curve = Curve::from_points(&dm[..n], &fm[..n])?;
-    Ok(DerivedCurve { curve, max_crush_m, raw_crush_m, raw_force_n, sign_flipped })
+    Ok(DerivedCurve {
+        curve,
+        max_crush_m,
+        raw_crush_m,
+        raw_force_n,
+        sign_flipped,
+    })
 }
 
 fn interp(xs: &[f64], ys: &[f64], x: f64) -> f64 {
     for i in 1..xs.len().min(ys.len()) {
         if xs[i] >= x {
             let span = xs[i] - xs[i - 1];
-            let t = if span > 0.0 { (x - xs[i - 1]) / span } else { 1.0 };
+            let t = if span > 0.0 {
+                (x - xs[i - 1]) / span
+            } else {
+                1.0
+            };
             return ys[i - 1] + t * (ys[i] - ys[i - 1]);
         }
     }

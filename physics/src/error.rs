@@ -27,7 +27,9 @@ impl fmt::Display for PhysicsError {
                 "curve needs more than {} points",
                 crate::stiffness::CURVE_CAPACITY
             ),
-            PhysicsError::ContactTooLong => write!(f, "contact phase did not end (unphysical input)"),
+            PhysicsError::ContactTooLong => {
+                write!(f, "contact phase did not end (unphysical input)")
+            }
             PhysicsError::InvalidSignal(why) => write!(f, "invalid signal: {why}"),
         }
     }

@@ -48,7 +48,9 @@ pub struct CfcCoefficients {
 /// 10 × CFC (J211 recommends ≥ 10× the filter's F_H) so the design stays well-conditioned.
 pub fn coefficients(cfc: Cfc, step_s: f64) -> Result<CfcCoefficients, PhysicsError> {
     if !(step_s.is_finite() && step_s > 0.0) {
-        return Err(PhysicsError::InvalidSignal("sampling step must be finite and > 0"));
+        return Err(PhysicsError::InvalidSignal(
+            "sampling step must be finite and > 0",
+        ));
     }
     if 1.0 / step_s < 10.0 * cfc.hz() {
         return Err(PhysicsError::InvalidSignal("sampling rate below 10 x CFC"));
@@ -101,7 +103,12 @@ pub fn magnitude(cfc: Cfc, step_s: f64, freq_hz: f64) -> Result<f64, PhysicsErro
     let c = coefficients(cfc, step_s)?;
     let w = 2.0 * core::f64::consts::PI * freq_hz * step_s;
     // H(z) = a0 (1 + 2 z^-1 + z^-2) / (1 − b1 z^-1 − b2 z^-2)
-    let (c1, s1, c2, s2) = (libm::cos(w), libm::sin(w), libm::cos(2.0 * w), libm::sin(2.0 * w));
+    let (c1, s1, c2, s2) = (
+        libm::cos(w),
+        libm::sin(w),
+        libm::cos(2.0 * w),
+        libm::sin(2.0 * w),
+    );
     let num_re = c.a0 * (1.0 + 2.0 * c1 + c2);
     let num_im = -c.a0 * (2.0 * s1 + s2);
     let den_re = 1.0 - c.b1 * c1 - c.b2 * c2;

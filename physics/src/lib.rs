@@ -15,6 +15,8 @@
 //! panics on input (property-tested); invalid input returns [`PhysicsError`].
 #![cfg_attr(not(feature = "std"), no_std)]
 #![forbid(unsafe_code)]
+// `!(x > 0.0)` is deliberate: it is true for NaN, which is how inputs are rejected NaN-safely.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 #![warn(missing_docs)]
 
 pub mod collision;

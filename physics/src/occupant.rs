@@ -140,7 +140,10 @@ pub struct OccupantOutcome {
 /// Ideal constant-force restraint bound a* = Δv² / (2 (D_veh + s_avail)) [m/s²]: the lowest
 /// constant deceleration that stops the occupant relative to the compartment's final velocity
 /// within the compartment's own ride-down D_veh plus the available excursion s_avail.
-pub fn ideal_constant_force_decel_mps2(pulse: &CompartmentPulse<'_>, available_ride_down_m: f64) -> f64 {
+pub fn ideal_constant_force_decel_mps2(
+    pulse: &CompartmentPulse<'_>,
+    available_ride_down_m: f64,
+) -> f64 {
     let dv = pulse.delta_v_mps();
     let d = pulse.ride_down_displacement_m() + available_ride_down_m;
     if d > 0.0 && dv.is_finite() {
@@ -157,26 +160,42 @@ fn validate(
     hw: &RestraintHardware,
 ) -> Result<(), PhysicsError> {
     if !defaults::STEP_BOUNDS_S.contains(pulse.step_s) {
-        return Err(PhysicsError::InvalidSignal("pulse step must be within 1 µs..=5 ms"));
+        return Err(PhysicsError::InvalidSignal(
+            "pulse step must be within 1 µs..=5 ms",
+        ));
     }
-    if pulse.accel_mps2.iter().any(|a| !a.is_finite() || a.abs() > 1.0e4) {
-        return Err(PhysicsError::InvalidSignal("pulse contains non-finite or > 1000 g samples"));
+    if pulse
+        .accel_mps2
+        .iter()
+        .any(|a| !a.is_finite() || a.abs() > 1.0e4)
+    {
+        return Err(PhysicsError::InvalidSignal(
+            "pulse contains non-finite or > 1000 g samples",
+        ));
     }
     if !(occ.mass_kg.is_finite() && occ.mass_kg >= 1.0 && occ.mass_kg <= 500.0) {
-        return Err(PhysicsError::InvalidInput("occupant mass must be within 1..=500 kg"));
+        return Err(PhysicsError::InvalidInput(
+            "occupant mass must be within 1..=500 kg",
+        ));
     }
     if !(occ.chest_to_wheel_m.is_finite()
         && occ.chest_to_wheel_m > hw.module_thickness_m
         && occ.chest_to_wheel_m <= 2.0)
     {
-        return Err(PhysicsError::InvalidInput("chest-to-wheel distance must exceed the module"));
+        return Err(PhysicsError::InvalidInput(
+            "chest-to-wheel distance must exceed the module",
+        ));
     }
     let ok = |v: f64| v.is_finite() && v >= 0.0;
     if !(ok(set.load_limiter_n) && ok(set.airbag_force_n)) {
-        return Err(PhysicsError::InvalidInput("restraint force levels must be finite and ≥ 0"));
+        return Err(PhysicsError::InvalidInput(
+            "restraint force levels must be finite and ≥ 0",
+        ));
     }
     if !(set.pretensioner_time_s.is_finite() && set.airbag_time_s.is_finite()) {
-        return Err(PhysicsError::InvalidInput("restraint trigger times must be finite"));
+        return Err(PhysicsError::InvalidInput(
+            "restraint trigger times must be finite",
+        ));
     }
     let hw_ok = ok(hw.belt_slack_m)
         && ok(hw.belt_stiffness_n_per_m)
@@ -192,7 +211,9 @@ fn validate(
         && ok(hw.max_sim_s)
         && hw.max_sim_s <= 10.0;
     if !hw_ok {
-        return Err(PhysicsError::InvalidInput("restraint hardware constants out of range"));
+        return Err(PhysicsError::InvalidInput(
+            "restraint hardware constants out of range",
+        ));
     }
     Ok(())
 }
@@ -214,19 +235,34 @@ pub fn simulate_occupant(
     let bag_depth = hw.airbag_depth_m.min(d_wheel);
     let friction_n = hw.seat_friction_coeff * m * defaults::STANDARD_GRAVITY_MPS2;
     let inv_v_reg = 1.0 / hw.seat_friction_regularisation_mps;
-    let inv_pt = if hw.pretensioner_duration_s > 0.0 { 1.0 / hw.pretensioner_duration_s } else { f64::INFINITY };
-    let inv_inf = if hw.airbag_inflation_s > 0.0 { 1.0 / hw.airbag_inflation_s } else { f64::INFINITY };
+    let inv_pt = if hw.pretensioner_duration_s > 0.0 {
+        1.0 / hw.pretensioner_duration_s
+    } else {
+        f64::INFINITY
+    };
+    let inv_inf = if hw.airbag_inflation_s > 0.0 {
+        1.0 / hw.airbag_inflation_s
+    } else {
+        f64::INFINITY
+    };
     let airbag_fires = set.airbag_force_n > 0.0;
     let belt_force_cap = set.load_limiter_n;
     let k_belt = hw.belt_stiffness_n_per_m;
     // After the last non-zero compartment sample nothing can push the occupant further forward
     // once it moves rearward (restraint forces are dissipative or restoring), so the simulation
     // may stop there: this halves the cost for predicted pulses, which end at separation.
-    let n_active = pulse.accel_mps2.iter().rposition(|a| *a != 0.0).map_or(0, |i| i + 1);
+    let n_active = pulse
+        .accel_mps2
+        .iter()
+        .rposition(|a| *a != 0.0)
+        .map_or(0, |i| i + 1);
     let max_steps = (hw.max_sim_s / dt) as usize;
 
     let (mut x, mut v, mut payout) = (0.0f64, 0.0f64, 0.0f64);
-    let mut out = OccupantOutcome { available_ride_down_m: s_avail, ..OccupantOutcome::default() };
+    let mut out = OccupantOutcome {
+        available_ride_down_m: s_avail,
+        ..OccupantOutcome::default()
+    };
     let mut onset_time: Option<f64> = None;
     let mut decel_integral = 0.0; // ∫ decel dt since restraint onset
     let mut mean_at_max = 0.0;
@@ -244,7 +280,11 @@ pub fn simulate_occupant(
                 f_belt = k_belt * stretch;
                 if f_belt > belt_force_cap {
                     // Pay-out at the limiter is permanent.
-                    payout = if k_belt > 0.0 { x - slack - belt_force_cap / k_belt } else { payout };
+                    payout = if k_belt > 0.0 {
+                        x - slack - belt_force_cap / k_belt
+                    } else {
+                        payout
+                    };
                     f_belt = belt_force_cap;
                 }
             }
@@ -288,7 +328,11 @@ pub fn simulate_occupant(
             out.max_excursion_time_s = t + dt;
             if let Some(t0) = onset_time {
                 let span = t + dt - t0;
-                mean_at_max = if span > 0.0 { decel_integral / span } else { 0.0 };
+                mean_at_max = if span > 0.0 {
+                    decel_integral / span
+                } else {
+                    0.0
+                };
             }
         }
         if i >= n_active && v <= 0.0 {

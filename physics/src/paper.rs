@@ -23,13 +23,48 @@ pub const TABLE5_OCCUPANT_KG: f64 = 75.0;
 
 /// Table 5, vehicle columns, as published. Index 0..=5 = class 1..=6, index 6 = combined.
 pub const TABLE5: [Table5Row; 7] = [
-    Table5Row { class: "1", crush_mm: 579.3, a_max_g: 40.06, a_mean_g: 21.59 },
-    Table5Row { class: "2", crush_mm: 665.5, a_max_g: 33.64, a_mean_g: 19.88 },
-    Table5Row { class: "3", crush_mm: 663.4, a_max_g: 34.50, a_mean_g: 19.85 },
-    Table5Row { class: "4", crush_mm: 653.9, a_max_g: 39.24, a_mean_g: 20.00 },
-    Table5Row { class: "5", crush_mm: 677.7, a_max_g: 38.25, a_mean_g: 19.56 },
-    Table5Row { class: "6", crush_mm: 649.9, a_max_g: 44.74, a_mean_g: 20.22 },
-    Table5Row { class: "1-6", crush_mm: 662.0, a_max_g: 37.64, a_mean_g: 19.89 },
+    Table5Row {
+        class: "1",
+        crush_mm: 579.3,
+        a_max_g: 40.06,
+        a_mean_g: 21.59,
+    },
+    Table5Row {
+        class: "2",
+        crush_mm: 665.5,
+        a_max_g: 33.64,
+        a_mean_g: 19.88,
+    },
+    Table5Row {
+        class: "3",
+        crush_mm: 663.4,
+        a_max_g: 34.50,
+        a_mean_g: 19.85,
+    },
+    Table5Row {
+        class: "4",
+        crush_mm: 653.9,
+        a_max_g: 39.24,
+        a_mean_g: 20.00,
+    },
+    Table5Row {
+        class: "5",
+        crush_mm: 677.7,
+        a_max_g: 38.25,
+        a_mean_g: 19.56,
+    },
+    Table5Row {
+        class: "6",
+        crush_mm: 649.9,
+        a_max_g: 44.74,
+        a_mean_g: 20.22,
+    },
+    Table5Row {
+        class: "1-6",
+        crush_mm: 662.0,
+        a_max_g: 37.64,
+        a_mean_g: 19.89,
+    },
 ];
 
 /// Calibration tolerances required by the issue (relative): crush ±8 %, peak ±15 %, mean ±10 %.

@@ -71,7 +71,11 @@ pub fn validate_points(deflection_mm: &[f64], force_kn: &[f64]) -> Result<(), &'
     if deflection_mm.len() > FILE_CURVE_MAX_POINTS {
         return Err("a curve may have at most 16 points");
     }
-    if deflection_mm.iter().chain(force_kn.iter()).any(|v| !v.is_finite()) {
+    if deflection_mm
+        .iter()
+        .chain(force_kn.iter())
+        .any(|v| !v.is_finite())
+    {
         return Err("non-finite value");
     }
     if deflection_mm[0] != 0.0 || force_kn[0] != 0.0 {
@@ -90,11 +94,19 @@ pub fn validate_points(deflection_mm: &[f64], force_kn: &[f64]) -> Result<(), &'
 /// non-overlapping mass ranges.
 pub fn validate_file(file: &ClassFile) -> Result<(), String> {
     if file.class.is_empty() || file.class.len() > 6 {
-        return Err(format!("expected 1..=6 classes, found {}", file.class.len()));
+        return Err(format!(
+            "expected 1..=6 classes, found {}",
+            file.class.len()
+        ));
     }
     for (i, c) in file.class.iter().enumerate() {
         if usize::from(c.id) != i + 1 {
-            return Err(format!("class #{} has id {}, expected {}", i + 1, c.id, i + 1));
+            return Err(format!(
+                "class #{} has id {}, expected {}",
+                i + 1,
+                c.id,
+                i + 1
+            ));
         }
         validate_points(&c.deflection_mm, &c.force_kn)
             .map_err(|e| format!("class {}: {e}", c.id))?;
@@ -102,7 +114,10 @@ pub fn validate_file(file: &ClassFile) -> Result<(), String> {
             return Err(format!("class {}: bad mass range", c.id));
         }
         if i > 0 && file.class[i - 1].upper_kg != c.lower_kg {
-            return Err(format!("class {}: mass range not contiguous with class {}", c.id, i));
+            return Err(format!(
+                "class {}: mass range not contiguous with class {}",
+                c.id, i
+            ));
         }
     }
     validate_points(&file.combined.deflection_mm, &file.combined.force_kn)

@@ -34,7 +34,11 @@ impl Curve {
         force_n: [f64; CURVE_CAPACITY],
         len: usize,
     ) -> Self {
-        Curve { deflection_m, force_n, len }
+        Curve {
+            deflection_m,
+            force_n,
+            len,
+        }
     }
 
     /// Build a curve from points (SI units). Requirements: 2..=32 points, all finite, first point
@@ -42,11 +46,15 @@ impl Curve {
     /// curves can be combined in series).
     pub fn from_points(deflection_m: &[f64], force_n: &[f64]) -> Result<Self, PhysicsError> {
         if deflection_m.len() != force_n.len() {
-            return Err(PhysicsError::InvalidCurve("deflection and force differ in length"));
+            return Err(PhysicsError::InvalidCurve(
+                "deflection and force differ in length",
+            ));
         }
         let len = deflection_m.len();
         if len < 2 {
-            return Err(PhysicsError::InvalidCurve("a curve needs at least 2 points"));
+            return Err(PhysicsError::InvalidCurve(
+                "a curve needs at least 2 points",
+            ));
         }
         if len > CURVE_CAPACITY {
             return Err(PhysicsError::CurveTooLong);
@@ -77,7 +85,9 @@ impl Curve {
     /// A linear spring `force = stiffness · deflection` (closed-form oracles, `--linear-stiffness`).
     pub fn linear(stiffness_n_per_m: f64) -> Result<Self, PhysicsError> {
         if !(stiffness_n_per_m.is_finite() && stiffness_n_per_m > 0.0) {
-            return Err(PhysicsError::InvalidInput("linear stiffness must be finite and > 0"));
+            return Err(PhysicsError::InvalidInput(
+                "linear stiffness must be finite and > 0",
+            ));
         }
         Curve::from_points(&[0.0, 1.0], &[0.0, stiffness_n_per_m])
     }
@@ -130,7 +140,11 @@ impl Curve {
             if deflection_m <= x0 {
                 return energy_j;
             }
-            let x_end = if i + 1 == d.len() { deflection_m } else { deflection_m.min(x1) };
+            let x_end = if i + 1 == d.len() {
+                deflection_m
+            } else {
+                deflection_m.min(x1)
+            };
             let f_end = self.force_at_n(x_end);
             energy_j += 0.5 * (f[i - 1] + f_end) * (x_end - x0);
         }
@@ -188,7 +202,9 @@ impl CombinedSpring {
             None => (ego.force_n(), &[]),
         };
         if fe.len() < 2 {
-            return Err(PhysicsError::InvalidCurve("ego curve has fewer than 2 points"));
+            return Err(PhysicsError::InvalidCurve(
+                "ego curve has fewer than 2 points",
+            ));
         }
         // Merge the two sorted force lists (both start at 0), dropping near-duplicates.
         let (mut i, mut j, mut n) = (0usize, 0usize, 0usize);
@@ -231,7 +247,9 @@ impl CombinedSpring {
         for k in 0..n.saturating_sub(1) {
             let dx = spring.x_m[k + 1] - spring.x_m[k];
             if !(dx > 0.0) {
-                return Err(PhysicsError::InvalidCurve("combined curve not strictly increasing"));
+                return Err(PhysicsError::InvalidCurve(
+                    "combined curve not strictly increasing",
+                ));
             }
             spring.stiffness_n_per_m[k] = (spring.force_n[k + 1] - spring.force_n[k]) / dx;
             spring.ego_share[k] = (spring.ego_m[k + 1] - spring.ego_m[k]) / dx;
@@ -315,7 +333,9 @@ impl MassClass {
 /// 2000–2500, ≥ 2500 kg (ranges from the data file). The estimate only needs to be rough.
 pub fn class_for_mass_kg(mass_kg: f64) -> Result<MassClass, PhysicsError> {
     if !(mass_kg.is_finite() && mass_kg > 0.0) {
-        return Err(PhysicsError::InvalidInput("vehicle mass must be finite and > 0"));
+        return Err(PhysicsError::InvalidInput(
+            "vehicle mass must be finite and > 0",
+        ));
     }
     for (i, &(_, upper)) in CLASS_RANGES_KG.iter().enumerate() {
         if mass_kg < upper {
@@ -364,7 +384,11 @@ mod loader {
         }
         let combined = curve_si(&file.combined.deflection_mm, &file.combined.force_kn)
             .map_err(|e| format!("combined: {e}"))?;
-        Ok(ClassSet { classes, combined, provenance: file.meta.provenance })
+        Ok(ClassSet {
+            classes,
+            combined,
+            provenance: file.meta.provenance,
+        })
     }
 
     /// Read, parse and validate a class file.

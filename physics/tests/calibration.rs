@@ -29,11 +29,19 @@ fn paper_module_matches_spec() {
 fn every_class_reproduces_table5_within_tolerance() {
     let mut buf = Box::new(DefaultPulseBuffer::new());
     for (i, &(class, crush_mm, a_max_g, a_mean_g)) in PUBLISHED.iter().enumerate() {
-        let curve = if i < 6 { &stiffness::CLASS_CURVES[i] } else { &stiffness::COMBINED_CURVE };
+        let curve = if i < 6 {
+            &stiffness::CLASS_CURVES[i]
+        } else {
+            &stiffness::COMBINED_CURVE
+        };
         let spring = CombinedSpring::series(curve, Some(curve)).unwrap();
         let input = CollisionInput::with_defaults(&spring, 1785.0, 1785.0, kph_to_mps(108.0));
         let s = simulate_collision(&input, &mut buf).unwrap();
-        let got = (s.vehicle.crush_m * 1e3, mps2_to_g(s.vehicle.a_max_mps2), mps2_to_g(s.vehicle.a_mean_mps2));
+        let got = (
+            s.vehicle.crush_m * 1e3,
+            mps2_to_g(s.vehicle.a_max_mps2),
+            mps2_to_g(s.vehicle.a_mean_mps2),
+        );
         let err = |a: f64, b: f64| (a / b - 1.0).abs();
         eprintln!(
             "| {class} | {:.1} / {crush_mm} ({:+.2} %) | {:.2} / {a_max_g} ({:+.2} %) | {:.2} / {a_mean_g} ({:+.2} %) |",
@@ -41,8 +49,20 @@ fn every_class_reproduces_table5_within_tolerance() {
             got.1, 100.0 * (got.1 / a_max_g - 1.0),
             got.2, 100.0 * (got.2 / a_mean_g - 1.0)
         );
-        assert!(err(got.0, crush_mm) <= 0.08, "class {class}: crush {} vs {crush_mm}", got.0);
-        assert!(err(got.1, a_max_g) <= 0.15, "class {class}: a_max {} vs {a_max_g}", got.1);
-        assert!(err(got.2, a_mean_g) <= 0.10, "class {class}: a_mean {} vs {a_mean_g}", got.2);
+        assert!(
+            err(got.0, crush_mm) <= 0.08,
+            "class {class}: crush {} vs {crush_mm}",
+            got.0
+        );
+        assert!(
+            err(got.1, a_max_g) <= 0.15,
+            "class {class}: a_max {} vs {a_max_g}",
+            got.1
+        );
+        assert!(
+            err(got.2, a_mean_g) <= 0.10,
+            "class {class}: a_mean {} vs {a_mean_g}",
+            got.2
+        );
     }
 }

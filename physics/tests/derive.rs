@@ -35,13 +35,21 @@ fn barrier_trace(curve: &Curve, mass_kg: f64, speed_mps: f64, noise_g: f64) -> (
         .iter()
         .enumerate()
         .map(|(i, a)| {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             let u = (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
             let ring = (2.0 * std::f64::consts::PI * 450.0 * i as f64 * 1e-4).sin();
             a + noise_g * 9.80665 * (u + ring)
         })
         .collect();
-    (BarrierTrace { step_s: 1e-4, accel_mps2: accel }, s.vehicle.crush_m)
+    (
+        BarrierTrace {
+            step_s: 1e-4,
+            accel_mps2: accel,
+        },
+        s.vehicle.crush_m,
+    )
 }
 
 #[test]
@@ -49,10 +57,19 @@ fn round_trip_recovers_the_curve() {
     let curve = known_curve();
     let (mass, v0) = (1785.0, 56.0 / 3.6);
     let (trace, crush_true) = barrier_trace(&curve, mass, v0, 3.0);
-    let opts = DeriveOptions { mass_kg: mass, impact_speed_mps: v0, points: 16, cfc: Cfc::Cfc60 };
+    let opts = DeriveOptions {
+        mass_kg: mass,
+        impact_speed_mps: v0,
+        points: 16,
+        cfc: Cfc::Cfc60,
+    };
     let derived = derive_curve(&trace, &opts).unwrap();
     assert!(!derived.sign_flipped);
-    assert!((derived.max_crush_m / crush_true - 1.0).abs() < 0.01, "{} vs {crush_true}", derived.max_crush_m);
+    assert!(
+        (derived.max_crush_m / crush_true - 1.0).abs() < 0.01,
+        "{} vs {crush_true}",
+        derived.max_crush_m
+    );
     // Compare at crush points away from the sharp knees (CFC 60 rounds them by design).
     for &x_mm in &[80.0, 200.0, 300.0, 400.0, 500.0, 600.0] {
         let x = x_mm * 1e-3;
@@ -76,7 +93,12 @@ fn flipped_sign_trace_is_detected() {
     let curve = known_curve();
     let (mut trace, _) = barrier_trace(&curve, 1500.0, 14.0, 0.0);
     trace.accel_mps2.iter_mut().for_each(|a| *a = -*a);
-    let opts = DeriveOptions { mass_kg: 1500.0, impact_speed_mps: 14.0, points: 12, cfc: Cfc::Cfc60 };
+    let opts = DeriveOptions {
+        mass_kg: 1500.0,
+        impact_speed_mps: 14.0,
+        points: 12,
+        cfc: Cfc::Cfc60,
+    };
     assert!(derive_curve(&trace, &opts).unwrap().sign_flipped);
 }
 
@@ -90,10 +112,14 @@ fn csv_parsing_and_errors() {
     assert!((t.step_s - 1e-4).abs() < 1e-12);
     assert!((t.accel_mps2[3] + 98.0665).abs() < 1e-9);
     assert!(parse_trace_csv("time_s,force\n0,1\n").is_err());
-    assert!(parse_trace_csv("time_s,accel_g\n0,1\n0.1,x\n").unwrap_err().contains("line 3"));
+    assert!(parse_trace_csv("time_s,accel_g\n0,1\n0.1,x\n")
+        .unwrap_err()
+        .contains("line 3"));
     let mut uneven = String::from("time_s,accel_g\n");
     for i in 0..20 {
         uneven.push_str(&format!("{},0\n", (i * i) as f64 * 1e-4));
     }
-    assert!(parse_trace_csv(&uneven).unwrap_err().contains("non-uniform"));
+    assert!(parse_trace_csv(&uneven)
+        .unwrap_err()
+        .contains("non-uniform"));
 }

@@ -6,6 +6,7 @@
 //!  * at F_N: upper +0.5 dB, lower −4 dB (straight on log-f between F_H and F_N),
 //!  * above F_N: upper falls 9 dB/octave from +0.5 dB; lower falls 24 dB/octave from −4 dB down
 //!    to −30 dB, below which it is unbounded.
+//!
 //! Measured by filtering long sinusoids (the real in-place filter), not only by the formula.
 
 use physics::j211::{filter_in_place, magnitude, Cfc};
@@ -21,13 +22,22 @@ fn corridor_db(cfc_hz: f64, f: f64) -> (f64, f64) {
     } else {
         let oct = (f / fnn).log2();
         let lower = -4.0 - 24.0 * oct;
-        (if lower < -30.0 { f64::NEG_INFINITY } else { lower }, 0.5 - 9.0 * oct)
+        (
+            if lower < -30.0 {
+                f64::NEG_INFINITY
+            } else {
+                lower
+            },
+            0.5 - 9.0 * oct,
+        )
     }
 }
 
 fn measured_gain(cfc: Cfc, step_s: f64, f: f64) -> f64 {
     let n = 40_000;
-    let mut x: Vec<f64> = (0..n).map(|i| (2.0 * std::f64::consts::PI * f * i as f64 * step_s).sin()).collect();
+    let mut x: Vec<f64> = (0..n)
+        .map(|i| (2.0 * std::f64::consts::PI * f * i as f64 * step_s).sin())
+        .collect();
     filter_in_place(&mut x, step_s, cfc).unwrap();
     // Amplitude over the middle half (away from edge transients).
     let mid = &x[n / 4..3 * n / 4];
@@ -44,9 +54,15 @@ fn magnitude_within_j211_corridor() {
             let g_formula_db = 20.0 * magnitude(cfc, step_s, f).unwrap().log10();
             let g_meas_db = 20.0 * measured_gain(cfc, step_s, f).log10();
             for g in [g_formula_db, g_meas_db] {
-                assert!(g >= lo - 1e-9 && g <= hi + 1e-9, "{cfc:?} {f} Hz: {g} dB not in [{lo}, {hi}]");
+                assert!(
+                    g >= lo - 1e-9 && g <= hi + 1e-9,
+                    "{cfc:?} {f} Hz: {g} dB not in [{lo}, {hi}]"
+                );
             }
-            assert!((g_formula_db - g_meas_db).abs() < 0.05, "{f} Hz: {g_formula_db} vs {g_meas_db}");
+            assert!(
+                (g_formula_db - g_meas_db).abs() < 0.05,
+                "{f} Hz: {g_formula_db} vs {g_meas_db}"
+            );
         }
     }
 }
@@ -56,9 +72,19 @@ fn phaseless_and_unit_dc_gain() {
     let step_s = 1.0e-4;
     // Symmetric pulse stays symmetric about its centre (zero phase) and a constant stays constant.
     let n = 2001;
-    let mut x: Vec<f64> = (0..n).map(|i| { let t = (i as f64 - 1000.0) * step_s; (-(t / 0.01).powi(2)).exp() }).collect();
+    let mut x: Vec<f64> = (0..n)
+        .map(|i| {
+            let t = (i as f64 - 1000.0) * step_s;
+            (-(t / 0.01).powi(2)).exp()
+        })
+        .collect();
     filter_in_place(&mut x, step_s, Cfc::Cfc60).unwrap();
-    let peak = x.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)).unwrap().0;
+    let peak = x
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .unwrap()
+        .0;
     assert_eq!(peak, 1000);
     let mut c = vec![3.5; 500];
     filter_in_place(&mut c, step_s, Cfc::Cfc180).unwrap();

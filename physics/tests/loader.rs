@@ -36,9 +36,13 @@ force_kn = [0, 200, 400]
 fn validation_errors_are_specific() {
     assert!(parse_class_file(GOOD).is_ok());
     let non_monotone = GOOD.replacen("[0, 100, 500]", "[0, 500, 100]", 1);
-    assert!(parse_class_file(&non_monotone).unwrap_err().contains("deflection must be strictly increasing"));
+    assert!(parse_class_file(&non_monotone)
+        .unwrap_err()
+        .contains("deflection must be strictly increasing"));
     let negative = GOOD.replacen("[0, 200, 400]", "[0, -200, 400]", 1);
-    assert!(parse_class_file(&negative).unwrap_err().contains("force must be strictly increasing"));
+    assert!(parse_class_file(&negative)
+        .unwrap_err()
+        .contains("force must be strictly increasing"));
     let nan = GOOD.replacen("[0, 200, 400]", "[0, nan, 400]", 1);
     assert!(parse_class_file(&nan).unwrap_err().contains("non-finite"));
     let short = GOOD.replacen("force_kn = [0, 200, 400]", "force_kn = [0, 200]", 1);

@@ -10,14 +10,32 @@ fn pulse(closing_kph: f64) -> Box<DefaultPulseBuffer> {
     let c = &stiffness::COMBINED_CURVE;
     let spring = CombinedSpring::series(c, Some(c)).unwrap();
     let mut buf = Box::new(DefaultPulseBuffer::new());
-    simulate_collision(&CollisionInput::with_defaults(&spring, 1785.0, 1785.0, kph_to_mps(closing_kph)), &mut buf)
-        .unwrap();
+    simulate_collision(
+        &CollisionInput::with_defaults(&spring, 1785.0, 1785.0, kph_to_mps(closing_kph)),
+        &mut buf,
+    )
+    .unwrap();
     buf
 }
 
-fn occ(buf: &DefaultPulseBuffer, mass_kg: f64, belted: bool, set: RestraintSettings) -> OccupantOutcome {
-    let input = OccupantInput { mass_kg, chest_to_wheel_m: 0.3, belted };
-    simulate_occupant(&buf.ego_pulse(), &input, &set, &RestraintHardware::default()).unwrap()
+fn occ(
+    buf: &DefaultPulseBuffer,
+    mass_kg: f64,
+    belted: bool,
+    set: RestraintSettings,
+) -> OccupantOutcome {
+    let input = OccupantInput {
+        mass_kg,
+        chest_to_wheel_m: 0.3,
+        belted,
+    };
+    simulate_occupant(
+        &buf.ego_pulse(),
+        &input,
+        &set,
+        &RestraintHardware::default(),
+    )
+    .unwrap()
 }
 
 fn set(limiter_kn: f64, bag_kn: f64) -> RestraintSettings {
@@ -34,7 +52,10 @@ fn heavier_occupant_same_forces_larger_excursion() {
     let buf = pulse(80.0);
     let light = occ(&buf, 50.0, true, set(5.0, 5.0));
     let heavy = occ(&buf, 110.0, true, set(5.0, 5.0));
-    assert!(heavy.max_excursion_m > light.max_excursion_m + 0.01, "{light:?} {heavy:?}");
+    assert!(
+        heavy.max_excursion_m > light.max_excursion_m + 0.01,
+        "{light:?} {heavy:?}"
+    );
 }
 
 #[test]
@@ -56,7 +77,10 @@ fn belt_only_and_airbag_only_respect_their_force_caps() {
     let belt_only = occ(&buf, 75.0, true, set(4.0, 0.0));
     assert_eq!(belt_only.max_airbag_force_n, 0.0);
     assert!(belt_only.max_belt_force_n <= 4000.0 + 1e-9);
-    assert!(belt_only.max_belt_force_n > 3999.0, "limiter should be reached: {belt_only:?}");
+    assert!(
+        belt_only.max_belt_force_n > 3999.0,
+        "limiter should be reached: {belt_only:?}"
+    );
     assert!(belt_only.belt_payout_m > 0.0, "pay-out at the limiter");
 
     let bag_only = occ(&buf, 75.0, false, set(4.0, 6.0));
@@ -69,7 +93,12 @@ fn belt_only_and_airbag_only_respect_their_force_caps() {
 fn decelerations_are_ordered_and_above_the_ideal_bound() {
     let buf = pulse(108.0);
     let o = occ(&buf, 75.0, true, set(12.0, 12.0));
-    eprintln!("{o:?} a_max {} g a_mean {} g a* {} g", mps2_to_g(o.max_decel_mps2), mps2_to_g(o.mean_decel_mps2), mps2_to_g(o.ideal_decel_mps2));
+    eprintln!(
+        "{o:?} a_max {} g a_mean {} g a* {} g",
+        mps2_to_g(o.max_decel_mps2),
+        mps2_to_g(o.mean_decel_mps2),
+        mps2_to_g(o.ideal_decel_mps2)
+    );
     assert!(!o.bottomed_out);
     assert!(o.mean_decel_mps2 > 0.0 && o.mean_decel_mps2 <= o.max_decel_mps2);
     // No restraint can beat the ideal constant force within the same ride-down.
@@ -94,8 +123,17 @@ fn pre_crash_pretensioner_reduces_excursion() {
 #[test]
 fn no_crash_no_motion() {
     let pulse = [0.0f64; 500];
-    let p = physics::CompartmentPulse { step_s: 1e-4, accel_mps2: &pulse };
-    let o = simulate_occupant(&p, &OccupantInput::default(), &set(6.0, 6.0), &RestraintHardware::default()).unwrap();
+    let p = physics::CompartmentPulse {
+        step_s: 1e-4,
+        accel_mps2: &pulse,
+    };
+    let o = simulate_occupant(
+        &p,
+        &OccupantInput::default(),
+        &set(6.0, 6.0),
+        &RestraintHardware::default(),
+    )
+    .unwrap();
     assert_eq!(o.max_excursion_m, 0.0);
     assert_eq!(o.max_decel_mps2, 0.0);
     assert!(!o.bottomed_out);
@@ -109,7 +147,10 @@ fn constant_pulse_ideal_bound_closed_form() {
     let n = 501; // 0..=50 ms at 0.1 ms, then zeros
     let mut s = vec![0.0; 1000];
     s[..n].iter_mut().for_each(|v| *v = -a);
-    let p = physics::CompartmentPulse { step_s: 1e-4, accel_mps2: &s };
+    let p = physics::CompartmentPulse {
+        step_s: 1e-4,
+        accel_mps2: &s,
+    };
     let dv = a * 0.05;
     let d_veh = 0.5 * a * 0.05 * 0.05;
     let bound = physics::ideal_constant_force_decel_mps2(&p, 0.24);

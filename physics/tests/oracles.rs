@@ -8,7 +8,14 @@ use std::f64::consts::PI;
 
 type Buf = PulseBuffer<4096>;
 
-fn run(spring: &CombinedSpring, m1: f64, m2: f64, v: f64, e: f64, step_s: f64) -> (physics::CollisionSummary, Box<Buf>) {
+fn run(
+    spring: &CombinedSpring,
+    m1: f64,
+    m2: f64,
+    v: f64,
+    e: f64,
+    step_s: f64,
+) -> (physics::CollisionSummary, Box<Buf>) {
     let mut buf = Box::new(Buf::new());
     let input = CollisionInput {
         spring,
@@ -33,9 +40,21 @@ fn linear_spring_elastic_matches_closed_form() {
     let mu = m1 * m2 / (m1 + m2);
     let spring = CombinedSpring::linear(k).unwrap();
     let (s, _) = run(&spring, m1, m2, v, 1.0, 1.0e-4);
-    assert!(rel(s.max_deflection_m, v * (mu / k).sqrt()) < 1e-3, "{}", s.max_deflection_m);
-    assert!(rel(s.peak_force_n, v * (k * mu).sqrt()) < 1e-3, "{}", s.peak_force_n);
-    assert!(rel(s.contact_duration_s, PI * (mu / k).sqrt()) < 1e-3, "{}", s.contact_duration_s);
+    assert!(
+        rel(s.max_deflection_m, v * (mu / k).sqrt()) < 1e-3,
+        "{}",
+        s.max_deflection_m
+    );
+    assert!(
+        rel(s.peak_force_n, v * (k * mu).sqrt()) < 1e-3,
+        "{}",
+        s.peak_force_n
+    );
+    assert!(
+        rel(s.contact_duration_s, PI * (mu / k).sqrt()) < 1e-3,
+        "{}",
+        s.contact_duration_s
+    );
     // e = 1 ⇒ unloading along the loading line.
     assert!(rel(s.unloading_stiffness_n_per_m, k) < 2e-3);
 }
@@ -67,7 +86,12 @@ fn delta_v_partition_momentum_and_energy() {
     let v2_end = buf.opp_vel_mps()[last];
     // Ground frame: ego starts at +v m2/(m1+m2)... use relative-frame energy: ½μ(u_end)².
     let u_end = v - (-v1_end) - (-v2_end);
-    assert!(rel(0.5 * mu * (v * v - u_end * u_end), 0.5 * mu * v * v * (1.0 - e * e)) < 1e-9);
+    assert!(
+        rel(
+            0.5 * mu * (v * v - u_end * u_end),
+            0.5 * mu * v * v * (1.0 - e * e)
+        ) < 1e-9
+    );
 }
 
 #[test]
@@ -80,7 +104,10 @@ fn restitution_exact_for_several_e_and_curves() {
             let last = buf.len() - 1;
             let u_end = 24.0 + buf.ego_vel_mps()[last] + buf.opp_vel_mps()[last];
             let e_measured = -u_end / 24.0;
-            assert!((e_measured - e).abs() < 1e-9, "class {class} e {e}: {e_measured}");
+            assert!(
+                (e_measured - e).abs() < 1e-9,
+                "class {class} e {e}: {e_measured}"
+            );
             assert!((s.separation_speed_mps - e * 24.0).abs() < 1e-9);
         }
     }
@@ -93,7 +120,10 @@ fn bilinear_hysteresis_e_equals_sqrt_k_over_ku() {
         let spring = CombinedSpring::linear(k).unwrap();
         let (s, _) = run(&spring, 1200.0, 1600.0, 15.0, e, 1.0e-4);
         let e_oracle = (k / s.unloading_stiffness_n_per_m).sqrt();
-        assert!((e_oracle - e).abs() < 1e-3 * e, "e {e}: sqrt(k/k_u) = {e_oracle}");
+        assert!(
+            (e_oracle - e).abs() < 1e-3 * e,
+            "e {e}: sqrt(k/k_u) = {e_oracle}"
+        );
     }
 }
 
@@ -127,7 +157,11 @@ fn series_combination_adds_deflections_at_equal_force() {
     }
     // Two linear springs k1, k2 in series: 1/k = 1/k1 + 1/k2.
     let (k1, k2) = (1.0e6, 3.0e6);
-    let s = CombinedSpring::series(&Curve::linear(k1).unwrap(), Some(&Curve::linear(k2).unwrap())).unwrap();
+    let s = CombinedSpring::series(
+        &Curve::linear(k1).unwrap(),
+        Some(&Curve::linear(k2).unwrap()),
+    )
+    .unwrap();
     assert!(rel(s.force_at_n(0.1), 0.1 / (1.0 / k1 + 1.0 / k2)) < 1e-12);
 }
 
@@ -145,7 +179,18 @@ fn accuracy_improves_with_smaller_step() {
 
 #[test]
 fn class_lookup_by_mass() {
-    let cases = [(900.0, 1), (1199.9, 1), (1200.0, 2), (1399.0, 2), (1400.0, 3), (1785.0, 4), (2000.0, 5), (2499.0, 5), (2500.0, 6), (3500.0, 6)];
+    let cases = [
+        (900.0, 1),
+        (1199.9, 1),
+        (1200.0, 2),
+        (1399.0, 2),
+        (1400.0, 3),
+        (1785.0, 4),
+        (2000.0, 5),
+        (2499.0, 5),
+        (2500.0, 6),
+        (3500.0, 6),
+    ];
     for (m, c) in cases {
         assert_eq!(physics::class_for_mass_kg(m).unwrap().number(), c, "{m} kg");
     }
