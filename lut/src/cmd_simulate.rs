@@ -62,7 +62,11 @@ fn class_or_lookup(explicit: Option<u8>, mass_kg: f64, who: &str) -> Result<Mass
 }
 
 pub fn run(args: &SimulateArgs) -> Result<()> {
-    for (name, v) in [("ego-mass-kg", args.ego_mass_kg), ("opp-mass-kg", args.opp_mass_kg), ("closing-kph", args.closing_kph)] {
+    for (name, v) in [
+        ("ego-mass-kg", args.ego_mass_kg),
+        ("opp-mass-kg", args.opp_mass_kg),
+        ("closing-kph", args.closing_kph),
+    ] {
         if !v.is_finite() || v < 0.0 {
             bail!("--{name} must be a finite, non-negative number (got {v})");
         }
@@ -72,17 +76,25 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let spring = match args.linear_stiffness_kn_per_m {
         // Two equal fronts of 2K in series give the combined K; each vehicle takes half the crush.
         Some(k) => {
-            let half = physics::Curve::linear(2.0 * k * 1e3).context("--linear-stiffness-kn-per-m")?;
+            let half =
+                physics::Curve::linear(2.0 * k * 1e3).context("--linear-stiffness-kn-per-m")?;
             CombinedSpring::series(&half, Some(&half))?
         }
         None => CombinedSpring::series(ego_class.curve(), Some(opp_class.curve()))?,
     };
-    let mut input = CollisionInput::with_defaults(&spring, args.ego_mass_kg, args.opp_mass_kg, kph_to_mps(args.closing_kph));
+    let mut input = CollisionInput::with_defaults(
+        &spring,
+        args.ego_mass_kg,
+        args.opp_mass_kg,
+        kph_to_mps(args.closing_kph),
+    );
     input.restitution = args.restitution;
     let mut buf = Box::new(DefaultPulseBuffer::new());
     let s = simulate_collision(&input, &mut buf).context("collision simulation")?;
 
-    let t_ms: Vec<f64> = (0..buf.len()).map(|k| k as f64 * buf.step_s() * 1e3).collect();
+    let t_ms: Vec<f64> = (0..buf.len())
+        .map(|k| k as f64 * buf.step_s() * 1e3)
+        .collect();
     let g = |v: &[f64]| v.iter().map(|a| mps2_to_g(*a)).collect::<Vec<_>>();
     let mm = |v: &[f64]| v.iter().map(|a| a * 1e3).collect::<Vec<_>>();
     if args.json {
@@ -115,12 +127,23 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             path,
             &[
                 plot::Panel {
-                    title: format!("Compartment acceleration, {:.0} kg vs {:.0} kg at {:.0} km/h", args.ego_mass_kg, args.opp_mass_kg, args.closing_kph),
+                    title: format!(
+                        "Compartment acceleration, {:.0} kg vs {:.0} kg at {:.0} km/h",
+                        args.ego_mass_kg, args.opp_mass_kg, args.closing_kph
+                    ),
                     x_label: "t [ms]",
                     y_label: "a [g]",
                     series: vec![
-                        plot::Series { label: "vehicle".into(), x: &t_ms, y: &ea },
-                        plot::Series { label: "opponent".into(), x: &t_ms, y: &oa },
+                        plot::Series {
+                            label: "vehicle".into(),
+                            x: &t_ms,
+                            y: &ea,
+                        },
+                        plot::Series {
+                            label: "opponent".into(),
+                            x: &t_ms,
+                            y: &oa,
+                        },
                     ],
                 },
                 plot::Panel {
@@ -128,8 +151,16 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
                     x_label: "t [ms]",
                     y_label: "dv [m/s]",
                     series: vec![
-                        plot::Series { label: "vehicle".into(), x: &t_ms, y: buf.ego_vel_mps() },
-                        plot::Series { label: "opponent".into(), x: &t_ms, y: buf.opp_vel_mps() },
+                        plot::Series {
+                            label: "vehicle".into(),
+                            x: &t_ms,
+                            y: buf.ego_vel_mps(),
+                        },
+                        plot::Series {
+                            label: "opponent".into(),
+                            x: &t_ms,
+                            y: buf.opp_vel_mps(),
+                        },
                     ],
                 },
             ],
@@ -142,9 +173,17 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
 fn print_table(args: &SimulateArgs, ego: MassClass, opp: MassClass, s: &CollisionSummary) {
     match args.linear_stiffness_kn_per_m {
         Some(k) => println!("linear combined spring {k} kN/m, e = {}", args.restitution),
-        None => println!("classes: vehicle {} / opponent {}, e = {}", ego.number(), opp.number(), args.restitution),
+        None => println!(
+            "classes: vehicle {} / opponent {}, e = {}",
+            ego.number(),
+            opp.number(),
+            args.restitution
+        ),
     }
-    println!("{:<10} {:>10} {:>9} {:>9} {:>10} {:>11}", "", "crush_mm", "a_max_g", "a_mean_g", "dv_mps", "contact_ms");
+    println!(
+        "{:<10} {:>10} {:>9} {:>9} {:>10} {:>11}",
+        "", "crush_mm", "a_max_g", "a_mean_g", "dv_mps", "contact_ms"
+    );
     for (name, v) in [("vehicle", &s.vehicle), ("opponent", &s.opponent)] {
         println!(
             "{:<10} {:>10.1} {:>9.2} {:>9.2} {:>10.2} {:>11.1}",

@@ -48,12 +48,30 @@ pub fn run(cmd: &StiffnessCommand) -> Result<()> {
 }
 
 fn derive(args: &DeriveArgs) -> Result<()> {
-    let text = std::fs::read_to_string(&args.trace).with_context(|| format!("cannot read trace {}", args.trace.display()))?;
-    let trace = parse_trace_csv(&text).map_err(|e| anyhow::anyhow!("{}: {e}", args.trace.display()))?;
-    let opts = DeriveOptions { mass_kg: args.mass_kg, impact_speed_mps: kph_to_mps(args.impact_kph), points: args.points, cfc: Cfc::Cfc60 };
-    let d = derive_curve(&trace, &opts).with_context(|| format!("deriving a curve from {}", args.trace.display()))?;
-    let mm: Vec<f64> = d.curve.deflection_m().iter().map(|v| (v * 1e4).round() / 10.0).collect();
-    let kn: Vec<f64> = d.curve.force_n().iter().map(|v| (v * 1e-2).round() / 10.0).collect();
+    let text = std::fs::read_to_string(&args.trace)
+        .with_context(|| format!("cannot read trace {}", args.trace.display()))?;
+    let trace =
+        parse_trace_csv(&text).map_err(|e| anyhow::anyhow!("{}: {e}", args.trace.display()))?;
+    let opts = DeriveOptions {
+        mass_kg: args.mass_kg,
+        impact_speed_mps: kph_to_mps(args.impact_kph),
+        points: args.points,
+        cfc: Cfc::Cfc60,
+    };
+    let d = derive_curve(&trace, &opts)
+        .with_context(|| format!("deriving a curve from {}", args.trace.display()))?;
+    let mm: Vec<f64> = d
+        .curve
+        .deflection_m()
+        .iter()
+        .map(|v| (v * 1e4).round() / 10.0)
+        .collect();
+    let kn: Vec<f64> = d
+        .curve
+        .force_n()
+        .iter()
+        .map(|v| (v * 1e-2).round() / 10.0)
+        .collect();
     if d.sign_flipped {
         eprintln!("note: trace had deceleration positive (not SAE J211 sign); flipped");
     }
@@ -62,23 +80,45 @@ fn derive(args: &DeriveArgs) -> Result<()> {
                           "sign_flipped": d.sign_flipped, "deflection_mm": mm, "force_kn": kn });
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
-        let list = |v: &[f64]| v.iter().map(|x| format!("{x:.1}")).collect::<Vec<_>>().join(", ");
-        println!("# derived from {} (mass {} kg, impact {} km/h, CFC 60); max crush {:.1} mm", args.trace.display(), args.mass_kg, args.impact_kph, d.max_crush_m * 1e3);
+        let list = |v: &[f64]| {
+            v.iter()
+                .map(|x| format!("{x:.1}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        println!(
+            "# derived from {} (mass {} kg, impact {} km/h, CFC 60); max crush {:.1} mm",
+            args.trace.display(),
+            args.mass_kg,
+            args.impact_kph,
+            d.max_crush_m * 1e3
+        );
         println!("deflection_mm = [{}]", list(&mm));
         println!("force_kn = [{}]", list(&kn));
     }
     if let Some(path) = &args.plot {
         let raw_x: Vec<f64> = d.raw_crush_m.iter().map(|v| v * 1e3).collect();
         let raw_y: Vec<f64> = d.raw_force_n.iter().map(|v| v * 1e-3).collect();
-        plot::draw(path, &[plot::Panel {
-            title: format!("Force-deflection from {}", args.trace.display()),
-            x_label: "crush [mm]",
-            y_label: "F [kN]",
-            series: vec![
-                plot::Series { label: "filtered m*a (loading)".into(), x: &raw_x, y: &raw_y },
-                plot::Series { label: "derived curve".into(), x: &mm, y: &kn },
-            ],
-        }])?;
+        plot::draw(
+            path,
+            &[plot::Panel {
+                title: format!("Force-deflection from {}", args.trace.display()),
+                x_label: "crush [mm]",
+                y_label: "F [kN]",
+                series: vec![
+                    plot::Series {
+                        label: "filtered m*a (loading)".into(),
+                        x: &raw_x,
+                        y: &raw_y,
+                    },
+                    plot::Series {
+                        label: "derived curve".into(),
+                        x: &mm,
+                        y: &kn,
+                    },
+                ],
+            }],
+        )?;
         eprintln!("plot written to {}", path.display());
     }
     Ok(())

@@ -25,15 +25,19 @@ const SIZE: (u32, u32) = (1000, 420);
 /// Draw panels stacked vertically into `path`.
 pub fn draw(path: &Path, panels: &[Panel<'_>]) -> Result<()> {
     let size = (SIZE.0, SIZE.1 * panels.len().max(1) as u32);
-    let is_svg = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("svg"));
+    let is_svg = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
     if is_svg {
         let root = SVGBackend::new(path, size).into_drawing_area();
         draw_on(&root, panels)?;
-        root.present().with_context(|| format!("writing {}", path.display()))?;
+        root.present()
+            .with_context(|| format!("writing {}", path.display()))?;
     } else {
         let root = BitMapBackend::new(path, size).into_drawing_area();
         draw_on(&root, panels)?;
-        root.present().with_context(|| format!("writing {}", path.display()))?;
+        root.present()
+            .with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(())
 }
@@ -41,7 +45,9 @@ pub fn draw(path: &Path, panels: &[Panel<'_>]) -> Result<()> {
 fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
         .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
     if !lo.is_finite() {
         return (0.0, 1.0);
     }

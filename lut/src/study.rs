@@ -42,9 +42,18 @@ fn stiffness_study(args: &StiffnessStudyArgs) -> Result<()> {
     let mut pulses: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
     let mut buf = Box::new(DefaultPulseBuffer::new());
     for (i, p) in paper::TABLE5.iter().enumerate() {
-        let curve = if i < 6 { &stiffness::CLASS_CURVES[i] } else { &stiffness::COMBINED_CURVE };
+        let curve = if i < 6 {
+            &stiffness::CLASS_CURVES[i]
+        } else {
+            &stiffness::COMBINED_CURVE
+        };
         let spring = CombinedSpring::series(curve, Some(curve))?;
-        let input = CollisionInput::with_defaults(&spring, paper::TABLE5_MASS_KG, paper::TABLE5_MASS_KG, kph_to_mps(paper::TABLE5_CLOSING_KPH));
+        let input = CollisionInput::with_defaults(
+            &spring,
+            paper::TABLE5_MASS_KG,
+            paper::TABLE5_MASS_KG,
+            kph_to_mps(paper::TABLE5_CLOSING_KPH),
+        );
         let s = simulate_collision(&input, &mut buf)?;
         let v = &s.vehicle;
         rows.push(json!({
@@ -57,15 +66,26 @@ fn stiffness_study(args: &StiffnessStudyArgs) -> Result<()> {
                 "a_mean_g": pct(mps2_to_g(v.a_mean_mps2), p.a_mean_g),
             },
         }));
-        let t: Vec<f64> = (0..buf.len()).map(|k| k as f64 * buf.step_s() * 1e3).collect();
+        let t: Vec<f64> = (0..buf.len())
+            .map(|k| k as f64 * buf.step_s() * 1e3)
+            .collect();
         let a: Vec<f64> = buf.ego_accel_mps2().iter().map(|x| mps2_to_g(*x)).collect();
         pulses.push((format!("class {}", p.class), t, a));
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&rows)?);
     } else {
-        println!("Table 5 case: {} kg vs {} kg, {} km/h, e = {}", paper::TABLE5_MASS_KG, paper::TABLE5_MASS_KG, paper::TABLE5_CLOSING_KPH, physics::defaults::RESTITUTION);
-        println!("{:<6} {:>22} {:>22} {:>22}", "class", "crush mm (paper, %)", "a_max g (paper, %)", "a_mean g (paper, %)");
+        println!(
+            "Table 5 case: {} kg vs {} kg, {} km/h, e = {}",
+            paper::TABLE5_MASS_KG,
+            paper::TABLE5_MASS_KG,
+            paper::TABLE5_CLOSING_KPH,
+            physics::defaults::RESTITUTION
+        );
+        println!(
+            "{:<6} {:>22} {:>22} {:>22}",
+            "class", "crush mm (paper, %)", "a_max g (paper, %)", "a_mean g (paper, %)"
+        );
         for (r, p) in rows.iter().zip(paper::TABLE5.iter()) {
             let v = &r["vehicle"];
             let e = &r["error_pct"];
@@ -80,8 +100,23 @@ fn stiffness_study(args: &StiffnessStudyArgs) -> Result<()> {
         }
     }
     if let Some(path) = &args.plot {
-        let series = pulses.iter().map(|(l, t, a)| plot::Series { label: l.clone(), x: t, y: a }).collect();
-        plot::draw(path, &[plot::Panel { title: "Table 5 case: vehicle pulse per stiffness class".into(), x_label: "t [ms]", y_label: "a [g]", series }])?;
+        let series = pulses
+            .iter()
+            .map(|(l, t, a)| plot::Series {
+                label: l.clone(),
+                x: t,
+                y: a,
+            })
+            .collect();
+        plot::draw(
+            path,
+            &[plot::Panel {
+                title: "Table 5 case: vehicle pulse per stiffness class".into(),
+                x_label: "t [ms]",
+                y_label: "a [g]",
+                series,
+            }],
+        )?;
         eprintln!("plot written to {}", path.display());
     }
     Ok(())
