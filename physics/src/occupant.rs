@@ -144,8 +144,13 @@ pub fn ideal_constant_force_decel_mps2(
     pulse: &CompartmentPulse<'_>,
     available_ride_down_m: f64,
 ) -> f64 {
-    let dv = pulse.delta_v_mps();
-    let d = pulse.ride_down_displacement_m() + available_ride_down_m;
+    ideal_bound(
+        pulse.delta_v_mps(),
+        pulse.ride_down_displacement_m() + available_ride_down_m,
+    )
+}
+
+fn ideal_bound(dv: f64, d: f64) -> f64 {
     if d > 0.0 && dv.is_finite() {
         dv * dv / (2.0 * d)
     } else {
@@ -162,15 +167,6 @@ fn validate(
     if !defaults::STEP_BOUNDS_S.contains(pulse.step_s) {
         return Err(PhysicsError::InvalidSignal(
             "pulse step must be within 1 µs..=5 ms",
-        ));
-    }
-    if pulse
-        .accel_mps2
-        .iter()
-        .any(|a| !a.is_finite() || a.abs() > 1.0e4)
-    {
-        return Err(PhysicsError::InvalidSignal(
-            "pulse contains non-finite or > 1000 g samples",
         ));
     }
     if !(occ.mass_kg.is_finite() && occ.mass_kg >= 1.0 && occ.mass_kg <= 500.0) {
@@ -248,14 +244,21 @@ pub fn simulate_occupant(
     let airbag_fires = set.airbag_force_n > 0.0;
     let belt_force_cap = set.load_limiter_n;
     let k_belt = hw.belt_stiffness_n_per_m;
-    // After the last non-zero compartment sample nothing can push the occupant further forward
-    // once it moves rearward (restraint forces are dissipative or restoring), so the simulation
-    // may stop there: this halves the cost for predicted pulses, which end at separation.
-    let n_active = pulse
-        .accel_mps2
-        .iter()
-        .rposition(|a| *a != 0.0)
-        .map_or(0, |i| i + 1);
+    // One pass: reject NaN/∞/> 1000 g samples and find the last non-zero sample. After it nothing
+    // can push the occupant further forward once it moves rearward (restraint forces are
+    // dissipative or restoring), so the simulation may stop there: this halves the cost for
+    // predicted pulses, which end at separation.
+    let mut n_active = 0;
+    for (i, a) in pulse.accel_mps2.iter().enumerate() {
+        if !(a.abs() <= 1.0e4) {
+            return Err(PhysicsError::InvalidSignal(
+                "pulse contains non-finite or > 1000 g samples",
+            ));
+        }
+        if *a != 0.0 {
+            n_active = i + 1;
+        }
+    }
     let max_steps = (hw.max_sim_s / dt) as usize;
 
     let (mut x, mut v, mut payout) = (0.0f64, 0.0f64, 0.0f64);
@@ -266,10 +269,19 @@ pub fn simulate_occupant(
     let mut onset_time: Option<f64> = None;
     let mut decel_integral = 0.0; // ∫ decel dt since restraint onset
     let mut mean_at_max = 0.0;
+    // Compartment velocity change and its integral (for a*), accumulated on the way.
+    let (mut a_prev, mut v_c, mut int_v_c, mut steps_done) = (0.0f64, 0.0f64, 0.0f64, 0usize);
 
     for i in 0..max_steps {
         let t = i as f64 * dt;
         let a_c = pulse.accel_mps2.get(i).copied().unwrap_or(0.0);
+        if i > 0 {
+            let v_next = v_c + 0.5 * (a_prev + a_c) * dt;
+            int_v_c += 0.5 * (v_c + v_next) * dt;
+            v_c = v_next;
+        }
+        a_prev = a_c;
+        steps_done = i;
         // Belt.
         let mut f_belt = 0.0;
         if occ.belted {
@@ -341,6 +353,12 @@ pub fn simulate_occupant(
     }
     out.mean_decel_mps2 = mean_at_max;
     out.belt_payout_m = payout;
-    out.ideal_decel_mps2 = ideal_constant_force_decel_mps2(pulse, s_avail);
+    out.ideal_decel_mps2 = if steps_done + 1 >= n_active {
+        // Beyond the last non-zero sample v_c is constant, so ∫(v − v_end) stops growing.
+        let d_veh = int_v_c - v_c * steps_done as f64 * dt;
+        ideal_bound(v_c, d_veh + s_avail)
+    } else {
+        ideal_constant_force_decel_mps2(pulse, s_avail)
+    };
     Ok(out)
 }

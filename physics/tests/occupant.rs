@@ -104,6 +104,14 @@ fn decelerations_are_ordered_and_above_the_ideal_bound() {
     // No restraint can beat the ideal constant force within the same ride-down.
     assert!(o.max_decel_mps2 >= o.ideal_decel_mps2, "{o:?}");
     // a* = Δv² / (2 (D_veh + s_avail)); its order of magnitude for this case: 10..25 g.
+    // The bound accumulated inside the simulation equals the stand-alone computation.
+    let standalone =
+        physics::ideal_constant_force_decel_mps2(&buf.ego_pulse(), o.available_ride_down_m);
+    assert!(
+        (o.ideal_decel_mps2 / standalone - 1.0).abs() < 1e-9,
+        "{} vs {standalone}",
+        o.ideal_decel_mps2
+    );
     let a_star_g = mps2_to_g(o.ideal_decel_mps2);
     assert!((10.0..25.0).contains(&a_star_g), "{a_star_g}");
 }
