@@ -22,7 +22,10 @@ fn bench_physics(c: &mut Criterion) {
     });
 
     // Series combination of two class curves (done once per opponent-class change in the ECU).
-    let (c4, c6) = (MassClass::new(4).unwrap().curve(), MassClass::new(6).unwrap().curve());
+    let (c4, c6) = (
+        MassClass::new(4).unwrap().curve(),
+        MassClass::new(6).unwrap().curve(),
+    );
     c.bench_function("series_combination_two_classes", |b| {
         b.iter(|| CombinedSpring::series(black_box(c4), Some(black_box(c6))).expect("valid"))
     });
@@ -38,8 +41,13 @@ fn bench_physics(c: &mut Criterion) {
     let hw = RestraintHardware::default();
     c.bench_function("occupant_simulation", |b| {
         b.iter(|| {
-            simulate_occupant(&buf.ego_pulse(), black_box(&occupant), black_box(&settings), &hw)
-                .expect("valid")
+            simulate_occupant(
+                &buf.ego_pulse(),
+                black_box(&occupant),
+                black_box(&settings),
+                &hw,
+            )
+            .expect("valid")
         })
     });
 }
