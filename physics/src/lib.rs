@@ -27,6 +27,8 @@ mod error;
 pub mod j211;
 pub mod occupant;
 pub mod paper;
+#[cfg(feature = "std")]
+pub mod reference;
 pub mod stiffness;
 
 pub use collision::{
