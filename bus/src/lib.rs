@@ -40,6 +40,8 @@ pub use meta::{
 #[cfg(feature = "socket")]
 pub mod socket;
 
+pub mod secoc;
+
 /// The DBC file itself, for tools that want to hand it to `cantools` or print it.
 pub const DBC_TEXT: &str = include_str!("../restraint.dbc");
 
