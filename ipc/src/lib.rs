@@ -43,6 +43,8 @@ pub const OBJECT_STATE_SUFFIX: &str = "ecu/in/object_state";
 pub const CRASH_ACCEL_SUFFIX: &str = "ecu/in/crash_accel";
 /// Suffix of the ECU diagnostics service (ECU → monitors).
 pub const DIAGNOSTICS_SUFFIX: &str = "ecu/out/diagnostics";
+/// Suffix of the bench-truth service (sensor feeds → actuator stubs; never read by the ECU).
+pub const BENCH_TRUTH_SUFFIX: &str = "bench/truth";
 
 /// Static settings of one publish-subscribe service. Every opener uses exactly these.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -94,6 +96,17 @@ pub const DIAGNOSTICS_PORTS: PortSettings = PortSettings {
     max_borrowed: 2,
 };
 
+/// Bench truth is published every ~10 ms and at the end; the stubs need only the newest
+/// (history 1 so a late-starting stub still learns the start time).
+pub const BENCH_TRUTH_PORTS: PortSettings = PortSettings {
+    subscriber_buffer: 8,
+    history: 1,
+    max_publishers: 1,
+    max_subscribers: 8,
+    max_nodes: 16,
+    max_borrowed: 2,
+};
+
 /// Fully qualified service names for one prefix.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ServiceNames {
@@ -103,6 +116,8 @@ pub struct ServiceNames {
     pub crash_accel: String,
     /// ECU diagnostics service.
     pub diagnostics: String,
+    /// Bench-truth service (sensor feeds → actuator stubs).
+    pub bench_truth: String,
 }
 
 impl ServiceNames {
@@ -113,6 +128,7 @@ impl ServiceNames {
             object_state: format!("{p}/{OBJECT_STATE_SUFFIX}"),
             crash_accel: format!("{p}/{CRASH_ACCEL_SUFFIX}"),
             diagnostics: format!("{p}/{DIAGNOSTICS_SUFFIX}"),
+            bench_truth: format!("{p}/{BENCH_TRUTH_SUFFIX}"),
         }
     }
 }
@@ -393,6 +409,90 @@ impl Default for EcuDiagnostics {
     }
 }
 
+/// Capacity of [`BenchTruth::scenario_name`] (UTF-8 bytes, zero padded).
+pub const SCENARIO_NAME_CAPACITY: usize = 64;
+
+/// What really happened in the played scenario (sensor feeds → actuator stubs, tests).
+///
+/// The ECU never subscribes to this: it is the bench's ground truth, used to judge the
+/// ECU's commands against the true contact instant and the true crash.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+pub struct BenchTruth {
+    /// CLOCK_MONOTONIC time of publication, ns.
+    pub timestamp_ns: u64,
+    /// Publisher sequence counter.
+    pub sequence: u64,
+    /// CLOCK_MONOTONIC time of scenario t = 0, ns.
+    pub start_ns: u64,
+    /// CLOCK_MONOTONIC time of the true first contact, ns; 0 = no contact (yet, or avoided).
+    pub contact_ns: u64,
+    /// True ego mass, kg.
+    pub ego_mass_kg: f32,
+    /// True opponent mass, kg (`f32::INFINITY` = rigid barrier).
+    pub opponent_mass_kg: f32,
+    /// True closing speed at contact, m/s (0 until contact).
+    pub closing_speed_at_contact_mps: f32,
+    /// Number of valid bytes in `scenario_name`.
+    pub scenario_name_len: u32,
+    /// Scenario name, UTF-8, zero padded.
+    pub scenario_name: [u8; SCENARIO_NAME_CAPACITY],
+    /// 1 when the scenario has finished playing (no more feeds will follow).
+    pub done: u8,
+    /// Explicit padding so the layout has no implicit holes.
+    pub _reserved: [u8; 7],
+}
+
+impl BenchTruth {
+    /// Nothing known yet.
+    pub const EMPTY: Self = Self {
+        timestamp_ns: 0,
+        sequence: 0,
+        start_ns: 0,
+        contact_ns: 0,
+        ego_mass_kg: 0.0,
+        opponent_mass_kg: 0.0,
+        closing_speed_at_contact_mps: 0.0,
+        scenario_name_len: 0,
+        scenario_name: [0; SCENARIO_NAME_CAPACITY],
+        done: 0,
+        _reserved: [0; 7],
+    };
+
+    /// Stores `name`, truncated at a character boundary to the capacity.
+    pub fn set_scenario_name(&mut self, name: &str) {
+        let mut end = name.len().min(SCENARIO_NAME_CAPACITY);
+        while !name.is_char_boundary(end) {
+            end -= 1;
+        }
+        self.scenario_name = [0; SCENARIO_NAME_CAPACITY];
+        self.scenario_name[..end].copy_from_slice(&name.as_bytes()[..end]);
+        self.scenario_name_len = end as u32;
+    }
+
+    /// The scenario name (invalid UTF-8 or a corrupt length yields the valid prefix).
+    pub fn scenario_name(&self) -> &str {
+        let n = (self.scenario_name_len as usize).min(SCENARIO_NAME_CAPACITY);
+        let bytes = self.scenario_name.get(..n).unwrap_or(&[]);
+        let text = match core::str::from_utf8(bytes) {
+            Ok(s) => s,
+            Err(e) => core::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or(""),
+        };
+        text.trim_end_matches('\0')
+    }
+
+    /// True once the feeds have finished.
+    pub fn is_done(&self) -> bool {
+        self.done == 1
+    }
+}
+
+impl Default for BenchTruth {
+    fn default() -> Self {
+        Self::EMPTY
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // Errors
 // ---------------------------------------------------------------------------------------
@@ -580,6 +680,15 @@ pub type ObjectSubscriber = PolledSubscriber<ObjectState>;
 pub type AccelSubscriber = PolledSubscriber<CrashAccelSample>;
 /// Diagnostics subscriber (monitor side).
 pub type DiagnosticsSubscriber = PolledSubscriber<EcuDiagnostics>;
+/// Bench-truth subscriber (actuator stubs, tests).
+pub type BenchTruthSubscriber = PolledSubscriber<BenchTruth>;
+
+impl BenchTruthSubscriber {
+    /// Subscribes to the bench-truth service `names.bench_truth`.
+    pub fn new(node: &IpcNode, names: &ServiceNames) -> Result<Self, IpcError> {
+        Self::create(node, &names.bench_truth, &BENCH_TRUTH_PORTS)
+    }
+}
 
 impl ObjectSubscriber {
     /// Subscribes to the object-state service `names.object_state`.
@@ -676,6 +785,15 @@ pub type DiagnosticsPublisher = ZeroCopyPublisher<EcuDiagnostics>;
 pub type ObjectPublisher = ZeroCopyPublisher<ObjectState>;
 /// Crash accelerometer publisher (sensor-feed / test side).
 pub type AccelPublisher = ZeroCopyPublisher<CrashAccelSample>;
+/// Bench-truth publisher (sensor-feed side).
+pub type BenchTruthPublisher = ZeroCopyPublisher<BenchTruth>;
+
+impl BenchTruthPublisher {
+    /// Publishes on `names.bench_truth`.
+    pub fn new(node: &IpcNode, names: &ServiceNames) -> Result<Self, IpcError> {
+        Self::create(node, &names.bench_truth, &BENCH_TRUTH_PORTS)
+    }
+}
 
 impl DiagnosticsPublisher {
     /// Publishes on `names.diagnostics`.
@@ -725,6 +843,20 @@ mod tests {
         assert_eq!(n.object_state, "x/ecu/in/object_state");
         assert_eq!(n.crash_accel, "x/ecu/in/crash_accel");
         assert_eq!(n.diagnostics, "x/ecu/out/diagnostics");
+        assert_eq!(n.bench_truth, "x/bench/truth");
+    }
+
+    #[test]
+    fn bench_truth_name_roundtrip_and_truncation() {
+        let mut t = BenchTruth::EMPTY;
+        t.set_scenario_name("taurus-48-48-abs");
+        assert_eq!(t.scenario_name(), "taurus-48-48-abs");
+        // 63 ASCII bytes + a 2-byte character: truncated before the character.
+        let long = format!("{}é", "a".repeat(63));
+        t.set_scenario_name(&long);
+        assert_eq!(t.scenario_name(), "a".repeat(63));
+        t.scenario_name_len = u32::MAX;
+        assert_eq!(t.scenario_name(), "a".repeat(63));
     }
 
     #[test]

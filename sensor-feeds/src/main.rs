@@ -1,2 +1,287 @@
-//! Scenario player: object, vehicle, occupant and crash-accelerometer feeds.
-fn main() {}
+//! `sensor-feeds --scenario FILE [--can vcan0 | --no-can] [--speedup F]`: plays a scenario in
+//! real time on CLOCK_MONOTONIC (see README.md).
+//!
+//! One 1 ms tick grid (absolute deadlines, no drift): object list over iceoryx2 at the
+//! scenario's period, EgoVehicleState (10 ms) and OccupantClassification (100 ms) over CAN with
+//! E2E, the compartment accelerometer in 1 ms batches (≥ 1 kHz samples; the TRUE crash pulse
+//! after contact), and BenchTruth every 10 ms for the actuator stubs.
+
+use anyhow::{Context, Result};
+use clap::Parser;
+use ipc::{
+    AccelPublisher, BenchTruth, BenchTruthPublisher, CrashAccelSample, ObjectPublisher,
+    ServiceNames,
+};
+use sensor_feeds::scenario::DropoutTarget;
+use sensor_feeds::{monotonic_ns, sleep_until_ns, Scenario, SensorModelSim, Truth};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Scenario player: object, vehicle, occupant and crash-accelerometer feeds.
+#[derive(Parser, Debug)]
+#[command(name = "sensor-feeds", version)]
+struct Cli {
+    /// Scenario file (TOML, schema in scenarios/README.md).
+    #[arg(long)]
+    scenario: PathBuf,
+    /// CAN interface for the vehicle and occupant frames.
+    #[arg(long, default_value = "vcan0", conflicts_with = "no_can")]
+    can: String,
+    /// Do not send CAN frames (iceoryx2 feeds only).
+    #[arg(long)]
+    no_can: bool,
+    /// Play faster than real time by this factor (function checks only: the ECU then sees
+    /// physically inconsistent timing).
+    #[arg(long, default_value_t = 1.0)]
+    speedup: f64,
+    /// iceoryx2 service prefix (must match the ECU's and the stubs').
+    #[arg(long, default_value = ipc::DEFAULT_SERVICE_PREFIX)]
+    service_prefix: String,
+    /// Only validate the scenario and print the true contact; play nothing.
+    #[arg(long)]
+    check: bool,
+}
+
+const TICK_NS: u64 = 1_000_000;
+const TRUTH_PERIOD_TICKS: u64 = 10;
+
+fn main() -> std::process::ExitCode {
+    let cli = Cli::parse();
+    match run(&cli) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("sensor-feeds: error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+fn describe(truth: &Truth) -> String {
+    let s = truth.scenario();
+    match (truth.contact_s, truth.collision) {
+        (Some(tc), Some(c)) => format!(
+            "scenario {}: true contact at {:.3} s, closing speed {:.1} km/h (ego {:.1}, opponent {:.1}), ego Δv {:.1} km/h, a_max {:.1} g, a_mean {:.1} g",
+            s.name,
+            tc,
+            truth.closing_speed_at_contact_mps() * 3.6,
+            truth.ego_speed_at_contact_mps * 3.6,
+            truth.opp_speed_at_contact_mps * 3.6,
+            c.vehicle.delta_v_mps * 3.6,
+            physics::mps2_to_g(c.vehicle.a_max_mps2),
+            physics::mps2_to_g(c.vehicle.a_mean_mps2),
+        ),
+        _ => format!("scenario {}: no contact within {:.2} s", s.name, s.duration_s),
+    }
+}
+
+fn run(cli: &Cli) -> Result<()> {
+    let scenario = Scenario::load(&cli.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
+    if !(cli.speedup.is_finite() && cli.speedup >= 0.1 && cli.speedup <= 100.0) {
+        anyhow::bail!("--speedup must be within 0.1..=100");
+    }
+    let truth =
+        Truth::new(&scenario).map_err(|e| anyhow::anyhow!("{}: {e}", cli.scenario.display()))?;
+    eprintln!("sensor-feeds: {}", describe(&truth));
+    if cli.check {
+        return Ok(());
+    }
+    let contact_s = truth.contact_s;
+    let mut model = SensorModelSim::new(truth);
+    let sensor = scenario.sensor.clone();
+
+    install_stop_signals()?;
+
+    let names = ServiceNames::with_prefix(&cli.service_prefix);
+    let node_name = format!("sensor-feeds-{}", std::process::id());
+    let (node, _) = ipc::create_node(&node_name, false)?;
+    let mut objects = ObjectPublisher::new(&node, &names)?;
+    let mut accel = AccelPublisher::new(&node, &names)?;
+    let mut truth_pub = BenchTruthPublisher::new(&node, &names)?;
+    let mut can = if cli.no_can {
+        None
+    } else {
+        Some(
+            bus::socket::BusSocket::open(&cli.can, &[]).with_context(|| {
+                format!(
+                    "CAN interface {} (bring it up with ./vcan-setup.sh, or pass --no-can)",
+                    cli.can
+                )
+            })?,
+        )
+    };
+    let mut protector = bus::E2eProtector::new();
+
+    let scale = 1.0 / cli.speedup;
+    let to_ns = |t_s: f64| (t_s * 1e9 * scale).round() as u64;
+    let start_ns = monotonic_ns() + TICK_NS;
+    let total_ticks = (scenario.duration_s * 1e3).round() as u64;
+    let obj_period_s = sensor.object_period_ms * 1e-3;
+    let veh_period_s = sensor.vehicle_period_ms * 1e-3;
+    let occ_period_s = sensor.occupant_period_ms * 1e-3;
+    let accel_dt_s = 1.0 / sensor.accel_rate_hz;
+    let (mut next_obj, mut next_veh, mut next_occ, mut next_accel_k) =
+        (0.0f64, 0.0f64, 0.0f64, 0u64);
+    let mut counts = Counts::default();
+    let mut accel_seq = 0u64;
+    let mut truth_rec = BenchTruth::EMPTY;
+    truth_rec.set_scenario_name(&scenario.name);
+    truth_rec.start_ns = start_ns;
+    truth_rec.ego_mass_kg = scenario.ego.mass_kg as f32;
+    truth_rec.opponent_mass_kg = scenario.opponent_mass_kg() as f32;
+    let mut contact_announced = false;
+
+    for tick in 0..=total_ticks {
+        if STOP_FLAG.load(Ordering::Relaxed) {
+            eprintln!("sensor-feeds: stopped by signal at t = {} ms", tick);
+            break;
+        }
+        let t = tick as f64 * 1e-3;
+        sleep_until_ns(start_ns + to_ns(t));
+        // Object list.
+        while next_obj <= t + 1e-9 {
+            let tp = next_obj;
+            next_obj += obj_period_s;
+            if sensor.dropped(DropoutTarget::Object, tp) {
+                counts.objects_dropped += 1;
+                continue;
+            }
+            if let (Some(mut o), Some(tm)) = (model.object(tp), model.measurement_time_s(tp)) {
+                o.timestamp_ns = start_ns + to_ns(tm);
+                match objects.publish(o) {
+                    Ok(()) => counts.objects += 1,
+                    Err(_) => counts.ipc_errors += 1,
+                }
+            }
+        }
+        // Accelerometer: every sample whose instant has passed, in batches of ≤ 8.
+        if !sensor.dropped(DropoutTarget::Accel, t) {
+            let mut batch = CrashAccelSample::EMPTY;
+            while (next_accel_k as f64) * accel_dt_s <= t + 1e-9 {
+                let ts = next_accel_k as f64 * accel_dt_s;
+                if batch.count == 0 {
+                    batch.first_timestamp_ns = start_ns + to_ns(ts);
+                    batch.sample_period_ns = to_ns(accel_dt_s) as u32;
+                }
+                batch.accel_mps2[batch.count as usize] = model.accel_mps2(ts) as f32;
+                batch.count += 1;
+                next_accel_k += 1;
+                if batch.count as usize == ipc::ACCEL_BATCH_CAPACITY {
+                    accel_seq += 1;
+                    batch.sequence = accel_seq;
+                    counts.accel_samples += u64::from(batch.count);
+                    if accel.publish(batch).is_err() {
+                        counts.ipc_errors += 1;
+                    }
+                    batch = CrashAccelSample::EMPTY;
+                }
+            }
+            if batch.count > 0 {
+                accel_seq += 1;
+                batch.sequence = accel_seq;
+                counts.accel_samples += u64::from(batch.count);
+                if accel.publish(batch).is_err() {
+                    counts.ipc_errors += 1;
+                }
+            }
+        } else {
+            // Samples in a dropout are lost, not delivered late.
+            next_accel_k = ((t / accel_dt_s).floor() as u64) + 1;
+        }
+        // CAN.
+        if let Some(sock) = can.as_mut() {
+            while next_veh <= t + 1e-9 {
+                let tp = next_veh;
+                next_veh += veh_period_s;
+                if sensor.dropped(DropoutTarget::Vehicle, tp) {
+                    continue;
+                }
+                let frame =
+                    protector.seal(model.ego_frame(tp).map_err(|e| anyhow::anyhow!("{e:?}"))?);
+                match sock.send(&frame) {
+                    Ok(()) => counts.can_frames += 1,
+                    Err(_) => counts.can_errors += 1,
+                }
+            }
+            while next_occ <= t + 1e-9 {
+                let tp = next_occ;
+                next_occ += occ_period_s;
+                if sensor.dropped(DropoutTarget::Occupant, tp) {
+                    continue;
+                }
+                let frame = protector.seal(
+                    model
+                        .occupant_frame()
+                        .map_err(|e| anyhow::anyhow!("{e:?}"))?,
+                );
+                match sock.send(&frame) {
+                    Ok(()) => counts.can_frames += 1,
+                    Err(_) => counts.can_errors += 1,
+                }
+            }
+        }
+        // Bench truth.
+        let mut announce = false;
+        if let Some(tc) = contact_s.filter(|tc| t >= *tc && !contact_announced) {
+            contact_announced = true;
+            announce = true;
+            truth_rec.contact_ns = start_ns + to_ns(tc);
+            truth_rec.closing_speed_at_contact_mps =
+                model.truth().closing_speed_at_contact_mps() as f32;
+        }
+        if announce || tick % TRUTH_PERIOD_TICKS == 0 {
+            truth_rec.sequence += 1;
+            truth_rec.timestamp_ns = monotonic_ns();
+            if truth_pub.publish(truth_rec).is_err() {
+                counts.ipc_errors += 1;
+            }
+        }
+    }
+    // Done: the final truth (with `done`), a few times so a busy subscriber cannot miss it.
+    truth_rec.done = 1;
+    for _ in 0..3 {
+        truth_rec.sequence += 1;
+        truth_rec.timestamp_ns = monotonic_ns();
+        if truth_pub.publish(truth_rec).is_err() {
+            counts.ipc_errors += 1;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    eprintln!(
+        "sensor-feeds: done: {} objects ({} dropped), {} accel samples, {} CAN frames, {} CAN errors, {} IPC errors",
+        counts.objects, counts.objects_dropped, counts.accel_samples, counts.can_frames, counts.can_errors, counts.ipc_errors
+    );
+    // Keep the publishers alive a moment so subscribers can read the last samples.
+    std::thread::sleep(std::time::Duration::from_millis(50));
+    Ok(())
+}
+
+#[derive(Default)]
+struct Counts {
+    objects: u64,
+    objects_dropped: u64,
+    accel_samples: u64,
+    can_frames: u64,
+    can_errors: u64,
+    ipc_errors: u64,
+}
+
+static STOP_FLAG: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_signal(_: nix::libc::c_int) {
+    STOP_FLAG.store(true, Ordering::Relaxed);
+}
+
+/// SIGTERM/SIGINT only store a flag (async-signal-safe); the tick loop polls it.
+fn install_stop_signals() -> Result<()> {
+    use nix::sys::signal::{sigaction, SaFlags, SigAction, SigHandler, SigSet, Signal};
+    let action = SigAction::new(
+        SigHandler::Handler(on_signal),
+        SaFlags::empty(),
+        SigSet::empty(),
+    );
+    for sig in [Signal::SIGTERM, Signal::SIGINT] {
+        // SAFETY: the handler only performs an atomic store.
+        unsafe { sigaction(sig, &action) }.context("installing signal handler")?;
+    }
+    Ok(())
+}

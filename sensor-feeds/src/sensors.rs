@@ -1,0 +1,234 @@
+//! The sensor model: what the ECU's sensors report about the true world (noise, bias, latency,
+//! range), as bench payloads and CAN frames. Pure and seeded (ChaCha8), so a run is reproducible
+//! and testable without a clock.
+
+use crate::scenario::{BrakeStateName, Scenario};
+use crate::truth::Truth;
+use bus::codec::{
+    EgoVehicleStateBrakeState, OccupantClassificationBeltBuckle,
+    OccupantClassificationOccupantClass,
+};
+use bus::{EgoVehicleState, EncodeError, OccupantClassification};
+use ipc::ObjectState;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// Tracker id of the opponent (one tracked object).
+pub const OPPONENT_OBJECT_ID: u32 = 7;
+
+/// Seeded sensor model over a solved [`Truth`].
+pub struct SensorModelSim {
+    truth: Truth,
+    rng: ChaCha8Rng,
+    object_sequence: u64,
+}
+
+/// A standard normal draw (Box–Muller; two uniforms per draw keeps the stream simple).
+fn gauss(rng: &mut ChaCha8Rng) -> f64 {
+    let u1: f64 = rng.gen_range(f64::MIN_POSITIVE..1.0);
+    let u2: f64 = rng.gen::<f64>();
+    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+}
+
+impl SensorModelSim {
+    /// Model over `truth`, seeded with the scenario's seed.
+    pub fn new(truth: Truth) -> Self {
+        let seed = truth.scenario().seed;
+        SensorModelSim {
+            truth,
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            object_sequence: 0,
+        }
+    }
+
+    /// The true world.
+    pub fn truth(&self) -> &Truth {
+        &self.truth
+    }
+
+    fn scenario(&self) -> &Scenario {
+        self.truth.scenario()
+    }
+
+    /// The object list entry published at scenario time `t_s`, measured at
+    /// `t_s − latency` (`None` before the first measurement exists). `timestamp_ns` is left 0:
+    /// the caller maps the measurement time [`Self::measurement_time_s`] onto CLOCK_MONOTONIC.
+    pub fn object(&mut self, t_s: f64) -> Option<ObjectState> {
+        let s = self.scenario().sensor.clone();
+        let t_meas = self.measurement_time_s(t_s)?;
+        let w = self.truth.state(t_meas);
+        self.object_sequence += 1;
+        let mut o = ObjectState::INVALID;
+        o.sequence = self.object_sequence;
+        o.object_id = OPPONENT_OBJECT_ID;
+        if w.distance_m > s.range_m || !w.in_path {
+            // Nothing in range: an explicit "no valid object" record keeps the stream alive.
+            return Some(o);
+        }
+        let true_mass = self.scenario().opponent_mass_kg();
+        let mass = s.mass_estimate_kg.unwrap_or(true_mass + s.mass_bias_kg)
+            + s.mass_noise_kg * gauss(&mut self.rng);
+        o.distance_m = (w.distance_m + s.distance_noise_m * gauss(&mut self.rng)).max(0.0) as f32;
+        o.closing_speed_mps =
+            (w.closing_speed_mps + s.speed_noise_mps * gauss(&mut self.rng)) as f32;
+        o.relative_accel_mps2 = w.relative_accel_mps2 as f32;
+        o.opponent_mass_kg = mass.max(1.0) as f32;
+        o.opponent_mass_sigma_kg = s.mass_sigma_kg as f32;
+        o.confidence = s.confidence as f32;
+        o.valid = ipc::VALID;
+        Some(o)
+    }
+
+    /// Measurement time of a record published at `t_s` (`None` if before scenario start).
+    pub fn measurement_time_s(&self, t_s: f64) -> Option<f64> {
+        let t = t_s - self.scenario().sensor.latency_ms * 1e-3;
+        (t >= 0.0).then_some(t)
+    }
+
+    /// Compartment accelerometer reading at `t_s` [m/s²]: braking deceleration before contact,
+    /// the TRUE crash pulse after it, plus sensor noise.
+    pub fn accel_mps2(&mut self, t_s: f64) -> f64 {
+        let w = self.truth.state(t_s);
+        w.ego_accel_mps2 + self.scenario().sensor.accel_noise_mps2 * gauss(&mut self.rng)
+    }
+
+    /// The `EgoVehicleState` frame content at `t_s` (E2E bytes are filled by the protector).
+    pub fn ego_frame(&self, t_s: f64) -> Result<EgoVehicleState, EncodeError> {
+        let w = self.truth.state(t_s);
+        let brake = if w.ego_braking {
+            match self.scenario().ego.braking.as_ref().map(|b| b.state) {
+                Some(BrakeStateName::Abs) => EgoVehicleStateBrakeState::AbsActive,
+                Some(BrakeStateName::Eba) => EgoVehicleStateBrakeState::EmergencyBrakeAssist,
+                Some(BrakeStateName::Aeb) => EgoVehicleStateBrakeState::AutonomousEmergencyBraking,
+                _ => EgoVehicleStateBrakeState::DriverBraking,
+            }
+        } else {
+            EgoVehicleStateBrakeState::Released
+        };
+        // The DBC's EgoSpeed is a non-negative speed over ground and EgoLongAccel is limited
+        // to ±150 m/s²: a crash pulse beyond that is clipped on this (vehicle-dynamics) frame,
+        // the crash accelerometer carries the full pulse.
+        EgoVehicleState::encode(
+            brake,
+            w.ego_speed_mps.clamp(0.0, 100.0) as f32,
+            w.ego_accel_mps2.clamp(-150.0, 150.0) as f32,
+        )
+    }
+
+    /// The `OccupantClassification` frame content (the occupant does not change in a run).
+    pub fn occupant_frame(&self) -> Result<OccupantClassification, EncodeError> {
+        let occ = &self.scenario().occupant;
+        let buckle = if occ.belted {
+            OccupantClassificationBeltBuckle::Buckled
+        } else {
+            OccupantClassificationBeltBuckle::Unbuckled
+        };
+        OccupantClassification::encode(
+            buckle,
+            occupant_class(occ.mass_kg),
+            95,
+            occ.mass_kg as f32,
+            occ.chest_to_wheel_mm.round() as u16,
+            occ.seat_track_mm.round() as u16,
+        )
+    }
+}
+
+/// Size class the occupant classifier reports for a mass (thresholds: 5th-percentile female
+/// ≈ 50 kg, 95th-percentile male ≈ 100 kg; SmallAdult < 55 kg ≤ MidAdult ≤ 90 kg < LargeAdult).
+pub fn occupant_class(mass_kg: f64) -> OccupantClassificationOccupantClass {
+    if mass_kg < 55.0 {
+        OccupantClassificationOccupantClass::SmallAdult
+    } else if mass_kg <= 90.0 {
+        OccupantClassificationOccupantClass::MidAdult
+    } else {
+        OccupantClassificationOccupantClass::LargeAdult
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sim(extra_sensor: &str) -> SensorModelSim {
+        let text = format!(
+            "name = \"t\"\nduration_s = 3\nseed = 42\n[ego]\nmass_kg = 1785\nspeed_kph = 36\n\
+             [opponent]\nkind = \"vehicle\"\nmass_kg = 1500\nspeed_kph = 36\ninitial_distance_m = 40\n\
+             [sensor]\n{extra_sensor}\n[occupant]\nmass_kg = 110\nbelted = false\n"
+        );
+        let s = Scenario::parse("t.toml", &text).expect("valid");
+        SensorModelSim::new(Truth::new(&s).expect("truth"))
+    }
+
+    #[test]
+    fn noise_free_object_is_the_delayed_truth() {
+        let mut m = sim("latency_ms = 50\ndistance_noise_m = 0\nspeed_noise_mps = 0\nmass_bias_kg = 300\nmass_sigma_kg = 250");
+        assert!(
+            m.object(0.04).is_none(),
+            "no measurement before t = latency"
+        );
+        let o = m.object(1.05).expect("object");
+        // Measured at 1.0 s: 40 − 2·10 m/s·1 s = 20 m, closing 20 m/s.
+        assert!((o.distance_m - 20.0).abs() < 1e-4, "{o:?}");
+        assert!((o.closing_speed_mps - 20.0).abs() < 1e-4);
+        assert_eq!(o.opponent_mass_kg, 1800.0);
+        assert_eq!(o.opponent_mass_sigma_kg, 250.0);
+        assert!(o.is_valid());
+        assert_eq!(o.sequence, 1);
+    }
+
+    #[test]
+    fn noise_has_the_configured_spread_and_is_reproducible() {
+        let mut a = sim("latency_ms = 0\ndistance_noise_m = 0.5\nmass_noise_kg = 100");
+        let mut b = sim("latency_ms = 0\ndistance_noise_m = 0.5\nmass_noise_kg = 100");
+        let n = 4000;
+        let (mut sum, mut sum2) = (0.0, 0.0);
+        for _ in 0..n {
+            let x = a.object(0.5).unwrap();
+            let y = b.object(0.5).unwrap();
+            assert_eq!(x, y, "same seed, same stream");
+            let e = x.opponent_mass_kg as f64 - 1500.0;
+            sum += e;
+            sum2 += e * e;
+        }
+        let mean = sum / n as f64;
+        let sd = (sum2 / n as f64 - mean * mean).sqrt();
+        // Sample sd of 4000 normal draws: within ±6 % of σ = 100 kg (≈ 4 standard errors).
+        assert!((sd - 100.0).abs() < 6.0, "sd {sd}");
+        assert!(mean.abs() < 7.0, "mean {mean}");
+    }
+
+    #[test]
+    fn out_of_range_reports_no_valid_object() {
+        let mut m = sim("latency_ms = 0\nrange_m = 10");
+        let o = m.object(0.0).unwrap();
+        assert!(!o.is_valid());
+    }
+
+    #[test]
+    fn occupant_frame_carries_the_occupant() {
+        let m = sim("");
+        let f = m.occupant_frame().unwrap();
+        assert!((f.occupant_mass() - 110.0).abs() < 0.051);
+        assert_eq!(f.chest_to_wheel(), 300);
+        assert_eq!(
+            u8::from(f.belt_buckle()),
+            u8::from(OccupantClassificationBeltBuckle::Unbuckled)
+        );
+        assert_eq!(
+            u8::from(f.occupant_class()),
+            u8::from(OccupantClassificationOccupantClass::LargeAdult)
+        );
+    }
+
+    #[test]
+    fn ego_frame_before_contact_is_speed_and_no_braking() {
+        let m = sim("");
+        let f = m.ego_frame(0.5).unwrap();
+        assert!((f.ego_speed() - 10.0).abs() < 0.006);
+        assert_eq!(
+            u8::from(f.brake_state()),
+            u8::from(EgoVehicleStateBrakeState::Released)
+        );
+    }
+}

@@ -1,0 +1,375 @@
+//! The true world of a scenario: closed-form pre-crash kinematics and, from the true first
+//! contact on, the true collision physics (`physics::simulate_collision` with the TRUE masses
+//! and stiffness classes). The sensor model only ever *observes* this.
+//!
+//! Axes: each vehicle's own forward direction (towards the other party); speeds ≥ 0 before
+//! contact (braking stops a vehicle, it never reverses). The gap between the fronts is
+//! `initial_distance − s_ego(t) − s_opp(t)` and therefore never increases before contact,
+//! which makes the contact instant a clean bisection root.
+
+use crate::scenario::{Braking, OpponentKind, Scenario};
+use physics::{CollisionInput, CollisionSummary, CombinedSpring, DefaultPulseBuffer};
+
+/// Speed [m/s], travelled distance [m] and acceleration [m/s², negative = braking] of one
+/// braking vehicle at time `t_s`, in closed form.
+///
+/// Deceleration ramps linearly 0 → A over r, then stays A until standstill:
+/// ramp (τ = t − t_b ≤ r): v = v0 − A τ²/(2r), s = v0 τ − A τ³/(6r);
+/// plateau: v = v_r − A (τ − r), s = s_r + v_r (τ − r) − A (τ − r)²/2.
+pub fn braking_motion(v0_mps: f64, braking: Option<&Braking>, t_s: f64) -> (f64, f64, f64) {
+    let Some(b) = braking else {
+        return (v0_mps, v0_mps * t_s, 0.0);
+    };
+    if t_s <= b.start_s {
+        return (v0_mps, v0_mps * t_s, 0.0);
+    }
+    let s0 = v0_mps * b.start_s;
+    let a = b.decel_mps2;
+    let r = b.ramp_s;
+    let tau = t_s - b.start_s;
+    // Standstill inside the ramp? v(τ) = 0 at τ = sqrt(2 r v0 / A).
+    let v_r = v0_mps - 0.5 * a * r;
+    if v_r <= 0.0 {
+        let tau_stop = (2.0 * r * v0_mps / a).sqrt();
+        let tt = tau.min(tau_stop);
+        let v = v0_mps - a * tt * tt / (2.0 * r);
+        let s = v0_mps * tt - a * tt * tt * tt / (6.0 * r);
+        let acc = if tau < tau_stop { -a * tau / r } else { 0.0 };
+        return (v.max(0.0), s0 + s, acc);
+    }
+    if tau <= r {
+        let v = v0_mps - a * tau * tau / (2.0 * r);
+        let s = v0_mps * tau - a * tau * tau * tau / (6.0 * r);
+        let acc = if r > 0.0 { -a * tau / r } else { -a };
+        return (v, s0 + s, acc);
+    }
+    let s_r = v0_mps * r - a * r * r / 6.0;
+    let tau_stop = v_r / a;
+    let tp = (tau - r).min(tau_stop);
+    let v = v_r - a * tp;
+    let s = s_r + v_r * tp - 0.5 * a * tp * tp;
+    let acc = if tau - r < tau_stop { -a } else { 0.0 };
+    (v.max(0.0), s0 + s, acc)
+}
+
+/// The state the sensors observe at one instant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorldState {
+    /// Gap between the fronts [m] (0 while in contact).
+    pub distance_m: f64,
+    /// Closing speed [m/s] (positive = approaching; negative after separation).
+    pub closing_speed_mps: f64,
+    /// Rate of change of the closing speed [m/s²].
+    pub relative_accel_mps2: f64,
+    /// Ego speed over ground [m/s] (may be negative after a crash with a heavier opponent).
+    pub ego_speed_mps: f64,
+    /// Ego compartment longitudinal acceleration [m/s²] (negative = deceleration).
+    pub ego_accel_mps2: f64,
+    /// Ego is braking.
+    pub ego_braking: bool,
+    /// The opponent is in the ego's path (false after an evasive manoeuvre).
+    pub in_path: bool,
+}
+
+/// The true world: kinematics, contact and crash pulse.
+pub struct Truth {
+    scenario: Scenario,
+    /// True first contact [s after scenario start], `None` if the collision is avoided or
+    /// happens after the run ends.
+    pub contact_s: Option<f64>,
+    /// Ego speed at contact [m/s].
+    pub ego_speed_at_contact_mps: f64,
+    /// Opponent speed at contact [m/s].
+    pub opp_speed_at_contact_mps: f64,
+    /// True collision summary (contact only).
+    pub collision: Option<CollisionSummary>,
+    /// True compartment pulses from first contact (0.1 ms steps).
+    pub pulse: Box<DefaultPulseBuffer>,
+}
+
+impl Truth {
+    /// Solves the scenario: contact instant (bisection to 1 µs) and the true crash.
+    pub fn new(scenario: &Scenario) -> Result<Self, String> {
+        let mut truth = Truth {
+            scenario: scenario.clone(),
+            contact_s: None,
+            ego_speed_at_contact_mps: 0.0,
+            opp_speed_at_contact_mps: 0.0,
+            collision: None,
+            pulse: Box::new(DefaultPulseBuffer::new()),
+        };
+        // After an evasive manoeuvre the opponent is out of the path: no contact afterwards.
+        let end = scenario
+            .opponent
+            .evade_s
+            .map_or(scenario.duration_s, |te| te.min(scenario.duration_s));
+        if truth.pre_contact_gap_m(end) > 0.0 {
+            return Ok(truth);
+        }
+        let (mut lo, mut hi) = (0.0, end);
+        while hi - lo > 1e-6 {
+            let mid = 0.5 * (lo + hi);
+            if truth.pre_contact_gap_m(mid) > 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let tc = hi;
+        let (ve, _, _) = truth.ego_motion(tc);
+        let (vo, _, _) = truth.opp_motion(tc);
+        let closing = ve + vo;
+        truth.contact_s = Some(tc);
+        truth.ego_speed_at_contact_mps = ve;
+        truth.opp_speed_at_contact_mps = vo;
+        let ego_curve = scenario.ego_class().curve();
+        let opp_curve = scenario.opponent_class().map(|c| c.curve());
+        let spring = CombinedSpring::series(ego_curve, opp_curve).map_err(|e| format!("{e:?}"))?;
+        let input = CollisionInput::with_defaults(
+            &spring,
+            scenario.ego.mass_kg,
+            scenario.opponent_mass_kg(),
+            closing,
+        );
+        let summary = physics::simulate_collision(&input, &mut truth.pulse)
+            .map_err(|e| format!("true collision physics: {e:?}"))?;
+        truth.collision = Some(summary);
+        Ok(truth)
+    }
+
+    /// The scenario this truth was solved for.
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+
+    fn ego_motion(&self, t: f64) -> (f64, f64, f64) {
+        let e = &self.scenario.ego;
+        braking_motion(physics::kph_to_mps(e.speed_kph), e.braking.as_ref(), t)
+    }
+
+    fn opp_motion(&self, t: f64) -> (f64, f64, f64) {
+        let o = &self.scenario.opponent;
+        match o.kind {
+            OpponentKind::Barrier => (0.0, 0.0, 0.0),
+            OpponentKind::Vehicle => {
+                braking_motion(physics::kph_to_mps(o.speed_kph), o.braking.as_ref(), t)
+            }
+        }
+    }
+
+    /// Gap between the fronts if nothing had collided [m].
+    fn pre_contact_gap_m(&self, t: f64) -> f64 {
+        let (_, se, _) = self.ego_motion(t);
+        let (_, so, _) = self.opp_motion(t);
+        self.scenario.opponent.initial_distance_m - se - so
+    }
+
+    /// True closing speed at contact [m/s] (0 without contact).
+    pub fn closing_speed_at_contact_mps(&self) -> f64 {
+        if self.contact_s.is_some() {
+            self.ego_speed_at_contact_mps + self.opp_speed_at_contact_mps
+        } else {
+            0.0
+        }
+    }
+
+    /// Ego compartment acceleration at `k`-th pulse position (linear interpolation of the
+    /// 0.1 ms pulse; 0 after the pulse).
+    fn pulse_at(&self, channel: &[f64], t_since_contact_s: f64) -> f64 {
+        let step = self.pulse.step_s();
+        if !(step > 0.0) || channel.is_empty() {
+            return 0.0;
+        }
+        let x = t_since_contact_s / step;
+        let i = x.floor() as usize;
+        match (channel.get(i), channel.get(i + 1)) {
+            (Some(a), Some(b)) => a + (b - a) * (x - i as f64),
+            (Some(a), None) => *a,
+            _ => *channel.last().unwrap_or(&0.0),
+        }
+    }
+
+    /// The true world at scenario time `t_s`.
+    pub fn state(&self, t_s: f64) -> WorldState {
+        match self.contact_s {
+            Some(tc) if t_s >= tc => self.crash_state(t_s - tc),
+            _ => {
+                let (ve, _, ae) = self.ego_motion(t_s);
+                let (vo, _, ao) = self.opp_motion(t_s);
+                WorldState {
+                    distance_m: self.pre_contact_gap_m(t_s).max(0.0),
+                    closing_speed_mps: ve + vo,
+                    relative_accel_mps2: ae + ao,
+                    ego_speed_mps: ve,
+                    ego_accel_mps2: ae,
+                    ego_braking: ae < 0.0,
+                    in_path: self.scenario.opponent.evade_s.is_none_or(|te| t_s < te),
+                }
+            }
+        }
+    }
+
+    fn crash_state(&self, dt: f64) -> WorldState {
+        let p = &self.pulse;
+        let dve = self.pulse_at(p.ego_vel_mps(), dt);
+        let dvo = self.pulse_at(p.opp_vel_mps(), dt);
+        let ae = self.pulse_at(p.ego_accel_mps2(), dt);
+        let ao = self.pulse_at(p.opp_accel_mps2(), dt);
+        let closing = self.closing_speed_at_contact_mps() + dve + dvo;
+        let contact_s = self.collision.map_or(0.0, |c| c.contact_duration_s);
+        // After separation the fronts move apart at the (constant) separation speed.
+        let distance = if dt > contact_s {
+            (dt - contact_s) * (-closing).max(0.0)
+        } else {
+            0.0
+        };
+        WorldState {
+            distance_m: distance,
+            closing_speed_mps: closing,
+            relative_accel_mps2: ae + ao,
+            ego_speed_mps: self.ego_speed_at_contact_mps + dve,
+            ego_accel_mps2: ae,
+            ego_braking: false,
+            in_path: true,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::{BrakeStateName, Scenario};
+
+    fn braking(start_s: f64, decel: f64, ramp: f64) -> Braking {
+        Braking {
+            start_s,
+            decel_mps2: decel,
+            ramp_s: ramp,
+            state: BrakeStateName::Abs,
+        }
+    }
+
+    #[test]
+    fn constant_decel_obeys_v2_equals_v02_minus_2as() {
+        // No ramp: textbook v² = v0² − 2 a s, stop distance v0²/(2a) = 20²/(2·8) = 25 m.
+        let b = braking(1.0, 8.0, 0.0);
+        let (v, s, a) = braking_motion(20.0, Some(&b), 2.0);
+        assert!((v - 12.0).abs() < 1e-9);
+        assert!((s - (20.0 + (400.0 - 144.0) / 16.0)).abs() < 1e-9);
+        assert_eq!(a, -8.0);
+        let (v, s, a) = braking_motion(20.0, Some(&b), 10.0);
+        assert_eq!(v, 0.0);
+        assert!((s - 45.0).abs() < 1e-9);
+        assert_eq!(a, 0.0);
+    }
+
+    #[test]
+    fn ramp_loses_half_a_r_of_speed() {
+        // Linear ramp 0 → 10 m/s² over 0.2 s: Δv = ½·10·0.2 = 1 m/s; s = v0 r − A r²/6.
+        let b = braking(0.0, 10.0, 0.2);
+        let (v, s, a) = braking_motion(20.0, Some(&b), 0.2);
+        assert!((v - 19.0).abs() < 1e-12);
+        assert!((s - (4.0 - 10.0 * 0.04 / 6.0)).abs() < 1e-12);
+        assert!((a + 10.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn vehicle_stopping_inside_the_ramp_stays_stopped() {
+        let b = braking(0.0, 10.0, 1.0);
+        // v0 = 2 m/s stops at τ = sqrt(2·1·2/10) = 0.632 s, after s = v0 τ − A τ³/6 = 2/3 τ·2.
+        let tau: f64 = (0.4f64).sqrt();
+        let (v, s, a) = braking_motion(2.0, Some(&b), 5.0);
+        assert_eq!(v, 0.0);
+        assert_eq!(a, 0.0);
+        assert!((s - (2.0 * tau - 10.0 * tau.powi(3) / 6.0)).abs() < 1e-12);
+    }
+
+    fn parse(text: &str) -> Scenario {
+        Scenario::parse("t.toml", text).expect("valid")
+    }
+
+    #[test]
+    fn constant_speed_head_on_contact_time_and_equal_mass_delta_v() {
+        // 50 + 50 km/h, 30 m: contact at 30 / (2·13.889) = 1.08 s. Equal masses and classes:
+        // Δv_ego = (1 + e) v_close / 2 (SPEC oracle) with e = 0.1.
+        let s = parse(
+            "name = \"t\"\nduration_s = 2\n[ego]\nmass_kg = 1785\nspeed_kph = 50\n\
+             [opponent]\nkind = \"vehicle\"\nmass_kg = 1785\nspeed_kph = 50\ninitial_distance_m = 30\n\
+             [occupant]\nmass_kg = 75\n",
+        );
+        let t = Truth::new(&s).expect("truth");
+        let tc = t.contact_s.expect("contact");
+        assert!((tc - 30.0 / (100.0 / 3.6)).abs() < 2e-6, "{tc}");
+        let v = 100.0 / 3.6;
+        let dv = t.collision.expect("crash").vehicle.delta_v_mps;
+        assert!((dv - 1.1 * v / 2.0).abs() < 0.01 * v, "{dv}");
+        let before = t.state(tc - 0.1);
+        assert!((before.distance_m - 0.1 * v).abs() < 1e-4, "{before:?}");
+        assert!((before.closing_speed_mps - v).abs() < 1e-9);
+        let during = t.state(tc + 0.02);
+        assert_eq!(during.distance_m, 0.0);
+        assert!(
+            during.ego_accel_mps2 < -50.0,
+            "crash pulse decelerates: {during:?}"
+        );
+        let after = t.state(tc + 0.3);
+        // Separated: receding at e·v_close.
+        assert!(
+            (after.closing_speed_mps + 0.1 * v).abs() < 0.01 * v,
+            "{after:?}"
+        );
+    }
+
+    #[test]
+    fn barrier_crash_equals_half_speed_car_to_car() {
+        // SPEC oracle: two equal cars at closing speed 2v ≡ one car into a rigid barrier at v.
+        let car = parse(
+            "name = \"c\"\nduration_s = 2\n[ego]\nmass_kg = 1785\nclass = 4\nspeed_kph = 48\n\
+             [opponent]\nkind = \"vehicle\"\nmass_kg = 1785\nclass = 4\nspeed_kph = 48\ninitial_distance_m = 20\n\
+             [occupant]\nmass_kg = 75\n",
+        );
+        let wall = parse(
+            "name = \"w\"\nduration_s = 2\n[ego]\nmass_kg = 1785\nclass = 4\nspeed_kph = 48\n\
+             [opponent]\nkind = \"barrier\"\ninitial_distance_m = 10\n\
+             [sensor]\nmass_estimate_kg = 3000\n[occupant]\nmass_kg = 75\n",
+        );
+        let a = Truth::new(&car).unwrap().collision.unwrap();
+        let b = Truth::new(&wall).unwrap().collision.unwrap();
+        assert!(
+            (a.vehicle.delta_v_mps - b.vehicle.delta_v_mps).abs() < 0.02 * b.vehicle.delta_v_mps
+        );
+        assert!((a.vehicle.crush_m - b.vehicle.crush_m).abs() < 0.03 * b.vehicle.crush_m);
+    }
+
+    #[test]
+    fn evasion_before_contact_avoids_the_crash() {
+        // 50 + 50 km/h from 50 m: contact would be at 1.8 s; the opponent swerves at 1.76 s.
+        let text = "name = \"e\"\nduration_s = 3\n[ego]\nmass_kg = 1785\nspeed_kph = 50\n\
+             [opponent]\nkind = \"vehicle\"\nmass_kg = 1785\nspeed_kph = 50\ninitial_distance_m = 50\nevade_s = 1.76\n\
+             [occupant]\nmass_kg = 75\n";
+        let t = Truth::new(&parse(text)).unwrap();
+        assert!(t.contact_s.is_none());
+        assert!(t.state(1.7).in_path);
+        assert!(!t.state(1.77).in_path);
+        let late = parse(&text.replace("1.76", "1.85"));
+        let t = Truth::new(&late).unwrap();
+        assert!((t.contact_s.unwrap() - 1.8).abs() < 1e-5);
+    }
+
+    #[test]
+    fn avoided_collision_has_no_contact() {
+        // Both stop from 30 km/h at 8 m/s² (no ramp): 2 · 8.333²/16 = 8.68 m < 10 m.
+        let s = parse(
+            "name = \"a\"\nduration_s = 3\n[ego]\nmass_kg = 1500\nspeed_kph = 30\n\
+             [ego.braking]\nstart_s = 0\ndecel_mps2 = 8\nramp_s = 0\n\
+             [opponent]\nkind = \"vehicle\"\nmass_kg = 1500\nspeed_kph = 30\ninitial_distance_m = 10\n\
+             [opponent.braking]\nstart_s = 0\ndecel_mps2 = 8\nramp_s = 0\n\
+             [occupant]\nmass_kg = 75\n",
+        );
+        let t = Truth::new(&s).unwrap();
+        assert!(t.contact_s.is_none());
+        assert!(t.collision.is_none());
+        let end = t.state(3.0);
+        assert!((end.distance_m - (10.0 - 2.0 * (30.0f64 / 3.6).powi(2) / 16.0)).abs() < 1e-9);
+    }
+}
