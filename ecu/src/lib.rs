@@ -6,12 +6,13 @@
 //!   RT settings (SCHED_FIFO, mlockall, pinning, PM-QoS), preallocated timing
 //!   histograms, the timing report, configuration, the iceoryx2 com layer and the
 //!   `monitor` command. It knows nothing about restraints.
-//! * the pure cycle logic (prediction, LUT interpolation, decision state machine) —
-//!   **INTEGRATION POINT**: it implements [`runtime::Activity`] and talks to the world
-//!   only through [`runtime::CycleIo`], so it runs unchanged under the real clock and
-//!   under [`runtime::SimClock`] with [`runtime::SimIo`] in tests. Until it lands the
-//!   shell runs [`runtime::PassthroughActivity`].
+//! * [`cycle`] — the pure cycle logic (prediction, LUT interpolation, decision state
+//!   machine): [`cycle::RestraintCycle`] implements [`runtime::Activity`] and talks to the
+//!   world only through [`runtime::CycleIo`], so it runs unchanged under the real clock and
+//!   under [`runtime::SimClock`] with [`runtime::SimIo`] in tests.
+//! * [`can_port`] — the SocketCAN [`runtime::CanPort`] over `bus::socket::BusSocket`.
 
 pub mod runtime;
 
-// INTEGRATION POINT: `pub mod cycle;` (pure cycle logic implementing `runtime::Activity`).
+pub mod can_port;
+pub mod cycle;

@@ -1,0 +1,75 @@
+//! The SocketCAN port of the ECU: [`CanPort`] over [`bus::socket::BusSocket`].
+//!
+//! Opened non-blocking with a kernel filter that passes only the ECU's input frames
+//! ([`crate::cycle::input_can_ids`]: EgoVehicleState, OccupantClassification), so the cycle
+//! never spends time on other traffic and a flooded bus costs the kernel, not the cycle.
+//! Nothing here allocates after [`SocketCanPort::open`].
+
+use std::io;
+
+use bus::socket::BusSocket;
+use bus::RawFrame;
+
+use crate::runtime::{CanFrame, CanPort, IoError};
+
+/// A non-blocking, kernel-filtered SocketCAN port.
+#[derive(Debug)]
+pub struct SocketCanPort {
+    sock: BusSocket,
+    rx_errors: u64,
+}
+
+impl SocketCanPort {
+    /// Opens `iface` receiving only `rx_ids` (standard ids).
+    pub fn open(iface: &str, rx_ids: &[u32]) -> io::Result<Self> {
+        Ok(Self {
+            sock: BusSocket::open(iface, rx_ids)?,
+            rx_errors: 0,
+        })
+    }
+
+    /// Opens `iface` with the ECU's input filter.
+    pub fn open_ecu(iface: &str) -> io::Result<Self> {
+        Self::open(iface, &crate::cycle::input_can_ids())
+    }
+
+    /// Socket counters (frames, error frames) and receive errors.
+    pub fn stats(&self) -> (bus::socket::SocketStats, u64) {
+        (*self.sock.stats(), self.rx_errors)
+    }
+}
+
+impl CanPort for SocketCanPort {
+    fn try_recv(&mut self) -> Option<CanFrame> {
+        match self.sock.recv() {
+            Ok(Some(rx)) => {
+                let f = rx.frame;
+                Some(CanFrame {
+                    id: f.id & !bus::CAN_EFF_FLAG,
+                    extended: f.id & bus::CAN_EFF_FLAG != 0,
+                    len: f.len,
+                    data: f.data,
+                })
+            }
+            Ok(None) => None,
+            Err(_) => {
+                self.rx_errors = self.rx_errors.saturating_add(1);
+                None
+            }
+        }
+    }
+
+    fn try_send(&mut self, frame: &CanFrame) -> Result<(), IoError> {
+        let id = if frame.extended {
+            frame.id | bus::CAN_EFF_FLAG
+        } else {
+            frame.id
+        };
+        let raw = RawFrame::new(id, frame.payload());
+        match self.sock.send(&raw) {
+            Ok(()) => Ok(()),
+            Err(e) if e.kind() == io::ErrorKind::WouldBlock => Err(IoError::CanWouldBlock),
+            Err(_) => Err(IoError::CanIo),
+        }
+    }
+}

@@ -1,0 +1,407 @@
+//! Whole-scenario tests of the restraint cycle under a simulated 1 kHz clock.
+//!
+//! Expected times and values are closed form: the test LUT's cells are linear in closing
+//! speed and opponent mass (multilinear interpolation reproduces them exactly), objects move
+//! at constant speed (TTC = d / v), and the crash pulse is a constant deceleration (Δv after n
+//! samples = n·a·1 ms). Every command is decoded with the bus crate (CRC checked).
+
+mod cycle_support;
+
+use bus::codec::{
+    AirbagStageCmdArm, AirbagStageCmdCmdSource, AirbagStageCmdFire, AirbagStageCmdStage,
+    BeltLimiterCmdCmdSource, BeltLimiterCmdPretensionerCmd, EcuStatusEcuMode,
+};
+use cycle_support::*;
+use ecu::cycle::{Phase, Pretensioner};
+use ipc::{degraded, EcuMode, ObjectState};
+
+const G: f32 = 9.806_65;
+
+/// Contact of the standard approach scenario.
+const C: u64 = T0 + 1_000 * MS;
+
+/// Runs until `end`: every 10 ms an object sample (approach towards `contact` from
+/// `approach_from`, a "no track" sample before), stops objects at `objects_until`, and from
+/// `crash_at` on a constant `decel_g` accelerometer sample per ms.
+#[allow(clippy::too_many_arguments)]
+fn run_scenario(
+    b: &mut Bench,
+    end: u64,
+    approach_from: u64,
+    contact: u64,
+    closing_mps: f32,
+    objects_until: u64,
+    crash_at: Option<u64>,
+    decel_g: f32,
+) {
+    while b.now < end {
+        if (b.now - T0) % (10 * MS) == 0 && b.now < objects_until {
+            if b.now >= approach_from && b.now < contact {
+                b.push_approach(contact, closing_mps, 1500.0, 100.0);
+            } else {
+                let mut o = ObjectState::INVALID;
+                o.timestamp_ns = b.now;
+                b.io.objects.push_back(o);
+            }
+        }
+        if let Some(c) = crash_at {
+            if b.now >= c {
+                b.push_accel(b.now, -decel_g * G);
+            }
+        }
+        b.step();
+    }
+}
+
+#[test]
+fn precrash_preset_pretensioner_at_planned_time_then_airbag_at_planned_time_and_level() {
+    let mut b = Bench::new(Some(test_lut()));
+    run_scenario(
+        &mut b,
+        C + 200 * MS,
+        T0 + 200 * MS,
+        C,
+        25.0,
+        C,
+        Some(C),
+        15.0,
+    );
+
+    // Oracle: 25 m/s = 90 km/h, conservative mass 1500 + 1·100 = 1600 kg.
+    let (v, m) = (90.0, 1600.0);
+    // PRE-CRASH at the first cycle whose time to the predicted contact (extrapolated from
+    // the newest sample) is below the 300 ms horizon: C − 299 ms.
+    assert_eq!(b.first_mode(EcuMode::PreCrash), Some(C - 299 * MS));
+    assert_eq!(b.mode_at(C - 300 * MS), EcuMode::Monitoring as u8);
+    let plan = b.ecu.crash_plan();
+    assert!(
+        (f64::from(plan.belt_limiter_kn) - belt_kn(v, m)).abs() < 1e-4,
+        "{plan:?}"
+    );
+    assert!((f64::from(plan.airbag_level_kn) - airbag_kn(v, m)).abs() < 1e-4);
+    assert!((f64::from(plan.pretensioner_time_ms) - pret_ms(v, m)).abs() < 1e-3);
+    assert!((f64::from(plan.airbag_time_ms) - airbag_ms(v, m)).abs() < 1e-3);
+
+    // Pretensioner: first Fire command at contact − 45 ms (1 ms cycle resolution).
+    let belts = b.belt_frames();
+    let (t_pt, f) = belts
+        .iter()
+        .find(|(_, f)| f.pretensioner_cmd() == BeltLimiterCmdPretensionerCmd::Fire)
+        .expect("pretensioner fired");
+    assert_eq!(*t_pt, C - 45 * MS);
+    assert_eq!(f.load_limiter_level(), q(belt_kn(v, m), 0.05));
+    assert!((f.pretensioner_fire_time() - (-45.0)).abs() < 0.051);
+    assert_eq!(f.cmd_source(), BeltLimiterCmdCmdSource::Adaptive);
+
+    // Confirmation: 15 g → Δv 0.147 m/s per ms: ≥ 0.5 m/s at the 4th sample (C + 3 ms).
+    assert_eq!(b.first_mode(EcuMode::Crash), Some(C + 3 * MS));
+    // Airbag: first Fire at contact + 14 ms with the planned stage and level.
+    let bags = b.airbag_frames();
+    let (t_ab, a) = bags
+        .iter()
+        .find(|(_, f)| f.fire() == AirbagStageCmdFire::Fire)
+        .expect("airbag fired");
+    assert_eq!(*t_ab, C + 14 * MS);
+    assert_eq!(a.arm(), AirbagStageCmdArm::Armed);
+    assert_eq!(a.stage(), AirbagStageCmdStage::Stage1); // 3.2 kN: between 1 and 6 kN
+    assert_eq!(a.force_level(), q(airbag_kn(v, m), 0.05));
+    assert!((a.fire_time() - 14.0).abs() < 0.051);
+    assert_eq!(a.cmd_source(), AirbagStageCmdCmdSource::Adaptive);
+    // Never before confirmation, and armed during pre-crash.
+    assert!(bags
+        .iter()
+        .filter(|(t, _)| *t < C + 3 * MS)
+        .all(|(_, f)| f.fire() == AirbagStageCmdFire::NoFire));
+    assert!(bags
+        .iter()
+        .filter(|(t, _)| *t >= C - 299 * MS)
+        .all(|(_, f)| f.arm() == AirbagStageCmdArm::Armed));
+    assert_eq!(b.first_mode(EcuMode::PostCrash), Some(C + 14 * MS));
+    assert_eq!(b.ecu.phase(), Phase::PostCrash);
+
+    // Cyclic + on change: never more than 10 ms between two frames of a command.
+    for w in bags.windows(2) {
+        assert!(w[1].0 - w[0].0 <= 10 * MS);
+    }
+    for w in belts.windows(2) {
+        assert!(w[1].0 - w[0].0 <= 10 * MS);
+    }
+    // Status heartbeat ≤ 20 ms apart, and Deployed at the end.
+    let st = b.status_frames();
+    for w in st.windows(2) {
+        assert!(w[1].0 - w[0].0 <= 20 * MS);
+    }
+    assert_eq!(st.last().unwrap().1.ecu_mode(), EcuStatusEcuMode::Deployed);
+    assert_eq!(st.last().unwrap().1.lut_id(), test_lut().lut_id());
+    // Every frame passes a strict receiver (alive counters consecutive per message).
+    let mut rx = bus::E2eChecker::new();
+    for (_, f) in &b.sent {
+        rx.check(f.id, f.payload()).expect("E2E-valid stream");
+    }
+    // Diagnostics carry the predicted pulse.
+    let d = b.io.diagnostics.last().unwrap();
+    assert!(d.pulse_points > 10 && d.predicted_delta_v_mps > 5.0);
+    assert!(d.pulse_accel_mps2.iter().any(|&a| a < -100.0));
+}
+
+#[test]
+fn avoided_collision_releases_pretensioner_and_never_fires_the_airbag() {
+    let mut b = Bench::new(Some(test_lut()));
+    // Approach as before until the pretensioner has fired (C − 45 ms) ...
+    run_scenario(&mut b, C - 30 * MS, T0 + 200 * MS, C, 25.0, C, None, 0.0);
+    assert_eq!(b.ecu.pretensioner(), Pretensioner::Fired);
+    // ... then the opponent turns away: receding object.
+    let mut o = cycle_support::object(b.now, -2.0, 1500.0, 100.0);
+    o.distance_m = 3.0;
+    b.io.objects.push_back(o);
+    let t_avoid = b.now;
+    b.step();
+    assert_eq!(b.ecu.phase(), Phase::Monitoring);
+    run_scenario(&mut b, C + 300 * MS, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    let belts = b.belt_frames();
+    let (t_rel, _) = belts
+        .iter()
+        .find(|(_, f)| f.pretensioner_cmd() == BeltLimiterCmdPretensionerCmd::Release)
+        .expect("released");
+    assert_eq!(*t_rel, t_avoid);
+    assert!(b
+        .airbag_frames()
+        .iter()
+        .all(|(_, f)| f.fire() == AirbagStageCmdFire::NoFire));
+    let last = b.airbag_frames().last().unwrap().1;
+    assert_eq!(last.arm(), AirbagStageCmdArm::Disarmed);
+}
+
+#[test]
+fn lost_object_counts_as_avoided() {
+    let mut b = Bench::new(Some(test_lut()));
+    run_scenario(&mut b, C - 20 * MS, T0 + 200 * MS, C, 25.0, C, None, 0.0);
+    assert_eq!(b.ecu.phase(), Phase::PreCrash);
+    // Tracker reports "no object" (valid = 0) from C − 20 ms on.
+    run_scenario(&mut b, C + 200 * MS, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    assert_eq!(b.mode_at(C - 20 * MS), EcuMode::Monitoring as u8);
+    assert_eq!(b.ecu.pretensioner(), Pretensioner::Released);
+    assert!(!b.ecu.airbag_fired());
+}
+
+#[test]
+fn stale_object_data_degrades_after_the_timeout_and_the_reference_fires() {
+    let mut b = Bench::new(Some(test_lut()));
+    // "No track" samples until T0 + 300 ms (last one at T0 + 290 ms), then silence.
+    let crash = T0 + 600 * MS;
+    run_scenario(
+        &mut b,
+        crash + 100 * MS,
+        u64::MAX,
+        0,
+        0.0,
+        T0 + 300 * MS,
+        Some(crash),
+        15.0,
+    );
+    // Last object received at T0 + 290 ms; stale when older than 100 ms.
+    assert_eq!(b.mode_at(T0 + 390 * MS), EcuMode::Monitoring as u8);
+    assert_eq!(b.first_mode(EcuMode::Degraded), Some(T0 + 391 * MS));
+    let d = &b.io.diagnostics[400];
+    assert_ne!(d.degraded_reasons & degraded::OBJECT_STALE, 0);
+    // Reference: pretensioner and airbag 10 ms after the measured contact, reference levels.
+    let bag = b
+        .airbag_frames()
+        .into_iter()
+        .find(|(_, f)| f.fire() == AirbagStageCmdFire::Fire)
+        .expect("reference airbag fired");
+    assert_eq!(bag.0, crash + 10 * MS);
+    assert_eq!(bag.1.force_level(), 12.0);
+    assert_eq!(bag.1.stage(), AirbagStageCmdStage::BothStages);
+    assert_eq!(bag.1.cmd_source(), AirbagStageCmdCmdSource::Reference);
+    let belt = b
+        .belt_frames()
+        .into_iter()
+        .find(|(_, f)| f.pretensioner_cmd() == BeltLimiterCmdPretensionerCmd::Fire)
+        .expect("reference pretensioner fired");
+    assert_eq!(belt.0, crash + 10 * MS);
+    assert_eq!(belt.1.load_limiter_level(), 8.5);
+    assert_eq!(belt.1.cmd_source(), BeltLimiterCmdCmdSource::Reference);
+    let st = b.status_frames();
+    assert!(st.iter().any(
+        |(_, s)| s.ecu_mode() == EcuStatusEcuMode::ReferenceFallback && s.fault_object_input()
+    ));
+}
+
+#[test]
+fn crash_without_pre_crash_detection_fires_the_reference() {
+    // The sensor is alive but never sees the opponent ("no track" throughout).
+    let mut b = Bench::new(Some(test_lut()));
+    let crash = T0 + 500 * MS;
+    run_scenario(
+        &mut b,
+        crash + 50 * MS,
+        u64::MAX,
+        0,
+        0.0,
+        u64::MAX,
+        Some(crash),
+        15.0,
+    );
+    assert_eq!(b.first_mode(EcuMode::PreCrash), None);
+    assert_eq!(b.first_mode(EcuMode::Degraded), None);
+    let bag = b
+        .airbag_frames()
+        .into_iter()
+        .find(|(_, f)| f.fire() == AirbagStageCmdFire::Fire)
+        .expect("fired");
+    assert_eq!(bag.0, crash + 10 * MS);
+    assert_eq!(bag.1.cmd_source(), AirbagStageCmdCmdSource::Reference);
+}
+
+#[test]
+fn sensor_dropout_before_pre_crash_then_crash_fires_the_reference() {
+    let mut b = Bench::new(Some(test_lut()));
+    // Approach seen from T0 + 200 ms, but the sensor dies at C − 400 ms (before the horizon).
+    run_scenario(
+        &mut b,
+        C + 50 * MS,
+        T0 + 200 * MS,
+        C,
+        25.0,
+        C - 400 * MS,
+        Some(C),
+        15.0,
+    );
+    assert_eq!(b.first_mode(EcuMode::PreCrash), None);
+    assert_eq!(
+        b.first_mode(EcuMode::Degraded),
+        Some(C - 410 * MS + 101 * MS)
+    );
+    let bag = b
+        .airbag_frames()
+        .into_iter()
+        .find(|(_, f)| f.fire() == AirbagStageCmdFire::Fire)
+        .expect("fired");
+    assert_eq!(bag.0, C + 10 * MS);
+    assert_eq!(bag.1.force_level(), 12.0);
+}
+
+#[test]
+fn e2e_failure_burst_degrades_for_the_hold_time() {
+    let mut b = Bench::new(Some(test_lut()));
+    let mut bad_tx = bus::E2eProtector::new();
+    let corrupt = |tx: &mut bus::E2eProtector| {
+        let m = bus::OccupantClassification::encode(
+            bus::codec::OccupantClassificationBeltBuckle::Buckled,
+            bus::codec::OccupantClassificationOccupantClass::MidAdult,
+            90,
+            75.0,
+            300,
+            150,
+        )
+        .unwrap();
+        let mut f = to_can(tx.seal(m));
+        f.data[5] ^= 0x10; // payload bit flip → CRC mismatch
+        f
+    };
+    // Two rejections 150 ms apart: no burst.
+    run_scenario(&mut b, T0 + 200 * MS, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    for _ in 0..2 {
+        b.io.can_rx.push_back(corrupt(&mut bad_tx));
+        let end = b.now + 150 * MS;
+        run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    }
+    assert_eq!(b.first_mode(EcuMode::Degraded), None);
+    // Three within 100 ms: burst at the third.
+    let mut t3 = 0;
+    for _ in 0..3 {
+        b.io.can_rx.push_back(corrupt(&mut bad_tx));
+        t3 = b.now;
+        let end = b.now + 10 * MS;
+        run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    }
+    run_scenario(&mut b, t3 + 700 * MS, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    assert_eq!(b.first_mode(EcuMode::Degraded), Some(t3));
+    let i = b.step_times.iter().position(|&t| t == t3).unwrap();
+    assert_ne!(
+        b.io.diagnostics[i].degraded_reasons & degraded::E2E_FAILURE,
+        0
+    );
+    // Held 500 ms after the last rejection, then back to monitoring.
+    assert_eq!(b.mode_at(t3 + 500 * MS), EcuMode::Degraded as u8);
+    assert_eq!(b.mode_at(t3 + 501 * MS), EcuMode::Monitoring as u8);
+    assert_eq!(
+        b.ecu
+            .e2e_stats()
+            .rejected_for(bus::RejectReason::CrcMismatch),
+        5
+    );
+}
+
+#[test]
+fn missing_lut_runs_degraded_from_the_start_and_fires_the_reference() {
+    let mut b = Bench::new(None);
+    run_scenario(
+        &mut b,
+        C + 50 * MS,
+        T0 + 200 * MS,
+        C,
+        25.0,
+        C,
+        Some(C),
+        15.0,
+    );
+    assert_eq!(b.mode_at(T0), EcuMode::Degraded as u8);
+    assert_ne!(
+        b.io.diagnostics[0].degraded_reasons & degraded::LUT_INVALID,
+        0
+    );
+    assert_eq!(b.first_mode(EcuMode::PreCrash), None);
+    let bag = b
+        .airbag_frames()
+        .into_iter()
+        .find(|(_, f)| f.fire() == AirbagStageCmdFire::Fire)
+        .expect("fired");
+    assert_eq!(bag.0, C + 10 * MS);
+    assert_eq!(bag.1.cmd_source(), AirbagStageCmdCmdSource::Reference);
+    let st = b.status_frames();
+    assert!(st.iter().all(|(_, s)| s.fault_lut() && s.lut_id() == 0));
+}
+
+#[test]
+fn low_closing_speed_never_fires_the_airbag_but_the_belt_follows_the_reference() {
+    let mut b = Bench::new(Some(test_lut()));
+    // 4 m/s against 1600 kg (conservative): EBS = 4·1600/3385·3.6 = 6.8 km/h < 20 km/h.
+    // 6 g: Δv 0.0588 m/s per ms → ≥ 0.5 m/s at the 9th sample (C + 8 ms).
+    run_scenario(&mut b, C + 100 * MS, T0 + 200 * MS, C, 4.0, C, Some(C), 6.0);
+    assert_eq!(b.first_mode(EcuMode::PreCrash), None);
+    assert_eq!(b.first_mode(EcuMode::Crash), Some(C + 8 * MS));
+    assert!(b
+        .airbag_frames()
+        .iter()
+        .all(|(_, f)| f.fire() == AirbagStageCmdFire::NoFire));
+    let last = b.airbag_frames().last().unwrap().1;
+    assert_eq!(last.stage(), AirbagStageCmdStage::NoStage);
+    let belt = b
+        .belt_frames()
+        .into_iter()
+        .find(|(_, f)| f.pretensioner_cmd() == BeltLimiterCmdPretensionerCmd::Fire)
+        .expect("belt fires per reference");
+    assert_eq!(belt.0, C + 10 * MS);
+    assert_eq!(belt.1.load_limiter_level(), 8.5);
+}
+
+#[test]
+fn nan_object_fields_degrade_until_a_valid_sample_arrives() {
+    let mut b = Bench::new(Some(test_lut()));
+    run_scenario(&mut b, T0 + 200 * MS, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    let mut o = cycle_support::object(b.now, f32::NAN, 1500.0, 100.0);
+    o.distance_m = f32::INFINITY;
+    b.io.objects.push_back(o);
+    let t_bad = b.now;
+    b.step();
+    assert_eq!(b.mode_at(t_bad), EcuMode::Degraded as u8);
+    assert_ne!(
+        b.io.diagnostics.last().unwrap().degraded_reasons & degraded::OBJECT_INVALID,
+        0
+    );
+    let end = b.now + 30 * MS;
+    run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    assert_eq!(b.ecu.phase(), Phase::Monitoring);
+}

@@ -1,0 +1,290 @@
+//! Shared helpers of the cycle tests: a small LUT with LINEAR cells (multilinear
+//! interpolation reproduces a linear function exactly, so the expected settings are closed
+//! form), a test reference restraint, E2E-sealed input frames and a 1 kHz simulated bench.
+#![allow(dead_code)]
+
+use bus::codec::{
+    EgoVehicleStateBrakeState, OccupantClassificationBeltBuckle,
+    OccupantClassificationOccupantClass,
+};
+use bus::{E2eProtector, EgoVehicleState, OccupantClassification};
+use diagram::{AirbagThresholds, Axes, BuildInfo, Cell, Diagram, EgoVehicle, Header};
+use ecu::cycle::{CycleConfig, RestraintCycle};
+use ecu::runtime::{Activity, CanFrame, CycleInfo, SimIo};
+use ipc::{CrashAccelSample, ObjectState, VALID};
+use physics::reference::ReferenceSettings;
+
+pub const MS: u64 = 1_000_000;
+
+/// Linear cell functions of (closing speed km/h, opponent kg): the oracle.
+pub fn belt_kn(v_kph: f64, m_kg: f64) -> f64 {
+    0.001 * m_kg + 0.05 * v_kph
+}
+pub fn airbag_kn(_v_kph: f64, m_kg: f64) -> f64 {
+    0.002 * m_kg
+}
+pub fn pret_ms(v_kph: f64, _m_kg: f64) -> f64 {
+    -0.5 * v_kph
+}
+pub fn airbag_ms(v_kph: f64, _m_kg: f64) -> f64 {
+    5.0 + 0.1 * v_kph
+}
+
+pub fn test_lut() -> Diagram {
+    let header = Header {
+        ego: EgoVehicle {
+            mass_kg: 1785.0,
+            class: 4,
+            description: "test".into(),
+        },
+        build: BuildInfo::default(),
+        airbag_thresholds: AirbagThresholds::DEFAULT,
+    };
+    let axes = Axes::new(
+        vec![40.0, 70.0, 108.0],
+        vec![800.0, 1500.0, 3000.0],
+        vec![30.0, 75.0, 125.0],
+        vec![200.0, 300.0, 450.0],
+    );
+    Diagram::from_fn(header, axes, |p| {
+        let v = f64::from(p.query.closing_speed_kph);
+        let m = f64::from(p.query.opponent_mass_kg);
+        Cell {
+            belt_limiter_kn: belt_kn(v, m) as f32,
+            airbag_level_kn: airbag_kn(v, m) as f32,
+            pretensioner_time_ms: pret_ms(v, m) as f32,
+            airbag_time_ms: airbag_ms(v, m) as f32,
+            a_max_g: 30.0,
+            a_mean_g: 20.0,
+            excursion_mm: 150.0,
+            bottoming_out: 0.0,
+            a_ideal_g: 15.0,
+        }
+    })
+    .expect("test LUT is valid")
+}
+
+/// The reference restraint of the tests (conventional: both fire 10 ms after contact).
+pub const REFERENCE: ReferenceSettings = ReferenceSettings {
+    belt_limiter_kn: 8.5,
+    airbag_level_kn: 12.0,
+    pretensioner_time_ms: 10.0,
+    airbag_time_ms: 10.0,
+};
+
+/// Simulated bench at 1 kHz with scripted CAN inputs.
+pub struct Bench {
+    pub ecu: RestraintCycle,
+    pub io: SimIo,
+    pub now: u64,
+    pub cycle: u64,
+    pub tx: E2eProtector,
+    pub send_vehicle: bool,
+    pub send_occupant: bool,
+    pub occupant_mass_kg: f32,
+    pub chest_mm: u16,
+    pub buckle: OccupantClassificationBeltBuckle,
+    /// (cycle index, now) of every step, aligned with `io.diagnostics`.
+    pub step_times: Vec<u64>,
+    /// (send time, frame) of every frame sent.
+    pub sent: Vec<(u64, CanFrame)>,
+}
+
+pub const T0: u64 = 10_000 * MS;
+
+impl Bench {
+    pub fn new(lut: Option<Diagram>) -> Self {
+        Self::with_config(CycleConfig::default(), lut)
+    }
+
+    pub fn with_config(cfg: CycleConfig, lut: Option<Diagram>) -> Self {
+        let (ecu, _) = RestraintCycle::new(cfg, lut, &REFERENCE).expect("valid config");
+        Self {
+            ecu,
+            io: SimIo::new(),
+            now: T0,
+            cycle: 0,
+            tx: E2eProtector::new(),
+            send_vehicle: true,
+            send_occupant: true,
+            occupant_mass_kg: 75.0,
+            chest_mm: 300,
+            buckle: OccupantClassificationBeltBuckle::Buckled,
+            step_times: Vec::new(),
+            sent: Vec::new(),
+        }
+    }
+
+    pub fn vehicle_frame(&mut self, speed_mps: f32) -> CanFrame {
+        let m =
+            EgoVehicleState::encode(EgoVehicleStateBrakeState::Released, speed_mps, 0.0).unwrap();
+        to_can(self.tx.seal(m))
+    }
+
+    pub fn occupant_frame(&mut self) -> CanFrame {
+        let m = OccupantClassification::encode(
+            self.buckle,
+            OccupantClassificationOccupantClass::MidAdult,
+            90,
+            self.occupant_mass_kg,
+            self.chest_mm,
+            150,
+        )
+        .unwrap();
+        to_can(self.tx.seal(m))
+    }
+
+    /// One 1 ms cycle; CAN inputs at their DBC rates (10 ms / 100 ms).
+    pub fn step(&mut self) {
+        let ms = (self.now - T0) / MS;
+        if self.send_vehicle && ms % 10 == 0 {
+            let f = self.vehicle_frame(15.0);
+            self.io.can_rx.push_back(f);
+        }
+        if self.send_occupant && ms % 100 == 0 {
+            let f = self.occupant_frame();
+            self.io.can_rx.push_back(f);
+        }
+        let info = CycleInfo {
+            cycle: self.cycle,
+            slot: self.cycle,
+            period_ns: MS,
+            deadline_ns: self.now,
+            now_ns: self.now,
+            ..CycleInfo::default()
+        };
+        let before = self.io.can_tx.len();
+        self.ecu.step(&info, &mut self.io);
+        for f in &self.io.can_tx[before..] {
+            self.sent.push((self.now, *f));
+        }
+        self.step_times.push(self.now);
+        self.now += MS;
+        self.cycle += 1;
+    }
+
+    pub fn run_ms(&mut self, n: u64) {
+        for _ in 0..n {
+            self.step();
+        }
+    }
+
+    /// Runs until `t` (exclusive).
+    pub fn run_until(&mut self, t: u64) {
+        while self.now < t {
+            self.step();
+        }
+    }
+
+    /// Pushes an object measured now on a straight constant-speed approach that reaches us
+    /// at `contact_ns`.
+    pub fn push_approach(&mut self, contact_ns: u64, closing_mps: f32, opp_kg: f32, sigma_kg: f32) {
+        let ttc_s = (contact_ns as f64 - self.now as f64) * 1e-9;
+        let mut o = object(self.now, closing_mps, opp_kg, sigma_kg);
+        o.distance_m = (ttc_s * f64::from(closing_mps)) as f32;
+        self.io.objects.push_back(o);
+    }
+
+    /// Pushes one 1-sample accelerometer batch measured at `t_ns`.
+    pub fn push_accel(&mut self, t_ns: u64, accel_mps2: f32) {
+        let mut a = CrashAccelSample::EMPTY;
+        a.first_timestamp_ns = t_ns;
+        a.sample_period_ns = 1_000_000;
+        a.count = 1;
+        a.accel_mps2[0] = accel_mps2;
+        a.sequence = t_ns / MS;
+        self.io.accel.push_back(a);
+    }
+
+    pub fn decoded(&self) -> Vec<(u64, bus::Messages)> {
+        self.sent
+            .iter()
+            .map(|(t, f)| {
+                (
+                    *t,
+                    bus::decode(f.id, f.payload()).expect("ECU frames decode"),
+                )
+            })
+            .collect()
+    }
+
+    pub fn belt_frames(&self) -> Vec<(u64, bus::BeltLimiterCmd)> {
+        self.decoded()
+            .into_iter()
+            .filter_map(|(t, m)| match m {
+                bus::Messages::BeltLimiterCmd(b) => Some((t, b)),
+                _ => None,
+            })
+            .collect()
+    }
+
+    pub fn airbag_frames(&self) -> Vec<(u64, bus::AirbagStageCmd)> {
+        self.decoded()
+            .into_iter()
+            .filter_map(|(t, m)| match m {
+                bus::Messages::AirbagStageCmd(b) => Some((t, b)),
+                _ => None,
+            })
+            .collect()
+    }
+
+    pub fn status_frames(&self) -> Vec<(u64, bus::EcuStatus)> {
+        self.decoded()
+            .into_iter()
+            .filter_map(|(t, m)| match m {
+                bus::Messages::EcuStatus(b) => Some((t, b)),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Mode byte of the diagnostics record published at time `t`.
+    pub fn mode_at(&self, t: u64) -> u8 {
+        let i = self
+            .step_times
+            .iter()
+            .position(|&x| x == t)
+            .expect("step at t");
+        self.io.diagnostics[i].mode
+    }
+
+    /// First step time at which the diagnostics mode equals `mode`.
+    pub fn first_mode(&self, mode: ipc::EcuMode) -> Option<u64> {
+        self.io
+            .diagnostics
+            .iter()
+            .zip(&self.step_times)
+            .find(|(d, _)| d.mode == mode as u8)
+            .map(|(_, t)| *t)
+    }
+}
+
+pub fn object(now: u64, closing_mps: f32, opp_kg: f32, sigma_kg: f32) -> ObjectState {
+    ObjectState {
+        timestamp_ns: now,
+        sequence: now / MS,
+        distance_m: 50.0,
+        closing_speed_mps: closing_mps,
+        relative_accel_mps2: 0.0,
+        opponent_mass_kg: opp_kg,
+        opponent_mass_sigma_kg: sigma_kg,
+        confidence: 0.95,
+        object_id: 7,
+        valid: VALID,
+        _reserved: [0; 3],
+    }
+}
+
+pub fn to_can(r: bus::RawFrame) -> CanFrame {
+    CanFrame {
+        id: r.id,
+        extended: false,
+        len: r.len,
+        data: r.data,
+    }
+}
+
+/// Rounds to the DBC step (0.05 kN / 0.1 ms) like the encoder does.
+pub fn q(v: f64, step: f64) -> f32 {
+    ((v / step).round() * step) as f32
+}
