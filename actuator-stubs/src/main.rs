@@ -1,2 +1,331 @@
-//! Belt retractor and airbag module stubs: validate, log, act on and judge commands.
-fn main() {}
+//! `actuator-stubs --scenario FILE --can vcan0 --out DIR`: the belt retractor and airbag modules
+//! on the bus (see README.md). Receives the ECU's commands with kernel filters, checks E2E,
+//! logs every frame with CLOCK_MONOTONIC receive times (DIR/commands.jsonl), acts at the
+//! commanded times, and at the end (bench truth `done`, timeout or SIGTERM) judges the occupant
+//! outcome of what was commanded: DIR/report.json + DIR/outcome.png.
+
+use actuator_stubs::commands::{self, CommandRecord, Modules};
+use actuator_stubs::outcome::{self, judge, no_worse, reference_as_fired};
+use actuator_stubs::plot;
+use actuator_stubs::report::{ecu_mode_name, Outcome, Report, TimedAction, TrueCrash};
+use anyhow::{Context, Result};
+use bus::socket::BusSocket;
+use clap::Parser;
+use ipc::{BenchTruth, BenchTruthSubscriber, ServiceNames};
+use physics::OccupantInput;
+use sensor_feeds::{monotonic_ns, Scenario, Truth};
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Belt retractor + airbag module stubs: validate, log, act on and judge commands.
+#[derive(Parser, Debug)]
+#[command(name = "actuator-stubs", version)]
+struct Cli {
+    /// Scenario file (the same the sensor feeds play).
+    #[arg(long)]
+    scenario: PathBuf,
+    /// CAN interface.
+    #[arg(long, default_value = "vcan0")]
+    can: String,
+    /// Output folder (commands.jsonl, report.json, outcome.png).
+    #[arg(long)]
+    out: PathBuf,
+    /// Reference restraint file (default: the built-in data/reference-restraint.toml).
+    #[arg(long)]
+    reference: Option<PathBuf>,
+    /// Give up waiting for the bench truth's `done` after this many seconds.
+    #[arg(long, default_value_t = 60.0)]
+    timeout_s: f64,
+    /// iceoryx2 service prefix (must match the sensor feeds').
+    #[arg(long, default_value = ipc::DEFAULT_SERVICE_PREFIX)]
+    service_prefix: String,
+}
+
+/// Ids the modules listen to (kernel filter): airbag cmd + auth, belt cmd + auth, ECU status.
+const RX_IDS: [u32; 5] = [0x030, 0x031, 0x040, 0x041, 0x110];
+
+static STOP: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_signal(_: nix::libc::c_int) {
+    STOP.store(true, Ordering::Relaxed);
+}
+
+fn install_stop_signals() -> Result<()> {
+    use nix::sys::signal::{sigaction, SaFlags, SigAction, SigHandler, SigSet, Signal};
+    let action = SigAction::new(
+        SigHandler::Handler(on_signal),
+        SaFlags::empty(),
+        SigSet::empty(),
+    );
+    for sig in [Signal::SIGTERM, Signal::SIGINT] {
+        // SAFETY: the handler only performs an atomic store.
+        unsafe { sigaction(sig, &action) }.context("installing signal handler")?;
+    }
+    Ok(())
+}
+
+fn main() -> std::process::ExitCode {
+    let cli = Cli::parse();
+    match run(&cli) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("actuator-stubs: error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+/// Offset CLOCK_REALTIME − CLOCK_MONOTONIC [ns], to map kernel (realtime) receive stamps.
+fn realtime_minus_monotonic_ns() -> i128 {
+    let rt = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos() as i128);
+    rt - monotonic_ns() as i128
+}
+
+fn run(cli: &Cli) -> Result<()> {
+    let scenario = Scenario::load(&cli.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let reference = match &cli.reference {
+        Some(p) => lut::reference::ReferenceRestraint::load(p),
+        None => lut::reference::ReferenceRestraint::builtin(),
+    }
+    .map_err(|e| anyhow::anyhow!("reference restraint: {e}"))?;
+    std::fs::create_dir_all(&cli.out).with_context(|| format!("creating {}", cli.out.display()))?;
+    install_stop_signals()?;
+    let mut sock = BusSocket::open(&cli.can, &RX_IDS).with_context(|| {
+        format!(
+            "CAN interface {} (bring it up with ./vcan-setup.sh)",
+            cli.can
+        )
+    })?;
+    let names = ServiceNames::with_prefix(&cli.service_prefix);
+    let (node, _) = ipc::create_node(&format!("actuator-stubs-{}", std::process::id()), false)?;
+    let mut truth_sub = BenchTruthSubscriber::new(&node, &names)?;
+    let log_path = cli.out.join("commands.jsonl");
+    let mut log = std::io::BufWriter::new(
+        std::fs::File::create(&log_path)
+            .with_context(|| format!("creating {}", log_path.display()))?,
+    );
+    let mut checker = bus::E2eChecker::new();
+    let mut modules = Modules::default();
+    let mut frames: BTreeMap<String, u64> = BTreeMap::new();
+    let mut accepted = 0u64;
+    let mut truth = BenchTruth::EMPTY;
+    let started = monotonic_ns();
+    let deadline = started + (cli.timeout_s * 1e9) as u64;
+    eprintln!(
+        "actuator-stubs: listening on {} for {}",
+        cli.can, scenario.name
+    );
+    let stop_reason = loop {
+        if STOP.load(Ordering::Relaxed) {
+            break "signal";
+        }
+        if monotonic_ns() > deadline {
+            break "timeout";
+        }
+        let mut got_any = false;
+        while let Some(rx) = sock.recv().context("CAN receive")? {
+            got_any = true;
+            let read_mono = monotonic_ns();
+            // Kernel arrival time mapped onto CLOCK_MONOTONIC (more exact than the read time);
+            // fall back to the read time if absent or implausible.
+            let rx_ns = rx
+                .kernel_time
+                .and_then(|k| k.duration_since(std::time::UNIX_EPOCH).ok())
+                .map(|d| d.as_nanos() as i128 - realtime_minus_monotonic_ns())
+                .filter(|k| {
+                    *k > 0 && *k <= read_mono as i128 && read_mono as i128 - *k < 1_000_000_000
+                })
+                .map_or(read_mono, |k| k as u64);
+            let f = rx.frame;
+            let name = bus::message_info(f.id)
+                .map_or("unknown", |i| i.name)
+                .to_owned();
+            *frames.entry(name.clone()).or_default() += 1;
+            let (e2e, decoded) = match checker.check_frame(&f) {
+                Ok(msg) => {
+                    accepted += 1;
+                    let d = commands::decode(&msg);
+                    modules.apply(rx_ns, &d);
+                    ("ok".to_owned(), Some(d))
+                }
+                Err(e) => (e.reason().name().to_owned(), None),
+            };
+            let rec = CommandRecord {
+                rx_mono_ns: rx_ns,
+                id: f.id,
+                message: name,
+                data_hex: f.payload().iter().map(|b| format!("{b:02x}")).collect(),
+                e2e,
+                decoded,
+            };
+            serde_json::to_writer(&mut log, &rec)?;
+            log.write_all(b"\n")?;
+        }
+        if let Some(t) = truth_sub.latest() {
+            truth = t;
+            if truth.is_done() {
+                // Drain what is still queued, then finish.
+                break "done";
+            }
+        }
+        if !got_any {
+            std::thread::sleep(std::time::Duration::from_micros(200));
+        }
+    };
+    log.flush()?;
+    let report = build_report(
+        cli,
+        &scenario,
+        &reference,
+        &truth,
+        &modules,
+        frames,
+        accepted,
+        &checker,
+        stop_reason,
+    )?;
+    let path = cli.out.join("report.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&report)?)
+        .with_context(|| format!("writing {}", path.display()))?;
+    eprintln!(
+        "actuator-stubs: {} ({}), report {}",
+        scenario.name,
+        stop_reason,
+        path.display()
+    );
+    Ok(())
+}
+
+#[allow(clippy::too_many_arguments)]
+fn build_report(
+    cli: &Cli,
+    scenario: &Scenario,
+    reference: &lut::reference::ReferenceRestraint,
+    truth: &BenchTruth,
+    modules: &Modules,
+    frames: BTreeMap<String, u64>,
+    accepted: u64,
+    checker: &bus::E2eChecker,
+    stop_reason: &str,
+) -> Result<Report> {
+    let contact_ns = truth.contact_ns;
+    let rel_ms = |t: u64| (contact_ns != 0).then_some((t as f64 - contact_ns as f64) * 1e-6);
+    let since_start_s =
+        |t: u64| (truth.start_ns != 0).then_some((t as f64 - truth.start_ns as f64) * 1e-9);
+    let e2e_rejected = bus::RejectReason::ALL
+        .iter()
+        .map(|r| (r.name().to_owned(), checker.stats().rejected_for(*r)))
+        .filter(|(_, n)| *n > 0)
+        .collect();
+    let pre = outcome::commanded(
+        modules,
+        if contact_ns != 0 {
+            contact_ns
+        } else {
+            u64::MAX
+        },
+    );
+    let mut report = Report {
+        scenario: scenario.name.clone(),
+        stop_reason: stop_reason.to_owned(),
+        start_ns: truth.start_ns,
+        contact_ns,
+        true_crash: None,
+        frames,
+        e2e_accepted: accepted,
+        e2e_rejected,
+        actions: modules
+            .actions
+            .iter()
+            .map(|a| TimedAction {
+                action: a.clone(),
+                t_ms: rel_ms(a.t_ns),
+            })
+            .collect(),
+        first_armed_ms: modules.first_armed_ns.and_then(rel_ms),
+        first_reference_cmd_ms: modules.first_reference_cmd_ns.and_then(rel_ms),
+        first_reference_cmd_s: modules.first_reference_cmd_ns.and_then(since_start_s),
+        ecu_modes: modules
+            .ecu_modes
+            .iter()
+            .map(|(t, m)| {
+                (
+                    rel_ms(*t)
+                        .or_else(|| since_start_s(*t).map(|s| s * 1e3))
+                        .unwrap_or(0.0),
+                    ecu_mode_name(*m).to_owned(),
+                )
+            })
+            .collect(),
+        pretensioner_before_contact: contact_ns != 0 && pre.pretensioner_s.is_some_and(|t| t < 0.0),
+        pretensioner_released: modules.action("pretensioner_release").is_some(),
+        airbag_fired: modules.airbag_fired,
+        outcome: None,
+        plot: None,
+    };
+    if contact_ns == 0 {
+        return Ok(report);
+    }
+    let t = Truth::new(scenario).map_err(|e| anyhow::anyhow!(e))?;
+    let Some(crash) = t.collision else {
+        anyhow::bail!("bench truth reports a contact but the scenario's true physics has none");
+    };
+    report.true_crash = Some(TrueCrash {
+        closing_speed_kph: t.closing_speed_at_contact_mps() * 3.6,
+        delta_v_kph: crash.vehicle.delta_v_mps * 3.6,
+        a_max_g: physics::mps2_to_g(crash.vehicle.a_max_mps2),
+        a_mean_g: physics::mps2_to_g(crash.vehicle.a_mean_mps2),
+        crush_mm: crash.vehicle.crush_m * 1e3,
+    });
+    let pulse = t.pulse.ego_pulse();
+    let occ = OccupantInput {
+        mass_kg: scenario.occupant.mass_kg,
+        chest_to_wheel_m: scenario.occupant.chest_to_wheel_mm * 1e-3,
+        belted: scenario.occupant.belted,
+    };
+    let ref_set = reference.settings();
+    let commanded = outcome::commanded(modules, contact_ns);
+    let (adaptive, out_a) =
+        judge(&pulse, &occ, &commanded.settings(&ref_set)).map_err(|e| anyhow::anyhow!(e))?;
+    let (refj, _) = judge(
+        &pulse,
+        &occ,
+        &reference_as_fired(&ref_set, crash.vehicle.delta_v_mps),
+    )
+    .map_err(|e| anyhow::anyhow!(e))?;
+    let sum_a = adaptive.a_max_g + adaptive.a_mean_g;
+    let sum_r = refj.a_max_g + refj.a_mean_g;
+    let png = cli.out.join("outcome.png");
+    let pulse_g: Vec<f64> = pulse
+        .accel_mps2
+        .iter()
+        .map(|a| -physics::mps2_to_g(*a))
+        .collect();
+    match plot::draw(
+        &png,
+        &scenario.name,
+        &adaptive,
+        &refj,
+        &pulse_g,
+        pulse.step_s * 1e3,
+    ) {
+        Ok(()) => report.plot = Some("outcome.png".into()),
+        Err(e) => eprintln!("actuator-stubs: warning: {e}"),
+    }
+    report.outcome = Some(Outcome {
+        adaptive_no_worse: no_worse(&adaptive, &refj),
+        change_pct: if sum_r > 0.0 {
+            (sum_a / sum_r - 1.0) * 100.0
+        } else {
+            0.0
+        },
+        ideal_g: physics::mps2_to_g(out_a.ideal_decel_mps2),
+        adaptive,
+        reference: refj,
+    });
+    Ok(report)
+}

@@ -37,8 +37,8 @@ pub use collision::{
 };
 pub use error::PhysicsError;
 pub use occupant::{
-    ideal_constant_force_decel_mps2, simulate_occupant, OccupantInput, OccupantOutcome,
-    RestraintHardware, RestraintSettings,
+    ideal_constant_force_decel_mps2, simulate_occupant, simulate_occupant_observed, OccupantInput,
+    OccupantOutcome, RestraintHardware, RestraintSettings,
 };
 pub use stiffness::{class_for_mass_kg, CombinedSpring, Curve, MassClass};
 

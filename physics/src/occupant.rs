@@ -222,6 +222,19 @@ pub fn simulate_occupant(
     set: &RestraintSettings,
     hw: &RestraintHardware,
 ) -> Result<OccupantOutcome, PhysicsError> {
+    simulate_occupant_observed(pulse, occ, set, hw, |_, _, _| {})
+}
+
+/// [`simulate_occupant`] that also hands every step's `(t_s, excursion_m, decel_mps2)` to
+/// `observe` (time histories for plots, e.g. the bench's outcome report); the no-op observer
+/// of [`simulate_occupant`] compiles away.
+pub fn simulate_occupant_observed(
+    pulse: &CompartmentPulse<'_>,
+    occ: &OccupantInput,
+    set: &RestraintSettings,
+    hw: &RestraintHardware,
+    mut observe: impl FnMut(f64, f64, f64),
+) -> Result<OccupantOutcome, PhysicsError> {
     validate(pulse, occ, set, hw)?;
     let dt = pulse.step_s;
     let m = occ.mass_kg;
@@ -332,6 +345,7 @@ pub fn simulate_occupant(
         out.max_belt_force_n = out.max_belt_force_n.max(f_belt);
         out.max_airbag_force_n = out.max_airbag_force_n.max(f_bag);
 
+        observe(t, x, decel);
         // Semi-implicit Euler.
         v += (-a_c - decel) * dt;
         x += v * dt;

@@ -1,0 +1,270 @@
+//! The judge: occupant outcome of what was actually commanded, against the TRUE crash pulse,
+//! beside the conventional reference restraint and the ideal constant-force bound.
+//!
+//! Commanded restraint (times relative to the TRUE contact, from receive timestamps):
+//! * pretensioner: time of the fire command if the pretensioner was still fired at contact
+//!   (a release before contact undoes a pre-crash fire) or fired after contact; never fired →
+//!   no pretensioning (slack stays);
+//! * load limiter: the level in force 10 ms after contact (the belt reaches its limit later
+//!   than that; commands after it are too late to change the hardware); no belt command at all
+//!   → the reference level (the passive retractor's built-in limiter);
+//! * airbag: receive time and level of the first armed fire command; none → no airbag.
+//!
+//! Reference restraint: `data/reference-restraint.toml` levels and times, fired as a
+//! conventional ECU would: below [`REFERENCE_NO_FIRE_DELTA_V_KPH`] of true ego Δv it does not
+//! fire the airbag (no-fire requirement).
+
+use physics::{OccupantInput, OccupantOutcome, RestraintHardware, RestraintSettings};
+use serde::{Deserialize, Serialize};
+
+/// Conventional no-fire limit on the ego's true velocity change [km/h] (SPEC: below about
+/// 20 km/h restraints must not fire).
+pub const REFERENCE_NO_FIRE_DELTA_V_KPH: f64 = 20.0;
+
+/// Hand-over instant of the load-limiter level after contact [s].
+pub const LIMITER_LATCH_AFTER_CONTACT_S: f64 = 0.010;
+
+/// "Never fired" trigger time [s after contact]: beyond every simulation.
+pub const NEVER_S: f64 = 100.0;
+
+/// Tolerance of the "adaptive no worse than reference" verdict on a_max + a_mean: command
+/// receive times carry scheduling jitter of a few ms (and UML's emulated timers), which moves
+/// the outcome by a few per cent even for identical settings.
+pub const NO_WORSE_TOLERANCE: f64 = 0.05;
+
+/// One restraint's occupant outcome and time history.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Judged {
+    /// Settings used (SI; times relative to true contact).
+    pub load_limiter_kn: f64,
+    /// Airbag level [kN] (0 = not fired).
+    pub airbag_level_kn: f64,
+    /// Pretensioner time [ms after contact] (None = not fired).
+    pub pretensioner_ms: Option<f64>,
+    /// Airbag time [ms after contact] (None = not fired).
+    pub airbag_ms: Option<f64>,
+    /// Peak occupant deceleration [g].
+    pub a_max_g: f64,
+    /// Mean occupant deceleration over the restraint phase [g].
+    pub a_mean_g: f64,
+    /// Maximum forward excursion [mm].
+    pub excursion_mm: f64,
+    /// Available ride-down [mm].
+    pub available_mm: f64,
+    /// Struck through to the wheel/dash.
+    pub bottomed_out: bool,
+    /// Time history: t [ms after contact].
+    #[serde(skip)]
+    pub t_ms: Vec<f64>,
+    /// Time history: occupant deceleration [g].
+    #[serde(skip)]
+    pub decel_g: Vec<f64>,
+    /// Time history: excursion [mm].
+    #[serde(skip)]
+    pub excursion_trace_mm: Vec<f64>,
+}
+
+/// Simulates `set` against `pulse` for `occ`, with its time history.
+pub fn judge(
+    pulse: &physics::CompartmentPulse<'_>,
+    occ: &OccupantInput,
+    set: &RestraintSettings,
+) -> Result<(Judged, OccupantOutcome), String> {
+    let (mut t_ms, mut decel_g, mut exc) = (Vec::new(), Vec::new(), Vec::new());
+    let hw = RestraintHardware::default();
+    let out = physics::simulate_occupant_observed(pulse, occ, set, &hw, |t, x, a| {
+        t_ms.push(t * 1e3);
+        decel_g.push(physics::mps2_to_g(a));
+        exc.push(x * 1e3);
+    })
+    .map_err(|e| format!("occupant simulation: {e:?}"))?;
+    let fired = |t: f64, on: bool| (on && t < NEVER_S).then_some(t * 1e3);
+    Ok((
+        Judged {
+            load_limiter_kn: set.load_limiter_n * 1e-3,
+            airbag_level_kn: set.airbag_force_n * 1e-3,
+            pretensioner_ms: fired(set.pretensioner_time_s, occ.belted),
+            airbag_ms: fired(set.airbag_time_s, set.airbag_force_n > 0.0),
+            a_max_g: physics::mps2_to_g(out.max_decel_mps2),
+            a_mean_g: physics::mps2_to_g(out.mean_decel_mps2),
+            excursion_mm: out.max_excursion_m * 1e3,
+            available_mm: out.available_ride_down_m * 1e3,
+            bottomed_out: out.bottomed_out,
+            t_ms,
+            decel_g,
+            excursion_trace_mm: exc,
+        },
+        out,
+    ))
+}
+
+/// Inputs of the commanded restraint, relative to the true contact.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Commanded {
+    /// Pretensioner fire time [s after contact], `None` = not fired (or released before contact).
+    pub pretensioner_s: Option<f64>,
+    /// Load-limiter level [kN], `None` = no belt command received.
+    pub load_limiter_kn: Option<f64>,
+    /// Airbag fire time [s after contact] and level [kN].
+    pub airbag: Option<(f64, f64)>,
+}
+
+impl Commanded {
+    /// Settings for the physics; a missing limiter level falls back to `reference`'s.
+    pub fn settings(&self, reference: &RestraintSettings) -> RestraintSettings {
+        RestraintSettings {
+            load_limiter_n: self
+                .load_limiter_kn
+                .map_or(reference.load_limiter_n, |k| k * 1e3),
+            airbag_force_n: self.airbag.map_or(0.0, |a| a.1 * 1e3),
+            pretensioner_time_s: self.pretensioner_s.unwrap_or(NEVER_S),
+            airbag_time_s: self.airbag.map_or(NEVER_S, |a| a.0),
+        }
+    }
+}
+
+/// Derives [`Commanded`] from the module state machines, the true contact [ns].
+pub fn commanded(m: &crate::commands::Modules, contact_ns: u64) -> Commanded {
+    let rel = |t_ns: u64| (t_ns as f64 - contact_ns as f64) * 1e-9;
+    // Pretensioner: the last fire that was not undone by a release before contact.
+    let mut pret: Option<u64> = None;
+    for a in &m.actions {
+        match a.what.as_str() {
+            "pretensioner_fire" if pret.is_none() => pret = Some(a.t_ns),
+            "pretensioner_release" if a.t_ns <= contact_ns => pret = None,
+            _ => {}
+        }
+    }
+    let latch_ns = contact_ns + (LIMITER_LATCH_AFTER_CONTACT_S * 1e9) as u64;
+    Commanded {
+        pretensioner_s: pret.map(rel),
+        load_limiter_kn: m.limiter_at(latch_ns),
+        airbag: m.action("airbag_fire").map(|a| (rel(a.t_ns), a.level_kn)),
+    }
+}
+
+/// Reference settings as fired by a conventional ECU for a crash of true ego Δv.
+pub fn reference_as_fired(
+    reference: &RestraintSettings,
+    ego_delta_v_mps: f64,
+) -> RestraintSettings {
+    if ego_delta_v_mps * 3.6 < REFERENCE_NO_FIRE_DELTA_V_KPH {
+        RestraintSettings {
+            airbag_force_n: 0.0,
+            airbag_time_s: NEVER_S,
+            ..*reference
+        }
+    } else {
+        *reference
+    }
+}
+
+/// True when the adaptive outcome is no worse than the reference: no bottoming-out the
+/// reference avoided, and a_max + a_mean within [`NO_WORSE_TOLERANCE`].
+pub fn no_worse(adaptive: &Judged, reference: &Judged) -> bool {
+    if adaptive.bottomed_out && !reference.bottomed_out {
+        return false;
+    }
+    adaptive.a_max_g + adaptive.a_mean_g
+        <= (reference.a_max_g + reference.a_mean_g) * (1.0 + NO_WORSE_TOLERANCE)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::commands::{Decoded, Modules};
+
+    fn belt(p: &str, kn: f64) -> Decoded {
+        Decoded::Belt {
+            pretensioner: p.into(),
+            source: "adaptive".into(),
+            load_limiter_kn: kn,
+            pretensioner_fire_time_ms: 0.0,
+        }
+    }
+
+    #[test]
+    fn release_before_contact_undoes_the_pre_crash_fire() {
+        let c = 1_000_000_000u64;
+        let mut m = Modules::default();
+        m.apply(c - 50_000_000, &belt("fire", 3.0));
+        m.apply(c - 20_000_000, &belt("release", 3.0));
+        assert_eq!(commanded(&m, c).pretensioner_s, None);
+        m.apply(c + 5_000_000, &belt("fire", 5.0));
+        let k = commanded(&m, c);
+        assert!((k.pretensioner_s.unwrap() - 0.005).abs() < 1e-9);
+        assert_eq!(k.load_limiter_kn, Some(5.0));
+        assert_eq!(k.airbag, None);
+    }
+
+    #[test]
+    fn pre_crash_fire_counts_with_negative_time() {
+        let c = 2_000_000_000u64;
+        let mut m = Modules::default();
+        m.apply(c - 40_000_000, &belt("fire", 4.0));
+        m.apply(
+            c + 12_000_000,
+            &Decoded::Airbag {
+                armed: true,
+                fire: true,
+                source: "adaptive".into(),
+                stage: 1,
+                force_level_kn: 7.0,
+                fire_time_ms: 12.0,
+            },
+        );
+        let k = commanded(&m, c);
+        assert!((k.pretensioner_s.unwrap() + 0.040).abs() < 1e-9);
+        let (t, l) = k.airbag.unwrap();
+        assert!((t - 0.012).abs() < 1e-9 && l == 7.0);
+    }
+
+    #[test]
+    fn reference_does_not_fire_below_the_no_fire_limit() {
+        let r = RestraintSettings {
+            load_limiter_n: 4e3,
+            airbag_force_n: 6e3,
+            pretensioner_time_s: 0.01,
+            airbag_time_s: 0.01,
+        };
+        assert_eq!(reference_as_fired(&r, 19.0 / 3.6).airbag_force_n, 0.0);
+        assert_eq!(reference_as_fired(&r, 21.0 / 3.6).airbag_force_n, 6e3);
+    }
+
+    #[test]
+    fn no_airbag_and_no_belt_strikes_through_in_a_real_crash() {
+        // Closed-form sanity of the judge: a 40 g·(0.1 s) square pulse (Δv 39 m/s… capped):
+        // use a 20 g, 80 ms square pulse (Δv 15.7 m/s); an unrestrained, unbelted occupant
+        // travels far beyond 240 mm of ride-down and bottoms out.
+        let step = 1e-4;
+        let pulse: Vec<f64> = (0..800)
+            .map(|_| -20.0 * physics::defaults::STANDARD_GRAVITY_MPS2)
+            .collect();
+        let p = physics::CompartmentPulse {
+            step_s: step,
+            accel_mps2: &pulse,
+        };
+        let occ = OccupantInput {
+            mass_kg: 75.0,
+            chest_to_wheel_m: 0.3,
+            belted: false,
+        };
+        let none = Commanded {
+            pretensioner_s: None,
+            load_limiter_kn: None,
+            airbag: None,
+        };
+        let r = RestraintSettings {
+            load_limiter_n: 4e3,
+            airbag_force_n: 6e3,
+            pretensioner_time_s: 0.01,
+            airbag_time_s: 0.01,
+        };
+        let (j, _) = judge(&p, &occ, &none.settings(&r)).unwrap();
+        assert!(j.bottomed_out && j.airbag_ms.is_none());
+        let (jr, _) = judge(&p, &occ, &r).unwrap();
+        assert!(!no_worse(&j, &jr) || jr.bottomed_out);
+        assert_eq!(j.t_ms.len(), j.decel_g.len());
+        assert!(!j.t_ms.is_empty());
+    }
+}

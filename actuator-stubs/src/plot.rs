@@ -1,0 +1,134 @@
+//! Outcome picture: occupant deceleration and forward excursion over time, adaptive vs
+//! reference, with the compartment pulse and the available ride-down for context.
+
+use crate::outcome::Judged;
+use plotters::prelude::*;
+use std::path::Path;
+
+/// Draws the two-panel PNG; `pulse_g` is the compartment deceleration [g] at `pulse_step_ms`.
+pub fn draw(
+    path: &Path,
+    title: &str,
+    adaptive: &Judged,
+    reference: &Judged,
+    pulse_g: &[f64],
+    pulse_step_ms: f64,
+) -> Result<(), String> {
+    let err = |e: &dyn std::fmt::Display| format!("plot {}: {e}", path.display());
+    let root = BitMapBackend::new(path, (1000, 800)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let (top, bottom) = root.split_vertically(400);
+    let t_end = adaptive
+        .t_ms
+        .last()
+        .copied()
+        .unwrap_or(0.0)
+        .max(reference.t_ms.last().copied().unwrap_or(0.0))
+        .max(pulse_g.len() as f64 * pulse_step_ms)
+        .max(10.0);
+    let max_g = adaptive
+        .decel_g
+        .iter()
+        .chain(&reference.decel_g)
+        .chain(pulse_g)
+        .fold(1.0f64, |m, v| if v.is_finite() { m.max(*v) } else { m });
+    let min_g = adaptive
+        .decel_g
+        .iter()
+        .chain(&reference.decel_g)
+        .fold(0.0f64, |m, v| m.min(*v));
+    let mut c = ChartBuilder::on(&top)
+        .caption(
+            format!("{title}: occupant deceleration"),
+            ("sans-serif", 20),
+        )
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(55)
+        .build_cartesian_2d(0.0..t_end, min_g.min(0.0)..max_g * 1.1)
+        .map_err(|e| err(&e))?;
+    c.configure_mesh()
+        .x_desc("time after true contact [ms]")
+        .y_desc("deceleration [g]")
+        .draw()
+        .map_err(|e| err(&e))?;
+    let pulse_series = pulse_g
+        .iter()
+        .enumerate()
+        .map(|(i, g)| (i as f64 * pulse_step_ms, *g));
+    c.draw_series(LineSeries::new(pulse_series, RGBColor(150, 150, 150)))
+        .map_err(|e| err(&e))?
+        .label("compartment (true pulse)")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RGBColor(150, 150, 150)));
+    for (j, name, color) in [
+        (adaptive, "adaptive (as commanded)", BLUE),
+        (reference, "reference restraint", RED),
+    ] {
+        c.draw_series(LineSeries::new(
+            j.t_ms.iter().copied().zip(j.decel_g.iter().copied()),
+            color.stroke_width(2),
+        ))
+        .map_err(|e| err(&e))?
+        .label(format!(
+            "{name}: a_max {:.1} g, a_mean {:.1} g",
+            j.a_max_g, j.a_mean_g
+        ))
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+    }
+    c.configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| err(&e))?;
+
+    let max_mm = adaptive
+        .excursion_trace_mm
+        .iter()
+        .chain(&reference.excursion_trace_mm)
+        .fold(adaptive.available_mm, |m, v| m.max(*v));
+    let mut c = ChartBuilder::on(&bottom)
+        .caption("occupant forward excursion", ("sans-serif", 20))
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(55)
+        .build_cartesian_2d(0.0..t_end, 0.0..max_mm * 1.1)
+        .map_err(|e| err(&e))?;
+    c.configure_mesh()
+        .x_desc("time after true contact [ms]")
+        .y_desc("excursion [mm]")
+        .draw()
+        .map_err(|e| err(&e))?;
+    let avail = adaptive.available_mm;
+    c.draw_series(LineSeries::new(
+        [(0.0, avail), (t_end, avail)],
+        BLACK.stroke_width(1),
+    ))
+    .map_err(|e| err(&e))?
+    .label(format!(
+        "available ride-down {avail:.0} mm (bottoming-out above)"
+    ))
+    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK));
+    for (j, name, color) in [(adaptive, "adaptive", BLUE), (reference, "reference", RED)] {
+        c.draw_series(LineSeries::new(
+            j.t_ms
+                .iter()
+                .copied()
+                .zip(j.excursion_trace_mm.iter().copied()),
+            color.stroke_width(2),
+        ))
+        .map_err(|e| err(&e))?
+        .label(format!(
+            "{name}: max {:.0} mm{}",
+            j.excursion_mm,
+            if j.bottomed_out { " BOTTOMED OUT" } else { "" }
+        ))
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+    }
+    c.configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| err(&e))?;
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}

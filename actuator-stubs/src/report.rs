@@ -1,0 +1,101 @@
+//! `report.json`: what the modules received and did, and the occupant outcome of it.
+//! Times named `*_ms` are relative to the TRUE first contact (negative = before it).
+
+use crate::commands::Action;
+use crate::outcome::Judged;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// The true crash (from the scenario's true physics).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct TrueCrash {
+    /// Closing speed at contact [km/h].
+    pub closing_speed_kph: f64,
+    /// Ego velocity change [km/h].
+    pub delta_v_kph: f64,
+    /// Ego compartment peak deceleration [g].
+    pub a_max_g: f64,
+    /// Ego compartment mean deceleration over contact [g].
+    pub a_mean_g: f64,
+    /// Ego crush [mm].
+    pub crush_mm: f64,
+}
+
+/// An action with its time relative to the true contact.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct TimedAction {
+    /// The action.
+    #[serde(flatten)]
+    pub action: Action,
+    /// Time relative to true contact [ms] (None without contact).
+    pub t_ms: Option<f64>,
+}
+
+/// The outcome comparison (contact only).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Outcome {
+    /// What was actually commanded.
+    pub adaptive: Judged,
+    /// The conventional reference restraint (as a conventional ECU would fire it).
+    pub reference: Judged,
+    /// Ideal constant-force bound a* [g].
+    pub ideal_g: f64,
+    /// Adaptive no worse than reference (see `outcome::no_worse`).
+    pub adaptive_no_worse: bool,
+    /// (a_max + a_mean) adaptive / reference − 1 [%] (negative = better).
+    pub change_pct: f64,
+}
+
+/// The whole report.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Report {
+    /// Scenario name.
+    pub scenario: String,
+    /// Why the stubs stopped: "done" | "timeout" | "signal".
+    pub stop_reason: String,
+    /// CLOCK_MONOTONIC scenario start [ns] (0 if no bench truth was received).
+    pub start_ns: u64,
+    /// CLOCK_MONOTONIC true contact [ns] (0 = none).
+    pub contact_ns: u64,
+    /// True crash, if any.
+    pub true_crash: Option<TrueCrash>,
+    /// Frames received per message name.
+    pub frames: BTreeMap<String, u64>,
+    /// Frames accepted by the E2E checker.
+    pub e2e_accepted: u64,
+    /// Rejections per reason.
+    pub e2e_rejected: BTreeMap<String, u64>,
+    /// Module actions in order.
+    pub actions: Vec<TimedAction>,
+    /// First armed airbag command [ms rel. contact].
+    pub first_armed_ms: Option<f64>,
+    /// First command from the reference restraint (ECU fallback) [ms rel. contact].
+    pub first_reference_cmd_ms: Option<f64>,
+    /// First command from the reference restraint [s after scenario start].
+    pub first_reference_cmd_s: Option<f64>,
+    /// ECU mode changes from EcuStatus: (ms rel. contact or since start, mode name).
+    pub ecu_modes: Vec<(f64, String)>,
+    /// Pretensioner fired before the true contact and still fired at contact.
+    pub pretensioner_before_contact: bool,
+    /// Pretensioner released at some point.
+    pub pretensioner_released: bool,
+    /// Airbag fired.
+    pub airbag_fired: bool,
+    /// Outcome comparison (contact only).
+    pub outcome: Option<Outcome>,
+    /// Plot file (relative to the report), if drawn.
+    pub plot: Option<String>,
+}
+
+/// DBC EcuMode names.
+pub fn ecu_mode_name(mode: u8) -> &'static str {
+    match mode {
+        0 => "Init",
+        1 => "Normal",
+        2 => "ReferenceFallback",
+        3 => "CrashDetected",
+        4 => "Deployed",
+        5 => "Fault",
+        _ => "Unknown",
+    }
+}
