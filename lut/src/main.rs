@@ -3,15 +3,23 @@
 //! Each sub-command lives in its own module; add new ones by adding a variant to [`Command`]
 //! and a module with `run(args)`.
 
+mod cmd_optim;
 mod cmd_simulate;
 mod cmd_stiffness;
+mod cmd_table;
+mod heatmap;
 mod plot;
 mod study;
+mod study_occ;
 
 use clap::{Parser, Subcommand};
 
 #[derive(Parser, Debug)]
-#[command(name = "lut", version, about = "Restraint optimiser, characteristic diagram and studies")]
+#[command(
+    name = "lut",
+    version,
+    about = "Restraint optimiser, characteristic diagram and studies"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -27,6 +35,22 @@ enum Command {
     /// Stiffness-class tools.
     #[command(subcommand)]
     Stiffness(cmd_stiffness::StiffnessCommand),
+    /// Optimise the conventional reference restraint for the two FMVSS 208 cases.
+    Reference(cmd_optim::ReferenceArgs),
+    /// Optimise the adaptive restraint for one situation (prints JSON with timing).
+    Optimise(cmd_optim::OptimiseArgs),
+    /// Build the characteristic diagram (or one shard of it) from a grid file.
+    Build(cmd_table::BuildArgs),
+    /// Merge shard files into one table.
+    Merge(cmd_table::MergeArgs),
+    /// Re-optimise random cells of a table and check it (non-zero exit on mismatch).
+    Verify(cmd_table::VerifyArgs),
+    /// Show a table's header, axes and cell statistics.
+    Inspect(cmd_table::InspectArgs),
+    /// Heat map of one output over two axes, the other two fixed.
+    Plot(cmd_table::PlotArgs),
+    /// Export a table as JSON.
+    ExportJson(cmd_table::ExportArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -34,5 +58,13 @@ fn main() -> anyhow::Result<()> {
         Command::Simulate(args) => cmd_simulate::run(&args),
         Command::Study(cmd) => study::run(&cmd),
         Command::Stiffness(cmd) => cmd_stiffness::run(&cmd),
+        Command::Reference(args) => cmd_optim::run_reference(&args),
+        Command::Optimise(args) => cmd_optim::run_optimise(&args),
+        Command::Build(args) => cmd_table::run_build(&args),
+        Command::Merge(args) => cmd_table::run_merge(&args),
+        Command::Verify(args) => cmd_table::run_verify(&args),
+        Command::Inspect(args) => cmd_table::run_inspect(&args),
+        Command::Plot(args) => cmd_table::run_plot(&args),
+        Command::ExportJson(args) => cmd_table::run_export(&args),
     }
 }

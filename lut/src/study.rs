@@ -15,6 +15,10 @@ pub enum StudyCommand {
     /// Table 5: symmetric 1785 kg vs 1785 kg at 108 km/h for each stiffness class, beside the
     /// paper's published vehicle results.
     Stiffness(StiffnessStudyArgs),
+    /// Adaptive occupant loading over opponent mass 800..3000 kg (200 kg steps).
+    OpponentMass(crate::study_occ::OpponentMassArgs),
+    /// Closing speed × occupant mass: reference restraint vs adaptive optimum, reductions in %.
+    Reduction(crate::study_occ::ReductionArgs),
 }
 
 #[derive(Args, Debug)]
@@ -30,6 +34,8 @@ pub struct StiffnessStudyArgs {
 pub fn run(cmd: &StudyCommand) -> Result<()> {
     match cmd {
         StudyCommand::Stiffness(args) => stiffness_study(args),
+        StudyCommand::OpponentMass(args) => crate::study_occ::opponent_mass(args),
+        StudyCommand::Reduction(args) => crate::study_occ::reduction(args),
     }
 }
 
@@ -59,7 +65,12 @@ fn stiffness_study(args: &StiffnessStudyArgs) -> Result<()> {
         rows.push(json!({
             "class": p.class,
             "vehicle": vehicle_json(v, s.contact_duration_s),
-            "paper": { "vehicle": { "crush_mm": p.crush_mm, "a_max_g": p.a_max_g, "a_mean_g": p.a_mean_g } },
+            // Occupant: adaptive optimum for the 75 kg occupant at 300 mm in this class's pulse.
+            "occupant": crate::study_occ::stiffness_occupant(&buf.ego_pulse())?,
+            "paper": {
+                "vehicle": { "crush_mm": p.crush_mm, "a_max_g": p.a_max_g, "a_mean_g": p.a_mean_g },
+                "occupant": { "a_mean_g_approx": crate::study_occ::PAPER_TABLE5_OCCUPANT_MEAN_G },
+            },
             "error_pct": {
                 "crush_mm": pct(v.crush_m * 1e3, p.crush_mm),
                 "a_max_g": pct(mps2_to_g(v.a_max_mps2), p.a_max_g),
@@ -90,12 +101,15 @@ fn stiffness_study(args: &StiffnessStudyArgs) -> Result<()> {
             let v = &r["vehicle"];
             let e = &r["error_pct"];
             let f = |x: &serde_json::Value| x.as_f64().unwrap_or(f64::NAN);
+            let o = &r["occupant"];
             println!(
-                "{:<6} {:>7.1} ({:>6.1},{:+5.1}) {:>7.2} ({:>6.2},{:+5.1}) {:>7.2} ({:>6.2},{:+5.1})",
+                "{:<6} {:>7.1} ({:>6.1},{:+5.1}) {:>7.2} ({:>6.2},{:+5.1}) {:>7.2} ({:>6.2},{:+5.1}) | {:>6.1} {:>6.2} {:>6.2}{}",
                 p.class,
                 f(&v["crush_mm"]), p.crush_mm, f(&e["crush_mm"]),
                 f(&v["a_max_g"]), p.a_max_g, f(&e["a_max_g"]),
                 f(&v["a_mean_g"]), p.a_mean_g, f(&e["a_mean_g"]),
+                f(&o["excursion_mm"]), f(&o["a_max_g"]), f(&o["a_mean_g"]),
+                if o["bottoming_out"].as_bool().unwrap_or(true) { " BOTTOMING-OUT" } else { "" },
             );
         }
     }

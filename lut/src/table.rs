@@ -1,0 +1,683 @@
+//! Characteristic-diagram building: grid files, one optimum per cell, sharded parallel builds,
+//! merging and verification.
+//!
+//! Every cell is independent: its collision is simulated once, its optimiser is seeded from the
+//! grid seed and the cell index only. Hence a build is byte-identical whatever the thread count
+//! or sharding, and `lut merge` of shards equals a full build.
+
+use crate::optimise::{self, Case, OptimiserConfig, SearchSpace};
+use crate::scenario::{Ego, Opponent, Pulse};
+use anyhow::{anyhow, bail, Context, Result};
+use diagram::{AirbagThresholds, Axes, BuildInfo, Cell, Diagram, EgoVehicle, GridPoint, Header};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use physics::{
+    defaults, mps2_to_g, MassClass, OccupantInput, OccupantOutcome, RestraintHardware,
+    RestraintSettings,
+};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::io::IsTerminal;
+use std::ops::Range;
+use std::path::Path;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+/// Grid file schema (TOML), see data/default-grid.toml.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridFile {
+    /// Ego vehicle.
+    pub ego: EgoSpec,
+    /// Optimiser effort and seed.
+    pub optimiser: OptimiserSpec,
+    /// Axis points.
+    pub axes: AxesSpec,
+}
+
+/// `[ego]` of a grid file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EgoSpec {
+    /// Ego mass [kg].
+    pub mass_kg: f64,
+    /// Ego stiffness class 1..=6.
+    pub class: u8,
+    /// Free text.
+    pub description: String,
+}
+
+/// `[optimiser]` of a grid file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OptimiserSpec {
+    /// Base seed (each cell's swarm is seeded from it and the cell index).
+    pub seed: u64,
+    /// Swarm size.
+    pub particles: usize,
+    /// Swarm iterations.
+    pub pso_iterations: u64,
+    /// Nelder–Mead iterations.
+    pub nm_iterations: u64,
+}
+
+/// `[axes]` of a grid file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxesSpec {
+    /// Car-to-car closing speed [km/h].
+    pub closing_speed_kph: Vec<f32>,
+    /// Opponent mass [kg].
+    pub opponent_mass_kg: Vec<f32>,
+    /// Occupant mass [kg].
+    pub occupant_mass_kg: Vec<f32>,
+    /// Seat distance chest to wheel [mm].
+    pub seat_distance_mm: Vec<f32>,
+}
+
+/// A validated grid: what to build.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Grid {
+    /// Ego vehicle.
+    pub ego: Ego,
+    /// Ego description (stored in the header).
+    pub description: String,
+    /// Optimiser configuration (seed = base seed).
+    pub optimiser: OptimiserConfig,
+    /// Axes.
+    pub axes: Axes,
+}
+
+const EXTRA_PARTICLES: &str = "optimiser.particles";
+const EXTRA_PSO: &str = "optimiser.pso_iterations";
+const EXTRA_NM: &str = "optimiser.nm_iterations";
+const EXTRA_NM_TOL: &str = "optimiser.nm_sd_tolerance_g";
+const EXTRA_NO_FIRE: &str = "optimiser.no_fire_below_kn";
+const EXTRA_RESERVE: &str = "optimiser.ride_down_reserve_mm";
+
+impl Grid {
+    /// Parse and validate grid TOML; `origin` names the source in errors.
+    pub fn parse(origin: &str, text: &str) -> Result<Self> {
+        let f: GridFile =
+            toml::from_str(text).with_context(|| format!("{origin}: invalid grid file"))?;
+        let class = MassClass::new(f.ego.class).map_err(|e| anyhow!("{origin}: ego.class: {e}"))?;
+        if !(f.ego.mass_kg.is_finite() && f.ego.mass_kg > 100.0) {
+            bail!("{origin}: ego.mass_kg must be a finite mass > 100 kg");
+        }
+        if f.optimiser.particles < 2 {
+            bail!("{origin}: optimiser.particles must be ≥ 2");
+        }
+        let axes = Axes::new(
+            f.axes.closing_speed_kph,
+            f.axes.opponent_mass_kg,
+            f.axes.occupant_mass_kg,
+            f.axes.seat_distance_mm,
+        );
+        axes.validate().map_err(|e| anyhow!("{origin}: {e}"))?;
+        let seat = &axes.seat_distance_mm;
+        let lo = defaults::MODULE_THICKNESS_M * 1e3;
+        if seat.first().is_some_and(|&d| f64::from(d) <= lo) {
+            bail!("{origin}: seat_distance_mm must exceed the {lo} mm module thickness");
+        }
+        let optimiser = OptimiserConfig {
+            seed: f.optimiser.seed,
+            particles: f.optimiser.particles,
+            pso_iterations: f.optimiser.pso_iterations,
+            nm_iterations: f.optimiser.nm_iterations,
+            ..OptimiserConfig::default()
+        };
+        Ok(Grid {
+            ego: Ego {
+                mass_kg: f.ego.mass_kg,
+                class,
+            },
+            description: f.ego.description,
+            optimiser,
+            axes,
+        })
+    }
+
+    /// Read a grid file.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        Self::parse(&path.display().to_string(), &text)
+    }
+
+    /// The header a build of this grid writes. Contains no time stamp, host or thread count,
+    /// so that rebuilds are byte-identical.
+    pub fn header(&self) -> Header {
+        let mut extra = BTreeMap::new();
+        let o = &self.optimiser;
+        extra.insert("tool".into(), format!("lut {}", env!("CARGO_PKG_VERSION")));
+        extra.insert(
+            "optimiser".into(),
+            "argmin particle swarm + Nelder-Mead, unit-cube coordinates".into(),
+        );
+        extra.insert(EXTRA_PARTICLES.into(), o.particles.to_string());
+        extra.insert(EXTRA_PSO.into(), o.pso_iterations.to_string());
+        extra.insert(EXTRA_NM.into(), o.nm_iterations.to_string());
+        extra.insert(EXTRA_NM_TOL.into(), format!("{:e}", o.nm_sd_tolerance));
+        extra.insert(EXTRA_NO_FIRE.into(), format!("{}", o.no_fire_below_n / 1e3));
+        extra.insert(EXTRA_RESERVE.into(), format!("{}", o.reserve_m * 1e3));
+        extra.insert(
+            "occupant".into(),
+            "belted; seat friction and hardware: physics::defaults".into(),
+        );
+        extra.insert(
+            "objective".into(),
+            "a_max_g + a_mean_g, no bottoming-out (penalty)".into(),
+        );
+        Header {
+            ego: EgoVehicle {
+                mass_kg: self.ego.mass_kg as f32,
+                class: self.ego.class.number(),
+                description: self.description.clone(),
+            },
+            build: BuildInfo {
+                optimiser_seed: o.seed,
+                restitution: defaults::RESTITUTION as f32,
+                defaults_hash: defaults_hash(),
+                extra,
+            },
+            airbag_thresholds: AirbagThresholds::DEFAULT,
+        }
+    }
+
+    /// Reconstruct the grid a table was built from (for `lut verify`).
+    pub fn from_table(d: &Diagram) -> Result<Self> {
+        let h = d.header();
+        let get = |k: &str| -> Result<String> {
+            h.build
+                .extra
+                .get(k)
+                .cloned()
+                .ok_or_else(|| anyhow!("table header lacks build.extra[{k:?}]"))
+        };
+        let optimiser = OptimiserConfig {
+            seed: h.build.optimiser_seed,
+            particles: get(EXTRA_PARTICLES)?.parse()?,
+            pso_iterations: get(EXTRA_PSO)?.parse()?,
+            nm_iterations: get(EXTRA_NM)?.parse()?,
+            nm_sd_tolerance: get(EXTRA_NM_TOL)?.parse()?,
+            no_fire_below_n: get(EXTRA_NO_FIRE)?.parse::<f64>()? * 1e3,
+            reserve_m: get(EXTRA_RESERVE)?.parse::<f64>()? * 1e-3,
+        };
+        Ok(Grid {
+            ego: Ego {
+                mass_kg: f64::from(h.ego.mass_kg),
+                class: MassClass::new(h.ego.class)?,
+            },
+            description: h.ego.description.clone(),
+            optimiser,
+            axes: d.axes().clone(),
+        })
+    }
+
+    /// Optimiser configuration of one cell: the base seed mixed with the cell index
+    /// (SplitMix64), so a cell's result does not depend on which shard or thread computes it.
+    pub fn cell_config(&self, index: usize) -> OptimiserConfig {
+        OptimiserConfig {
+            seed: splitmix64(self.optimiser.seed ^ splitmix64(index as u64)),
+            ..self.optimiser
+        }
+    }
+}
+
+/// SplitMix64 finaliser (Steele et al.): decorrelates neighbouring seeds.
+pub fn splitmix64(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// FNV-1a hash (hex) of every physics default a table depends on: restraint hardware,
+/// stiffness classes, step, pulse length and restitution. A table built with other defaults
+/// shows a different hash in `lut inspect`.
+pub fn defaults_hash() -> String {
+    let text = format!(
+        "{:?}|{:?}|{:?}|{}|{}|{}",
+        RestraintHardware::default(),
+        physics::stiffness::CLASS_CURVES,
+        physics::stiffness::COMBINED_CURVE,
+        defaults::STEP_S,
+        defaults::PULSE_DURATION_S,
+        defaults::RESTITUTION
+    );
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in text.bytes() {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    format!("{h:016x}")
+}
+
+/// The belted occupant of a grid point.
+pub fn occupant_at(q: &diagram::Query) -> OccupantInput {
+    OccupantInput {
+        mass_kg: f64::from(q.occupant_mass_kg),
+        chest_to_wheel_m: f64::from(q.seat_distance_mm) * 1e-3,
+        belted: true,
+    }
+}
+
+/// The predicted ego pulse of a grid point (car-to-car with an opponent of the point's mass).
+pub fn pulse_at(ego: &Ego, q: &diagram::Query) -> Result<Pulse> {
+    Pulse::predict(
+        ego,
+        Opponent::Car {
+            mass_kg: f64::from(q.opponent_mass_kg),
+        },
+        f64::from(q.closing_speed_kph),
+    )
+}
+
+/// Turn an optimum into a diagram cell.
+pub fn cell_of(set: &RestraintSettings, o: &OccupantOutcome) -> Cell {
+    Cell {
+        belt_limiter_kn: (set.load_limiter_n * 1e-3) as f32,
+        airbag_level_kn: (set.airbag_force_n * 1e-3) as f32,
+        pretensioner_time_ms: (set.pretensioner_time_s * 1e3) as f32,
+        airbag_time_ms: (set.airbag_time_s * 1e3) as f32,
+        a_max_g: mps2_to_g(o.max_decel_mps2) as f32,
+        a_mean_g: mps2_to_g(o.mean_decel_mps2) as f32,
+        excursion_mm: (o.max_excursion_m * 1e3) as f32,
+        bottoming_out: if o.bottomed_out { 1.0 } else { 0.0 },
+        a_ideal_g: mps2_to_g(o.ideal_decel_mps2) as f32,
+    }
+}
+
+/// Settings stored in a cell, in SI units.
+pub fn settings_of(c: &Cell) -> RestraintSettings {
+    RestraintSettings {
+        load_limiter_n: f64::from(c.belt_limiter_kn) * 1e3,
+        airbag_force_n: f64::from(c.airbag_level_kn) * 1e3,
+        pretensioner_time_s: f64::from(c.pretensioner_time_ms) * 1e-3,
+        airbag_time_s: f64::from(c.airbag_time_ms) * 1e-3,
+    }
+}
+
+/// One optimised cell.
+#[derive(Clone, Debug)]
+pub struct CellResult {
+    /// The cell.
+    pub cell: Cell,
+    /// The full optimum.
+    pub optimum: optimise::Optimum,
+}
+
+/// Optimise the cell at grid point `p` with `cfg`.
+pub fn optimise_point(grid: &Grid, p: &GridPoint, cfg: &OptimiserConfig) -> Result<CellResult> {
+    let pulse = pulse_at(&grid.ego, &p.query)?;
+    let case = Case {
+        pulse: pulse.ego(),
+        occupant: occupant_at(&p.query),
+    };
+    let optimum = optimise::optimise(
+        &[case],
+        &SearchSpace::adaptive(),
+        &RestraintHardware::default(),
+        cfg,
+    )
+    .with_context(|| format!("cell {} {:?}", p.index, p.coords))?;
+    let o = optimum
+        .outcomes
+        .first()
+        .ok_or_else(|| anyhow!("no outcome"))?;
+    Ok(CellResult {
+        cell: cell_of(&optimum.settings, o),
+        optimum,
+    })
+}
+
+/// Optimise cell `index` of the grid (with its per-cell seed).
+pub fn optimise_cell(grid: &Grid, index: usize) -> Result<CellResult> {
+    let p = grid
+        .axes
+        .point(index)
+        .ok_or_else(|| anyhow!("cell index {index} outside the grid"))?;
+    optimise_point(grid, &p, &grid.cell_config(index))
+}
+
+/// Contiguous index range of shard `k` of `n` (1-based k) over `count` cells.
+pub fn shard_range(count: usize, k: usize, n: usize) -> Result<Range<usize>> {
+    if n == 0 || k == 0 || k > n {
+        bail!("shard {k}/{n}: need 1 ≤ K ≤ N");
+    }
+    let start = count * (k - 1) / n;
+    let end = count * k / n;
+    Ok(start..end)
+}
+
+/// Statistics of a build.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct BuildStats {
+    /// Cells optimised.
+    pub cells: usize,
+    /// Occupant simulations run.
+    pub occupant_simulations: u64,
+    /// Wall-clock time.
+    pub wall: Duration,
+}
+
+/// Progress reporting: an indicatif bar with ETA on a terminal, plain periodic lines otherwise
+/// (batch schedulers capture stderr into files; a bar would be invisible there).
+pub struct Progress {
+    bar: ProgressBar,
+    tty: bool,
+    total: usize,
+    done: AtomicUsize,
+    start: Instant,
+    last_line: Mutex<Instant>,
+    every: Duration,
+    quiet: bool,
+}
+
+impl Progress {
+    /// Progress over `total` cells; `quiet` suppresses all output (tests).
+    pub fn new(total: usize, label: &str, quiet: bool) -> Self {
+        let tty = std::io::stderr().is_terminal() && !quiet;
+        let bar = if tty {
+            let b = ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr());
+            if let Ok(style) = ProgressStyle::with_template(
+                "{msg} [{elapsed_precise}] {wide_bar} {pos}/{len} cells, ETA {eta}",
+            ) {
+                b.set_style(style);
+            }
+            b.set_message(label.to_string());
+            b
+        } else {
+            ProgressBar::hidden()
+        };
+        let now = Instant::now();
+        Progress {
+            bar,
+            tty,
+            total,
+            done: AtomicUsize::new(0),
+            start: now,
+            last_line: Mutex::new(now),
+            every: Duration::from_secs(10),
+            quiet,
+        }
+    }
+
+    /// One cell finished.
+    pub fn inc(&self) {
+        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        if self.tty {
+            self.bar.inc(1);
+        } else if !self.quiet {
+            let now = Instant::now();
+            let mut last = match self.last_line.lock() {
+                Ok(g) => g,
+                Err(p) => p.into_inner(),
+            };
+            if now.duration_since(*last) >= self.every || done == self.total {
+                *last = now;
+                let el = now.duration_since(self.start).as_secs_f64();
+                let eta = if done > 0 {
+                    el / done as f64 * (self.total - done) as f64
+                } else {
+                    f64::NAN
+                };
+                eprintln!(
+                    "progress: {done}/{} cells ({:.0} %), elapsed {el:.0} s, ETA {eta:.0} s",
+                    self.total,
+                    100.0 * done as f64 / self.total.max(1) as f64
+                );
+            }
+        }
+    }
+
+    /// Finish the bar.
+    pub fn finish(&self) {
+        self.bar.finish();
+    }
+}
+
+/// Optimise the cells of `range` in parallel (rayon; `threads` = None → all cores).
+pub fn build_cells(
+    grid: &Grid,
+    range: Range<usize>,
+    threads: Option<usize>,
+    quiet: bool,
+) -> Result<(Vec<Cell>, BuildStats)> {
+    let count = grid.axes.cell_count();
+    if range.end > count {
+        bail!("range {range:?} exceeds the {count} cells of the grid");
+    }
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        builder = builder.num_threads(n);
+    }
+    let pool = builder
+        .build()
+        .context("cannot start the rayon thread pool")?;
+    let progress = Progress::new(range.len(), "optimising", quiet);
+    let sims = AtomicU64::new(0);
+    let start = Instant::now();
+    let cells: Result<Vec<Cell>> = pool.install(|| {
+        range
+            .clone()
+            .into_par_iter()
+            .map(|i| {
+                let r = optimise_cell(grid, i)?;
+                sims.fetch_add(r.optimum.occupant_simulations, Ordering::Relaxed);
+                progress.inc();
+                Ok(r.cell)
+            })
+            .collect()
+    });
+    progress.finish();
+    let cells = cells?;
+    let stats = BuildStats {
+        cells: cells.len(),
+        occupant_simulations: sims.into_inner(),
+        wall: start.elapsed(),
+    };
+    Ok((cells, stats))
+}
+
+/// Build the whole table.
+pub fn build_table(
+    grid: &Grid,
+    threads: Option<usize>,
+    quiet: bool,
+) -> Result<(Diagram, BuildStats)> {
+    let (cells, stats) = build_cells(grid, 0..grid.axes.cell_count(), threads, quiet)?;
+    let d = Diagram::from_cells(grid.header(), grid.axes.clone(), cells)
+        .map_err(|e| anyhow!("built table is invalid: {e}"))?;
+    Ok((d, stats))
+}
+
+/// Identifies shard files.
+pub const SHARD_FORMAT: &str = "restraint-lut-shard";
+/// Shard file version.
+pub const SHARD_VERSION: u16 = 1;
+
+/// A shard: a contiguous range of cells plus everything needed to check that shards belong
+/// together (header and axes must be identical).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Shard {
+    /// [`SHARD_FORMAT`].
+    pub format: String,
+    /// [`SHARD_VERSION`].
+    pub version: u16,
+    /// Shard number K (1-based) of N.
+    pub k: u32,
+    /// Shard count N.
+    pub n: u32,
+    /// First cell index.
+    pub start: u64,
+    /// Header of the table.
+    pub header: Header,
+    /// Axes of the table.
+    pub axes: Axes,
+    /// Cells start.. in row-major order.
+    pub cells: Vec<Cell>,
+}
+
+impl Shard {
+    /// Serialise (postcard; deterministic).
+    pub fn to_bytes(&self) -> Result<Vec<u8>> {
+        postcard::to_allocvec(self).context("encoding shard")
+    }
+    /// Deserialise and check the format tag.
+    pub fn from_bytes(origin: &str, bytes: &[u8]) -> Result<Self> {
+        let s: Shard =
+            postcard::from_bytes(bytes).with_context(|| format!("{origin}: not a shard file"))?;
+        if s.format != SHARD_FORMAT || s.version != SHARD_VERSION {
+            bail!(
+                "{origin}: shard format {:?} v{} (expected {SHARD_FORMAT:?} v{SHARD_VERSION})",
+                s.format,
+                s.version
+            );
+        }
+        Ok(s)
+    }
+}
+
+/// Build shard `k` of `n`.
+pub fn build_shard(
+    grid: &Grid,
+    k: usize,
+    n: usize,
+    threads: Option<usize>,
+    quiet: bool,
+) -> Result<(Shard, BuildStats)> {
+    let range = shard_range(grid.axes.cell_count(), k, n)?;
+    let start = range.start as u64;
+    let (cells, stats) = build_cells(grid, range, threads, quiet)?;
+    Ok((
+        Shard {
+            format: SHARD_FORMAT.into(),
+            version: SHARD_VERSION,
+            k: k as u32,
+            n: n as u32,
+            start,
+            header: grid.header(),
+            axes: grid.axes.clone(),
+            cells,
+        },
+        stats,
+    ))
+}
+
+/// Merge shards (any order) into the full table; rejects mismatched headers/axes, overlaps and
+/// gaps.
+pub fn merge_shards(shards: &[Shard]) -> Result<Diagram> {
+    let first = shards.first().ok_or_else(|| anyhow!("no shard given"))?;
+    for s in shards {
+        if s.header != first.header || s.axes != first.axes {
+            bail!("shard {}/{} was built from a different grid or build configuration than shard {}/{}", s.k, s.n, first.k, first.n);
+        }
+    }
+    let cells = shards.iter().flat_map(|s| {
+        s.cells
+            .iter()
+            .enumerate()
+            .map(move |(i, c)| (s.start as usize + i, *c))
+    });
+    Diagram::from_indexed_cells(first.header.clone(), first.axes.clone(), cells)
+        .map_err(|e| anyhow!("merge: {e}"))
+}
+
+/// Objective value stored in a cell (a_max + a_mean [g]).
+pub fn cell_objective_g(c: &Cell) -> f64 {
+    f64::from(c.a_max_g) + f64::from(c.a_mean_g)
+}
+
+/// Tolerance of `lut verify` when re-simulating a cell's stored setting: the stored setting is
+/// rounded to f32, which can move a trigger time across a 0.1 ms integration step.
+pub const RESIM_TOL_ABS_G: f64 = 0.05;
+/// Relative part of the re-simulation tolerance.
+pub const RESIM_TOL_REL: f64 = 0.005;
+/// Tolerance of `lut verify` when comparing the table's objective with an independent
+/// re-optimisation (another seed): the table may be worse by at most this much (absolute) ...
+pub const REOPT_TOL_ABS_G: f64 = 1.0;
+/// ... or this fraction, whichever is larger.
+pub const REOPT_TOL_REL: f64 = 0.03;
+
+/// One verified cell.
+#[derive(Clone, Debug, Serialize)]
+pub struct VerifyRow {
+    /// Cell index.
+    pub index: usize,
+    /// Grid coordinates.
+    pub coords: [usize; 4],
+    /// Stored objective [g].
+    pub table_objective_g: f64,
+    /// Objective of the stored setting re-simulated now [g].
+    pub resimulated_objective_g: f64,
+    /// Objective of an independent re-optimisation [g].
+    pub reoptimised_objective_g: f64,
+    /// Stored bottoming-out flag.
+    pub table_bottoming_out: bool,
+    /// Bottoming-out of the independent re-optimisation.
+    pub reoptimised_bottoming_out: bool,
+    /// Passed.
+    pub ok: bool,
+    /// Why not.
+    pub problem: Option<String>,
+}
+
+/// Re-optimise `n` random cells (chosen with `seed`, and re-optimised with seeds derived from
+/// `seed`, independent of the build's) and check the table: (1) the stored setting re-simulated
+/// reproduces the stored objective and flag within [`RESIM_TOL_ABS_G`]/[`RESIM_TOL_REL`];
+/// (2) the independent optimum is not better than the table by more than
+/// [`REOPT_TOL_ABS_G`]/[`REOPT_TOL_REL`], and not feasible where the table says infeasible.
+pub fn verify(d: &Diagram, n: usize, seed: u64) -> Result<Vec<VerifyRow>> {
+    let grid = Grid::from_table(d)?;
+    let count = grid.axes.cell_count();
+    let mut picks = Vec::new();
+    let mut state = seed;
+    while picks.len() < n.min(count) {
+        state = splitmix64(state);
+        let i = (state % count as u64) as usize;
+        if !picks.contains(&i) {
+            picks.push(i);
+        }
+    }
+    let hw = RestraintHardware::default();
+    picks
+        .par_iter()
+        .map(|&i| {
+            let p = grid.axes.point(i).ok_or_else(|| anyhow!("cell {i} outside the grid"))?;
+            let c = d.cells().get(i).ok_or_else(|| anyhow!("cell {i} missing"))?;
+            let table_obj = cell_objective_g(c);
+            let pulse = pulse_at(&grid.ego, &p.query)?;
+            let case = Case { pulse: pulse.ego(), occupant: occupant_at(&p.query) };
+            let (_, outs) = optimise::evaluate(&[case], &settings_of(c), &hw, grid.optimiser.reserve_m)?;
+            let resim = outs.first().ok_or_else(|| anyhow!("no outcome"))?;
+            let resim_obj = mps2_to_g(resim.max_decel_mps2) + mps2_to_g(resim.mean_decel_mps2);
+            let cfg = OptimiserConfig { seed: splitmix64(seed ^ 0xA5A5_5A5A ^ i as u64), ..grid.optimiser };
+            let re = optimise_point(&grid, &p, &cfg)?;
+            let re_obj = cell_objective_g(&re.cell);
+            let mut problem = None;
+            if resim.bottomed_out != c.is_bottoming_out() {
+                problem = Some(format!("stored setting re-simulated: bottoming_out {} but table says {}", resim.bottomed_out, c.is_bottoming_out()));
+            } else if (resim_obj - table_obj).abs() > RESIM_TOL_ABS_G.max(RESIM_TOL_REL * table_obj) {
+                problem = Some(format!("stored setting re-simulated: objective {resim_obj:.3} g vs stored {table_obj:.3} g"));
+            } else if c.is_bottoming_out() && !re.optimum.bottoming_out() {
+                problem = Some("table says bottoming-out but an independent optimisation found a feasible setting".into());
+            } else if !c.is_bottoming_out() && table_obj - re_obj > REOPT_TOL_ABS_G.max(REOPT_TOL_REL * re_obj) {
+                problem = Some(format!("independent optimum {re_obj:.3} g is better than the table's {table_obj:.3} g beyond tolerance"));
+            }
+            Ok(VerifyRow {
+                index: i,
+                coords: p.coords,
+                table_objective_g: table_obj,
+                resimulated_objective_g: resim_obj,
+                reoptimised_objective_g: re_obj,
+                table_bottoming_out: c.is_bottoming_out(),
+                reoptimised_bottoming_out: re.optimum.bottoming_out(),
+                ok: problem.is_none(),
+                problem,
+            })
+        })
+        .collect()
+}

@@ -1,0 +1,258 @@
+//! Optimiser tests with oracles that do not come from the optimiser itself: closed-form minima
+//! of test functions, the physical lower bound a*, the reference setting as a feasible point,
+//! and the feasibility ordering of the penalty.
+
+use lut::optimise::{
+    case_cost, minimise, optimise, Case, OptimiserConfig, SearchSpace, DEFAULT_RESERVE_M,
+    INFEASIBLE_OFFSET,
+};
+use lut::reference::ReferenceRestraint;
+use lut::scenario::{Ego, Opponent, Pulse};
+use physics::{mps2_to_g, simulate_occupant, OccupantInput, OccupantOutcome, RestraintHardware};
+
+fn cfg(seed: u64) -> OptimiserConfig {
+    OptimiserConfig {
+        seed,
+        ..OptimiserConfig::default()
+    }
+}
+
+#[test]
+fn finds_the_minimum_of_a_shifted_quadratic() {
+    // Minimum at a known interior point; value 1.5 there.
+    let target = [0.2, 0.7, 0.45, 0.9];
+    let f = |u: &[f64]| -> anyhow::Result<f64> {
+        Ok(1.5
+            + u.iter()
+                .zip(target)
+                .map(|(x, t)| 3.0 * (x - t) * (x - t))
+                .sum::<f64>())
+    };
+    let m = minimise(4, &f, &cfg(3)).unwrap();
+    for (x, t) in m.u.iter().zip(target) {
+        assert!((x - t).abs() < 2e-3, "{:?} vs {target:?}", m.u);
+    }
+    assert!((m.cost - 1.5).abs() < 1e-5);
+}
+
+#[test]
+fn finds_the_global_minimum_of_a_multimodal_function() {
+    // Rastrigin-like in 2-D, global minimum 0 at (0.3, 0.6), many local minima around it.
+    let f = |u: &[f64]| -> anyhow::Result<f64> {
+        let (x, y) = ((u[0] - 0.3) * 10.0, (u[1] - 0.6) * 10.0);
+        Ok(
+            20.0 + x * x - 10.0 * (std::f64::consts::TAU * x).cos() + y * y
+                - 10.0 * (std::f64::consts::TAU * y).cos(),
+        )
+    };
+    let m = minimise(
+        2,
+        &f,
+        &OptimiserConfig {
+            particles: 40,
+            pso_iterations: 60,
+            ..cfg(11)
+        },
+    )
+    .unwrap();
+    assert!(
+        (m.u[0] - 0.3).abs() < 1e-3 && (m.u[1] - 0.6).abs() < 1e-3,
+        "cost {} at {:?}",
+        m.cost,
+        m.u
+    );
+    assert!(m.cost < 1e-4, "cost {} at {:?}", m.cost, m.u);
+}
+
+#[test]
+fn penalty_keeps_the_constrained_optimum_on_the_boundary() {
+    // min (x − 0.8)² s.t. x ≤ 0.5, penalty of the same kind as the restraint objective:
+    // closed-form answer x = 0.5.
+    let f = |u: &[f64]| -> anyhow::Result<f64> {
+        let x = u[0];
+        let obj = (x - 0.8) * (x - 0.8);
+        Ok(if x > 0.5 {
+            INFEASIBLE_OFFSET + 1e3 * (x - 0.5) + obj
+        } else {
+            obj
+        })
+    };
+    let m = minimise(1, &f, &cfg(5)).unwrap();
+    assert!((m.u[0] - 0.5).abs() < 1e-3, "{:?}", m.u);
+}
+
+#[test]
+fn infeasible_costs_are_worse_than_every_feasible_cost() {
+    let feasible = OccupantOutcome {
+        max_decel_mps2: 1.0e5,
+        mean_decel_mps2: 1.0e5,
+        max_excursion_m: 0.2,
+        available_ride_down_m: 0.24,
+        ..Default::default()
+    };
+    let barely = OccupantOutcome {
+        max_decel_mps2: 1.0,
+        mean_decel_mps2: 1.0,
+        max_excursion_m: 0.2401,
+        available_ride_down_m: 0.24,
+        bottomed_out: true,
+        ..Default::default()
+    };
+    let deeper = OccupantOutcome {
+        max_excursion_m: 0.26,
+        ..barely
+    };
+    // Nine feasible cases at the cap still beat one infeasible case.
+    let r = DEFAULT_RESERVE_M;
+    assert!(9.0 * case_cost(&feasible, r) < case_cost(&barely, r));
+    assert!(
+        case_cost(&barely, r) < case_cost(&deeper, r),
+        "less strike-through must be less bad"
+    );
+    // Eating into the reserve is infeasible for the optimiser, too (but not bottoming-out).
+    let in_reserve = OccupantOutcome {
+        max_excursion_m: 0.235,
+        bottomed_out: false,
+        ..barely
+    };
+    assert!(
+        case_cost(&in_reserve, r) >= INFEASIBLE_OFFSET
+            && case_cost(&in_reserve, 0.0) < INFEASIBLE_OFFSET
+    );
+}
+
+fn pulse(kph: f64, opp: f64) -> Pulse {
+    Pulse::predict(&Ego::default(), Opponent::Car { mass_kg: opp }, kph).unwrap()
+}
+
+#[test]
+fn optimum_is_feasible_never_worse_than_the_reference_and_above_the_ideal_bound() {
+    let reference = ReferenceRestraint::builtin().unwrap().settings();
+    let hw = RestraintHardware::default();
+    for (kph, opp, occ_kg, seat_mm) in [
+        (50.0, 1200.0, 45.0, 300.0),
+        (80.0, 1800.0, 75.0, 300.0),
+        (90.0, 2400.0, 90.0, 400.0),
+        (60.0, 3000.0, 30.0, 250.0),
+    ] {
+        let p = pulse(kph, opp);
+        let occupant = OccupantInput {
+            mass_kg: occ_kg,
+            chest_to_wheel_m: seat_mm * 1e-3,
+            belted: true,
+        };
+        let case = Case {
+            pulse: p.ego(),
+            occupant,
+        };
+        let opt = optimise(&[case], &SearchSpace::adaptive(), &hw, &cfg(1)).unwrap();
+        let o = opt.outcomes[0];
+        let r = simulate_occupant(&p.ego(), &occupant, &reference, &hw).unwrap();
+        assert!(
+            !o.bottomed_out,
+            "{kph} km/h {occ_kg} kg: optimum bottoms out"
+        );
+        let c = |x: &OccupantOutcome| case_cost(x, DEFAULT_RESERVE_M);
+        assert!(
+            c(&o) <= c(&r) + 1e-9,
+            "{kph} km/h: optimum {} worse than reference {}",
+            c(&o),
+            c(&r)
+        );
+        assert!(
+            o.max_excursion_m <= o.available_ride_down_m - DEFAULT_RESERVE_M + 1e-9,
+            "reserve not kept"
+        );
+        // No restraint can stop the occupant within the available distance with a peak below
+        // the ideal constant-force deceleration (small allowance for the discrete step).
+        assert!(
+            o.max_decel_mps2 >= 0.99 * o.ideal_decel_mps2,
+            "{kph} km/h: a_max {} g below a* {} g",
+            mps2_to_g(o.max_decel_mps2),
+            mps2_to_g(o.ideal_decel_mps2)
+        );
+        // Settings inside the hardware bounds.
+        let s = opt.settings;
+        assert!(
+            (1e3..=12e3).contains(&s.load_limiter_n) && (0.0..=12e3).contains(&s.airbag_force_n)
+        );
+        assert!(
+            (-0.1..=0.02).contains(&s.pretensioner_time_s)
+                && (0.003..=0.04).contains(&s.airbag_time_s)
+        );
+    }
+}
+
+#[test]
+fn same_seed_same_optimum_bit_for_bit() {
+    let p = pulse(90.0, 2000.0);
+    let case = Case {
+        pulse: p.ego(),
+        occupant: OccupantInput {
+            mass_kg: 60.0,
+            chest_to_wheel_m: 0.35,
+            belted: true,
+        },
+    };
+    let hw = RestraintHardware::default();
+    let a = optimise(&[case], &SearchSpace::adaptive(), &hw, &cfg(42)).unwrap();
+    let b = optimise(&[case], &SearchSpace::adaptive(), &hw, &cfg(42)).unwrap();
+    assert_eq!(a, b);
+}
+
+#[test]
+fn infeasible_situation_is_reported_not_hidden() {
+    // 108 km/h into a 3000 kg opponent, 125 kg occupant 200 mm from the wheel (140 mm ride-down).
+    let p = pulse(108.0, 3000.0);
+    let occupant = OccupantInput {
+        mass_kg: 125.0,
+        chest_to_wheel_m: 0.2,
+        belted: true,
+    };
+    let hw = RestraintHardware::default();
+    // Independent oracle: an exhaustive 7^4 grid over the hardware bounds finds no setting
+    // without bottoming-out.
+    let steps = |lo: f64, hi: f64| (0..7).map(move |i| lo + (hi - lo) * f64::from(i) / 6.0);
+    let mut any_feasible = false;
+    for ll in steps(1e3, 12e3) {
+        for ab in steps(0.0, 12e3) {
+            for pt in steps(-0.1, 0.02) {
+                for at in steps(0.003, 0.04) {
+                    let s = physics::RestraintSettings {
+                        load_limiter_n: ll,
+                        airbag_force_n: ab,
+                        pretensioner_time_s: pt,
+                        airbag_time_s: at,
+                    };
+                    any_feasible |= !simulate_occupant(&p.ego(), &occupant, &s, &hw)
+                        .unwrap()
+                        .bottomed_out;
+                }
+            }
+        }
+    }
+    assert!(
+        !any_feasible,
+        "precondition: the situation must be infeasible"
+    );
+    let opt = optimise(
+        &[Case {
+            pulse: p.ego(),
+            occupant,
+        }],
+        &SearchSpace::adaptive(),
+        &hw,
+        &cfg(1),
+    )
+    .unwrap();
+    assert!(opt.bottoming_out(), "reported as feasible");
+    assert!(opt.cost >= INFEASIBLE_OFFSET);
+    let o = opt.outcomes[0];
+    assert!(o.max_excursion_m > o.available_ride_down_m);
+    // Least-bad: both force levels at their maximum (more force can only reduce strike-through).
+    assert!(
+        opt.settings.load_limiter_n > 11.5e3 && opt.settings.airbag_force_n > 11.5e3,
+        "{:?}",
+        opt.settings
+    );
+}

@@ -1,0 +1,139 @@
+//! End-to-end characteristic-diagram build on the small CI grid: build → rebuild is
+//! byte-identical → shards merged equal the full build → verify → inspect (the binary).
+
+use diagram::Diagram;
+use lut::table::{self, Grid};
+use std::path::PathBuf;
+use std::process::Command;
+
+fn workspace() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("lut-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn ci_grid_end_to_end() {
+    let grid = Grid::load(workspace().join("data/ci-grid.toml")).unwrap();
+    let (full, stats) = table::build_table(&grid, Some(2), true).unwrap();
+    assert_eq!(stats.cells, grid.axes.cell_count());
+    let bytes = full.to_bytes();
+
+    // Rerun with another thread count: byte-identical.
+    let (again, _) = table::build_table(&grid, Some(1), true).unwrap();
+    assert_eq!(again.to_bytes(), bytes, "rebuild is not byte-identical");
+
+    // Shards (merged out of order) equal the full build.
+    let n = 3;
+    let mut shards: Vec<_> = (1..=n)
+        .map(|k| table::build_shard(&grid, k, n, Some(1), true).unwrap().0)
+        .collect();
+    shards.reverse();
+    let shard_bytes: Vec<Vec<u8>> = shards.iter().map(|s| s.to_bytes().unwrap()).collect();
+    let decoded: Vec<_> = shard_bytes
+        .iter()
+        .map(|b| table::Shard::from_bytes("t", b).unwrap())
+        .collect();
+    let merged = table::merge_shards(&decoded).unwrap();
+    assert_eq!(
+        merged.to_bytes(),
+        bytes,
+        "merged shards differ from the full build"
+    );
+    // A missing shard is an error naming the gap, not a silently smaller table.
+    assert!(table::merge_shards(&decoded[..2]).is_err());
+
+    // Every cell's optimum lies inside the hardware bounds and its prediction is self-consistent.
+    for c in full.cells() {
+        assert!(
+            (1.0..=12.0).contains(&c.belt_limiter_kn) && (0.0..=12.0).contains(&c.airbag_level_kn)
+        );
+        assert!(
+            (-100.0..=20.0).contains(&c.pretensioner_time_ms)
+                && (3.0..=40.0).contains(&c.airbag_time_ms)
+        );
+        assert!(c.a_max_g >= c.a_mean_g);
+    }
+
+    // Save, then verify and inspect through the binary.
+    let path = tmp("ci.lut");
+    full.save(&path).unwrap();
+    assert_eq!(Diagram::load(&path).unwrap().to_bytes(), bytes);
+    let exe = env!("CARGO_BIN_EXE_lut");
+    let out = Command::new(exe)
+        .args([
+            "verify",
+            path.to_str().unwrap(),
+            "--cells",
+            "6",
+            "--seed",
+            "3",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "verify failed: {}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = Command::new(exe)
+        .args(["inspect", path.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("closing_speed_kph") && text.contains("bottoming-out"),
+        "{text}"
+    );
+
+    // A corrupted table makes verify fail with a message naming the file.
+    let mut bad = bytes.clone();
+    let last = bad.len() - 3;
+    bad[last] ^= 0x40;
+    let bad_path = tmp("bad.lut");
+    std::fs::write(&bad_path, &bad).unwrap();
+    let out = Command::new(exe)
+        .args(["verify", bad_path.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("bad.lut"));
+}
+
+#[test]
+fn verify_detects_a_table_that_does_not_match_the_physics() {
+    // Tamper with one stored outcome (and re-checksum it, so the file itself is valid): the
+    // re-simulation of the stored setting must expose it.
+    let grid = Grid::load(workspace().join("data/ci-grid.toml")).unwrap();
+    let (d, _) = table::build_table(&grid, Some(2), true).unwrap();
+    let mut data = d.into_data();
+    for c in data.cells.iter_mut() {
+        c.a_mean_g *= 0.8;
+    }
+    let tampered = Diagram::new(data).unwrap();
+    let rows = table::verify(&tampered, 4, 9).unwrap();
+    assert!(rows.iter().all(|r| !r.ok), "{rows:?}");
+}
+
+#[test]
+fn shard_ranges_cover_the_grid_exactly_once() {
+    for count in [1usize, 7, 24, 4536] {
+        for n in 1..=9 {
+            let mut next = 0;
+            for k in 1..=n {
+                let r = table::shard_range(count, k, n).unwrap();
+                assert_eq!(r.start, next);
+                next = r.end;
+            }
+            assert_eq!(next, count);
+        }
+    }
+    assert!(table::shard_range(10, 0, 3).is_err());
+    assert!(table::shard_range(10, 4, 3).is_err());
+}
