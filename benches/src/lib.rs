@@ -1,1 +1,18 @@
 //! Criterion benches (benches/benches/) and the per-cycle budget gate.
+//!
+//! The library holds what the benches, the instruction-count binaries (`icount_*`) and the gate
+//! share, so that the criterion figure and the callgrind figure of a stage measure the *same*
+//! code on the *same* inputs:
+//!
+//! * [`workload`] — the measured work: one cycle's input frames, its command frames, the bench
+//!   characteristic diagram and the composed worst-case stage chain.
+//! * [`budgets`] — `benches/budgets.toml`, the one file of budgets.
+//! * [`gate`] — reading criterion's `estimates.json` and comparing with the budgets.
+//! * [`icount`] — instructions per iteration from two callgrind runs.
+//! * [`latency`] — cyclictest histogram and ECU report parsing for the loop harness.
+
+pub mod budgets;
+pub mod gate;
+pub mod icount;
+pub mod latency;
+pub mod workload;
