@@ -1,7 +1,10 @@
 //! The fixed-rate restraint ECU process (`ecu --help`).
 
 use clap::Parser;
-use ecu::runtime::{app, monitor, Cli, Command, EcuConfig, PassthroughActivity};
+use ecu::can_port::SocketCanPort;
+use ecu::cycle::RestraintCycle;
+use ecu::runtime::{app, monitor, CanPort, Cli, Command, EcuConfig};
+use physics::reference::ReferenceRestraint;
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
@@ -18,13 +21,68 @@ fn main() -> std::process::ExitCode {
     }
 }
 
+/// The LUT, or `None` with a clear message: the ECU then runs DEGRADED on the reference
+/// restraint instead of refusing to start (never "no protection").
+fn load_lut(cfg: &EcuConfig) -> Option<diagram::Diagram> {
+    match diagram::Diagram::load_any(&cfg.cycle.lut) {
+        Ok(d) => {
+            eprintln!(
+                "ecu: lut          {} (id {:#06x}, ego {} kg class {})",
+                cfg.cycle.lut.display(),
+                d.lut_id(),
+                d.header().ego.mass_kg,
+                d.header().ego.class
+            );
+            Some(d)
+        }
+        Err(e) => {
+            eprintln!(
+                "ecu: error: characteristic diagram unusable: {e} — running DEGRADED with the \
+                 reference restraint (build one with `lut build`, or pass --lut FILE)"
+            );
+            None
+        }
+    }
+}
+
+fn load_reference(cfg: &EcuConfig) -> anyhow::Result<ReferenceRestraint> {
+    match ReferenceRestraint::load(&cfg.cycle.reference) {
+        Ok(r) => Ok(r),
+        Err(e) => {
+            eprintln!("ecu: warning: {e} — using the reference restraint built into this binary");
+            ReferenceRestraint::builtin().map_err(anyhow::Error::msg)
+        }
+    }
+}
+
 fn run(cli: &Cli) -> anyhow::Result<()> {
     let cfg = EcuConfig::resolve(&cli.run)?;
     let stop = app::install_stop_signals()?;
-    // INTEGRATION POINT: replace the pass-through activity by the pure cycle logic and
-    // pass the bus crate's SocketCAN port instead of `None`.
-    let mut activity = PassthroughActivity::new();
-    let outcome = app::run_ecu(&cfg, &mut activity, None, stop, !cli.run.quiet)?;
+    let lut = load_lut(&cfg);
+    let reference = load_reference(&cfg)?;
+    let (mut activity, notes) = RestraintCycle::new(cfg.cycle.clone(), lut, &reference.restraint)
+        .map_err(anyhow::Error::msg)?;
+    for w in &notes.warnings {
+        eprintln!("ecu: warning: {w}");
+    }
+    // SocketCAN with the kernel input filter when CAN is on and the interface exists; the
+    // shell's CAN decision reports a missing interface (and `--no-can` switches CAN off).
+    let can: Option<Box<dyn CanPort>> = if cfg.can.enabled
+        && std::path::Path::new("/sys/class/net")
+            .join(&cfg.can.interface)
+            .exists()
+    {
+        let port = SocketCanPort::open_ecu(&cfg.can.interface).map_err(|e| {
+            anyhow::anyhow!(
+                "cannot open CAN interface {}: {e} (bring it up with vcan-setup.sh or pass --no-can)",
+                cfg.can.interface
+            )
+        })?;
+        Some(Box::new(port))
+    } else {
+        None
+    };
+    let outcome = app::run_ecu(&cfg, &mut activity, can, stop, !cli.run.quiet)?;
     print!("{}", outcome.text);
     Ok(())
 }

@@ -108,7 +108,6 @@ fn no_allocation_in_precrash_and_crash_cycles() {
         diag: EcuDiagnostics::ZERO,
     };
     let mut now = T0;
-    let mut cycle = 0u64;
     let mut allocations = 0u64;
     let mut precrash_cycles = 0u64;
     let mut crash_cycles = 0u64;
@@ -119,7 +118,7 @@ fn no_allocation_in_precrash_and_crash_cycles() {
     let crash_from = 11_000u64;
     for k in 0..total {
         let ms = k;
-        if ms < crash_from && ms % 10 == 0 {
+        if ms < crash_from && ms.is_multiple_of(10) {
             let mut o = cycle_support::object(now, 25.0, 1500.0, 100.0);
             o.distance_m = 6.25; // 250 ms at 25 m/s
             io.object = Some(o);
@@ -133,21 +132,21 @@ fn no_allocation_in_precrash_and_crash_cycles() {
             io.accel = Some(a);
         }
         io.can_n = 0;
-        if ms % 10 == 0 {
+        if ms.is_multiple_of(10) {
             io.can[0] = bench.vehicle_frame(25.0);
             io.can_n = 1;
         }
-        if ms % 100 == 0 {
+        if ms.is_multiple_of(100) {
             io.can[1] = bench.occupant_frame();
             io.can_n = 2;
-            if ms % 10 != 0 {
+            if !ms.is_multiple_of(10) {
                 io.can[0] = io.can[1];
                 io.can_n = 1;
             }
         }
         let info = CycleInfo {
-            cycle,
-            slot: cycle,
+            cycle: k,
+            slot: k,
             period_ns: MS,
             deadline_ns: now,
             now_ns: now,
@@ -170,7 +169,6 @@ fn no_allocation_in_precrash_and_crash_cycles() {
             }
         }
         now += MS;
-        cycle += 1;
     }
     assert_eq!(allocations, 0, "heap allocations in the cycle");
     assert!(

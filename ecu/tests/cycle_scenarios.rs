@@ -35,7 +35,7 @@ fn run_scenario(
     decel_g: f32,
 ) {
     while b.now < end {
-        if (b.now - T0) % (10 * MS) == 0 && b.now < objects_until {
+        if (b.now - T0).is_multiple_of(10 * MS) && b.now < objects_until {
             if b.now >= approach_from && b.now < contact {
                 b.push_approach(contact, closing_mps, 1500.0, 100.0);
             } else {

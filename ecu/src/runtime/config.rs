@@ -26,6 +26,8 @@ pub struct EcuConfig {
     pub ipc: IpcConfig,
     /// CAN settings.
     pub can: CanConfig,
+    /// Restraint decision thresholds, LUT and reference-restraint files (`crate::cycle`).
+    pub cycle: crate::cycle::CycleConfig,
 }
 
 /// Real-time settings; each is optional and degrades with a message when not permitted.
@@ -73,6 +75,7 @@ impl Default for EcuConfig {
             rt: RtConfig::default(),
             ipc: IpcConfig::default(),
             can: CanConfig::default(),
+            cycle: crate::cycle::CycleConfig::default(),
         }
     }
 }
@@ -208,6 +211,9 @@ impl EcuConfig {
                 ),
             ));
         }
+        if let Err(m) = self.cycle.validate() {
+            return Err(invalid("cycle", m));
+        }
         if self.ipc.node_name.is_empty() {
             return Err(invalid("ipc.node_name", "must not be empty".into()));
         }
@@ -251,6 +257,12 @@ impl EcuConfig {
         }
         if let Some(v) = a.prefault_stack_kib {
             self.rt.prefault_stack_kib = v;
+        }
+        if let Some(v) = &a.lut {
+            self.cycle.lut = v.clone();
+        }
+        if let Some(v) = &a.reference {
+            self.cycle.reference = v.clone();
         }
         if a.no_can {
             self.can.enabled = false;
@@ -411,6 +423,14 @@ pub struct RunArgs {
     /// Do not print the start-up summary.
     #[arg(long)]
     pub quiet: bool,
+    /// Characteristic diagram (default data/default.lut). Missing or corrupt: the ECU says
+    /// why and runs DEGRADED on the reference restraint.
+    #[arg(long, value_name = "FILE")]
+    pub lut: Option<PathBuf>,
+    /// Reference-restraint file (default data/reference-restraint.toml; missing or corrupt:
+    /// the copy built into the binary).
+    #[arg(long, value_name = "FILE")]
+    pub reference: Option<PathBuf>,
 }
 
 impl RunArgs {

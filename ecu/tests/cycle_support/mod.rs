@@ -137,11 +137,11 @@ impl Bench {
     /// One 1 ms cycle; CAN inputs at their DBC rates (10 ms / 100 ms).
     pub fn step(&mut self) {
         let ms = (self.now - T0) / MS;
-        if self.send_vehicle && ms % 10 == 0 {
+        if self.send_vehicle && ms.is_multiple_of(10) {
             let f = self.vehicle_frame(15.0);
             self.io.can_rx.push_back(f);
         }
-        if self.send_occupant && ms % 100 == 0 {
+        if self.send_occupant && ms.is_multiple_of(100) {
             let f = self.occupant_frame();
             self.io.can_rx.push_back(f);
         }
