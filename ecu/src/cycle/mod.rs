@@ -271,7 +271,7 @@ pub struct RestraintCycle {
     last_belt_tx_ns: u64,
     last_airbag: Option<AirbagContent>,
     last_airbag_tx_ns: u64,
-    last_status: Option<(EcuStatusEcuMode, u8, u16)>,
+    last_status: Option<(EcuStatusEcuMode, u8)>,
     last_status_tx_ns: u64,
     counters: CycleCounters,
 }
@@ -1017,7 +1017,9 @@ impl RestraintCycle {
             | u8::from(r & degraded::LUT_INVALID != 0) << 5
             | u8::from(info.overruns > 0) << 6;
         let overruns = u16::try_from(info.overruns).unwrap_or(u16::MAX);
-        let status = (mode, faults, overruns);
+        // On change of mode or fault bits (not of the overrun count: a noisy host would
+        // turn the heartbeat into bus load), else cyclically.
+        let status = (mode, faults);
         if Self::due(
             self.last_status,
             status,

@@ -1,0 +1,204 @@
+//! Real process test on a real (virtual) CAN bus: the `ecu` binary with CAN on vcan0, an
+//! iceoryx2 ObjectState publisher (this test), ego/occupant frames from our encoder on the
+//! bus, and `candump -L` recording what the ECU sends. Checks: E2E-valid BeltLimiterCmd,
+//! AirbagStageCmd and EcuStatus frames appear in candump's log, the pre-crash preset reaches
+//! the bus (CmdSource Adaptive, the LUT's pretensioner time), the heartbeat carries the LUT id.
+//!
+//! On a host without SocketCAN the visible test re-runs the `#[ignore]`d worker inside a
+//! user-mode Linux guest through `vcan-setup.sh --run`; with neither it FAILS (never skipped).
+
+mod cycle_support;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use bus::codec::BeltLimiterCmdCmdSource;
+use bus::socket::{interface_usable, BusSocket};
+use ipc::{ObjectPublisher, ObjectState, ServiceNames, VALID};
+
+const ECU: &str = env!("CARGO_BIN_EXE_ecu");
+
+fn iface() -> String {
+    std::env::var("VCAN").unwrap_or_else(|_| "vcan0".into())
+}
+
+fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
+}
+
+fn monotonic_ns() -> u64 {
+    let t = nix::time::clock_gettime(nix::time::ClockId::CLOCK_MONOTONIC).unwrap();
+    t.tv_sec() as u64 * 1_000_000_000 + t.tv_nsec() as u64
+}
+
+#[test]
+fn ecu_process_on_vcan_sends_e2e_valid_commands() {
+    if interface_usable(&iface()) {
+        worker_body();
+        return;
+    }
+    assert!(
+        std::env::var_os("VCAN_IN_UML").is_none(),
+        "inside the UML guest but {} is not usable",
+        iface()
+    );
+    eprintln!(
+        "host has no usable {}; re-running inside user-mode Linux",
+        iface()
+    );
+    let out = Command::new(repo_root().join("vcan-setup.sh"))
+        .args(["--iface", &iface(), "--run", "--"])
+        .arg(std::env::current_exe().unwrap())
+        .args([
+            "--exact",
+            "inner_vcan_worker",
+            "--ignored",
+            "--nocapture",
+            "--test-threads=1",
+        ])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdin(Stdio::null())
+        .output()
+        .expect("run vcan-setup.sh");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    eprintln!("--- guest stdout ---\n{stdout}\n--- vcan-setup stderr ---\n{stderr}");
+    assert!(
+        out.status.success(),
+        "worker failed inside UML (or UML unavailable)"
+    );
+    assert!(stdout.contains("1 passed"), "worker did not run: {stdout}");
+}
+
+#[test]
+#[ignore = "worker: run by ecu_process_on_vcan_sends_e2e_valid_commands (host vcan or UML)"]
+fn inner_vcan_worker() {
+    worker_body();
+}
+
+fn worker_body() {
+    let dir = std::env::temp_dir().join(format!("ecu-vcan-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let lut_path = dir.join("test.lut");
+    let lut = cycle_support::test_lut();
+    lut.save(&lut_path).unwrap();
+    let log = dir.join("candump.log");
+    let prefix = format!("ecu-vcan-{}", std::process::id());
+
+    let mut candump = Command::new("candump")
+        .args(["-L", &iface()])
+        .stdout(std::fs::File::create(&log).unwrap())
+        .spawn()
+        .expect("candump (can-utils) must be installed: ./vcan-setup.sh installs it");
+    let ecu = Command::new(ECU)
+        .args(["--can-interface", &iface(), "--cycles", "2500", "--quiet"])
+        .args([
+            "--service-prefix",
+            &prefix,
+            "--node-name",
+            &format!("{prefix}-ecu"),
+        ])
+        .arg("--lut")
+        .arg(&lut_path)
+        .arg("--reference")
+        .arg(repo_root().join("data/reference-restraint.toml"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+
+    // Inputs: ego speed every 10 ms, occupant every 100 ms (our encoder, E2E-sealed), and an
+    // opponent 250 ms ahead at 25 m/s over iceoryx2 every 10 ms (steady PRE-CRASH).
+    let (node, _) = ipc::create_node(&format!("{prefix}-feed"), false).unwrap();
+    let names = ServiceNames::with_prefix(&prefix);
+    let mut objects = ObjectPublisher::new(&node, &names).unwrap();
+    let mut bus_tx = BusSocket::open(&iface(), &[]).unwrap();
+    let mut b = cycle_support::Bench::new(None); // frame builder only
+    let start = Instant::now();
+    let mut k = 0u64;
+    while start.elapsed() < Duration::from_millis(2_000) {
+        let f = b.vehicle_frame(15.0);
+        bus_tx.send(&bus::RawFrame::new(f.id, f.payload())).unwrap();
+        if k.is_multiple_of(10) {
+            let f = b.occupant_frame();
+            bus_tx.send(&bus::RawFrame::new(f.id, f.payload())).unwrap();
+        }
+        let now = monotonic_ns();
+        objects
+            .publish_with(ObjectState::INVALID, |o| {
+                o.timestamp_ns = now;
+                o.sequence = k + 1;
+                o.distance_m = 6.25;
+                o.closing_speed_mps = 25.0;
+                o.opponent_mass_kg = 1500.0;
+                o.opponent_mass_sigma_kg = 100.0;
+                o.confidence = 0.9;
+                o.valid = VALID;
+            })
+            .unwrap();
+        k += 1;
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let out = ecu.wait_with_output().unwrap();
+    std::thread::sleep(Duration::from_millis(100));
+    let _ = candump.kill();
+    let _ = candump.wait();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "ecu failed:\n{stdout}\n{stderr}");
+
+    // Parse candump -L: "(sec.usec) vcan0 040#0011223344556677".
+    let text = std::fs::read_to_string(&log).unwrap();
+    let mut rx = bus::E2eChecker::with_max_lost(15);
+    let (mut belts, mut adaptive_belts, mut bags, mut status) = (0, 0, 0, 0);
+    let mut lut_id_seen = None;
+    for line in text.lines() {
+        let Some(frame) = line.split_whitespace().nth(2) else {
+            continue;
+        };
+        let Some((id, data)) = frame.split_once('#') else {
+            continue;
+        };
+        let id = u32::from_str_radix(id, 16).unwrap();
+        let bytes: Vec<u8> = (0..data.len() / 2)
+            .map(|i| u8::from_str_radix(&data[2 * i..2 * i + 2], 16).unwrap())
+            .collect();
+        match rx.check(id, &bytes) {
+            Ok(bus::Messages::BeltLimiterCmd(m)) => {
+                belts += 1;
+                if m.cmd_source() == BeltLimiterCmdCmdSource::Adaptive {
+                    adaptive_belts += 1;
+                    // Test LUT: pretensioner −0.5 ms per km/h at 90 km/h → −45 ms.
+                    assert!((m.pretensioner_fire_time() + 45.0).abs() < 0.051, "{m:?}");
+                }
+            }
+            Ok(bus::Messages::AirbagStageCmd(_)) => bags += 1,
+            Ok(bus::Messages::EcuStatus(m)) => {
+                status += 1;
+                lut_id_seen = Some(m.lut_id());
+            }
+            Ok(_) => {}
+            Err(e) => {
+                // Only the ECU's frames must be E2E-valid; ours are checked the same way.
+                panic!("E2E-invalid frame on the bus: {line}: {e}");
+            }
+        }
+    }
+    eprintln!("candump: belt {belts} (adaptive {adaptive_belts}), airbag {bags}, status {status}");
+    assert!(belts >= 20, "BeltLimiterCmd frames: {belts}\n{text}");
+    assert!(
+        adaptive_belts >= 1,
+        "pre-crash preset never reached the bus\n{stdout}\n{stderr}"
+    );
+    assert!(bags >= 20 && status >= 10);
+    assert_eq!(lut_id_seen, Some(lut.lut_id()));
+    assert!(
+        stdout.contains("activity restraint-cycle") || stdout.contains("restraint-cycle"),
+        "{stdout}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
