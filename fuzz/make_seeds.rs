@@ -1,0 +1,191 @@
+//! Writes the committed seed corpora, `corpus/<target>/seed-*`, from the project's own encoders
+//! (so every seed is a valid input that reaches deep code, and stays valid when formats change:
+//! rerun it). Run from `fuzz/`:
+//!
+//! ```sh
+//! cargo run --example make_seeds --no-default-features
+//! ```
+//!
+//! Seeds are deliberately few and small; libFuzzer grows its own corpus from them.
+
+use std::fs;
+use std::path::Path;
+
+use bus::codec::{
+    AirbagStageCmdArm, AirbagStageCmdCmdSource, AirbagStageCmdFire, AirbagStageCmdStage,
+    BeltLimiterCmdCmdSource, BeltLimiterCmdPretensionerCmd, EgoVehicleStateBrakeState,
+};
+use bus::{AirbagStageCmd, BeltLimiterCmd, E2eProtector, EgoVehicleState, RawFrame};
+
+fn write(target: &str, name: &str, bytes: &[u8]) {
+    let dir = Path::new("corpus").join(target);
+    fs::create_dir_all(&dir).expect("create corpus dir");
+    fs::write(dir.join(format!("seed-{name}")), bytes).expect("write seed");
+}
+
+fn frames() -> Vec<RawFrame> {
+    let mut tx = E2eProtector::new();
+    let mut v = Vec::new();
+    for i in 0..3 {
+        v.push(tx.seal(
+            AirbagStageCmd::encode(
+                AirbagStageCmdArm::Armed,
+                if i == 2 { AirbagStageCmdFire::Fire } else { AirbagStageCmdFire::NoFire },
+                AirbagStageCmdCmdSource::Adaptive,
+                AirbagStageCmdStage::Stage1,
+                6.5,
+                12.0,
+            )
+            .expect("valid airbag command"),
+        ));
+        v.push(tx.seal(
+            BeltLimiterCmd::encode(
+                BeltLimiterCmdPretensionerCmd::Fire,
+                BeltLimiterCmdCmdSource::Reference,
+                4.0,
+                -20.0,
+            )
+            .expect("valid belt command"),
+        ));
+        v.push(tx.seal(
+            EgoVehicleState::encode(EgoVehicleStateBrakeState::AbsActive, 14.4, -7.5)
+                .expect("valid ego state"),
+        ));
+    }
+    v
+}
+
+fn bus_seeds(frames: &[RawFrame]) {
+    for (i, f) in frames.iter().enumerate() {
+        // bus_decode: id (LE u16), flag byte, payload.
+        let mut b = (f.id as u16).to_le_bytes().to_vec();
+        b.push(0);
+        b.extend_from_slice(f.payload());
+        write("bus_decode", &format!("{i:02}-{:03x}", f.id), &b);
+    }
+    // e2e_check: max_lost, then records [0xF0][id LE][len][bytes] (explicit ids).
+    let mut seq = vec![0u8];
+    for f in frames {
+        seq.push(0xF0);
+        seq.extend_from_slice(&(f.id as u16).to_le_bytes());
+        seq.push(f.len);
+        seq.extend_from_slice(f.payload());
+    }
+    write("e2e_check", "stream", &seq);
+    let mut tolerant = seq.clone();
+    tolerant[0] = 2;
+    write("e2e_check", "stream-tolerant", &tolerant);
+}
+
+fn secoc_seeds() {
+    // secoc_verify: stream bit, then ops (see the target's docs).
+    let mut ops = vec![0u8];
+    for i in 0..4u8 {
+        ops.push(0);
+        ops.extend_from_slice(&[0x5A, 0x10 + i, 0x06, 0, 0x82, 0x00, 0, 0]);
+    }
+    ops.extend_from_slice(&[3, 1, 1]); // replay pair 1
+    ops.extend_from_slice(&[2, 70]); // lose 70 authenticators (beyond the window)
+    ops.push(0);
+    ops.extend_from_slice(&[1; 8]);
+    ops.extend_from_slice(&[4, 200, 8]); // 51 ms pass
+    ops.extend_from_slice(&[5, 8, 1, 2, 3, 4, 5, 6, 7, 8]); // attacker command
+    ops.extend_from_slice(&[6, 8, 1, 0, 0, 9, 9, 9, 9, 9]); // attacker authenticator
+    ops.extend_from_slice(&[7, 0x31, 0x00, 8, 2, 0, 0, 1, 2, 3, 4, 5]); // via the router
+    write("secoc_verify", "session", &ops);
+    let mut belt = ops.clone();
+    belt[0] = 1;
+    write("secoc_verify", "session-belt", &belt);
+}
+
+fn lut_seeds() {
+    use diagram::{AirbagThresholds, Axes, BuildInfo, Cell, Diagram, EgoVehicle, Header};
+    let header = Header {
+        ego: EgoVehicle {
+            mass_kg: 1785.0,
+            class: 4,
+            description: "fuzz seed".into(),
+        },
+        build: BuildInfo::default(),
+        airbag_thresholds: AirbagThresholds::DEFAULT,
+    };
+    let axes = Axes::new(
+        vec![40.0, 80.0, 108.0],
+        vec![800.0, 1785.0, 3000.0],
+        vec![30.0, 125.0],
+        vec![200.0, 450.0],
+    );
+    let d = Diagram::from_fn(header, axes, |p| {
+        let s = p.index as f32;
+        Cell {
+            belt_limiter_kn: 1.0 + (s % 11.0),
+            airbag_level_kn: s % 12.0,
+            pretensioner_time_ms: -10.0,
+            airbag_time_ms: 10.0,
+            a_max_g: 30.0,
+            a_mean_g: 20.0,
+            excursion_mm: 150.0,
+            bottoming_out: 0.0,
+            a_ideal_g: 15.0,
+        }
+    })
+    .expect("valid seed table");
+    write("lut_load", "small.lut", &d.to_bytes());
+    write("lut_load", "small.json", d.to_json_string().as_bytes());
+}
+
+fn config_seeds() {
+    let ecu_toml = fs::read("../ecu/ecu.toml").expect("ecu/ecu.toml");
+    write("ecu_config", "ecu.toml", &ecu_toml);
+    write("ecu_config", "minimal.toml", b"period_us = 1000\n[can]\nenabled = false\n");
+}
+
+fn scenario_seeds() {
+    let mut names: Vec<_> = fs::read_dir("../scenarios")
+        .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    names.retain(|p| p.extension().is_some_and(|e| e == "toml"));
+    names.sort();
+    for p in names.iter().take(3) {
+        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("scenario.toml");
+        write("scenario_parse", name, &fs::read(p).expect("scenario file"));
+    }
+}
+
+/// ecu_cycle: reserved byte, then records (see the target): an object closing in, the
+/// vehicle's CAN state, cycles, then a crash pulse on the accelerometer.
+fn cycle_seeds(frames: &[RawFrame]) {
+    let mut b = vec![0u8];
+    let f32s = |b: &mut Vec<u8>, v: &[f32]| v.iter().for_each(|x| b.extend_from_slice(&x.to_le_bytes()));
+    for k in 0..20u8 {
+        b.extend_from_slice(&[0, 0, k]);
+        f32s(&mut b, &[8.0 - 0.3 * f32::from(k), 15.0, -2.0, 1500.0, 150.0, 0.95]);
+        b.push(1);
+        if let Some(f) = frames.get(usize::from(k) % frames.len()) {
+            b.push(2);
+            b.extend_from_slice(&(f.id as u16).to_le_bytes());
+            b.push(f.len);
+            b.extend_from_slice(&f.data);
+        }
+        b.extend_from_slice(&[3, 40]); // 10 ms
+    }
+    for k in 0..5u8 {
+        b.extend_from_slice(&[1, 0, k]);
+        b.extend_from_slice(&100_000u32.to_le_bytes());
+        b.push(16);
+        f32s(&mut b, &[-300.0; 16]);
+        b.extend_from_slice(&[3, 4]); // 1 ms
+    }
+    write("ecu_cycle", "approach-crash", &b);
+}
+
+fn main() {
+    let f = frames();
+    bus_seeds(&f);
+    secoc_seeds();
+    lut_seeds();
+    config_seeds();
+    scenario_seeds();
+    cycle_seeds(&f);
+    println!("seeds written under fuzz/corpus/");
+}
