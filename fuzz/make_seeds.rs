@@ -27,30 +27,40 @@ fn frames() -> Vec<RawFrame> {
     let mut tx = E2eProtector::new();
     let mut v = Vec::new();
     for i in 0..3 {
-        v.push(tx.seal(
-            AirbagStageCmd::encode(
-                AirbagStageCmdArm::Armed,
-                if i == 2 { AirbagStageCmdFire::Fire } else { AirbagStageCmdFire::NoFire },
-                AirbagStageCmdCmdSource::Adaptive,
-                AirbagStageCmdStage::Stage1,
-                6.5,
-                12.0,
-            )
-            .expect("valid airbag command"),
-        ));
-        v.push(tx.seal(
-            BeltLimiterCmd::encode(
-                BeltLimiterCmdPretensionerCmd::Fire,
-                BeltLimiterCmdCmdSource::Reference,
-                4.0,
-                -20.0,
-            )
-            .expect("valid belt command"),
-        ));
-        v.push(tx.seal(
-            EgoVehicleState::encode(EgoVehicleStateBrakeState::AbsActive, 14.4, -7.5)
-                .expect("valid ego state"),
-        ));
+        v.push(
+            tx.seal(
+                AirbagStageCmd::encode(
+                    AirbagStageCmdArm::Armed,
+                    if i == 2 {
+                        AirbagStageCmdFire::Fire
+                    } else {
+                        AirbagStageCmdFire::NoFire
+                    },
+                    AirbagStageCmdCmdSource::Adaptive,
+                    AirbagStageCmdStage::Stage1,
+                    6.5,
+                    12.0,
+                )
+                .expect("valid airbag command"),
+            ),
+        );
+        v.push(
+            tx.seal(
+                BeltLimiterCmd::encode(
+                    BeltLimiterCmdPretensionerCmd::Fire,
+                    BeltLimiterCmdCmdSource::Reference,
+                    4.0,
+                    -20.0,
+                )
+                .expect("valid belt command"),
+            ),
+        );
+        v.push(
+            tx.seal(
+                EgoVehicleState::encode(EgoVehicleStateBrakeState::AbsActive, 14.4, -7.5)
+                    .expect("valid ego state"),
+            ),
+        );
     }
     v
 }
@@ -137,7 +147,11 @@ fn lut_seeds() {
 fn config_seeds() {
     let ecu_toml = fs::read("../ecu/ecu.toml").expect("ecu/ecu.toml");
     write("ecu_config", "ecu.toml", &ecu_toml);
-    write("ecu_config", "minimal.toml", b"period_us = 1000\n[can]\nenabled = false\n");
+    write(
+        "ecu_config",
+        "minimal.toml",
+        b"period_us = 1000\n[can]\nenabled = false\n",
+    );
 }
 
 fn scenario_seeds() {
@@ -147,7 +161,10 @@ fn scenario_seeds() {
     names.retain(|p| p.extension().is_some_and(|e| e == "toml"));
     names.sort();
     for p in names.iter().take(3) {
-        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("scenario.toml");
+        let name = p
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("scenario.toml");
         write("scenario_parse", name, &fs::read(p).expect("scenario file"));
     }
 }
@@ -156,10 +173,14 @@ fn scenario_seeds() {
 /// vehicle's CAN state, cycles, then a crash pulse on the accelerometer.
 fn cycle_seeds(frames: &[RawFrame]) {
     let mut b = vec![0u8];
-    let f32s = |b: &mut Vec<u8>, v: &[f32]| v.iter().for_each(|x| b.extend_from_slice(&x.to_le_bytes()));
+    let f32s =
+        |b: &mut Vec<u8>, v: &[f32]| v.iter().for_each(|x| b.extend_from_slice(&x.to_le_bytes()));
     for k in 0..20u8 {
         b.extend_from_slice(&[0, 0, k]);
-        f32s(&mut b, &[8.0 - 0.3 * f32::from(k), 15.0, -2.0, 1500.0, 150.0, 0.95]);
+        f32s(
+            &mut b,
+            &[8.0 - 0.3 * f32::from(k), 15.0, -2.0, 1500.0, 150.0, 0.95],
+        );
         b.push(1);
         if let Some(f) = frames.get(usize::from(k) % frames.len()) {
             b.push(2);

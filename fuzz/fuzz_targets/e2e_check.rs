@@ -24,10 +24,17 @@ fuzz_target!(|data: &[u8]| {
     while rest.len() >= 2 {
         let sel = rest[0];
         let (id, after) = if sel < 0xF0 {
-            (bus::MESSAGES[usize::from(sel) % bus::MESSAGES.len()].id, &rest[1..])
+            (
+                bus::MESSAGES[usize::from(sel) % bus::MESSAGES.len()].id,
+                &rest[1..],
+            )
         } else if rest.len() >= 3 {
             let raw = u32::from(u16::from_le_bytes([rest[1], rest[2]]));
-            let id = if sel & 1 == 1 { raw | bus::CAN_EFF_FLAG } else { raw };
+            let id = if sel & 1 == 1 {
+                raw | bus::CAN_EFF_FLAG
+            } else {
+                raw
+            };
             (id, &rest[3..])
         } else {
             return;
@@ -49,7 +56,10 @@ fuzz_target!(|data: &[u8]| {
         });
         match &r {
             Ok(_) => {
-                assert!(bus::decode(id, payload).is_ok(), "checker accepted, decode did not");
+                assert!(
+                    bus::decode(id, payload).is_ok(),
+                    "checker accepted, decode did not"
+                );
                 if let Some(i) = info.filter(|i| i.e2e_data_id.is_some()) {
                     let counter = payload[1] & 0x0F;
                     let slot = &mut last_counter[(i.id as usize) & 0x7FF];
@@ -60,8 +70,10 @@ fuzz_target!(|data: &[u8]| {
             Err(e) => {
                 // State updates on counter skips and range errors after a valid counter too.
                 if crc_ok {
-                    if let (Some(i), bus::RejectReason::CounterSkipped | bus::RejectReason::OutOfRange) =
-                        (info.filter(|i| i.e2e_data_id.is_some()), e.reason())
+                    if let (
+                        Some(i),
+                        bus::RejectReason::CounterSkipped | bus::RejectReason::OutOfRange,
+                    ) = (info.filter(|i| i.e2e_data_id.is_some()), e.reason())
                     {
                         last_counter[(i.id as usize) & 0x7FF] = Some(payload[1] & 0x0F);
                     }

@@ -74,7 +74,8 @@ fuzz_target!(|data: &[u8]| {
             }
             1 => {
                 let mut a = ipc::CrashAccelSample::EMPTY;
-                a.first_timestamp_ns = now_ns.saturating_sub(u64::from(r.u8().unwrap_or(0)) * 100_000);
+                a.first_timestamp_ns =
+                    now_ns.saturating_sub(u64::from(r.u8().unwrap_or(0)) * 100_000);
                 a.sequence = u64::from(r.u8().unwrap_or(0));
                 a.sample_period_ns = r.u32().unwrap_or(100_000);
                 a.count = u32::from(r.u8().unwrap_or(0));
@@ -118,7 +119,11 @@ fuzz_target!(|data: &[u8]| {
     for f in &io.can_tx {
         if let Err(e) = bus::decode(f.id, f.payload()) {
             // The SecOC authenticators carry no E2E; everything else must decode.
-            panic!("ECU sent an invalid frame {:#x} {:?}: {e}", f.id, f.payload());
+            panic!(
+                "ECU sent an invalid frame {:#x} {:?}: {e}",
+                f.id,
+                f.payload()
+            );
         }
     }
 });

@@ -15,7 +15,10 @@ fuzz_target!(|data: &[u8]| {
         Err(e) => {
             let _ = e.to_string();
             if let Some(line) = e.line {
-                assert!(line >= 1 && line <= text.lines().count() + 1, "line {line} outside the text");
+                assert!(
+                    line >= 1 && line <= text.lines().count() + 1,
+                    "line {line} outside the text"
+                );
             }
         }
     }

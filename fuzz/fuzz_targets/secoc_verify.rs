@@ -46,7 +46,9 @@ fuzz_target!(|data: &[u8]| {
                 let mut p = [0u8; 8];
                 p[..b.len()].copy_from_slice(&b);
                 let cmd = RawFrame::new(stream.command_id(), &p);
-                let Ok(auth) = tx.authenticate(&cmd) else { return };
+                let Ok(auth) = tx.authenticate(&cmd) else {
+                    return;
+                };
                 let fv = tx.next_freshness() - 1;
                 genuine.push((p, fv, auth));
                 let in_window = fv - rx.last_accepted() <= WINDOW;
@@ -82,7 +84,8 @@ fuzz_target!(|data: &[u8]| {
             // Time passes.
             4 => {
                 let b = input.bytes(2);
-                let dt = u64::from(b.first().copied().unwrap_or(0)) << (b.get(1).copied().unwrap_or(0) % 16);
+                let dt = u64::from(b.first().copied().unwrap_or(0))
+                    << (b.get(1).copied().unwrap_or(0) % 16);
                 now_us = now_us.saturating_add(dt);
                 rx.expire(now_us);
                 None
@@ -122,7 +125,9 @@ fuzz_target!(|data: &[u8]| {
             if let Ok(c) = r {
                 accepted += 1;
                 assert!(
-                    genuine.iter().any(|(p, fv, _)| *p == c.payload && *fv == c.freshness),
+                    genuine
+                        .iter()
+                        .any(|(p, fv, _)| *p == c.payload && *fv == c.freshness),
                     "accepted a command the sender never authenticated: {c:?}"
                 );
                 assert!(c.freshness > last_ok, "freshness did not increase");
