@@ -78,8 +78,11 @@ fn run() -> anyhow::Result<()> {
 
     // --- cyclictest ---------------------------------------------------------------------
     let histfile = a.out_dir.join("cyclictest-hist.txt");
+    // rt-tests 2.x: clock_nanosleep with an absolute deadline is the default (the old `-n`
+    // flag is gone); `-t1` one thread; `-q` summary only.
+    let _ = std::fs::remove_file(&histfile);
     let mut ct = Command::new("cyclictest");
-    ct.args(["-n", "-t1", "-q"])
+    ct.args(["-t1", "-q"])
         .arg(format!("-i{}", a.period_us))
         .arg(format!("-l{}", a.cycles))
         .arg(format!("-h{}", a.hist_max_us))
