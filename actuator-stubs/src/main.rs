@@ -88,8 +88,8 @@ fn realtime_minus_monotonic_ns() -> i128 {
 fn run(cli: &Cli) -> Result<()> {
     let scenario = Scenario::load(&cli.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
     let reference = match &cli.reference {
-        Some(p) => lut::reference::ReferenceRestraint::load(p),
-        None => lut::reference::ReferenceRestraint::builtin(),
+        Some(p) => physics::reference::ReferenceRestraint::load(p),
+        None => physics::reference::ReferenceRestraint::builtin(),
     }
     .map_err(|e| anyhow::anyhow!("reference restraint: {e}"))?;
     std::fs::create_dir_all(&cli.out).with_context(|| format!("creating {}", cli.out.display()))?;
@@ -103,6 +103,10 @@ fn run(cli: &Cli) -> Result<()> {
     let names = ServiceNames::with_prefix(&cli.service_prefix);
     let (node, _) = ipc::create_node(&format!("actuator-stubs-{}", std::process::id()), false)?;
     let mut truth_sub = BenchTruthSubscriber::new(&node, &names)?;
+    // ECU diagnostics: only for the timeline (when the ECU entered pre-crash); the judgement
+    // uses nothing but the bus.
+    let mut diag_sub = ipc::DiagnosticsSubscriber::new(&node, &names)?;
+    let mut diag_modes: Vec<(u64, u8)> = Vec::new();
     let log_path = cli.out.join("commands.jsonl");
     let mut log = std::io::BufWriter::new(
         std::fs::File::create(&log_path)
@@ -165,6 +169,11 @@ fn run(cli: &Cli) -> Result<()> {
             serde_json::to_writer(&mut log, &rec)?;
             log.write_all(b"\n")?;
         }
+        diag_sub.drain(|d| {
+            if diag_modes.last().map(|m| m.1) != Some(d.mode) {
+                diag_modes.push((d.timestamp_ns, d.mode));
+            }
+        });
         if let Some(t) = truth_sub.latest() {
             truth = t;
             if truth.is_done() {
@@ -183,6 +192,7 @@ fn run(cli: &Cli) -> Result<()> {
         &reference,
         &truth,
         &modules,
+        &diag_modes,
         frames,
         accepted,
         &checker,
@@ -204,9 +214,10 @@ fn run(cli: &Cli) -> Result<()> {
 fn build_report(
     cli: &Cli,
     scenario: &Scenario,
-    reference: &lut::reference::ReferenceRestraint,
+    reference: &physics::reference::ReferenceRestraint,
     truth: &BenchTruth,
     modules: &Modules,
+    diag_modes: &[(u64, u8)],
     frames: BTreeMap<String, u64>,
     accepted: u64,
     checker: &bus::E2eChecker,
@@ -229,6 +240,13 @@ fn build_report(
             u64::MAX
         },
     );
+    let mode_name = |m: u8| ipc::EcuMode::from_u8(m).map_or("unknown", |m| m.name()).to_owned();
+    let threat_ns = diag_modes
+        .iter()
+        .find(|(_, m)| *m == ipc::EcuMode::PreCrash as u8)
+        .map(|(t, _)| *t);
+    let preset_ns = threat_ns.and_then(|th| modules.limiter_levels.iter().find(|(t, _)| *t >= th).map(|(t, _)| *t));
+    let rel_or_start_ms = |t: u64| rel_ms(t).or_else(|| since_start_s(t).map(|s| s * 1e3)).unwrap_or(0.0);
     let mut report = Report {
         scenario: scenario.name.clone(),
         stop_reason: stop_reason.to_owned(),
@@ -249,18 +267,10 @@ fn build_report(
         first_armed_ms: modules.first_armed_ns.and_then(rel_ms),
         first_reference_cmd_ms: modules.first_reference_cmd_ns.and_then(rel_ms),
         first_reference_cmd_s: modules.first_reference_cmd_ns.and_then(since_start_s),
-        ecu_modes: modules
-            .ecu_modes
-            .iter()
-            .map(|(t, m)| {
-                (
-                    rel_ms(*t)
-                        .or_else(|| since_start_s(*t).map(|s| s * 1e3))
-                        .unwrap_or(0.0),
-                    ecu_mode_name(*m).to_owned(),
-                )
-            })
-            .collect(),
+        ecu_modes: modules.ecu_modes.iter().map(|(t, m)| (rel_or_start_ms(*t), ecu_mode_name(*m).to_owned())).collect(),
+        ecu_diag_modes: diag_modes.iter().map(|(t, m)| (rel_or_start_ms(*t), mode_name(*m))).collect(),
+        threat_detected_ms: threat_ns.map(rel_or_start_ms),
+        settings_preset_ms: preset_ns.map(rel_or_start_ms),
         pretensioner_before_contact: contact_ns != 0 && pre.pretensioner_s.is_some_and(|t| t < 0.0),
         pretensioner_released: modules.action("pretensioner_release").is_some(),
         airbag_fired: modules.airbag_fired,
@@ -316,7 +326,16 @@ fn build_report(
         Ok(()) => report.plot = Some("outcome.png".into()),
         Err(e) => eprintln!("actuator-stubs: warning: {e}"),
     }
+    // The same levels at the ECU's PLANNED times (relative to its predicted contact ≈ the true
+    // one): separates the plan's quality from command timing.
+    let planned = outcome::Commanded {
+        pretensioner_s: commanded.pretensioner_s.and(modules.action("pretensioner_fire").map(|a| a.planned_ms * 1e-3)),
+        load_limiter_kn: commanded.load_limiter_kn,
+        airbag: modules.action("airbag_fire").map(|a| (a.planned_ms * 1e-3, a.level_kn)),
+    };
+    let adaptive_planned = judge(&pulse, &occ, &planned.settings(&ref_set)).ok().map(|j| j.0);
     report.outcome = Some(Outcome {
+        adaptive_planned,
         adaptive_no_worse: no_worse(&adaptive, &refj),
         change_pct: if sum_r > 0.0 {
             (sum_a / sum_r - 1.0) * 100.0

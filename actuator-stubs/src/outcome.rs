@@ -11,15 +11,16 @@
 //! * airbag: receive time and level of the first armed fire command; none → no airbag.
 //!
 //! Reference restraint: `data/reference-restraint.toml` levels and times, fired as a
-//! conventional ECU would: below [`REFERENCE_NO_FIRE_DELTA_V_KPH`] of true ego Δv it does not
-//! fire the airbag (no-fire requirement).
+//! conventional ECU would: below [`REFERENCE_NO_FIRE_EBS_KPH`] of true equivalent barrier speed
+//! (ego Δv / (1 + e)) it does not fire the airbag (no-fire requirement; same limit as the
+//! ECU's default `no_fire_ebs_kph`).
 
 use physics::{OccupantInput, OccupantOutcome, RestraintHardware, RestraintSettings};
 use serde::{Deserialize, Serialize};
 
-/// Conventional no-fire limit on the ego's true velocity change [km/h] (SPEC: below about
-/// 20 km/h restraints must not fire).
-pub const REFERENCE_NO_FIRE_DELTA_V_KPH: f64 = 20.0;
+/// Conventional no-fire limit on the ego's true equivalent barrier speed [km/h] (SPEC: below
+/// about 20 km/h restraints must not fire).
+pub const REFERENCE_NO_FIRE_EBS_KPH: f64 = 20.0;
 
 /// Hand-over instant of the load-limiter level after contact [s].
 pub const LIMITER_LATCH_AFTER_CONTACT_S: f64 = 0.010;
@@ -148,7 +149,8 @@ pub fn reference_as_fired(
     reference: &RestraintSettings,
     ego_delta_v_mps: f64,
 ) -> RestraintSettings {
-    if ego_delta_v_mps * 3.6 < REFERENCE_NO_FIRE_DELTA_V_KPH {
+    let ebs_kph = ego_delta_v_mps * 3.6 / (1.0 + physics::defaults::RESTITUTION);
+    if ebs_kph < REFERENCE_NO_FIRE_EBS_KPH {
         RestraintSettings {
             airbag_force_n: 0.0,
             airbag_time_s: NEVER_S,
@@ -227,8 +229,9 @@ mod tests {
             pretensioner_time_s: 0.01,
             airbag_time_s: 0.01,
         };
-        assert_eq!(reference_as_fired(&r, 19.0 / 3.6).airbag_force_n, 0.0);
-        assert_eq!(reference_as_fired(&r, 21.0 / 3.6).airbag_force_n, 6e3);
+        // EBS = Δv / 1.1: 21.9 km/h Δv → 19.9 km/h EBS (no fire), 22.1 → 20.1 (fire).
+        assert_eq!(reference_as_fired(&r, 21.9 / 3.6).airbag_force_n, 0.0);
+        assert_eq!(reference_as_fired(&r, 22.1 / 3.6).airbag_force_n, 6e3);
     }
 
     #[test]

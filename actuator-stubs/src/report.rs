@@ -36,6 +36,9 @@ pub struct TimedAction {
 pub struct Outcome {
     /// What was actually commanded.
     pub adaptive: Judged,
+    /// The commanded levels at the ECU's planned times (FireTime signals) instead of the
+    /// receive times: how good the plan was, independent of command timing.
+    pub adaptive_planned: Option<Judged>,
     /// The conventional reference restraint (as a conventional ECU would fire it).
     pub reference: Judged,
     /// Ideal constant-force bound a* [g].
@@ -75,6 +78,12 @@ pub struct Report {
     pub first_reference_cmd_s: Option<f64>,
     /// ECU mode changes from EcuStatus: (ms rel. contact or since start, mode name).
     pub ecu_modes: Vec<(f64, String)>,
+    /// ECU mode changes from its iceoryx2 diagnostics: (ms rel. contact or since start, mode).
+    pub ecu_diag_modes: Vec<(f64, String)>,
+    /// ECU entered pre-crash (diagnostics) [ms rel. contact].
+    pub threat_detected_ms: Option<f64>,
+    /// First load-limiter level received after the threat was detected [ms rel. contact].
+    pub settings_preset_ms: Option<f64>,
     /// Pretensioner fired before the true contact and still fired at contact.
     pub pretensioner_before_contact: bool,
     /// Pretensioner released at some point.

@@ -1,1 +1,334 @@
-//! End-to-end tests of the real bench processes (see tests/tests/).
+//! End-to-end tests of the real bench processes (see tests/tests/) and the bench orchestration
+//! they share with the demo (`hil-bench`).
+//!
+//! One scenario run: `candump -L IF > candump.log`, `actuator-stubs`, `ecu --report-json`, then
+//! `sensor-feeds` (which plays the scenario in real time); when the feeds finish the stubs see
+//! the bench truth's `done` and judge; then the ECU and candump get SIGTERM. Everything a run
+//! produced lands in `OUT/<scenario>/`. Every run uses its own iceoryx2 service prefix, so
+//! leftovers of an earlier (killed) run can never be mistaken for this run's samples.
+
+use actuator_stubs::report::Report;
+use anyhow::{bail, Context, Result};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// What one run needs.
+#[derive(Clone, Debug)]
+pub struct RunConfig {
+    /// Scenario file.
+    pub scenario: PathBuf,
+    /// Output root (the run writes `out/<scenario name>/`).
+    pub out: PathBuf,
+    /// CAN interface.
+    pub can: String,
+    /// Folder with the `ecu`, `sensor-feeds` and `actuator-stubs` binaries.
+    pub bin_dir: PathBuf,
+    /// iceoryx2 service prefix for this run.
+    pub service_prefix: String,
+    /// Extra arguments for the ECU.
+    pub ecu_args: Vec<String>,
+    /// Working directory of the ECU (its config paths `data/default.lut`,
+    /// `data/reference-restraint.toml` are relative to the repository root).
+    pub ecu_cwd: PathBuf,
+}
+
+/// What one run produced.
+#[derive(Debug)]
+pub struct RunResult {
+    /// Scenario name.
+    pub name: String,
+    /// Output folder.
+    pub dir: PathBuf,
+    /// The stubs' report.
+    pub report: Report,
+    /// The ECU's JSON report (if it wrote one).
+    pub ecu_report: Option<serde_json::Value>,
+    /// Readable summary (also in summary.txt).
+    pub summary: String,
+    /// Process problems (non-zero exits), empty when all went well.
+    pub problems: Vec<String>,
+}
+
+/// The repository root (this crate lives in `<root>/tests`).
+pub fn repo_root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("."))
+}
+
+fn spawn(cmd: &mut Command, what: &str) -> Result<Child> {
+    cmd.spawn().with_context(|| format!("starting {what} ({cmd:?})"))
+}
+
+fn terminate(child: &mut Child, what: &str, grace: Duration) -> Result<std::process::ExitStatus> {
+    if let Ok(Some(st)) = child.try_wait() {
+        return Ok(st);
+    }
+    let pid = nix::unistd::Pid::from_raw(child.id() as i32);
+    let _ = nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGTERM);
+    let until = Instant::now() + grace;
+    while Instant::now() < until {
+        if let Some(st) = child.try_wait()? {
+            return Ok(st);
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let _ = child.kill();
+    let st = child.wait()?;
+    eprintln!("hil-bench: {what} did not stop on SIGTERM within {grace:?}; killed");
+    Ok(st)
+}
+
+fn wait_timeout(child: &mut Child, timeout: Duration) -> Result<Option<std::process::ExitStatus>> {
+    let until = Instant::now() + timeout;
+    while Instant::now() < until {
+        if let Some(st) = child.try_wait()? {
+            return Ok(Some(st));
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    Ok(None)
+}
+
+/// Runs one scenario through the real processes.
+pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
+    let scenario = sensor_feeds::Scenario::load(&cfg.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let dir = cfg.out.join(&scenario.name);
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    for stale in ["report.json", "ecu-report.json", "candump.log", "commands.jsonl", "outcome.png", "summary.txt"] {
+        let _ = std::fs::remove_file(dir.join(stale));
+    }
+    let bin = |name: &str| cfg.bin_dir.join(name);
+    for b in ["ecu", "sensor-feeds", "actuator-stubs"] {
+        if !bin(b).exists() {
+            bail!("{} missing: build with `cargo build --release --workspace --bins`", bin(b).display());
+        }
+    }
+    let mut problems = Vec::new();
+    // Absolute paths: the ECU runs in the repository root.
+    let dir = std::path::absolute(&dir)?;
+    let candump_log = std::fs::File::create(dir.join("candump.log"))?;
+    let mut candump = spawn(
+        Command::new("candump").args(["-L", &cfg.can]).stdout(candump_log).stderr(Stdio::inherit()),
+        "candump (install can-utils)",
+    )?;
+    let mut stubs = spawn(
+        Command::new(bin("actuator-stubs"))
+            .arg("--scenario")
+            .arg(&cfg.scenario)
+            .args(["--can", &cfg.can, "--service-prefix", &cfg.service_prefix, "--timeout-s"])
+            .arg(format!("{}", scenario.duration_s + 30.0))
+            .arg("--out")
+            .arg(&dir),
+        "actuator-stubs",
+    )?;
+    let ecu_log = std::fs::File::create(dir.join("ecu-stdout.txt"))?;
+    let mut ecu = spawn(
+        Command::new(bin("ecu"))
+            .args(["--can-interface", &cfg.can, "--service-prefix", &cfg.service_prefix, "--quiet"])
+            .arg("--node-name")
+            .arg(format!("ecu-{}", std::process::id()))
+            .arg("--report-json")
+            .arg(dir.join("ecu-report.json"))
+            .args(&cfg.ecu_args)
+            .current_dir(&cfg.ecu_cwd)
+            .stdout(ecu_log),
+        "ecu",
+    )?;
+    // Let the ECU and the stubs come up (nodes, services, CAN sockets) before the scenario.
+    std::thread::sleep(Duration::from_millis(400));
+    if let Ok(Some(st)) = ecu.try_wait() {
+        problems.push(format!("ecu exited early: {st}"));
+    }
+    let feeds_status = Command::new(bin("sensor-feeds"))
+        .arg("--scenario")
+        .arg(&cfg.scenario)
+        .args(["--can", &cfg.can, "--service-prefix", &cfg.service_prefix])
+        .status()
+        .context("running sensor-feeds")?;
+    if !feeds_status.success() {
+        problems.push(format!("sensor-feeds: {feeds_status}"));
+    }
+    match wait_timeout(&mut stubs, Duration::from_secs(20))? {
+        Some(st) if st.success() => {}
+        Some(st) => problems.push(format!("actuator-stubs: {st}")),
+        None => {
+            let st = terminate(&mut stubs, "actuator-stubs", Duration::from_secs(5))?;
+            problems.push(format!("actuator-stubs did not finish after the feeds ({st})"));
+        }
+    }
+    let st = terminate(&mut ecu, "ecu", Duration::from_secs(5))?;
+    if !st.success() {
+        problems.push(format!("ecu: {st}"));
+    }
+    std::thread::sleep(Duration::from_millis(50));
+    let _ = terminate(&mut candump, "candump", Duration::from_secs(2))?;
+
+    let report_path = dir.join("report.json");
+    let report: Report = serde_json::from_str(
+        &std::fs::read_to_string(&report_path).with_context(|| format!("reading {}", report_path.display()))?,
+    )
+    .with_context(|| format!("parsing {}", report_path.display()))?;
+    let ecu_report = std::fs::read_to_string(dir.join("ecu-report.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok());
+    let summary = summarise(&scenario, &report, ecu_report.as_ref(), &dir, &problems);
+    std::fs::write(dir.join("summary.txt"), &summary)?;
+    Ok(RunResult { name: scenario.name, dir, report, ecu_report, summary, problems })
+}
+
+fn ms(v: Option<f64>) -> String {
+    v.map_or_else(|| "—".to_owned(), |x| format!("{x:+8.1} ms"))
+}
+
+/// The readable summary of one run.
+pub fn summarise(
+    scenario: &sensor_feeds::Scenario,
+    r: &Report,
+    ecu: Option<&serde_json::Value>,
+    dir: &Path,
+    problems: &[String],
+) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "=== {} ===", r.scenario);
+    let _ = writeln!(s, "{}", scenario.description);
+    match &r.true_crash {
+        Some(c) => {
+            let _ = writeln!(
+                s,
+                "true crash: closing {:.1} km/h, ego Δv {:.1} km/h, compartment a_max {:.1} g, a_mean {:.1} g, crush {:.0} mm",
+                c.closing_speed_kph, c.delta_v_kph, c.a_max_g, c.a_mean_g, c.crush_mm
+            );
+        }
+        None => {
+            let _ = writeln!(s, "true crash: none (no contact)");
+        }
+    }
+    let _ = writeln!(s, "\ntimeline (ms relative to TRUE contact):");
+    let action = |w: &str| r.actions.iter().find(|a| a.action.what == w);
+    let _ = writeln!(s, "  threat detected (ECU pre-crash)                  {}", ms(r.threat_detected_ms));
+    let _ = writeln!(s, "  settings preset (limiter level sent)             {}", ms(r.settings_preset_ms));
+    if let Some(a) = action("pretensioner_fire") {
+        let _ = writeln!(
+            s,
+            "  pretensioner fire                                {}  (planned {:+.1} ms, limiter {:.2} kN, {})",
+            ms(a.t_ms),
+            a.action.planned_ms,
+            a.action.level_kn,
+            a.action.source
+        );
+    } else {
+        let _ = writeln!(s, "  pretensioner fire                                {}", ms(None));
+    }
+    if r.contact_ns != 0 {
+        let _ = writeln!(s, "  contact                                          {}", ms(Some(0.0)));
+    } else {
+        let _ = writeln!(s, "  contact                                          none");
+    }
+    if let Some(a) = action("airbag_fire") {
+        let _ = writeln!(
+            s,
+            "  airbag fire                                      {}  (planned {:+.1} ms, level {:.2} kN, {})",
+            ms(a.t_ms),
+            a.action.planned_ms,
+            a.action.level_kn,
+            a.action.source
+        );
+        if let Some(t) = a.t_ms {
+            let _ = writeln!(
+                s,
+                "  command latency: airbag command received {:+.1} ms after its planned time",
+                t - a.action.planned_ms
+            );
+        }
+    } else {
+        let _ = writeln!(s, "  airbag fire                                      {}", ms(None));
+    }
+    if let Some(a) = action("pretensioner_release") {
+        let _ = writeln!(s, "  pretensioner release                             {}", ms(a.t_ms));
+    }
+    if r.first_reference_cmd_s.is_some() {
+        let _ = writeln!(
+            s,
+            "  first reference-restraint command (fallback)     {}  ({:.3} s after start)",
+            ms(r.first_reference_cmd_ms),
+            r.first_reference_cmd_s.unwrap_or(0.0)
+        );
+    }
+    if !r.ecu_diag_modes.is_empty() {
+        let modes: Vec<String> = r.ecu_diag_modes.iter().map(|(t, m)| format!("{m}@{t:+.0}")).collect();
+        let _ = writeln!(s, "  ECU modes (diagnostics): {}", modes.join(" → "));
+    }
+    if !r.ecu_modes.is_empty() {
+        let modes: Vec<String> = r.ecu_modes.iter().map(|(t, m)| format!("{m}@{t:+.0}")).collect();
+        let _ = writeln!(s, "  ECU modes (EcuStatus): {}", modes.join(" → "));
+    }
+    let frames: Vec<String> = r.frames.iter().map(|(k, v)| format!("{k} {v}")).collect();
+    let _ = writeln!(
+        s,
+        "bus: {} | E2E accepted {}, rejected {:?}",
+        frames.join(", "),
+        r.e2e_accepted,
+        r.e2e_rejected
+    );
+    if let Some(o) = &r.outcome {
+        let _ = writeln!(s, "\noccupant ({} kg, {} mm, {}):", scenario.occupant.mass_kg, scenario.occupant.chest_to_wheel_mm, if scenario.occupant.belted { "belted" } else { "UNBELTED" });
+        let _ = writeln!(s, "  {:<22} {:>8} {:>8} {:>11} {:>9} {:>8} {:>8}", "", "a_max g", "a_mean g", "excursion", "limiter", "airbag", "fire ms");
+        let mut rows = vec![("adaptive (commanded)", &o.adaptive)];
+        if let Some(p) = &o.adaptive_planned {
+            rows.push(("adaptive (at plan time)", p));
+        }
+        rows.push(("reference restraint", &o.reference));
+        for (name, j) in rows {
+            let _ = writeln!(
+                s,
+                "  {:<22} {:>8.1} {:>8.1} {:>8.0} mm{} {:>6.2} kN {:>5.2} kN {:>8}",
+                name,
+                j.a_max_g,
+                j.a_mean_g,
+                j.excursion_mm,
+                if j.bottomed_out { "!" } else { " " },
+                j.load_limiter_kn,
+                j.airbag_level_kn,
+                j.airbag_ms.map_or("—".to_owned(), |t| format!("{t:.1}"))
+            );
+        }
+        let _ = writeln!(s, "  {:<22} {:>8.1}   (constant-force bound a*, ride-down {:.0} mm)", "ideal", o.ideal_g, o.adaptive.available_mm);
+        let _ = writeln!(
+            s,
+            "  adaptive vs reference: {:+.1} % on a_max + a_mean → {}{}",
+            o.change_pct,
+            if o.adaptive_no_worse { "no worse" } else { "WORSE" },
+            if o.adaptive.bottomed_out { " (adaptive BOTTOMED OUT)" } else { "" }
+        );
+    }
+    if let Some(e) = ecu {
+        let p = |k: &str, q: &str| e.get(k).and_then(|v| v.get(q)).and_then(|v| v.as_f64()).unwrap_or(f64::NAN);
+        let _ = writeln!(
+            s,
+            "\nECU timing: {} cycles, {} overruns; wake latency p50 {:.0} / p99 {:.0} / max {:.0} µs; exec p50 {:.1} / p99 {:.1} / max {:.1} µs; activity {}",
+            e.get("cycles").and_then(|v| v.as_u64()).unwrap_or(0),
+            e.get("overruns").and_then(|v| v.as_u64()).unwrap_or(0),
+            p("wake_latency_us", "p50"),
+            p("wake_latency_us", "p99"),
+            p("wake_latency_us", "max"),
+            p("exec_us", "p50"),
+            p("exec_us", "p99"),
+            p("exec_us", "max"),
+            e.get("activity").and_then(|v| v.as_str()).unwrap_or("?")
+        );
+        if std::env::var_os("VCAN_IN_UML").is_some() {
+            let _ = writeln!(s, "  (inside user-mode Linux: syscalls are emulated, these timings are meaningless — measure on a real kernel)");
+        }
+    } else {
+        let _ = writeln!(s, "\nECU timing: no ecu-report.json");
+    }
+    for p in problems {
+        let _ = writeln!(s, "PROBLEM: {p}");
+    }
+    let _ = writeln!(s, "output: {}", dir.display());
+    s
+}

@@ -1,0 +1,85 @@
+//! `hil-bench --scenario FILE [--scenario FILE …] [--out DIR]`: runs scenarios through the real
+//! bench processes on a CAN interface that must already exist (run it through
+//! `./vcan-setup.sh --run -- target/release/hil-bench …`). One guest boot, many scenarios.
+
+use anyhow::Result;
+use clap::Parser;
+use e2e_tests::{run_scenario, RunConfig};
+use std::path::PathBuf;
+
+/// HIL bench orchestrator: candump + actuator-stubs + ecu + sensor-feeds per scenario.
+#[derive(Parser, Debug)]
+#[command(name = "hil-bench", version)]
+struct Cli {
+    /// Scenario file(s), run one after the other.
+    #[arg(long, required = true)]
+    scenario: Vec<PathBuf>,
+    /// Output root; each scenario writes OUT/<name>/.
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    /// CAN interface (default: $VCAN or vcan0).
+    #[arg(long)]
+    can: Option<String>,
+    /// Folder of the bench binaries (default: this binary's folder).
+    #[arg(long)]
+    bin_dir: Option<PathBuf>,
+    /// Extra ECU argument (repeatable), e.g. --ecu-arg=--config --ecu-arg=ecu.toml.
+    #[arg(long, allow_hyphen_values = true)]
+    ecu_arg: Vec<String>,
+    /// Repository root (the ECU's working directory; default: where this crate was built).
+    #[arg(long)]
+    repo: Option<PathBuf>,
+    /// Print only the one-line verdicts, not the full summaries.
+    #[arg(long)]
+    brief: bool,
+}
+
+fn main() -> std::process::ExitCode {
+    match run() {
+        Ok(true) => std::process::ExitCode::SUCCESS,
+        Ok(false) => std::process::ExitCode::from(1),
+        Err(e) => {
+            eprintln!("hil-bench: error: {e:#}");
+            std::process::ExitCode::from(2)
+        }
+    }
+}
+
+fn run() -> Result<bool> {
+    let cli = Cli::parse();
+    let bin_dir = match cli.bin_dir {
+        Some(d) => d,
+        None => std::env::current_exe()?.parent().map(PathBuf::from).unwrap_or_default(),
+    };
+    let can = cli.can.or_else(|| std::env::var("VCAN").ok()).unwrap_or_else(|| "vcan0".into());
+    let mut all_ok = true;
+    for (i, scenario) in cli.scenario.iter().enumerate() {
+        let cfg = RunConfig {
+            scenario: scenario.clone(),
+            out: cli.out.clone(),
+            can: can.clone(),
+            bin_dir: bin_dir.clone(),
+            service_prefix: format!("hil-bench-{}-{i}", std::process::id()),
+            ecu_args: cli.ecu_arg.clone(),
+            ecu_cwd: cli.repo.clone().unwrap_or_else(e2e_tests::repo_root),
+        };
+        match run_scenario(&cfg) {
+            Ok(r) => {
+                if cli.brief {
+                    let verdict = r.report.outcome.as_ref().map_or("no contact".to_owned(), |o| {
+                        format!("{:+.1} % vs reference ({})", o.change_pct, if o.adaptive_no_worse { "no worse" } else { "WORSE" })
+                    });
+                    println!("{}: airbag {}, {verdict}", r.name, if r.report.airbag_fired { "fired" } else { "not fired" });
+                } else {
+                    println!("{}", r.summary);
+                }
+                all_ok &= r.problems.is_empty();
+            }
+            Err(e) => {
+                eprintln!("hil-bench: {}: {e:#}", scenario.display());
+                all_ok = false;
+            }
+        }
+    }
+    Ok(all_ok)
+}
