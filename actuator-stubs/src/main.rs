@@ -240,13 +240,27 @@ fn build_report(
             u64::MAX
         },
     );
-    let mode_name = |m: u8| ipc::EcuMode::from_u8(m).map_or("unknown", |m| m.name()).to_owned();
+    let mode_name = |m: u8| {
+        ipc::EcuMode::from_u8(m)
+            .map_or("unknown", |m| m.name())
+            .to_owned()
+    };
     let threat_ns = diag_modes
         .iter()
         .find(|(_, m)| *m == ipc::EcuMode::PreCrash as u8)
         .map(|(t, _)| *t);
-    let preset_ns = threat_ns.and_then(|th| modules.limiter_levels.iter().find(|(t, _)| *t >= th).map(|(t, _)| *t));
-    let rel_or_start_ms = |t: u64| rel_ms(t).or_else(|| since_start_s(t).map(|s| s * 1e3)).unwrap_or(0.0);
+    let preset_ns = threat_ns.and_then(|th| {
+        modules
+            .limiter_levels
+            .iter()
+            .find(|(t, _)| *t >= th)
+            .map(|(t, _)| *t)
+    });
+    let rel_or_start_ms = |t: u64| {
+        rel_ms(t)
+            .or_else(|| since_start_s(t).map(|s| s * 1e3))
+            .unwrap_or(0.0)
+    };
     let mut report = Report {
         scenario: scenario.name.clone(),
         stop_reason: stop_reason.to_owned(),
@@ -267,8 +281,15 @@ fn build_report(
         first_armed_ms: modules.first_armed_ns.and_then(rel_ms),
         first_reference_cmd_ms: modules.first_reference_cmd_ns.and_then(rel_ms),
         first_reference_cmd_s: modules.first_reference_cmd_ns.and_then(since_start_s),
-        ecu_modes: modules.ecu_modes.iter().map(|(t, m)| (rel_or_start_ms(*t), ecu_mode_name(*m).to_owned())).collect(),
-        ecu_diag_modes: diag_modes.iter().map(|(t, m)| (rel_or_start_ms(*t), mode_name(*m))).collect(),
+        ecu_modes: modules
+            .ecu_modes
+            .iter()
+            .map(|(t, m)| (rel_or_start_ms(*t), ecu_mode_name(*m).to_owned()))
+            .collect(),
+        ecu_diag_modes: diag_modes
+            .iter()
+            .map(|(t, m)| (rel_or_start_ms(*t), mode_name(*m)))
+            .collect(),
         threat_detected_ms: threat_ns.map(rel_or_start_ms),
         settings_preset_ms: preset_ns.map(rel_or_start_ms),
         pretensioner_before_contact: contact_ns != 0 && pre.pretensioner_s.is_some_and(|t| t < 0.0),
@@ -329,11 +350,19 @@ fn build_report(
     // The same levels at the ECU's PLANNED times (relative to its predicted contact ≈ the true
     // one): separates the plan's quality from command timing.
     let planned = outcome::Commanded {
-        pretensioner_s: commanded.pretensioner_s.and(modules.action("pretensioner_fire").map(|a| a.planned_ms * 1e-3)),
+        pretensioner_s: commanded.pretensioner_s.and(
+            modules
+                .action("pretensioner_fire")
+                .map(|a| a.planned_ms * 1e-3),
+        ),
         load_limiter_kn: commanded.load_limiter_kn,
-        airbag: modules.action("airbag_fire").map(|a| (a.planned_ms * 1e-3, a.level_kn)),
+        airbag: modules
+            .action("airbag_fire")
+            .map(|a| (a.planned_ms * 1e-3, a.level_kn)),
     };
-    let adaptive_planned = judge(&pulse, &occ, &planned.settings(&ref_set)).ok().map(|j| j.0);
+    let adaptive_planned = judge(&pulse, &occ, &planned.settings(&ref_set))
+        .ok()
+        .map(|j| j.0);
     report.outcome = Some(Outcome {
         adaptive_planned,
         adaptive_no_worse: no_worse(&adaptive, &refj),

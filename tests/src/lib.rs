@@ -60,7 +60,8 @@ pub fn repo_root() -> PathBuf {
 }
 
 fn spawn(cmd: &mut Command, what: &str) -> Result<Child> {
-    cmd.spawn().with_context(|| format!("starting {what} ({cmd:?})"))
+    cmd.spawn()
+        .with_context(|| format!("starting {what} ({cmd:?})"))
 }
 
 fn terminate(child: &mut Child, what: &str, grace: Duration) -> Result<std::process::ExitStatus> {
@@ -95,16 +96,27 @@ fn wait_timeout(child: &mut Child, timeout: Duration) -> Result<Option<std::proc
 
 /// Runs one scenario through the real processes.
 pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
-    let scenario = sensor_feeds::Scenario::load(&cfg.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let scenario =
+        sensor_feeds::Scenario::load(&cfg.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
     let dir = cfg.out.join(&scenario.name);
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-    for stale in ["report.json", "ecu-report.json", "candump.log", "commands.jsonl", "outcome.png", "summary.txt"] {
+    for stale in [
+        "report.json",
+        "ecu-report.json",
+        "candump.log",
+        "commands.jsonl",
+        "outcome.png",
+        "summary.txt",
+    ] {
         let _ = std::fs::remove_file(dir.join(stale));
     }
     let bin = |name: &str| cfg.bin_dir.join(name);
     for b in ["ecu", "sensor-feeds", "actuator-stubs"] {
         if !bin(b).exists() {
-            bail!("{} missing: build with `cargo build --release --workspace --bins`", bin(b).display());
+            bail!(
+                "{} missing: build with `cargo build --release --workspace --bins`",
+                bin(b).display()
+            );
         }
     }
     let mut problems = Vec::new();
@@ -112,14 +124,23 @@ pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
     let dir = std::path::absolute(&dir)?;
     let candump_log = std::fs::File::create(dir.join("candump.log"))?;
     let mut candump = spawn(
-        Command::new("candump").args(["-L", &cfg.can]).stdout(candump_log).stderr(Stdio::inherit()),
+        Command::new("candump")
+            .args(["-L", &cfg.can])
+            .stdout(candump_log)
+            .stderr(Stdio::inherit()),
         "candump (install can-utils)",
     )?;
     let mut stubs = spawn(
         Command::new(bin("actuator-stubs"))
             .arg("--scenario")
             .arg(&cfg.scenario)
-            .args(["--can", &cfg.can, "--service-prefix", &cfg.service_prefix, "--timeout-s"])
+            .args([
+                "--can",
+                &cfg.can,
+                "--service-prefix",
+                &cfg.service_prefix,
+                "--timeout-s",
+            ])
             .arg(format!("{}", scenario.duration_s + 30.0))
             .arg("--out")
             .arg(&dir),
@@ -128,7 +149,13 @@ pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
     let ecu_log = std::fs::File::create(dir.join("ecu-stdout.txt"))?;
     let mut ecu = spawn(
         Command::new(bin("ecu"))
-            .args(["--can-interface", &cfg.can, "--service-prefix", &cfg.service_prefix, "--quiet"])
+            .args([
+                "--can-interface",
+                &cfg.can,
+                "--service-prefix",
+                &cfg.service_prefix,
+                "--quiet",
+            ])
             .arg("--node-name")
             .arg(format!("ecu-{}", std::process::id()))
             .arg("--report-json")
@@ -157,7 +184,9 @@ pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
         Some(st) => problems.push(format!("actuator-stubs: {st}")),
         None => {
             let st = terminate(&mut stubs, "actuator-stubs", Duration::from_secs(5))?;
-            problems.push(format!("actuator-stubs did not finish after the feeds ({st})"));
+            problems.push(format!(
+                "actuator-stubs did not finish after the feeds ({st})"
+            ));
         }
     }
     let st = terminate(&mut ecu, "ecu", Duration::from_secs(5))?;
@@ -169,7 +198,8 @@ pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
 
     let report_path = dir.join("report.json");
     let report: Report = serde_json::from_str(
-        &std::fs::read_to_string(&report_path).with_context(|| format!("reading {}", report_path.display()))?,
+        &std::fs::read_to_string(&report_path)
+            .with_context(|| format!("reading {}", report_path.display()))?,
     )
     .with_context(|| format!("parsing {}", report_path.display()))?;
     let ecu_report = std::fs::read_to_string(dir.join("ecu-report.json"))
@@ -177,7 +207,14 @@ pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
         .and_then(|t| serde_json::from_str(&t).ok());
     let summary = summarise(&scenario, &report, ecu_report.as_ref(), &dir, &problems);
     std::fs::write(dir.join("summary.txt"), &summary)?;
-    Ok(RunResult { name: scenario.name, dir, report, ecu_report, summary, problems })
+    Ok(RunResult {
+        name: scenario.name,
+        dir,
+        report,
+        ecu_report,
+        summary,
+        problems,
+    })
 }
 
 fn ms(v: Option<f64>) -> String {
@@ -209,8 +246,16 @@ pub fn summarise(
     }
     let _ = writeln!(s, "\ntimeline (ms relative to TRUE contact):");
     let action = |w: &str| r.actions.iter().find(|a| a.action.what == w);
-    let _ = writeln!(s, "  threat detected (ECU pre-crash)                  {}", ms(r.threat_detected_ms));
-    let _ = writeln!(s, "  settings preset (limiter level sent)             {}", ms(r.settings_preset_ms));
+    let _ = writeln!(
+        s,
+        "  threat detected (ECU pre-crash)                  {}",
+        ms(r.threat_detected_ms)
+    );
+    let _ = writeln!(
+        s,
+        "  settings preset (limiter level sent)             {}",
+        ms(r.settings_preset_ms)
+    );
     if let Some(a) = action("pretensioner_fire") {
         let _ = writeln!(
             s,
@@ -221,10 +266,18 @@ pub fn summarise(
             a.action.source
         );
     } else {
-        let _ = writeln!(s, "  pretensioner fire                                {}", ms(None));
+        let _ = writeln!(
+            s,
+            "  pretensioner fire                                {}",
+            ms(None)
+        );
     }
     if r.contact_ns != 0 {
-        let _ = writeln!(s, "  contact                                          {}", ms(Some(0.0)));
+        let _ = writeln!(
+            s,
+            "  contact                                          {}",
+            ms(Some(0.0))
+        );
     } else {
         let _ = writeln!(s, "  contact                                          none");
     }
@@ -245,10 +298,18 @@ pub fn summarise(
             );
         }
     } else {
-        let _ = writeln!(s, "  airbag fire                                      {}", ms(None));
+        let _ = writeln!(
+            s,
+            "  airbag fire                                      {}",
+            ms(None)
+        );
     }
     if let Some(a) = action("pretensioner_release") {
-        let _ = writeln!(s, "  pretensioner release                             {}", ms(a.t_ms));
+        let _ = writeln!(
+            s,
+            "  pretensioner release                             {}",
+            ms(a.t_ms)
+        );
     }
     if r.first_reference_cmd_s.is_some() {
         let _ = writeln!(
@@ -259,11 +320,19 @@ pub fn summarise(
         );
     }
     if !r.ecu_diag_modes.is_empty() {
-        let modes: Vec<String> = r.ecu_diag_modes.iter().map(|(t, m)| format!("{m}@{t:+.0}")).collect();
+        let modes: Vec<String> = r
+            .ecu_diag_modes
+            .iter()
+            .map(|(t, m)| format!("{m}@{t:+.0}"))
+            .collect();
         let _ = writeln!(s, "  ECU modes (diagnostics): {}", modes.join(" → "));
     }
     if !r.ecu_modes.is_empty() {
-        let modes: Vec<String> = r.ecu_modes.iter().map(|(t, m)| format!("{m}@{t:+.0}")).collect();
+        let modes: Vec<String> = r
+            .ecu_modes
+            .iter()
+            .map(|(t, m)| format!("{m}@{t:+.0}"))
+            .collect();
         let _ = writeln!(s, "  ECU modes (EcuStatus): {}", modes.join(" → "));
     }
     let frames: Vec<String> = r.frames.iter().map(|(k, v)| format!("{k} {v}")).collect();
@@ -275,8 +344,22 @@ pub fn summarise(
         r.e2e_rejected
     );
     if let Some(o) = &r.outcome {
-        let _ = writeln!(s, "\noccupant ({} kg, {} mm, {}):", scenario.occupant.mass_kg, scenario.occupant.chest_to_wheel_mm, if scenario.occupant.belted { "belted" } else { "UNBELTED" });
-        let _ = writeln!(s, "  {:<22} {:>8} {:>8} {:>11} {:>9} {:>8} {:>8}", "", "a_max g", "a_mean g", "excursion", "limiter", "airbag", "fire ms");
+        let _ = writeln!(
+            s,
+            "\noccupant ({} kg, {} mm, {}):",
+            scenario.occupant.mass_kg,
+            scenario.occupant.chest_to_wheel_mm,
+            if scenario.occupant.belted {
+                "belted"
+            } else {
+                "UNBELTED"
+            }
+        );
+        let _ = writeln!(
+            s,
+            "  {:<22} {:>8} {:>8} {:>11} {:>9} {:>8} {:>8}",
+            "", "a_max g", "a_mean g", "excursion", "limiter", "airbag", "fire ms"
+        );
         let mut rows = vec![("adaptive (commanded)", &o.adaptive)];
         if let Some(p) = &o.adaptive_planned {
             rows.push(("adaptive (at plan time)", p));
@@ -296,17 +379,34 @@ pub fn summarise(
                 j.airbag_ms.map_or("—".to_owned(), |t| format!("{t:.1}"))
             );
         }
-        let _ = writeln!(s, "  {:<22} {:>8.1}   (constant-force bound a*, ride-down {:.0} mm)", "ideal", o.ideal_g, o.adaptive.available_mm);
+        let _ = writeln!(
+            s,
+            "  {:<22} {:>8.1}   (constant-force bound a*, ride-down {:.0} mm)",
+            "ideal", o.ideal_g, o.adaptive.available_mm
+        );
         let _ = writeln!(
             s,
             "  adaptive vs reference: {:+.1} % on a_max + a_mean → {}{}",
             o.change_pct,
-            if o.adaptive_no_worse { "no worse" } else { "WORSE" },
-            if o.adaptive.bottomed_out { " (adaptive BOTTOMED OUT)" } else { "" }
+            if o.adaptive_no_worse {
+                "no worse"
+            } else {
+                "WORSE"
+            },
+            if o.adaptive.bottomed_out {
+                " (adaptive BOTTOMED OUT)"
+            } else {
+                ""
+            }
         );
     }
     if let Some(e) = ecu {
-        let p = |k: &str, q: &str| e.get(k).and_then(|v| v.get(q)).and_then(|v| v.as_f64()).unwrap_or(f64::NAN);
+        let p = |k: &str, q: &str| {
+            e.get(k)
+                .and_then(|v| v.get(q))
+                .and_then(|v| v.as_f64())
+                .unwrap_or(f64::NAN)
+        };
         let _ = writeln!(
             s,
             "\nECU timing: {} cycles, {} overruns; wake latency p50 {:.0} / p99 {:.0} / max {:.0} µs; exec p50 {:.1} / p99 {:.1} / max {:.1} µs; activity {}",

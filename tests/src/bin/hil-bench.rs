@@ -49,9 +49,15 @@ fn run() -> Result<bool> {
     let cli = Cli::parse();
     let bin_dir = match cli.bin_dir {
         Some(d) => d,
-        None => std::env::current_exe()?.parent().map(PathBuf::from).unwrap_or_default(),
+        None => std::env::current_exe()?
+            .parent()
+            .map(PathBuf::from)
+            .unwrap_or_default(),
     };
-    let can = cli.can.or_else(|| std::env::var("VCAN").ok()).unwrap_or_else(|| "vcan0".into());
+    let can = cli
+        .can
+        .or_else(|| std::env::var("VCAN").ok())
+        .unwrap_or_else(|| "vcan0".into());
     let mut all_ok = true;
     for (i, scenario) in cli.scenario.iter().enumerate() {
         let cfg = RunConfig {
@@ -66,10 +72,30 @@ fn run() -> Result<bool> {
         match run_scenario(&cfg) {
             Ok(r) => {
                 if cli.brief {
-                    let verdict = r.report.outcome.as_ref().map_or("no contact".to_owned(), |o| {
-                        format!("{:+.1} % vs reference ({})", o.change_pct, if o.adaptive_no_worse { "no worse" } else { "WORSE" })
-                    });
-                    println!("{}: airbag {}, {verdict}", r.name, if r.report.airbag_fired { "fired" } else { "not fired" });
+                    let verdict = r
+                        .report
+                        .outcome
+                        .as_ref()
+                        .map_or("no contact".to_owned(), |o| {
+                            format!(
+                                "{:+.1} % vs reference ({})",
+                                o.change_pct,
+                                if o.adaptive_no_worse {
+                                    "no worse"
+                                } else {
+                                    "WORSE"
+                                }
+                            )
+                        });
+                    println!(
+                        "{}: airbag {}, {verdict}",
+                        r.name,
+                        if r.report.airbag_fired {
+                            "fired"
+                        } else {
+                            "not fired"
+                        }
+                    );
                 } else {
                     println!("{}", r.summary);
                 }
