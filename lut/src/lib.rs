@@ -1,9 +1,8 @@
 //! Library half of the `lut` package: the restraint optimiser, the reference restraint, the
 //! characteristic-diagram builder and helpers shared by the `lut` binary, tests and benches.
 //!
-//! * [`reference`] — the conventional reference restraint (data/reference-restraint.toml):
-//!   schema + loader. Needs only `physics`, `serde` and `toml`, so the ECU can depend on this
-//!   package with `default-features = false` and get the loader without argmin/rayon.
+//! * [`reference`] — the FMVSS 208 load cases of the conventional reference restraint; its file
+//!   schema + loader is `physics::reference` (re-exported here).
 //! * `scenario` (feature `tools`) — predict the ego compartment pulse of a situation once.
 //! * `optimise` (feature `tools`) — particle swarm + Nelder–Mead over the four restraint
 //!   variables, penalty method for the no-bottoming-out constraint.
