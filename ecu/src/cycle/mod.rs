@@ -664,12 +664,15 @@ impl RestraintCycle {
             self.counters.prediction_errors = self.counters.prediction_errors.saturating_add(1);
             return;
         };
-        let input = CollisionInput::with_defaults(
-            spring,
-            self.cfg.ego_mass_kg,
-            sit.opponent_mass_kg,
-            sit.closing_speed_mps,
-        );
+        let input = CollisionInput {
+            step_s: self.cfg.prediction_step_ms * 1e-3,
+            ..CollisionInput::with_defaults(
+                spring,
+                self.cfg.ego_mass_kg,
+                sit.opponent_mass_kg,
+                sit.closing_speed_mps,
+            )
+        };
         match simulate_collision(&input, &mut self.pulse) {
             Ok(s) => {
                 self.summary = Some(s);
