@@ -95,6 +95,7 @@ const EXTRA_NM: &str = "optimiser.nm_iterations";
 const EXTRA_NM_TOL: &str = "optimiser.nm_sd_tolerance_g";
 const EXTRA_NO_FIRE: &str = "optimiser.no_fire_below_kn";
 const EXTRA_RESERVE: &str = "optimiser.ride_down_reserve_mm";
+const EXTRA_FIRE_DELAY: &str = "optimiser.fire_delay_tolerance_ms";
 
 impl Grid {
     /// Parse and validate grid TOML; `origin` names the source in errors.
@@ -163,6 +164,10 @@ impl Grid {
         extra.insert(EXTRA_NO_FIRE.into(), format!("{}", o.no_fire_below_n / 1e3));
         extra.insert(EXTRA_RESERVE.into(), format!("{}", o.reserve_m * 1e3));
         extra.insert(
+            EXTRA_FIRE_DELAY.into(),
+            format!("{}", o.fire_delay_tolerance_s * 1e3),
+        );
+        extra.insert(
             "occupant".into(),
             "belted; seat friction and hardware: physics::defaults".into(),
         );
@@ -204,6 +209,7 @@ impl Grid {
             nm_sd_tolerance: get(EXTRA_NM_TOL)?.parse()?,
             no_fire_below_n: get(EXTRA_NO_FIRE)?.parse::<f64>()? * 1e3,
             reserve_m: get(EXTRA_RESERVE)?.parse::<f64>()? * 1e-3,
+            fire_delay_tolerance_s: get(EXTRA_FIRE_DELAY)?.parse::<f64>()? * 1e-3,
         };
         Ok(Grid {
             ego: Ego {
