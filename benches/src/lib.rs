@@ -5,13 +5,16 @@
 //! code on the *same* inputs:
 //!
 //! * [`workload`] — the measured work: one cycle's input frames, its command frames, the bench
-//!   characteristic diagram and the composed worst-case stage chain.
+//!   characteristic diagram.
+//! * [`ecu_cycle`] — the real ECU cycle (`ecu::cycle::RestraintCycle`) on its worst-case and
+//!   common paths, set up once for the `cycle` bench and the `icount_cycle` binary.
 //! * [`budgets`] — `benches/budgets.toml`, the one file of budgets.
 //! * [`gate`] — reading criterion's `estimates.json` and comparing with the budgets.
 //! * [`icount`] — instructions per iteration from two callgrind runs.
 //! * [`latency`] — cyclictest histogram and ECU report parsing for the loop harness.
 
 pub mod budgets;
+pub mod ecu_cycle;
 pub mod gate;
 pub mod icount;
 pub mod latency;

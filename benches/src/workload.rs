@@ -15,8 +15,6 @@ use bus::{
     OccupantClassification, RawFrame,
 };
 use diagram::{AirbagThresholds, Axes, BuildInfo, Cell, Diagram, EgoVehicle, Header, Query};
-use physics::collision::{simulate_collision, CollisionInput, DefaultPulseBuffer};
-use physics::{stiffness, CombinedSpring};
 
 /// Alive counters are 4 bits: 16 pre-sealed frames per message replay as a valid stream forever.
 const COUNTER_PERIOD: usize = 16;
@@ -272,82 +270,6 @@ pub fn bench_queries(n: usize) -> Vec<Query> {
         .collect()
 }
 
-/// The composed worst-case computation of one ECU cycle *without* the decision logic (which
-/// belongs to `ecu::cycle`): decode both input frames → one full collision prediction (150 ms
-/// pulse at 0.1 ms, 108 km/h closing, equal Table-5 masses) → one LUT lookup → encode and seal
-/// the three command frames. It is the deterministic stand-in the instruction-count gate uses
-/// until the ECU's own cycle is measurable, and a lower bound of the full cycle afterwards.
-pub struct StageChain {
-    inputs: CycleInputFrames,
-    encoder: CommandEncoder,
-    spring: CombinedSpring,
-    pulse: Box<DefaultPulseBuffer>,
-    table: Diagram,
-    frames: [RawFrame; 3],
-}
-
-impl StageChain {
-    /// Builds tables, springs and buffers (not part of the measured work).
-    ///
-    /// # Errors
-    /// Bench set-up failed (a bug in the bench, reported rather than panicking).
-    pub fn new() -> Result<Self, String> {
-        let curve = &stiffness::COMBINED_CURVE;
-        let spring = CombinedSpring::series(curve, Some(curve)).map_err(|e| format!("{e:?}"))?;
-        Ok(Self {
-            inputs: CycleInputFrames::new().map_err(|e| format!("{e:?}"))?,
-            encoder: CommandEncoder::new(),
-            spring,
-            pulse: Box::new(DefaultPulseBuffer::new()),
-            table: bench_table(),
-            frames: [RawFrame::new(0, &[]); 3],
-        })
-    }
-
-    /// One cycle of the chain; the output depends on every stage (so nothing is optimised away).
-    pub fn run_once(&mut self) -> ChainOutput {
-        let inp = self.inputs.decode_next();
-        // Object closing speed comes over iceoryx2 (not CAN): ego 27.5 m/s + opponent 2.5 m/s.
-        let closing_mps = f64::from(inp.ego_speed_mps) + 2.5;
-        let input = CollisionInput::with_defaults(&self.spring, 1785.0, 1785.0, closing_mps);
-        let summary = simulate_collision(&input, &mut self.pulse).unwrap_or_default();
-        let q = Query {
-            closing_speed_kph: (closing_mps * 3.6) as f32,
-            opponent_mass_kg: 1785.0,
-            occupant_mass_kg: inp.occupant_mass_kg,
-            seat_distance_mm: f32::from(inp.chest_to_wheel_mm),
-        };
-        let l = self.table.view().lookup(&q);
-        let cmd = Commands {
-            airbag_force_kn: l.values.airbag_level_kn.clamp(0.0, 12.0),
-            airbag_fire_time_ms: l.values.airbag_time_ms.clamp(-200.0, 200.0),
-            load_limiter_kn: l.values.belt_limiter_kn.clamp(0.0, 12.0),
-            pretensioner_fire_time_ms: l.values.pretensioner_time_ms.clamp(-200.0, 200.0),
-            overruns: 0,
-        };
-        let airbag_crc = match self.encoder.encode(&cmd, &mut self.frames) {
-            Ok(()) => self.frames[0].data[0],
-            Err(_) => 0,
-        };
-        ChainOutput {
-            delta_v_mps: summary.vehicle.delta_v_mps,
-            airbag_level_kn: l.values.airbag_level_kn,
-            airbag_crc,
-        }
-    }
-}
-
-/// What one [`StageChain::run_once`] produced.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ChainOutput {
-    /// Predicted ego Δv, m/s.
-    pub delta_v_mps: f64,
-    /// Interpolated airbag level, kN.
-    pub airbag_level_kn: f32,
-    /// CRC byte of the sealed airbag frame.
-    pub airbag_crc: u8,
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -401,16 +323,5 @@ mod tests {
             ..Commands::FIRE
         };
         assert!(enc.encode(&too_high, &mut out).is_err());
-    }
-
-    #[test]
-    fn stage_chain_runs_and_predicts_a_crash() {
-        let mut c = StageChain::new().unwrap();
-        let out = c.run_once();
-        // First cycle: 27.5 + 2.5 = 30 m/s closing, equal masses, e = 0.1:
-        // Δv = (1 + e) v m2 / (m1 + m2) = 16.5 m/s (closed form, SPEC §1).
-        assert!((out.delta_v_mps - 16.5).abs() < 0.2, "{out:?}");
-        // Bench table: airbag level 12 kN * s with s = 108 km/h / 108 = 1 → 12 kN.
-        assert!((out.airbag_level_kn - 12.0).abs() < 0.01, "{out:?}");
     }
 }
