@@ -107,6 +107,43 @@ impl CyclictestHistogram {
         self.max_us
     }
 
+    /// The 1 µs buckets re-binned into the ECU report's log buckets (10 per decade, upper
+    /// edges 0.1 µs · 10^(k/10)), as `(lower_us, upper_us, count)` from 1 µs to the last
+    /// non-empty bucket; overflows go to the bucket of the exact max. A cyclictest bucket
+    /// [us, us+1) goes to the log bucket containing its lower edge (cyclictest truncates to
+    /// whole µs), so both histograms can be drawn on the same axes.
+    pub fn log_buckets(&self) -> Vec<(f64, f64, u64)> {
+        let step = 10f64.powf(0.1);
+        let bucket = |us: f64| ((10.0 * (us / 0.1).log10()) - 1e-9).ceil().max(0.0) as usize;
+        let mut counts: Vec<u64> = Vec::new();
+        let mut add = |k: usize, n: u64| {
+            if counts.len() <= k {
+                counts.resize(k + 1, 0);
+            }
+            if let Some(c) = counts.get_mut(k) {
+                *c += n;
+            }
+        };
+        for (us, &n) in self.counts.iter().enumerate() {
+            if n > 0 {
+                add(bucket((us as f64).max(0.1)), n);
+            }
+        }
+        if self.overflows > 0 {
+            add(bucket(self.max_us.max(0.1)), self.overflows);
+        }
+        let first = counts.iter().position(|&c| c > 0).unwrap_or(counts.len());
+        counts
+            .iter()
+            .enumerate()
+            .skip(first)
+            .map(|(k, &c)| {
+                let upper = 0.1 * 10f64.powf(k as f64 / 10.0);
+                (upper / step, upper, c)
+            })
+            .collect()
+    }
+
     /// p50/p99/p99.9/max in the ECU report's shape.
     pub fn percentiles(&self) -> PercentilesUs {
         PercentilesUs {
@@ -131,6 +168,13 @@ pub struct EcuReport {
     pub wake_latency_us: PercentilesUs,
     /// Step duration.
     pub exec_us: PercentilesUs,
+    /// Wake − deadline histogram, `[upper_us, count]` per log bucket (10 per decade, upper
+    /// edges 0.1 µs · 10^(k/10)); empty from an ECU that predates it.
+    #[serde(default)]
+    pub wake_latency_hist_us: Vec<(f64, u64)>,
+    /// Step duration histogram, same buckets.
+    #[serde(default)]
+    pub exec_hist_us: Vec<(f64, u64)>,
     /// Activity that ran (`passthrough` until the cycle logic lands).
     pub activity: String,
     /// RT settings as granted (kept as JSON, printed).
@@ -157,6 +201,26 @@ mod tests {
         // rank 100 is the overflow sample → exact max.
         assert_eq!(h.quantile_us(0.999), 250.0);
         assert_eq!(h.percentiles().max, 250.0);
+    }
+
+    #[test]
+    fn rebins_into_log_buckets() {
+        let h = CyclictestHistogram::parse(SAMPLE).unwrap();
+        let b = h.log_buckets();
+        // 2 µs → k = ceil(10·log10(20)) = 14 (upper 2.512); 3 µs → 15 (3.162); 4 µs → 17
+        // (10·log10(40) = 16.02 → 17, upper 5.012); the overflow at 250 µs → 34 (10·log10(2500)
+        // = 33.98 → 34, upper 251.2). Contiguous from k = 14 to 34.
+        assert_eq!(b.len(), 34 - 14 + 1, "{b:?}");
+        let count_at = |upper: f64| {
+            b.iter()
+                .find(|x| (x.1 - upper).abs() < 1e-9 * upper)
+                .map(|x| x.2)
+        };
+        assert_eq!(count_at(0.1 * 10f64.powf(1.4)), Some(50));
+        assert_eq!(count_at(0.1 * 10f64.powf(1.5)), Some(40));
+        assert_eq!(count_at(0.1 * 10f64.powf(1.7)), Some(9));
+        assert_eq!(count_at(0.1 * 10f64.powf(3.4)), Some(1));
+        assert_eq!(b.iter().map(|x| x.2).sum::<u64>(), 100);
     }
 
     #[test]

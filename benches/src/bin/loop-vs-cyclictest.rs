@@ -220,10 +220,11 @@ fn side_by_side(a: &Args, h: &CyclictestHistogram, c: &PercentilesUs, r: &EcuRep
     s
 }
 
-/// Two panels: cyclictest's wake-latency histogram (log counts), and the exceedance curve
-/// P(latency > x) of cyclictest with the ECU's p50/p99/p99.9/max as points on the same axes —
-/// the ECU report carries percentiles, not buckets, so its distribution is shown where it is
-/// known exactly.
+/// Two panels on the same log-spaced buckets (10 per decade): the wake-up latency histograms
+/// of cyclictest (its 1 µs buckets re-binned) and of the ECU loop (the report's
+/// `wake_latency_hist_us`), as fractions of samples; and the exceedance curves P(latency > x)
+/// of both with the ECU's p50/p99/p99.9/max as points. An ECU report without buckets (older
+/// binary) is drawn as percentile lines only.
 fn plot(
     png: &Path,
     h: &CyclictestHistogram,
@@ -237,50 +238,68 @@ fn plot(
     let root = BitMapBackend::new(png, (1000, 900)).into_drawing_area();
     root.fill(&WHITE)?;
     let (top, bottom) = root.split_vertically(430);
-    let x_max = (c.max.max(r.wake_latency_us.max) * 1.2).max(10.0);
+    let x_max = (c.max.max(r.wake_latency_us.max) * 1.5).max(10.0);
+    let floor = 0.5 / cycles.max(1) as f64;
 
-    let max_count = h.counts.iter().copied().max().unwrap_or(1).max(1) as f64;
+    let ct_buckets = h.log_buckets();
+    let ct_total = h.total().max(1) as f64;
+    let step = 10f64.powf(0.1);
+    let ecu_total = r
+        .wake_latency_hist_us
+        .iter()
+        .map(|b| b.1)
+        .sum::<u64>()
+        .max(1) as f64;
     let mut ch = ChartBuilder::on(&top)
         .caption(
-            "cyclictest wake-up latency histogram (1 µs buckets)",
+            "wake-up latency histograms (10 log buckets per decade, fraction of samples)",
             ("sans-serif", 20),
         )
         .margin(10)
         .x_label_area_size(40)
         .y_label_area_size(60)
-        .build_cartesian_2d(
-            (1f64..x_max).log_scale(),
-            (0.5f64..max_count * 2.0).log_scale(),
-        )?;
+        .build_cartesian_2d((1f64..x_max).log_scale(), (floor..1.0f64).log_scale())?;
     ch.configure_mesh()
         .x_desc("wake-up latency, µs")
-        .y_desc("samples")
+        .y_desc("fraction of samples")
         .draw()?;
-    ch.draw_series(
-        h.counts
-            .iter()
-            .enumerate()
-            .filter(|(_, &n)| n > 0)
-            .map(|(us, &n)| {
-                let x0 = (us as f64).max(1.0);
-                Rectangle::new([(x0, 0.5), (x0 + 1.0, n as f64)], BLUE.mix(0.6).filled())
-            }),
-    )?
-    .label("cyclictest")
-    .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], BLUE.filled()));
-    for (name, v, col) in [
-        ("ECU p50", r.wake_latency_us.p50, RED),
-        ("ECU p99", r.wake_latency_us.p99, MAGENTA),
-        ("ECU p99.9", r.wake_latency_us.p999, GREEN),
-        ("ECU max", r.wake_latency_us.max, BLACK),
-    ] {
-        let v = v.max(1.0);
-        ch.draw_series(LineSeries::new(
-            vec![(v, 0.5), (v, max_count * 2.0)],
-            col.stroke_width(2),
-        ))?
-        .label(format!("{name} {v:.1} µs"))
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], col.stroke_width(2)));
+    ch.draw_series(ct_buckets.iter().filter(|b| b.2 > 0).map(|&(lo, hi, n)| {
+        Rectangle::new(
+            [(lo.max(1.0), floor), (hi, n as f64 / ct_total)],
+            BLUE.mix(0.45).filled(),
+        )
+    }))?
+    .label(format!("cyclictest ({} samples)", h.total()))
+    .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], BLUE.mix(0.45).filled()));
+    if r.wake_latency_hist_us.is_empty() {
+        for (name, v, col) in [
+            ("ECU p50", r.wake_latency_us.p50, RED),
+            ("ECU p99", r.wake_latency_us.p99, MAGENTA),
+            ("ECU p99.9", r.wake_latency_us.p999, GREEN),
+            ("ECU max", r.wake_latency_us.max, BLACK),
+        ] {
+            let v = v.max(1.0);
+            ch.draw_series(LineSeries::new(
+                vec![(v, floor), (v, 1.0)],
+                col.stroke_width(2),
+            ))?
+            .label(format!("{name} {v:.1} µs"))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], col.stroke_width(2)));
+        }
+    } else {
+        ch.draw_series(
+            r.wake_latency_hist_us
+                .iter()
+                .filter(|b| b.1 > 0)
+                .map(|&(hi, n)| {
+                    Rectangle::new(
+                        [((hi / step).max(1.0), floor), (hi, n as f64 / ecu_total)],
+                        RED.stroke_width(2),
+                    )
+                }),
+        )?
+        .label(format!("ECU loop ({} cycles)", r.cycles))
+        .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], RED.stroke_width(2)));
     }
     ch.configure_series_labels()
         .background_style(WHITE.mix(0.85))
@@ -289,10 +308,9 @@ fn plot(
         .draw()?;
 
     let total = h.total().max(1) as f64;
-    let floor = 0.5 / cycles.max(1) as f64;
     let mut ch = ChartBuilder::on(&bottom)
         .caption(
-            "exceedance P(latency > x): cyclictest curve vs ECU percentiles",
+            "exceedance P(latency > x): cyclictest vs ECU loop",
             ("sans-serif", 20),
         )
         .margin(10)
@@ -317,6 +335,19 @@ fn plot(
     ch.draw_series(LineSeries::new(pts, BLUE.stroke_width(2)))?
         .label("cyclictest")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], BLUE.stroke_width(2)));
+    if !r.wake_latency_hist_us.is_empty() {
+        let mut above = ecu_total;
+        let mut pts = Vec::new();
+        for &(hi, n) in &r.wake_latency_hist_us {
+            above -= n as f64;
+            if above > 0.0 {
+                pts.push((hi.max(1.0), above / ecu_total));
+            }
+        }
+        ch.draw_series(LineSeries::new(pts, RED.stroke_width(2)))?
+            .label("ECU loop (log buckets)")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], RED.stroke_width(2)));
+    }
     let ecu_pts = [
         (r.wake_latency_us.p50, 0.5),
         (r.wake_latency_us.p99, 0.01),

@@ -54,6 +54,11 @@ impl LatencyHistogram {
         self.h.reset();
     }
 
+    /// The underlying histogram, for report-time bucket export (`report.rs`).
+    pub(super) fn hdr(&self) -> &Histogram<u64> {
+        &self.h
+    }
+
     /// Percentile summary.
     pub fn percentiles(&self) -> Percentiles {
         if self.h.is_empty() {

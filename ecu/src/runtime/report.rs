@@ -3,6 +3,7 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
+use hdrhistogram::Histogram;
 use serde::Serialize;
 
 use super::histogram::Percentiles;
@@ -32,6 +33,49 @@ impl From<Percentiles> for PercentilesUs {
             max: us(p.max_ns),
         }
     }
+}
+
+/// Log-spaced histogram buckets per decade in the report (upper edges 0.1 µs · 10^(k/10)).
+pub const HIST_BUCKETS_PER_DECADE: u32 = 10;
+/// Upper edge of bucket k = 0, µs.
+pub const HIST_LOWEST_UPPER_US: f64 = 0.1;
+
+/// Index of the log bucket holding `value_us` (values ≤ the lowest edge go to bucket 0).
+fn log_bucket(value_us: f64) -> usize {
+    let k = f64::from(HIST_BUCKETS_PER_DECADE) * (value_us / HIST_LOWEST_UPPER_US).log10();
+    // Tolerance so a value on an edge (1.0 µs) stays in the bucket it closes.
+    (k - 1e-9).ceil().max(0.0) as usize
+}
+
+/// Upper edge of log bucket `k`, µs.
+fn log_bucket_upper_us(k: usize) -> f64 {
+    HIST_LOWEST_UPPER_US * 10f64.powf(k as f64 / f64::from(HIST_BUCKETS_PER_DECADE))
+}
+
+/// `[upper_us, count]` per log-spaced bucket, contiguous from the first to the last non-empty
+/// bucket (zeros in between). Why: percentiles alone cannot be plotted as a distribution next
+/// to cyclictest's histogram. Computed at report time from the preallocated hdrhistogram (each
+/// of its sub-buckets assigned by its median-equivalent value, 0.1 % resolution); the loop
+/// itself never allocates for it.
+fn log_buckets_us(h: &Histogram<u64>) -> Vec<(f64, u64)> {
+    let mut counts: Vec<u64> = Vec::new();
+    for v in h.iter_recorded() {
+        let us = h.median_equivalent(v.value_iterated_to()) as f64 / 1_000.0;
+        let k = log_bucket(us);
+        if counts.len() <= k {
+            counts.resize(k + 1, 0);
+        }
+        if let Some(c) = counts.get_mut(k) {
+            *c += v.count_since_last_iteration();
+        }
+    }
+    let first = counts.iter().position(|&c| c > 0).unwrap_or(counts.len());
+    counts
+        .iter()
+        .enumerate()
+        .skip(first)
+        .map(|(k, &c)| (log_bucket_upper_us(k), c))
+        .collect()
 }
 
 /// CAN side status.
@@ -88,6 +132,11 @@ pub struct TimingReport<'a> {
     pub wake_latency_us: PercentilesUs,
     /// Cycle execution time.
     pub exec_us: PercentilesUs,
+    /// Wake-up latency histogram: `[upper_us, count]`, 10 log-spaced buckets per decade
+    /// (upper edges 0.1 µs · 10^(k/10)), contiguous from the first to the last non-empty one.
+    pub wake_latency_hist_us: Vec<(f64, u64)>,
+    /// Execution-time histogram, same buckets.
+    pub exec_hist_us: Vec<(f64, u64)>,
     /// Name of the activity that ran.
     pub activity: &'static str,
     /// Activity counters (input staleness etc.).
@@ -123,6 +172,8 @@ impl<'a> TimingReport<'a> {
             duration_s: stats.end_ns.saturating_sub(stats.first_deadline_ns) as f64 / 1e9,
             wake_latency_us: stats.wake_latency.percentiles().into(),
             exec_us: stats.exec.percentiles().into(),
+            wake_latency_hist_us: log_buckets_us(stats.wake_latency.hdr()),
+            exec_hist_us: log_buckets_us(stats.exec.hdr()),
             activity,
             counters: counters.iter().copied().collect(),
             rt,
@@ -247,6 +298,36 @@ mod tests {
         assert_eq!(v["can"]["enabled"], false);
         assert_eq!(v["can"]["reason"], "--no-can");
         assert_eq!(v["counters"]["object_stale_cycles"], 2);
+        // Log buckets, closed form k = ceil(10·log10(v / 0.1 µs)), upper edge 0.1·10^(k/10):
+        // 1 µs → k 10 (edge 1.0), 2 µs → 13.01 → k 14 (2.512), 3 µs → 14.77 → k 15 (3.162);
+        // contiguous k = 10..=15 → 6 buckets, the empty ones 0.
+        let hist = v["wake_latency_hist_us"].as_array().unwrap();
+        let buckets: Vec<(f64, u64)> = hist
+            .iter()
+            .map(|b| (b[0].as_f64().unwrap(), b[1].as_u64().unwrap()))
+            .collect();
+        assert_eq!(buckets.len(), 15 - 10 + 1, "{buckets:?}");
+        let expect = |upper: f64, n: u64| {
+            assert!(
+                buckets
+                    .iter()
+                    .any(|&(u, c)| (u - upper).abs() < 1e-9 * upper && c == n),
+                "no bucket ({upper}, {n}) in {buckets:?}"
+            );
+        };
+        expect(1.0, 1);
+        expect(0.1 * 10f64.powf(1.4), 1); // 2.512 µs holds 2 µs
+        expect(0.1 * 10f64.powf(1.5), 1); // 3.162 µs holds 3 µs
+        assert_eq!(buckets.iter().map(|b| b.1).sum::<u64>(), 3);
+        assert_eq!(
+            v["exec_hist_us"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|b| b[1].as_u64().unwrap())
+                .sum::<u64>(),
+            3
+        );
         let text = r.to_text();
         assert!(text.contains("cycles 3  overruns 1"), "{text}");
         assert!(text.contains("p99.9"), "{text}");
