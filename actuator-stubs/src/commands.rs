@@ -139,6 +139,9 @@ pub struct Modules {
     pub actions: Vec<Action>,
     /// Load-limiter level history: (t_ns, kN).
     pub limiter_levels: Vec<(u64, f64)>,
+    /// Receive times of belt commands whose source is the adaptive plan [ns] (the first one
+    /// after the threat is the preset, whether or not its level differs from the last one).
+    pub adaptive_belt_cmds: Vec<u64>,
     /// ECU mode changes seen on EcuStatus: (t_ns, mode).
     pub ecu_modes: Vec<(u64, u8)>,
     /// First command (belt or airbag) whose source is the reference restraint [ns].
@@ -159,6 +162,9 @@ impl Modules {
             } => {
                 if source == "reference" {
                     self.first_reference_cmd_ns.get_or_insert(t_ns);
+                }
+                if source == "adaptive" && self.adaptive_belt_cmds.last() != Some(&t_ns) {
+                    self.adaptive_belt_cmds.push(t_ns);
                 }
                 if self.limiter_levels.last().map(|l| l.1) != Some(*load_limiter_kn) {
                     self.limiter_levels.push((t_ns, *load_limiter_kn));
@@ -266,6 +272,25 @@ mod tests {
             force_level_kn: kn,
             fire_time_ms: 12.0,
         }
+    }
+
+    #[test]
+    fn adaptive_belt_commands_are_recorded_even_when_the_level_does_not_change() {
+        // The e2e bench found a plan whose limiter level equalled the level already on the
+        // bus: the preset must still be seen (it is the adaptive command, not a level change).
+        let mut m = Modules::default();
+        let reference = Decoded::Belt {
+            pretensioner: "idle".into(),
+            source: "reference".into(),
+            load_limiter_kn: 12.0,
+            pretensioner_fire_time_ms: 10.0,
+        };
+        m.apply(10, &reference);
+        m.apply(20, &belt("idle", 12.0));
+        m.apply(30, &belt("idle", 12.0));
+        assert_eq!(m.limiter_levels, vec![(10, 12.0)]);
+        assert_eq!(m.adaptive_belt_cmds, vec![20, 30]);
+        assert_eq!(m.first_reference_cmd_ns, Some(10));
     }
 
     #[test]

@@ -249,12 +249,14 @@ fn build_report(
         .iter()
         .find(|(_, m)| *m == ipc::EcuMode::PreCrash as u8)
         .map(|(t, _)| *t);
+    // The preset is the first adaptive belt command after the threat (its level may equal the
+    // one already on the bus, so a level change is not the criterion).
     let preset_ns = threat_ns.and_then(|th| {
         modules
-            .limiter_levels
+            .adaptive_belt_cmds
             .iter()
-            .find(|(t, _)| *t >= th)
-            .map(|(t, _)| *t)
+            .find(|t| **t >= th)
+            .copied()
     });
     let rel_or_start_ms = |t: u64| {
         rel_ms(t)
