@@ -158,8 +158,17 @@ fn pre_crash_cases_preset_before_contact_and_fire_at_the_planned_time() {
             .unwrap_or_else(|| panic!("{}: pretensioner never fired", s.name));
         let pt = p.t_ms.expect("contact");
         assert!(pt < 0.0, "{}: pretensioner at {pt:+.1} ms", s.name);
-        let a =
-            action(&r, "airbag_fire").unwrap_or_else(|| panic!("{}: airbag never fired", s.name));
+        // Whether the bag fires is the table's decision (declared per scenario where fixed);
+        // when it fires, it must fire at its planned time.
+        let Some(a) = action(&r, "airbag_fire") else {
+            assert!(
+                s.expect.airbag_fires != Some(true),
+                "{}: airbag never fired",
+                s.name
+            );
+            eprintln!("{}: preset {preset:+.1} ms, pretensioner {pt:+.1} ms, airbag: no fire (table's choice)", s.name);
+            continue;
+        };
         let at = a.t_ms.expect("contact");
         let planned = a.action.planned_ms;
         eprintln!("{}: preset {preset:+.1} ms, pretensioner {pt:+.1} ms (planned {:+.1}), airbag {at:+.1} ms (planned {planned:+.1})", s.name, p.action.planned_ms);
