@@ -4,50 +4,15 @@
 //! confirmation, airbag fire and POST-CRASH with 8-sample accelerometer batches every cycle.
 //! The com layer of this test is itself allocation-free (preallocated buffers).
 
-mod cycle_support;
+mod alloc_counter;
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
+use alloc_counter::{allocations_here, set_counting};
+mod cycle_support;
 
 use cycle_support::{MS, REFERENCE, T0};
 use ecu::cycle::{CycleConfig, Phase, RestraintCycle};
 use ecu::runtime::{Activity, CanFrame, CycleInfo, CycleIo, IoError};
 use ipc::{CrashAccelSample, EcuDiagnostics, ObjectState};
-
-struct Counting;
-
-thread_local! {
-    static COUNT_HERE: Cell<bool> = const { Cell::new(false) };
-    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
-}
-
-fn note() {
-    if COUNT_HERE.try_with(Cell::get).unwrap_or(false) {
-        let _ = ALLOCATIONS.try_with(|a| a.set(a.get() + 1));
-    }
-}
-
-// SAFETY: forwards to the system allocator unchanged; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        note();
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        note();
-        unsafe { System.alloc_zeroed(layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        note();
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
 
 /// Allocation-free com layer: fixed inputs per cycle, outputs counted.
 struct FixedIo {
@@ -156,11 +121,11 @@ fn no_allocation_in_precrash_and_crash_cycles() {
             predictions_before = ecu.counters().predictions;
         }
         let count = k >= 1_000;
-        COUNT_HERE.with(|c| c.set(count));
-        let before = ALLOCATIONS.with(Cell::get);
+        set_counting(count);
+        let before = allocations_here();
         ecu.step(&info, &mut io);
-        allocations += ALLOCATIONS.with(Cell::get) - before;
-        COUNT_HERE.with(|c| c.set(false));
+        allocations += allocations_here() - before;
+        set_counting(false);
         if count {
             match ecu.phase() {
                 Phase::PreCrash => precrash_cycles += 1,

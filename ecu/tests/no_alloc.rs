@@ -6,8 +6,9 @@
 //! loop really receives every cycle and its diagnostics really reach a subscriber (via
 //! the companion publisher thread, see `runtime::com`).
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
+mod alloc_counter;
+
+use alloc_counter::{allocations_here, set_counting};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
@@ -20,45 +21,6 @@ use ipc::{
     AccelPublisher, CrashAccelSample, DiagnosticsSubscriber, ObjectPublisher, ObjectState,
     ServiceNames, VALID,
 };
-
-struct Counting;
-
-thread_local! {
-    static COUNT_HERE: Cell<bool> = const { Cell::new(false) };
-    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
-}
-
-fn note() {
-    if COUNT_HERE.try_with(Cell::get).unwrap_or(false) {
-        let _ = ALLOCATIONS.try_with(|a| a.set(a.get() + 1));
-    }
-}
-
-fn allocations_here() -> u64 {
-    ALLOCATIONS.with(Cell::get)
-}
-
-// SAFETY: forwards to the system allocator unchanged; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        note();
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        note();
-        unsafe { System.alloc_zeroed(layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        note();
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
 
 const WARMUP_CYCLES: u64 = 1_000;
 const MEASURED_CYCLES: u64 = 10_000;
@@ -81,12 +43,12 @@ impl Activity for Counted {
         if info.cycle == WARMUP_CYCLES {
             self.objects_at_start = self.inner.objects_rx();
             self.accel_at_start = self.inner.accel_batches_rx();
-            COUNT_HERE.with(|c| c.set(true));
+            set_counting(true);
         }
         self.inner.step(info, io);
     }
     fn shutdown(&mut self, now_ns: u64, io: &mut dyn CycleIo) {
-        COUNT_HERE.with(|c| c.set(false));
+        set_counting(false);
         self.inner.shutdown(now_ns, io);
     }
 }
@@ -176,11 +138,11 @@ fn steady_state_loop_with_iceoryx2_allocates_nothing() {
 fn counting_allocator_detects_allocations() {
     // Guards the guard: the counter must see an allocation on a counted thread.
     std::thread::spawn(|| {
-        COUNT_HERE.with(|c| c.set(true));
+        set_counting(true);
         let before = allocations_here();
         let v = std::hint::black_box(vec![1u8; 64]);
         let after = allocations_here();
-        COUNT_HERE.with(|c| c.set(false));
+        set_counting(false);
         drop(v);
         assert!(after > before);
     })
