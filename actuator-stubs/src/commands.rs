@@ -27,6 +27,10 @@ pub struct CommandRecord {
     pub data_hex: String,
     /// "ok" or the E2E/decoding rejection reason.
     pub e2e: String,
+    /// SecOC verdict (command and authenticator frames only): "held", "ok" or the
+    /// rejection reason; see [`crate::rx`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub secoc: Option<String>,
     /// Decoded physical values (accepted frames only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub decoded: Option<Decoded>,

@@ -4,6 +4,8 @@
 //!   (pretensioner fire/release, airbag fire while armed) acting at receive times.
 //! * [`outcome`] — the judge: occupant outcome of what was actually commanded against the TRUE
 //!   pulse, beside the reference restraint and the ideal bound.
+//! * [`rx`] — per-frame E2E check and SecOC pairing: the modules act only on authenticated
+//!   commands.
 //! * [`report`] — the `report.json` schema (also read by the `hil-bench` orchestrator).
 //! * [`plot`] — occupant deceleration and excursion over time, adaptive vs reference (PNG).
 #![forbid(unsafe_code)]
@@ -13,3 +15,4 @@ pub mod commands;
 pub mod outcome;
 pub mod plot;
 pub mod report;
+pub mod rx;

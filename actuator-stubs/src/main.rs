@@ -4,10 +4,11 @@
 //! commanded times, and at the end (bench truth `done`, timeout or SIGTERM) judges the occupant
 //! outcome of what was commanded: DIR/report.json + DIR/outcome.png.
 
-use actuator_stubs::commands::{self, CommandRecord, Modules};
+use actuator_stubs::commands::{CommandRecord, Modules};
 use actuator_stubs::outcome::{self, judge, no_worse, reference_as_fired};
 use actuator_stubs::plot;
 use actuator_stubs::report::{ecu_mode_name, Outcome, Report, TimedAction, TrueCrash};
+use actuator_stubs::rx::Receiver;
 use anyhow::{Context, Result};
 use bus::socket::BusSocket;
 use clap::Parser;
@@ -41,6 +42,25 @@ struct Cli {
     /// iceoryx2 service prefix (must match the sensor feeds').
     #[arg(long, default_value = ipc::DEFAULT_SERVICE_PREFIX)]
     service_prefix: String,
+    /// SecOC key file (format: data/secoc-keys.example.toml). Default: that example file's
+    /// keys, built into the binary (the ECU's default key file), so the stubs need no
+    /// working directory. A bad file is an error: the stubs would reject every command.
+    #[arg(long, value_name = "FILE")]
+    secoc_keys: Option<PathBuf>,
+}
+
+/// The ECU's default key file, for the default of `--secoc-keys`.
+const EXAMPLE_KEYS: &str = include_str!("../../data/secoc-keys.example.toml");
+
+fn load_keys(cli: &Cli) -> Result<bus::secoc::SecOcKeys> {
+    match &cli.secoc_keys {
+        Some(p) => bus::secoc::SecOcKeys::load(p),
+        None => bus::secoc::SecOcKeys::from_toml_str(
+            EXAMPLE_KEYS,
+            std::path::Path::new("data/secoc-keys.example.toml (built in)"),
+        ),
+    }
+    .map_err(|e| anyhow::anyhow!("SecOC keys: {e}"))
 }
 
 /// Ids the modules listen to (kernel filter): airbag cmd + auth, belt cmd + auth, ECU status.
@@ -92,6 +112,7 @@ fn run(cli: &Cli) -> Result<()> {
         None => physics::reference::ReferenceRestraint::builtin(),
     }
     .map_err(|e| anyhow::anyhow!("reference restraint: {e}"))?;
+    let keys = load_keys(cli)?;
     std::fs::create_dir_all(&cli.out).with_context(|| format!("creating {}", cli.out.display()))?;
     install_stop_signals()?;
     let mut sock = BusSocket::open(&cli.can, &RX_IDS).with_context(|| {
@@ -112,10 +133,9 @@ fn run(cli: &Cli) -> Result<()> {
         std::fs::File::create(&log_path)
             .with_context(|| format!("creating {}", log_path.display()))?,
     );
-    let mut checker = bus::E2eChecker::new();
+    let mut receiver = Receiver::new(&keys);
     let mut modules = Modules::default();
     let mut frames: BTreeMap<String, u64> = BTreeMap::new();
-    let mut accepted = 0u64;
     let mut truth = BenchTruth::EMPTY;
     let started = monotonic_ns();
     let deadline = started + (cli.timeout_s * 1e9) as u64;
@@ -149,26 +169,23 @@ fn run(cli: &Cli) -> Result<()> {
                 .map_or("unknown", |i| i.name)
                 .to_owned();
             *frames.entry(name.clone()).or_default() += 1;
-            let (e2e, decoded) = match checker.check_frame(&f) {
-                Ok(msg) => {
-                    accepted += 1;
-                    let d = commands::decode(&msg);
-                    modules.apply(rx_ns, &d);
-                    ("ok".to_owned(), Some(d))
-                }
-                Err(e) => (e.reason().name().to_owned(), None),
-            };
+            let v = receiver.on_frame(&f, rx_ns);
+            if let Some(d) = &v.act {
+                modules.apply(rx_ns, d);
+            }
             let rec = CommandRecord {
                 rx_mono_ns: rx_ns,
                 id: f.id,
                 message: name,
                 data_hex: f.payload().iter().map(|b| format!("{b:02x}")).collect(),
-                e2e,
-                decoded,
+                e2e: v.e2e,
+                secoc: v.secoc,
+                decoded: v.decoded,
             };
             serde_json::to_writer(&mut log, &rec)?;
             log.write_all(b"\n")?;
         }
+        receiver.expire(monotonic_ns());
         diag_sub.drain(|d| {
             if diag_modes.last().map(|m| m.1) != Some(d.mode) {
                 diag_modes.push((d.timestamp_ns, d.mode));
@@ -194,8 +211,7 @@ fn run(cli: &Cli) -> Result<()> {
         &modules,
         &diag_modes,
         frames,
-        accepted,
-        &checker,
+        &receiver,
         stop_reason,
     )?;
     let path = cli.out.join("report.json");
@@ -219,8 +235,7 @@ fn build_report(
     modules: &Modules,
     diag_modes: &[(u64, u8)],
     frames: BTreeMap<String, u64>,
-    accepted: u64,
-    checker: &bus::E2eChecker,
+    receiver: &Receiver,
     stop_reason: &str,
 ) -> Result<Report> {
     let contact_ns = truth.contact_ns;
@@ -229,7 +244,12 @@ fn build_report(
         |t: u64| (truth.start_ns != 0).then_some((t as f64 - truth.start_ns as f64) * 1e-9);
     let e2e_rejected = bus::RejectReason::ALL
         .iter()
-        .map(|r| (r.name().to_owned(), checker.stats().rejected_for(*r)))
+        .map(|r| {
+            (
+                r.name().to_owned(),
+                receiver.checker().stats().rejected_for(*r),
+            )
+        })
         .filter(|(_, n)| *n > 0)
         .collect();
     let pre = outcome::commanded(
@@ -270,7 +290,10 @@ fn build_report(
         contact_ns,
         true_crash: None,
         frames,
-        e2e_accepted: accepted,
+        e2e_accepted: receiver.e2e_accepted(),
+        secoc_accepted: receiver.secoc_accepted(),
+        secoc_rejected: receiver.secoc_rejected(),
+        secoc_commands_dropped: receiver.secoc_commands_dropped(),
         e2e_rejected,
         actions: modules
             .actions

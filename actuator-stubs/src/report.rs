@@ -68,6 +68,15 @@ pub struct Report {
     pub e2e_accepted: u64,
     /// Rejections per reason.
     pub e2e_rejected: BTreeMap<String, u64>,
+    /// Commands authenticated by SecOC (the only ones the modules acted on).
+    #[serde(default)]
+    pub secoc_accepted: u64,
+    /// SecOC rejections by reason (`bus::secoc::SecOcReject::name`): forged, replayed, stale…
+    #[serde(default)]
+    pub secoc_rejected: BTreeMap<String, u64>,
+    /// Commands that passed E2E but never got a valid authenticator (not acted on).
+    #[serde(default)]
+    pub secoc_commands_dropped: u64,
     /// Module actions in order.
     pub actions: Vec<TimedAction>,
     /// First armed airbag command [ms rel. contact].

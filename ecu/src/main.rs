@@ -45,6 +45,25 @@ fn load_lut(cfg: &EcuConfig) -> Option<diagram::Diagram> {
     }
 }
 
+/// The SecOC sender, or `None` with a clear message: the ECU then starts without
+/// authenticator frames and reports `FaultConfig` (see `CycleConfig::secoc_keys`) rather than
+/// refusing to start — its commands still go out, the bench sees why the actuators ignore them.
+fn load_secoc(cfg: &EcuConfig) -> Option<bus::secoc::SecOcTx> {
+    match bus::secoc::SecOcKeys::load(&cfg.cycle.secoc_keys) {
+        Ok(keys) => {
+            eprintln!("ecu: secoc keys   {}", cfg.cycle.secoc_keys.display());
+            // Freshness starts at 1: the actuators start with last accepted = 0.
+            Some(keys.tx(1))
+        }
+        Err(e) => {
+            eprintln!(
+                "ecu: error: SecOC keys unusable: {e} — commands are sent WITHOUT                  authenticators (authenticated actuators will ignore them), EcuStatus.FaultConfig                  set (pass --secoc-keys FILE)"
+            );
+            None
+        }
+    }
+}
+
 fn load_reference(cfg: &EcuConfig) -> anyhow::Result<ReferenceRestraint> {
     match ReferenceRestraint::load(&cfg.cycle.reference) {
         Ok(r) => Ok(r),
@@ -65,6 +84,7 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
     for w in &notes.warnings {
         eprintln!("ecu: warning: {w}");
     }
+    activity.set_secoc(load_secoc(&cfg));
     // SocketCAN with the kernel input filter when CAN is on and the interface exists; the
     // shell's CAN decision reports a missing interface (and `--no-can` switches CAN off).
     let can: Option<Box<dyn CanPort>> = if cfg.can.enabled

@@ -2,6 +2,8 @@
 //! ≥ 10 000 cycles in PRE-CRASH (a new object sample every 10 ms → collision prediction + LUT
 //! lookup + state machine + E2E command encode) and ≥ 10 000 cycles through crash
 //! confirmation, airbag fire and POST-CRASH with 8-sample accelerometer batches every cycle.
+//! SecOC is on (the example key file): every command frame is followed by its AES-CMAC
+//! authenticator, computed inside the counted cycles.
 //! The com layer of this test is itself allocation-free (preallocated buffers).
 
 mod alloc_counter;
@@ -21,6 +23,7 @@ struct FixedIo {
     can: [CanFrame; 2],
     can_n: usize,
     tx: u64,
+    auth_tx: u64,
     last_tx: CanFrame,
     diag: EcuDiagnostics,
 }
@@ -42,6 +45,9 @@ impl CycleIo for FixedIo {
     }
     fn send_can(&mut self, frame: &CanFrame) -> Result<(), IoError> {
         self.tx += 1;
+        if bus::secoc::SecOcStream::for_auth_id(frame.id).is_some() {
+            self.auth_tx += 1;
+        }
         self.last_tx = *frame;
         Ok(())
     }
@@ -62,6 +68,9 @@ impl CycleIo for FixedIo {
 fn no_allocation_in_precrash_and_crash_cycles() {
     let lut = cycle_support::test_lut();
     let (mut ecu, _) = RestraintCycle::new(CycleConfig::default(), Some(lut), &REFERENCE).unwrap();
+    let keys =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/secoc-keys.example.toml");
+    ecu.set_secoc(Some(bus::secoc::SecOcKeys::load(&keys).unwrap().tx(1)));
     let mut bench = cycle_support::Bench::new(None); // only for its sealed CAN frames
     let mut io = FixedIo {
         object: None,
@@ -69,6 +78,7 @@ fn no_allocation_in_precrash_and_crash_cycles() {
         can: [CanFrame::default(); 2],
         can_n: 0,
         tx: 0,
+        auth_tx: 0,
         last_tx: CanFrame::default(),
         diag: EcuDiagnostics::ZERO,
     };
@@ -145,4 +155,6 @@ fn no_allocation_in_precrash_and_crash_cycles() {
     // The worst-case path really ran: a prediction per new object sample.
     assert_eq!(ecu.counters().predictions - predictions_before, 1_000);
     assert!(io.tx > 2_000);
+    // Commands go out every 10 ms on two streams, each with its authenticator.
+    assert!(io.auth_tx > 2_000, "authenticators sent: {}", io.auth_tx);
 }

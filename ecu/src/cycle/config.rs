@@ -17,6 +17,12 @@ pub struct CycleConfig {
     /// Reference-restraint file (`--reference`). Missing/corrupt → the copy built into the
     /// binary (same file at build time), with a warning.
     pub reference: PathBuf,
+    /// SecOC key file (`--secoc-keys`, format in `bus::secoc::SecOcKeys`). Missing/corrupt →
+    /// the ECU still starts and still sends its (E2E-protected) commands, but without
+    /// authenticator frames, and reports `FaultConfig` in `EcuStatus`: an unauthenticated
+    /// command that authenticated actuators ignore is still better than refusing to protect,
+    /// and the fault bit tells the bench why the actuators are not acting.
+    pub secoc_keys: PathBuf,
 
     /// Ego vehicle mass, kg (*default* 1785 kg: the paper's Ford Taurus). The LUT header must
     /// agree (±1 %), otherwise the LUT is rejected: its cells were optimised for another car.
@@ -99,6 +105,7 @@ impl Default for CycleConfig {
         Self {
             lut: PathBuf::from("data/default.lut"),
             reference: PathBuf::from("data/reference-restraint.toml"),
+            secoc_keys: PathBuf::from("data/secoc-keys.example.toml"),
             ego_mass_kg: 1785.0,
             ego_class: 4,
             prediction_step_ms: 0.5,

@@ -40,6 +40,7 @@ use bus::codec::{
     BeltLimiterCmdCmdSource, BeltLimiterCmdPretensionerCmd, EcuStatusEcuMode,
     OccupantClassificationBeltBuckle, OccupantClassificationOccupantClass,
 };
+use bus::secoc::SecOcTx;
 use bus::{
     AirbagStageCmd, BeltLimiterCmd, E2eChecker, E2eProtector, EcuStatus, Messages, RawFrame,
     RejectReason,
@@ -232,6 +233,8 @@ pub struct RestraintCycle {
 
     checker: E2eChecker,
     protector: E2eProtector,
+    secoc: Option<SecOcTx>,
+    secoc_unavailable: bool,
     e2e_ring: [u64; MAX_E2E_BURST],
     e2e_ring_next: usize,
     e2e_ring_len: usize,
@@ -354,6 +357,8 @@ impl RestraintCycle {
             reference,
             checker: E2eChecker::with_max_lost(cfg.e2e_max_lost),
             protector: E2eProtector::new(),
+            secoc: None,
+            secoc_unavailable: false,
             e2e_ring: [0; MAX_E2E_BURST],
             e2e_ring_next: 0,
             e2e_ring_len: 0,
@@ -400,6 +405,22 @@ impl RestraintCycle {
             cfg,
         };
         Ok((s, notes))
+    }
+
+    /// Sets the SecOC sender (call once before the first `step`). `Some`: every
+    /// `BeltLimiterCmd` / `AirbagStageCmd` frame is followed by its authenticator frame.
+    /// `None`: the key file was unusable — commands go out without authenticators (the
+    /// actuators ignore them) and `EcuStatus.FaultConfig` is set, so the failure is visible on
+    /// the bus instead of the ECU refusing to start. A cycle never given a sender (tests,
+    /// benches) sends no authenticators and reports no fault.
+    pub fn set_secoc(&mut self, tx: Option<SecOcTx>) {
+        self.secoc_unavailable = tx.is_none();
+        self.secoc = tx;
+    }
+
+    /// Whether authenticator frames are sent.
+    pub fn secoc_enabled(&self) -> bool {
+        self.secoc.is_some()
     }
 
     /// Current phase.
@@ -937,6 +958,20 @@ impl RestraintCycle {
         }
     }
 
+    /// Sends a command frame and, with SecOC on, its authenticator right after it (the
+    /// receiver pairs them within one command cycle). `authenticate` is allocation-free.
+    fn send_authenticated(&mut self, io: &mut dyn CycleIo, raw: RawFrame) {
+        self.send(io, raw);
+        if let Some(tx) = self.secoc.as_mut() {
+            match tx.authenticate(&raw) {
+                Ok(auth) => self.send(io, auth),
+                Err(_) => {
+                    self.counters.encode_errors = self.counters.encode_errors.saturating_add(1)
+                }
+            }
+        }
+    }
+
     fn due<T: PartialEq>(
         last: Option<T>,
         now_content: T,
@@ -963,7 +998,7 @@ impl RestraintCycle {
             match BeltLimiterCmd::encode(belt.cmd, belt.source, belt.level_kn, belt.time_ms) {
                 Ok(m) => {
                     let raw = self.protector.seal(m);
-                    self.send(io, raw);
+                    self.send_authenticated(io, raw);
                     self.last_belt = Some(belt);
                     self.last_belt_tx_ns = now;
                 }
@@ -990,7 +1025,7 @@ impl RestraintCycle {
             ) {
                 Ok(m) => {
                     let raw = self.protector.seal(m);
-                    self.send(io, raw);
+                    self.send_authenticated(io, raw);
                     self.last_airbag = Some(bag);
                     self.last_airbag_tx_ns = now;
                 }
@@ -1040,7 +1075,7 @@ impl RestraintCycle {
                 bit(4),
                 bit(5),
                 bit(6),
-                false,
+                self.secoc_unavailable,
                 overruns,
                 self.lut_id,
             ) {

@@ -264,6 +264,9 @@ impl EcuConfig {
         if let Some(v) = &a.reference {
             self.cycle.reference = v.clone();
         }
+        if let Some(v) = &a.secoc_keys {
+            self.cycle.secoc_keys = v.clone();
+        }
         if a.no_can {
             self.can.enabled = false;
         }
@@ -431,6 +434,10 @@ pub struct RunArgs {
     /// the copy built into the binary).
     #[arg(long, value_name = "FILE")]
     pub reference: Option<PathBuf>,
+    /// SecOC key file (default data/secoc-keys.example.toml; missing or corrupt: the ECU
+    /// starts without authenticator frames and reports FaultConfig).
+    #[arg(long, value_name = "FILE")]
+    pub secoc_keys: Option<PathBuf>,
 }
 
 impl RunArgs {
