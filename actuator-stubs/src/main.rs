@@ -10,6 +10,7 @@ use actuator_stubs::plot;
 use actuator_stubs::report::{ecu_mode_name, Outcome, Report, TimedAction, TrueCrash};
 use actuator_stubs::rx::Receiver;
 use anyhow::{Context, Result};
+use bus::secoc::SecOcConfig;
 use bus::socket::BusSocket;
 use clap::Parser;
 use ipc::{BenchTruth, BenchTruthSubscriber, ServiceNames};
@@ -47,6 +48,16 @@ struct Cli {
     /// working directory. A bad file is an error: the stubs would reject every command.
     #[arg(long, value_name = "FILE")]
     secoc_keys: Option<PathBuf>,
+    /// How long a held command waits for its authenticator, ms (SecOC pairing timeout; the
+    /// ECU sends both in the same cycle). Longer only where the kernel stalls processes
+    /// (user-mode Linux): the bench names the value in the report.
+    #[arg(long, value_name = "MS", default_value_t = SecOcConfig::DEFAULT_PAIRING_TIMEOUT_US as f64 / 1e3)]
+    secoc_pairing_timeout_ms: f64,
+    /// After the scenario is done, keep receiving until the bus has been quiet this long (at
+    /// most 5 s), so the commands the ECU sends until it is stopped are still received and
+    /// counted (the fault campaign compares them with what the ECU sent).
+    #[arg(long, value_name = "MS", default_value_t = 0.0)]
+    drain_quiet_ms: f64,
 }
 
 /// The ECU's default key file, for the default of `--secoc-keys`.
@@ -67,6 +78,9 @@ fn load_keys(cli: &Cli) -> Result<bus::secoc::SecOcKeys> {
 const RX_IDS: [u32; 5] = [0x030, 0x031, 0x040, 0x041, 0x110];
 
 static STOP: AtomicBool = AtomicBool::new(false);
+
+/// Upper bound of the post-scenario drain (--drain-quiet-ms), in case the bus never goes quiet.
+const MAX_DRAIN_NS: u64 = 5_000_000_000;
 
 extern "C" fn on_signal(_: nix::libc::c_int) {
     STOP.store(true, Ordering::Relaxed);
@@ -133,7 +147,19 @@ fn run(cli: &Cli) -> Result<()> {
         std::fs::File::create(&log_path)
             .with_context(|| format!("creating {}", log_path.display()))?,
     );
-    let mut receiver = Receiver::new(&keys);
+    if !(cli.secoc_pairing_timeout_ms.is_finite()
+        && (0.1..=1000.0).contains(&cli.secoc_pairing_timeout_ms))
+    {
+        anyhow::bail!("--secoc-pairing-timeout-ms must be within 0.1..=1000");
+    }
+    if !(cli.drain_quiet_ms.is_finite() && (0.0..=5000.0).contains(&cli.drain_quiet_ms)) {
+        anyhow::bail!("--drain-quiet-ms must be within 0..=5000");
+    }
+    let secoc_config = SecOcConfig {
+        pairing_timeout_us: (cli.secoc_pairing_timeout_ms * 1e3).round() as u64,
+        ..SecOcConfig::default()
+    };
+    let mut receiver = Receiver::with_config(&keys, secoc_config);
     let mut modules = Modules::default();
     let mut frames: BTreeMap<String, u64> = BTreeMap::new();
     let mut truth = BenchTruth::EMPTY;
@@ -143,16 +169,28 @@ fn run(cli: &Cli) -> Result<()> {
         "actuator-stubs: listening on {} for {}",
         cli.can, scenario.name
     );
+    // Set once the scenario is done: then run on until the bus is quiet (--drain-quiet-ms).
+    let mut done_at_ns: Option<u64> = None;
+    let mut last_rx_ns = started;
+    let quiet_ns = (cli.drain_quiet_ms * 1e6) as u64;
     let stop_reason = loop {
         if STOP.load(Ordering::Relaxed) {
             break "signal";
         }
-        if monotonic_ns() > deadline {
+        let now = monotonic_ns();
+        if let Some(done) = done_at_ns {
+            if now.saturating_sub(last_rx_ns) >= quiet_ns
+                || now.saturating_sub(done) >= MAX_DRAIN_NS
+            {
+                break "done";
+            }
+        } else if now > deadline {
             break "timeout";
         }
         let mut got_any = false;
         while let Some(rx) = sock.recv().context("CAN receive")? {
             got_any = true;
+            last_rx_ns = monotonic_ns();
             let read_mono = monotonic_ns();
             // Kernel arrival time mapped onto CLOCK_MONOTONIC (more exact than the read time);
             // fall back to the read time if absent or implausible.
@@ -193,9 +231,13 @@ fn run(cli: &Cli) -> Result<()> {
         });
         if let Some(t) = truth_sub.latest() {
             truth = t;
-            if truth.is_done() {
-                // Drain what is still queued, then finish.
-                break "done";
+            if truth.is_done() && done_at_ns.is_none() {
+                // Drain what is still queued (and, with --drain-quiet-ms, what follows), then
+                // finish.
+                done_at_ns = Some(monotonic_ns());
+                if quiet_ns == 0 {
+                    break "done";
+                }
             }
         }
         if !got_any {
@@ -294,6 +336,7 @@ fn build_report(
         secoc_accepted: receiver.secoc_accepted(),
         secoc_rejected: receiver.secoc_rejected(),
         secoc_commands_dropped: receiver.secoc_commands_dropped(),
+        secoc_pairing_timeout_ms: cli.secoc_pairing_timeout_ms,
         e2e_rejected,
         actions: modules
             .actions

@@ -77,6 +77,9 @@ pub struct Report {
     /// Commands that passed E2E but never got a valid authenticator (not acted on).
     #[serde(default)]
     pub secoc_commands_dropped: u64,
+    /// SecOC pairing timeout the stubs ran with [ms] (default 10; longer under user-mode Linux).
+    #[serde(default)]
+    pub secoc_pairing_timeout_ms: f64,
     /// Module actions in order.
     pub actions: Vec<TimedAction>,
     /// First armed airbag command [ms rel. contact].

@@ -46,9 +46,15 @@ pub struct Receiver {
 }
 
 impl Receiver {
-    /// Receiver with the stream keys; freshness starts above 0 (the ECU's first is 1).
+    /// Receiver with the stream keys and the default SecOC configuration; freshness starts
+    /// above 0 (the ECU's first is 1).
     pub fn new(keys: &SecOcKeys) -> Self {
-        let v = |s| keys.verifier(s, SecOcConfig::default(), 0);
+        Self::with_config(keys, SecOcConfig::default())
+    }
+
+    /// Receiver with an explicit SecOC configuration (acceptance window, pairing timeout).
+    pub fn with_config(keys: &SecOcKeys, config: SecOcConfig) -> Self {
+        let v = |s| keys.verifier(s, config, 0);
         Self {
             checker: E2eChecker::new(),
             verifiers: [v(SecOcStream::AirbagStage), v(SecOcStream::BeltLimiter)],

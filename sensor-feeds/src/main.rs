@@ -40,6 +40,12 @@ struct Cli {
     /// Only validate the scenario and print the true contact; play nothing.
     #[arg(long)]
     check: bool,
+    /// CLOCK_MONOTONIC time [ns] of scenario t = 0 (default: now + 1 ms). A feed restarted
+    /// after a crash is given the first run's epoch and resumes on the same time base: the
+    /// ticks already past are skipped, exactly as if the feed had been silent meanwhile (the
+    /// fault campaign kills and restarts the feeds this way).
+    #[arg(long, value_name = "NS")]
+    epoch_ns: Option<u64>,
 }
 
 const TICK_NS: u64 = 1_000_000;
@@ -113,14 +119,40 @@ fn run(cli: &Cli) -> Result<()> {
 
     let scale = 1.0 / cli.speedup;
     let to_ns = |t_s: f64| (t_s * 1e9 * scale).round() as u64;
-    let start_ns = monotonic_ns() + TICK_NS;
+    let now_ns = monotonic_ns();
+    let start_ns = cli.epoch_ns.unwrap_or(now_ns + TICK_NS);
+    // Resuming (epoch in the past): start at the first tick not yet due.
+    let first_tick = if now_ns > start_ns {
+        ((now_ns - start_ns) as f64 / (TICK_NS as f64 * scale)).ceil() as u64
+    } else {
+        0
+    };
     let total_ticks = (scenario.duration_s * 1e3).round() as u64;
+    if first_tick > total_ticks {
+        anyhow::bail!(
+            "--epoch-ns {start_ns} lies {:.3} s in the past: the scenario ({} s) is over",
+            (now_ns - start_ns) as f64 * 1e-9,
+            scenario.duration_s
+        );
+    }
+    let t0_s = first_tick as f64 * 1e-3;
+    if first_tick > 0 {
+        eprintln!("sensor-feeds: resuming at t = {t0_s:.3} s (epoch {start_ns} ns)");
+    }
     let obj_period_s = sensor.object_period_ms * 1e-3;
     let veh_period_s = sensor.vehicle_period_ms * 1e-3;
     let occ_period_s = sensor.occupant_period_ms * 1e-3;
     let accel_dt_s = 1.0 / sensor.accel_rate_hz;
-    let (mut next_obj, mut next_veh, mut next_occ, mut next_accel_k) =
-        (0.0f64, 0.0f64, 0.0f64, 0u64);
+    // First instant of each feed at or after t0 (all 0 on a fresh start).
+    let first_at = |period_s: f64| (t0_s / period_s - 1e-9).ceil().max(0.0) * period_s;
+    let (mut next_obj, mut next_veh, mut next_occ, mut next_accel_k) = (
+        first_at(obj_period_s),
+        first_at(veh_period_s),
+        first_at(occ_period_s),
+        (t0_s / accel_dt_s - 1e-9).ceil().max(0.0) as u64,
+    );
+    // The last object sample published: what a stuck sensor keeps repeating.
+    let mut last_object: Option<ipc::ObjectState> = None;
     let mut counts = Counts::default();
     let mut accel_seq = 0u64;
     let mut truth_rec = BenchTruth::EMPTY;
@@ -130,7 +162,7 @@ fn run(cli: &Cli) -> Result<()> {
     truth_rec.opponent_mass_kg = scenario.opponent_mass_kg() as f32;
     let mut contact_announced = false;
 
-    for tick in 0..=total_ticks {
+    for tick in first_tick..=total_ticks {
         if STOP_FLAG.load(Ordering::Relaxed) {
             eprintln!("sensor-feeds: stopped by signal at t = {} ms", tick);
             break;
@@ -145,8 +177,21 @@ fn run(cli: &Cli) -> Result<()> {
                 counts.objects_dropped += 1;
                 continue;
             }
-            if let (Some(mut o), Some(tm)) = (model.object(tp), model.measurement_time_s(tp)) {
-                o.timestamp_ns = start_ns + to_ns(tm);
+            let sample = match last_object.filter(|_| sensor.frozen(tp)) {
+                Some(stuck) => {
+                    counts.objects_frozen += 1;
+                    Some(stuck)
+                }
+                None => match (model.object(tp), model.measurement_time_s(tp)) {
+                    (Some(mut o), Some(tm)) => {
+                        o.timestamp_ns = start_ns + to_ns(tm);
+                        Some(o)
+                    }
+                    _ => None,
+                },
+            };
+            if let Some(o) = sample {
+                last_object = Some(o);
                 match objects.publish(o) {
                     Ok(()) => counts.objects += 1,
                     Err(_) => counts.ipc_errors += 1,
@@ -247,8 +292,8 @@ fn run(cli: &Cli) -> Result<()> {
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
     eprintln!(
-        "sensor-feeds: done: {} objects ({} dropped), {} accel samples, {} CAN frames, {} CAN errors, {} IPC errors",
-        counts.objects, counts.objects_dropped, counts.accel_samples, counts.can_frames, counts.can_errors, counts.ipc_errors
+        "sensor-feeds: done: {} objects ({} dropped, {} stale repeats), {} accel samples, {} CAN frames, {} CAN errors, {} IPC errors",
+        counts.objects, counts.objects_dropped, counts.objects_frozen, counts.accel_samples, counts.can_frames, counts.can_errors, counts.ipc_errors
     );
     // Keep the publishers alive a moment so subscribers can read the last samples.
     std::thread::sleep(std::time::Duration::from_millis(50));
@@ -259,6 +304,7 @@ fn run(cli: &Cli) -> Result<()> {
 struct Counts {
     objects: u64,
     objects_dropped: u64,
+    objects_frozen: u64,
     accel_samples: u64,
     can_frames: u64,
     can_errors: u64,

@@ -154,6 +154,18 @@ pub struct Dropout {
     pub target: DropoutTarget,
 }
 
+/// A time window in which the object list is *stuck*: it keeps publishing its last sample
+/// unchanged (same measurement timestamp, same sequence number) — a hung sensor whose transport
+/// still runs. Unlike a dropout the data keeps arriving, so only its age can reveal it.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Freeze {
+    /// Window start [s after scenario start].
+    pub start_s: f64,
+    /// Window end [s after scenario start] (exclusive).
+    pub end_s: f64,
+}
+
 /// Sensor model; every field has a documented default.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
@@ -189,6 +201,8 @@ pub struct SensorModel {
     pub accel_noise_mps2: f64,
     /// Feed dropouts.
     pub dropouts: Vec<Dropout>,
+    /// Stuck object-list windows (stale data: the last sample repeated).
+    pub freezes: Vec<Freeze>,
 }
 
 impl Default for SensorModel {
@@ -209,6 +223,7 @@ impl Default for SensorModel {
             accel_rate_hz: 4000.0,
             accel_noise_mps2: 0.5,
             dropouts: Vec::new(),
+            freezes: Vec::new(),
         }
     }
 }
@@ -221,6 +236,13 @@ impl SensorModel {
                 && t_s >= d.start_s
                 && t_s < d.end_s
         })
+    }
+
+    /// True if the object list is stuck at scenario time `t_s`.
+    pub fn frozen(&self, t_s: f64) -> bool {
+        self.freezes
+            .iter()
+            .any(|f| t_s >= f.start_s && t_s < f.end_s)
     }
 }
 
@@ -589,19 +611,22 @@ impl Scenario {
             50.0,
             "m/s²",
         )?;
-        for (i, d) in s.dropouts.iter().enumerate() {
-            let f = format!("sensor.dropouts[{i}]");
-            if !(d.start_s.is_finite()
-                && d.end_s.is_finite()
-                && d.start_s >= 0.0
-                && d.end_s > d.start_s)
-            {
+        let windows = s
+            .dropouts
+            .iter()
+            .enumerate()
+            .map(|(i, d)| (format!("sensor.dropouts[{i}]"), d.start_s, d.end_s))
+            .chain(
+                s.freezes
+                    .iter()
+                    .enumerate()
+                    .map(|(i, d)| (format!("sensor.freezes[{i}]"), d.start_s, d.end_s)),
+            );
+        for (f, start_s, end_s) in windows {
+            if !(start_s.is_finite() && end_s.is_finite() && start_s >= 0.0 && end_s > start_s) {
                 return Err((
                     f,
-                    format!(
-                        "window {}..{} s must satisfy 0 <= start_s < end_s",
-                        d.start_s, d.end_s
-                    ),
+                    format!("window {start_s}..{end_s} s must satisfy 0 <= start_s < end_s"),
                 ));
             }
         }
@@ -755,6 +780,20 @@ mass_kg = 75
         let s = Scenario::parse("x.toml", &ok).expect("valid barrier");
         assert!(s.opponent_mass_kg().is_infinite());
         assert!(s.opponent_class().is_none());
+    }
+
+    #[test]
+    fn freeze_windows() {
+        let text = format!("{OK}\n[sensor]\nfreezes = [{{ start_s = 0.6, end_s = 0.9 }}]\n");
+        let s = Scenario::parse("x.toml", &text).expect("valid");
+        assert!(!s.sensor.frozen(0.59));
+        assert!(s.sensor.frozen(0.6));
+        assert!(!s.sensor.frozen(0.9));
+        let bad = text.replace("end_s = 0.9", "end_s = 0.6");
+        let e = Scenario::parse("x.toml", &bad).unwrap_err();
+        assert_eq!(e.field.as_deref(), Some("sensor.freezes[0]"), "{e}");
+        let unknown = text.replace("end_s = 0.9", "end_s = 0.9, target = \"object\"");
+        assert!(Scenario::parse("x.toml", &unknown).is_err());
     }
 
     #[test]

@@ -32,7 +32,92 @@ pub struct RunConfig {
     /// Working directory of the ECU (its config paths `data/default.lut`,
     /// `data/reference-restraint.toml` are relative to the repository root).
     pub ecu_cwd: PathBuf,
+    /// Extra arguments for the actuator stubs (see [`default_stubs_args`]).
+    pub stubs_args: Vec<String>,
 }
+
+/// SecOC pairing timeout the stubs get inside user-mode Linux, ms. There the emulated kernel
+/// stalls processes for 20–35 ms now and then, also between the ECU's command frame and its
+/// authenticator (sent in the same cycle), which made ~1 genuine command in 8 000 go stale at
+/// the 10 ms default. The security properties do not depend on it (the MAC binds the exact
+/// payload and a fresh counter); it only bounds how old a held command may be when acted on.
+pub const UML_SECOC_PAIRING_TIMEOUT_MS: f64 = 50.0;
+
+/// True inside the user-mode-Linux guest of `vcan-setup.sh --run` (it sets `VCAN_IN_UML`).
+pub fn in_uml_guest() -> bool {
+    std::env::var_os("VCAN_IN_UML").is_some()
+}
+
+/// The stubs' bench arguments: drain the bus until the ECU has stopped (so every command it
+/// sent is received and counted), and the user-mode-Linux pairing timeout where it applies.
+pub fn default_stubs_args() -> Vec<String> {
+    let mut v = vec!["--drain-quiet-ms".to_owned(), "200".to_owned()];
+    if in_uml_guest() {
+        v.push("--secoc-pairing-timeout-ms".to_owned());
+        v.push(format!("{UML_SECOC_PAIRING_TIMEOUT_MS}"));
+    }
+    v
+}
+
+/// What a run needs to know to disturb it (fault campaign).
+pub struct RunCtx<'a> {
+    /// The run's configuration.
+    pub cfg: &'a RunConfig,
+    /// The scenario being played.
+    pub scenario: &'a sensor_feeds::Scenario,
+    /// The run's output folder.
+    pub dir: PathBuf,
+    /// CLOCK_MONOTONIC ns of scenario t = 0 (the feeds' `--epoch-ns`).
+    pub epoch_ns: u64,
+}
+
+impl RunCtx<'_> {
+    /// Path of a bench binary.
+    pub fn bin(&self, name: &str) -> PathBuf {
+        self.cfg.bin_dir.join(name)
+    }
+
+    /// The sensor-feeds command of this run (on the run's epoch, so a restart resumes).
+    pub fn feeds_command(&self) -> Command {
+        let mut c = Command::new(self.bin("sensor-feeds"));
+        c.arg("--scenario")
+            .arg(&self.cfg.scenario)
+            .args(["--can", &self.cfg.can])
+            .args(["--service-prefix", &self.cfg.service_prefix])
+            .arg("--epoch-ns")
+            .arg(self.epoch_ns.to_string());
+        c
+    }
+
+    /// Sleeps until scenario time `t_s`.
+    pub fn sleep_until_s(&self, t_s: f64) {
+        sensor_feeds::sleep_until_ns(self.epoch_ns + (t_s * 1e9) as u64);
+    }
+}
+
+/// Something done to a run: before it, beside it, or to its sensor feeds. The plain bench run
+/// is [`Undisturbed`].
+pub trait Disturbance {
+    /// Before any bench process starts (e.g. leave a stale iceoryx2 service behind).
+    fn prepare(&mut self, _cfg: &RunConfig, _dir: &Path) -> Result<()> {
+        Ok(())
+    }
+    /// Processes started just before the feeds (bus injectors, floods), stdout piped. They are
+    /// given 5 s to end by themselves after the feeds, then SIGTERM; their stdout is returned
+    /// in [`RunResult::disturbance_output`].
+    fn start(&mut self, _ctx: &RunCtx) -> Result<Vec<(String, Child)>> {
+        Ok(Vec::new())
+    }
+    /// Plays the scenario; the default runs the feeds once to the end.
+    fn play(&mut self, ctx: &RunCtx) -> Result<std::process::ExitStatus> {
+        ctx.feeds_command().status().context("running sensor-feeds")
+    }
+}
+
+/// The plain bench run.
+pub struct Undisturbed;
+
+impl Disturbance for Undisturbed {}
 
 /// What one run produced.
 #[derive(Debug)]
@@ -49,6 +134,10 @@ pub struct RunResult {
     pub summary: String,
     /// Process problems (non-zero exits), empty when all went well.
     pub problems: Vec<String>,
+    /// CLOCK_MONOTONIC ns of scenario t = 0.
+    pub epoch_ns: u64,
+    /// What the disturbance processes printed, by name.
+    pub disturbance_output: Vec<(String, String)>,
 }
 
 /// The repository root (this crate lives in `<root>/tests`).
@@ -96,6 +185,11 @@ fn wait_timeout(child: &mut Child, timeout: Duration) -> Result<Option<std::proc
 
 /// Runs one scenario through the real processes.
 pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
+    run_disturbed(cfg, &mut Undisturbed)
+}
+
+/// Runs one scenario through the real processes, disturbed by `dist`.
+pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunResult> {
     let scenario =
         sensor_feeds::Scenario::load(&cfg.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
     let dir = cfg.out.join(&scenario.name);
@@ -122,6 +216,7 @@ pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
     let mut problems = Vec::new();
     // Absolute paths: the ECU runs in the repository root.
     let dir = std::path::absolute(&dir)?;
+    dist.prepare(cfg, &dir)?;
     let candump_log = std::fs::File::create(dir.join("candump.log"))?;
     let mut candump = spawn(
         Command::new("candump")
@@ -143,7 +238,8 @@ pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
             ])
             .arg(format!("{}", scenario.duration_s + 30.0))
             .arg("--out")
-            .arg(&dir),
+            .arg(&dir)
+            .args(&cfg.stubs_args),
         "actuator-stubs",
     )?;
     let ecu_log = std::fs::File::create(dir.join("ecu-stdout.txt"))?;
@@ -170,14 +266,35 @@ pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
     if let Ok(Some(st)) = ecu.try_wait() {
         problems.push(format!("ecu exited early: {st}"));
     }
-    let feeds_status = Command::new(bin("sensor-feeds"))
-        .arg("--scenario")
-        .arg(&cfg.scenario)
-        .args(["--can", &cfg.can, "--service-prefix", &cfg.service_prefix])
-        .status()
-        .context("running sensor-feeds")?;
-    if !feeds_status.success() {
-        problems.push(format!("sensor-feeds: {feeds_status}"));
+    // Scenario t = 0 a little ahead, so the feeds start on time.
+    let epoch_ns = sensor_feeds::monotonic_ns() + 200_000_000;
+    let ctx = RunCtx {
+        cfg,
+        scenario: &scenario,
+        dir: dir.clone(),
+        epoch_ns,
+    };
+    let mut side = dist.start(&ctx)?;
+    match dist.play(&ctx) {
+        Ok(st) if st.success() => {}
+        Ok(st) => problems.push(format!("sensor-feeds: {st}")),
+        Err(e) => problems.push(format!("sensor-feeds: {e:#}")),
+    }
+    let mut disturbance_output = Vec::new();
+    for (name, child) in side.iter_mut() {
+        if wait_timeout(child, Duration::from_secs(5))?.is_none() {
+            terminate(child, name, Duration::from_secs(2))?;
+        }
+    }
+    for (name, child) in side {
+        let o = child.wait_with_output()?;
+        disturbance_output.push((name, String::from_utf8_lossy(&o.stdout).into_owned()));
+    }
+    // The ECU stops first; the stubs drain the bus until it is quiet (--drain-quiet-ms), so
+    // they see every command the ECU sent.
+    let st = terminate(&mut ecu, "ecu", Duration::from_secs(5))?;
+    if !st.success() {
+        problems.push(format!("ecu: {st}"));
     }
     match wait_timeout(&mut stubs, Duration::from_secs(20))? {
         Some(st) if st.success() => {}
@@ -188,10 +305,6 @@ pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
                 "actuator-stubs did not finish after the feeds ({st})"
             ));
         }
-    }
-    let st = terminate(&mut ecu, "ecu", Duration::from_secs(5))?;
-    if !st.success() {
-        problems.push(format!("ecu: {st}"));
     }
     std::thread::sleep(Duration::from_millis(50));
     let _ = terminate(&mut candump, "candump", Duration::from_secs(2))?;
@@ -214,6 +327,8 @@ pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
         ecu_report,
         summary,
         problems,
+        epoch_ns,
+        disturbance_output,
     })
 }
 
@@ -342,6 +457,17 @@ pub fn summarise(
         frames.join(", "),
         r.e2e_accepted,
         r.e2e_rejected
+    );
+    let _ = writeln!(
+        s,
+        "SecOC: {} commands authenticated (ECU sent {}), rejected {:?}, unpaired {}; pairing timeout {} ms",
+        r.secoc_accepted,
+        ecu.and_then(|e| e.pointer("/counters/secoc_commands_tx"))
+            .and_then(|v| v.as_u64())
+            .map_or("?".to_owned(), |n| n.to_string()),
+        r.secoc_rejected,
+        r.secoc_commands_dropped,
+        r.secoc_pairing_timeout_ms
     );
     if let Some(o) = &r.outcome {
         let _ = writeln!(

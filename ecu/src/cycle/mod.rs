@@ -203,6 +203,8 @@ pub struct CycleCounters {
     pub can_tx: u64,
     /// CAN send failures.
     pub can_tx_errors: u64,
+    /// Commands sent together with their SecOC authenticator (both frames taken by the socket).
+    pub secoc_commands_tx: u64,
     /// Command encode failures (value outside the DBC after clamping: should stay 0).
     pub encode_errors: u64,
     /// Diagnostics publish failures.
@@ -945,7 +947,8 @@ impl RestraintCycle {
         }
     }
 
-    fn send(&mut self, io: &mut dyn CycleIo, raw: RawFrame) {
+    /// Sends one frame; true if the socket took it.
+    fn send(&mut self, io: &mut dyn CycleIo, raw: RawFrame) -> bool {
         let frame = CanFrame {
             id: raw.id,
             extended: false,
@@ -953,18 +956,31 @@ impl RestraintCycle {
             data: raw.data,
         };
         match io.send_can(&frame) {
-            Ok(()) => self.counters.can_tx = self.counters.can_tx.saturating_add(1),
-            Err(_) => self.counters.can_tx_errors = self.counters.can_tx_errors.saturating_add(1),
+            Ok(()) => {
+                self.counters.can_tx = self.counters.can_tx.saturating_add(1);
+                true
+            }
+            Err(_) => {
+                self.counters.can_tx_errors = self.counters.can_tx_errors.saturating_add(1);
+                false
+            }
         }
     }
 
     /// Sends a command frame and, with SecOC on, its authenticator right after it (the
     /// receiver pairs them within one command cycle). `authenticate` is allocation-free.
+    /// Complete pairs are counted: an actuator that acts on fewer authenticated commands
+    /// than this lost some (the fault campaign's "commands lost").
     fn send_authenticated(&mut self, io: &mut dyn CycleIo, raw: RawFrame) {
-        self.send(io, raw);
+        let cmd_sent = self.send(io, raw);
         if let Some(tx) = self.secoc.as_mut() {
             match tx.authenticate(&raw) {
-                Ok(auth) => self.send(io, auth),
+                Ok(auth) => {
+                    if self.send(io, auth) && cmd_sent {
+                        self.counters.secoc_commands_tx =
+                            self.counters.secoc_commands_tx.saturating_add(1);
+                    }
+                }
                 Err(_) => {
                     self.counters.encode_errors = self.counters.encode_errors.saturating_add(1)
                 }
@@ -1233,6 +1249,7 @@ impl Activity for RestraintCycle {
             ("degraded_cycles", c.degraded_cycles),
             ("can_tx", c.can_tx),
             ("can_tx_errors", c.can_tx_errors),
+            ("secoc_commands_tx", c.secoc_commands_tx),
             ("encode_errors", c.encode_errors),
             ("diagnostics_publish_failures", c.diagnostics_failures),
         ]);

@@ -68,6 +68,7 @@ fn run() -> Result<bool> {
             service_prefix: format!("hil-bench-{}-{i}", std::process::id()),
             ecu_args: cli.ecu_arg.clone(),
             ecu_cwd: cli.repo.clone().unwrap_or_else(e2e_tests::repo_root),
+            stubs_args: e2e_tests::default_stubs_args(),
         };
         match run_scenario(&cfg) {
             Ok(r) => {

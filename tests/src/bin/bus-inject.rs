@@ -1,0 +1,266 @@
+//! `bus-inject`: a bus attacker / faulty node for the fault campaign (issue 8).
+//!
+//! * `bus-inject mirror --mode crc|counter|replay|delay --id 0x0A0 --epoch-ns N --from-s A --to-s B`
+//!   watches a message on the live bus and, for every genuine frame seen inside the window
+//!   (scenario seconds on the feeds' time base), puts a faulty frame next to it:
+//!   - `crc`: the same payload with the CRC byte inverted (a corrupted frame);
+//!   - `counter`: the alive counter advanced by 5 and the CRC recomputed (a node whose counter
+//!     jumped: the CRC is right, the sequence is not);
+//!   - `replay`: the identical frame again right away (a replay: repeated counter);
+//!   - `delay`: the identical frame again `--delay-ms` later (a delayed / stale frame).
+//!
+//!   It prints one JSON line `{"injected": n, "seen": m}` when the window is over.
+//! * `bus-inject forge-fire --counter C [--freshness F]` prints, for `cansend`, an
+//!   `AirbagStageCmd` that requests Armed + Fire with a *valid* E2E CRC and alive counter `C`,
+//!   followed by an `AirbagStageAuth` with freshness `F` and a MAC the attacker has to guess —
+//!   exactly what someone with the public DBC but without the key can put on the bus.
+//!
+//! E2E positions come from the DBC (`bus::message_info`): CRC in byte 0, alive counter in the
+//! low nibble of byte 1.
+
+use anyhow::{bail, Context, Result};
+use bus::RawFrame;
+use clap::{Parser, Subcommand, ValueEnum};
+use std::collections::VecDeque;
+use std::time::Duration;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "bus-inject",
+    version,
+    about = "Bus attacker / faulty node for the fault campaign"
+)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+#[derive(Subcommand, Debug)]
+enum Cmd {
+    /// Put a faulty copy next to every genuine frame of one message inside a time window.
+    Mirror {
+        /// CAN interface.
+        #[arg(long, default_value = "vcan0")]
+        can: String,
+        /// What the copy gets wrong.
+        #[arg(long, value_enum)]
+        mode: Mode,
+        /// Message id (hex with 0x, or decimal); must be E2E protected in the DBC.
+        #[arg(long, value_parser = parse_id)]
+        id: u32,
+        /// CLOCK_MONOTONIC ns of scenario t = 0 (the feeds' --epoch-ns).
+        #[arg(long)]
+        epoch_ns: u64,
+        /// Window start, scenario seconds.
+        #[arg(long)]
+        from_s: f64,
+        /// Window end, scenario seconds.
+        #[arg(long)]
+        to_s: f64,
+        /// Delay of the copies in `delay` mode, ms.
+        #[arg(long, default_value_t = 200.0)]
+        delay_ms: f64,
+    },
+    /// Print a forged Armed+Fire AirbagStageCmd and a guessed authenticator as `cansend` args.
+    ForgeFire {
+        /// Alive counter to put in the forged command (0..=15).
+        #[arg(long)]
+        counter: u8,
+        /// Freshness value (low 24 bits) of the forged authenticator.
+        #[arg(long, default_value_t = 1)]
+        freshness: u32,
+        /// The attacker's MAC guess (40 bits).
+        #[arg(long, default_value_t = 0x5A5A_5A5A_5A)]
+        mac: u64,
+    },
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+enum Mode {
+    Crc,
+    Counter,
+    Replay,
+    Delay,
+}
+
+fn parse_id(s: &str) -> Result<u32, String> {
+    let r = match s.strip_prefix("0x").or_else(|| s.strip_prefix("0X")) {
+        Some(h) => u32::from_str_radix(h, 16),
+        None => s.parse(),
+    };
+    r.map_err(|e| format!("bad CAN id {s:?}: {e}"))
+}
+
+fn main() -> std::process::ExitCode {
+    match run(Cli::parse()) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("bus-inject: error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+/// `ID#HEX` as `cansend` takes it.
+fn cansend_arg(f: &RawFrame) -> String {
+    let hex: String = f.payload().iter().map(|b| format!("{b:02X}")).collect();
+    format!("{:03X}#{hex}", f.id)
+}
+
+/// The faulty copy of a genuine E2E frame for `mode` (`delay`/`replay`: the frame itself).
+fn faulty_copy(mode: Mode, data_id: u16, genuine: &RawFrame) -> RawFrame {
+    let mut f = *genuine;
+    match mode {
+        Mode::Crc => f.data[0] = !f.data[0],
+        Mode::Counter => {
+            let c = (f.data[1] & 0x0F).wrapping_add(5) & 0x0F;
+            f.data[1] = (f.data[1] & 0xF0) | c;
+            f.data[0] = bus::e2e_crc(data_id, 0, f.payload());
+        }
+        Mode::Replay | Mode::Delay => {}
+    }
+    f
+}
+
+/// A forged Armed+Fire `AirbagStageCmd` with a valid E2E CRC and alive counter `counter`, and
+/// an `AirbagStageAuth` carrying `freshness` and the guessed `mac`.
+fn forge_fire(counter: u8, freshness: u32, mac: u64) -> Result<(RawFrame, RawFrame)> {
+    if counter > 15 || freshness > 0xFF_FFFF || mac >= 1 << 40 {
+        bail!("counter 0..=15, freshness < 2^24, mac < 2^40");
+    }
+    // Crc, AliveCounter, Arm, Fire, CmdSource (adaptive), Stage (both), ForceLevel, FireTime.
+    let mut cmd = bus::encode_values(
+        0x030,
+        &[0.0, f64::from(counter), 1.0, 1.0, 0.0, 3.0, 6.0, 0.0],
+    )
+    .map_err(|e| anyhow::anyhow!("encoding the forged command: {e:?}"))?;
+    let data_id = bus::message_info(0x030)
+        .and_then(|i| i.e2e_data_id)
+        .context("AirbagStageCmd has an E2E data id in the DBC")?;
+    cmd.data[0] = bus::e2e_crc(data_id, 0, cmd.payload());
+    let auth = bus::encode_values(0x031, &[f64::from(freshness), mac as f64])
+        .map_err(|e| anyhow::anyhow!("encoding the forged authenticator: {e:?}"))?;
+    Ok((cmd, auth))
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.cmd {
+        Cmd::ForgeFire {
+            counter,
+            freshness,
+            mac,
+        } => {
+            let (cmd, auth) = forge_fire(counter, freshness, mac)?;
+            println!("{} {}", cansend_arg(&cmd), cansend_arg(&auth));
+            Ok(())
+        }
+        Cmd::Mirror {
+            can,
+            mode,
+            id,
+            epoch_ns,
+            from_s,
+            to_s,
+            delay_ms,
+        } => {
+            if !(from_s.is_finite() && to_s.is_finite() && to_s > from_s && from_s >= 0.0) {
+                bail!("window must satisfy 0 <= from_s < to_s");
+            }
+            let data_id = bus::message_info(id)
+                .and_then(|i| i.e2e_data_id)
+                .with_context(|| format!("0x{id:03X} is not an E2E-protected DBC message"))?;
+            let mut sock = bus::socket::BusSocket::open(&can, &[id])
+                .with_context(|| format!("opening {can}"))?;
+            let at = |s: f64| epoch_ns.saturating_add((s * 1e9) as u64);
+            let (start, end) = (at(from_s), at(to_s));
+            let delay_ns = (delay_ms * 1e6) as u64;
+            let mut queue: VecDeque<(u64, RawFrame)> = VecDeque::new();
+            let (mut seen, mut injected) = (0u64, 0u64);
+            loop {
+                let now = sensor_feeds::monotonic_ns();
+                while let Some(rx) = sock.recv().context("CAN receive")? {
+                    let t = sensor_feeds::monotonic_ns();
+                    if rx.frame.id != id || t < start || t >= end {
+                        continue;
+                    }
+                    seen += 1;
+                    let due = if mode == Mode::Delay { t + delay_ns } else { t };
+                    queue.push_back((due, faulty_copy(mode, data_id, &rx.frame)));
+                }
+                while queue.front().is_some_and(|(due, _)| *due <= now) {
+                    if let Some((_, f)) = queue.pop_front() {
+                        match sock.send(&f) {
+                            Ok(()) => injected += 1,
+                            Err(e) => eprintln!("bus-inject: send: {e}"),
+                        }
+                    }
+                }
+                if now >= end && queue.is_empty() {
+                    break;
+                }
+                std::thread::sleep(Duration::from_micros(200));
+            }
+            println!("{{\"injected\": {injected}, \"seen\": {seen}}}");
+            Ok(())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A genuine EgoVehicleState with alive counter 3 and a correct CRC.
+    fn genuine() -> (u16, RawFrame) {
+        let data_id = bus::message_info(0x0A0)
+            .and_then(|i| i.e2e_data_id)
+            .expect("E2E id");
+        // Crc, AliveCounter, BrakeState, EgoSpeed, EgoLongAccel.
+        let mut f = bus::encode_values(0x0A0, &[0.0, 3.0, 0.0, 13.0, 0.0]).expect("encode");
+        f.data[0] = bus::e2e_crc(data_id, 0, f.payload());
+        (data_id, f)
+    }
+
+    #[test]
+    fn each_fault_is_rejected_for_its_own_reason() {
+        use bus::RejectReason as R;
+        let (data_id, g) = genuine();
+        for (mode, want) in [
+            (Mode::Crc, Some(R::CrcMismatch)),
+            (Mode::Counter, Some(R::CounterSkipped)),
+            (Mode::Replay, Some(R::CounterRepeated)),
+        ] {
+            let mut checker = bus::E2eChecker::new();
+            checker.check_frame(&g).expect("genuine frame accepted");
+            let bad = faulty_copy(mode, data_id, &g);
+            let got = checker.check_frame(&bad).err().map(|e| e.reason());
+            assert_eq!(got, want, "{mode:?}");
+        }
+    }
+
+    #[test]
+    fn forged_fire_frame_passes_e2e_and_asks_to_fire() {
+        let (cmd, auth) = forge_fire(7, 1, 0x12_3456_789A).expect("forge");
+        let text = cansend_arg(&cmd);
+        let (id, hex) = text.split_once('#').expect("ID#HEX");
+        assert_eq!(id, "030");
+        let bytes: Vec<u8> = (0..hex.len())
+            .step_by(2)
+            .map(|i| u8::from_str_radix(&hex[i..i + 2], 16).expect("hex"))
+            .collect();
+        assert_eq!(cansend_arg(&auth).split_once('#').map(|p| p.0), Some("031"));
+        let mut checker = bus::E2eChecker::new();
+        let msg = checker.check(0x030, &bytes).expect("valid E2E");
+        match msg {
+            bus::Messages::AirbagStageCmd(m) => {
+                assert!(
+                    matches!(m.arm(), bus::codec::AirbagStageCmdArm::Armed)
+                        && matches!(m.fire(), bus::codec::AirbagStageCmdFire::Fire),
+                    "{m:?}"
+                );
+                assert_eq!(m.alive_counter(), 7);
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+}
