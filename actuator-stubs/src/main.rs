@@ -177,14 +177,7 @@ fn run(cli: &Cli) -> Result<()> {
         if STOP.load(Ordering::Relaxed) {
             break "signal";
         }
-        let now = monotonic_ns();
-        if let Some(done) = done_at_ns {
-            if now.saturating_sub(last_rx_ns) >= quiet_ns
-                || now.saturating_sub(done) >= MAX_DRAIN_NS
-            {
-                break "done";
-            }
-        } else if now > deadline {
+        if done_at_ns.is_none() && monotonic_ns() > deadline {
             break "timeout";
         }
         let mut got_any = false;
@@ -238,6 +231,16 @@ fn run(cli: &Cli) -> Result<()> {
                 if quiet_ns == 0 {
                     break "done";
                 }
+            }
+        }
+        if let (Some(done), false) = (done_at_ns, got_any) {
+            // Quiet only counts after a drain found the socket empty: a stubs process that was
+            // descheduled for a while must first read what queued up meanwhile.
+            let now = monotonic_ns();
+            if now.saturating_sub(last_rx_ns) >= quiet_ns
+                || now.saturating_sub(done) >= MAX_DRAIN_NS
+            {
+                break "done";
             }
         }
         if !got_any {

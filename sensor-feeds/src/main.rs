@@ -135,6 +135,14 @@ fn run(cli: &Cli) -> Result<()> {
             scenario.duration_s
         );
     }
+    // Machine-readable time base for orchestrators (the fault campaign starts its injectors
+    // and restarts killed feeds on it); everything else goes to stderr.
+    {
+        use std::io::Write;
+        let mut out = std::io::stdout().lock();
+        let _ = writeln!(out, "epoch_ns {start_ns}");
+        let _ = out.flush();
+    }
     let t0_s = first_tick as f64 * 1e-3;
     if first_tick > 0 {
         eprintln!("sensor-feeds: resuming at t = {t0_s:.3} s (epoch {start_ns} ns)");

@@ -7,6 +7,8 @@
 //! produced lands in `OUT/<scenario>/`. Every run uses its own iceoryx2 service prefix, so
 //! leftovers of an earlier (killed) run can never be mistaken for this run's samples.
 
+pub mod faults;
+
 use actuator_stubs::report::Report;
 use anyhow::{bail, Context, Result};
 use std::fmt::Write as _;
@@ -102,15 +104,19 @@ pub trait Disturbance {
     fn prepare(&mut self, _cfg: &RunConfig, _dir: &Path) -> Result<()> {
         Ok(())
     }
-    /// Processes started just before the feeds (bus injectors, floods), stdout piped. They are
-    /// given 5 s to end by themselves after the feeds, then SIGTERM; their stdout is returned
-    /// in [`RunResult::disturbance_output`].
+    /// Processes started once the feeds have fixed the time base (bus injectors, floods),
+    /// stdout piped. They are given 5 s to end by themselves after the feeds, then SIGTERM;
+    /// their stdout is returned in [`RunResult::disturbance_output`].
     fn start(&mut self, _ctx: &RunCtx) -> Result<Vec<(String, Child)>> {
         Ok(Vec::new())
     }
-    /// Plays the scenario; the default runs the feeds once to the end.
-    fn play(&mut self, ctx: &RunCtx) -> Result<std::process::ExitStatus> {
-        ctx.feeds_command().status().context("running sensor-feeds")
+    /// While the feeds play (`feeds` is running); the default waits for them to finish.
+    fn feeds_running(
+        &mut self,
+        _ctx: &RunCtx,
+        feeds: &mut Child,
+    ) -> Result<std::process::ExitStatus> {
+        feeds.wait().context("waiting for sensor-feeds")
     }
 }
 
@@ -183,6 +189,20 @@ fn wait_timeout(child: &mut Child, timeout: Duration) -> Result<Option<std::proc
     Ok(None)
 }
 
+/// Reads the feeds' "epoch_ns N" line (their first line on stdout).
+pub fn read_epoch(feeds: &mut Child) -> Result<u64> {
+    use std::io::BufRead;
+    let out = feeds.stdout.take().context("sensor-feeds stdout")?;
+    let mut line = String::new();
+    std::io::BufReader::new(out)
+        .read_line(&mut line)
+        .context("reading sensor-feeds' epoch")?;
+    line.trim()
+        .strip_prefix("epoch_ns ")
+        .and_then(|n| n.parse().ok())
+        .with_context(|| format!("sensor-feeds did not announce its epoch (got {line:?})"))
+}
+
 /// Runs one scenario through the real processes.
 pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
     run_disturbed(cfg, &mut Undisturbed)
@@ -197,6 +217,7 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     for stale in [
         "report.json",
         "ecu-report.json",
+        "ecu-stderr.txt",
         "candump.log",
         "commands.jsonl",
         "outcome.png",
@@ -258,24 +279,64 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
             .arg(dir.join("ecu-report.json"))
             .args(&cfg.ecu_args)
             .current_dir(&cfg.ecu_cwd)
-            .stdout(ecu_log),
+            .stdout(ecu_log)
+            .stderr(Stdio::piped()),
         "ecu",
     )?;
+    // The ECU's start-up messages (LUT/keys accepted or rejected) go to the console as before
+    // and into ecu-stderr.txt, where the fault campaign reads them.
+    let ecu_stderr = ecu.stderr.take().map(|pipe| {
+        let path = dir.join("ecu-stderr.txt");
+        std::thread::spawn(move || {
+            use std::io::{BufRead, Write};
+            let mut file = std::fs::File::create(path).ok();
+            for line in std::io::BufReader::new(pipe).lines().map_while(Result::ok) {
+                eprintln!("{line}");
+                if let Some(f) = file.as_mut() {
+                    let _ = writeln!(f, "{line}");
+                }
+            }
+        })
+    });
     // Let the ECU and the stubs come up (nodes, services, CAN sockets) before the scenario.
     std::thread::sleep(Duration::from_millis(400));
     if let Ok(Some(st)) = ecu.try_wait() {
         problems.push(format!("ecu exited early: {st}"));
     }
-    // Scenario t = 0 a little ahead, so the feeds start on time.
-    let epoch_ns = sensor_feeds::monotonic_ns() + 200_000_000;
+    // The feeds fix scenario t = 0 when they are ready and print it ("epoch_ns N").
+    let mut feeds = spawn(
+        Command::new(bin("sensor-feeds"))
+            .arg("--scenario")
+            .arg(&cfg.scenario)
+            .args(["--can", &cfg.can, "--service-prefix", &cfg.service_prefix])
+            .stdout(Stdio::piped()),
+        "sensor-feeds",
+    )?;
+    let epoch_ns = match read_epoch(&mut feeds) {
+        Ok(e) => e,
+        Err(e) => {
+            let _ = feeds.kill();
+            let _ = feeds.wait();
+            let _ = terminate(&mut ecu, "ecu", Duration::from_secs(5));
+            let _ = terminate(&mut stubs, "actuator-stubs", Duration::from_secs(5));
+            let _ = terminate(&mut candump, "candump", Duration::from_secs(2));
+            return Err(e);
+        }
+    };
     let ctx = RunCtx {
         cfg,
         scenario: &scenario,
         dir: dir.clone(),
         epoch_ns,
     };
-    let mut side = dist.start(&ctx)?;
-    match dist.play(&ctx) {
+    let mut side = match dist.start(&ctx) {
+        Ok(s) => s,
+        Err(e) => {
+            problems.push(format!("disturbance: {e:#}"));
+            Vec::new()
+        }
+    };
+    match dist.feeds_running(&ctx, &mut feeds) {
         Ok(st) if st.success() => {}
         Ok(st) => problems.push(format!("sensor-feeds: {st}")),
         Err(e) => problems.push(format!("sensor-feeds: {e:#}")),
@@ -295,6 +356,9 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     let st = terminate(&mut ecu, "ecu", Duration::from_secs(5))?;
     if !st.success() {
         problems.push(format!("ecu: {st}"));
+    }
+    if let Some(t) = ecu_stderr {
+        let _ = t.join();
     }
     match wait_timeout(&mut stubs, Duration::from_secs(20))? {
         Some(st) if st.success() => {}

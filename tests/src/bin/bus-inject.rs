@@ -9,7 +9,8 @@
 //!   - `replay`: the identical frame again right away (a replay: repeated counter);
 //!   - `delay`: the identical frame again `--delay-ms` later (a delayed / stale frame).
 //!
-//!   It prints one JSON line `{"injected": n, "seen": m}` when the window is over.
+//!   It prints one JSON line `{"injected": n, "seen": m, "first_s": a, "last_s": b}` (scenario
+//!   times of the first and last injected frame) when the window is over.
 //! * `bus-inject forge-fire --counter C [--freshness F]` prints, for `cansend`, an
 //!   `AirbagStageCmd` that requests Armed + Fire with a *valid* E2E CRC and alive counter `C`,
 //!   followed by an `AirbagStageAuth` with freshness `F` and a MAC the attacker has to guess —
@@ -176,6 +177,8 @@ fn run(cli: Cli) -> Result<()> {
             let delay_ns = (delay_ms * 1e6) as u64;
             let mut queue: VecDeque<(u64, RawFrame)> = VecDeque::new();
             let (mut seen, mut injected) = (0u64, 0u64);
+            // Scenario times of the first and last injected frame.
+            let (mut first_s, mut last_s) = (f64::NAN, f64::NAN);
             loop {
                 let now = sensor_feeds::monotonic_ns();
                 while let Some(rx) = sock.recv().context("CAN receive")? {
@@ -190,7 +193,14 @@ fn run(cli: Cli) -> Result<()> {
                 while queue.front().is_some_and(|(due, _)| *due <= now) {
                     if let Some((_, f)) = queue.pop_front() {
                         match sock.send(&f) {
-                            Ok(()) => injected += 1,
+                            Ok(()) => {
+                                injected += 1;
+                                let t_s = now.saturating_sub(epoch_ns) as f64 * 1e-9;
+                                if injected == 1 {
+                                    first_s = t_s;
+                                }
+                                last_s = t_s;
+                            }
                             Err(e) => eprintln!("bus-inject: send: {e}"),
                         }
                     }
@@ -200,7 +210,18 @@ fn run(cli: Cli) -> Result<()> {
                 }
                 std::thread::sleep(Duration::from_micros(200));
             }
-            println!("{{\"injected\": {injected}, \"seen\": {seen}}}");
+            let json_s = |t: f64| {
+                if t.is_finite() {
+                    format!("{t:.4}")
+                } else {
+                    "null".to_owned()
+                }
+            };
+            println!(
+                "{{\"injected\": {injected}, \"seen\": {seen}, \"first_s\": {}, \"last_s\": {}}}",
+                json_s(first_s),
+                json_s(last_s)
+            );
             Ok(())
         }
     }

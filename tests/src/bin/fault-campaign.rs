@@ -1,1 +1,126 @@
-fn main() {}
+//! `fault-campaign`: the fault-injection campaign and the robustness report (issue 8).
+//!
+//! * `fault-campaign run [--out DIR] [--case NAME …]` runs the cases (tests/src/faults.rs) on a
+//!   CAN interface that must exist — start it through
+//!   `./vcan-setup.sh --run -- target/release/fault-campaign run …` — and writes
+//!   `DIR/campaign.json`; exit 1 if a case failed.
+//! * `fault-campaign report --campaign DIR/campaign.json [--fuzz fuzz.json]` prints the
+//!   robustness report: cases tried, faults survived, commands lost, deadline misses, frames
+//!   rejected by reason, and the fuzzing figures of `tests/fuzz-smoke.sh` (FUZZ_REPORT_JSON).
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use e2e_tests::faults::{report_text, run_campaign, Campaign, CampaignConfig, FuzzTarget};
+use std::path::PathBuf;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "fault-campaign",
+    version,
+    about = "Fault-injection campaign and robustness report"
+)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+#[derive(Subcommand, Debug)]
+enum Cmd {
+    /// Run the campaign (needs a CAN interface; see vcan-setup.sh --run).
+    Run {
+        /// Output root.
+        #[arg(long, default_value = "out/faults")]
+        out: PathBuf,
+        /// Only these cases (the baseline always runs).
+        #[arg(long = "case")]
+        cases: Vec<String>,
+        /// CAN interface (default: $VCAN or vcan0).
+        #[arg(long)]
+        can: Option<String>,
+        /// Folder of the bench binaries (default: this binary's folder).
+        #[arg(long)]
+        bin_dir: Option<PathBuf>,
+        /// Repository root (default: where this crate was built).
+        #[arg(long)]
+        repo: Option<PathBuf>,
+        /// Also print the robustness report with these fuzzing figures.
+        #[arg(long)]
+        fuzz: Option<PathBuf>,
+    },
+    /// Print the robustness report of a finished campaign.
+    Report {
+        /// campaign.json of a run.
+        #[arg(long)]
+        campaign: PathBuf,
+        /// Fuzzing figures (tests/fuzz-smoke.sh with FUZZ_REPORT_JSON).
+        #[arg(long)]
+        fuzz: Option<PathBuf>,
+    },
+}
+
+fn main() -> std::process::ExitCode {
+    match run() {
+        Ok(true) => std::process::ExitCode::SUCCESS,
+        Ok(false) => std::process::ExitCode::from(1),
+        Err(e) => {
+            eprintln!("fault-campaign: error: {e:#}");
+            std::process::ExitCode::from(2)
+        }
+    }
+}
+
+fn load_fuzz(path: Option<&PathBuf>) -> Result<Option<Vec<FuzzTarget>>> {
+    path.map(|p| {
+        let text =
+            std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
+        serde_json::from_str(&text).with_context(|| format!("parsing {}", p.display()))
+    })
+    .transpose()
+}
+
+fn run() -> Result<bool> {
+    match Cli::parse().cmd {
+        Cmd::Run {
+            out,
+            cases,
+            can,
+            bin_dir,
+            repo,
+            fuzz,
+        } => {
+            let bin_dir = match bin_dir {
+                Some(d) => d,
+                None => std::env::current_exe()?
+                    .parent()
+                    .map(PathBuf::from)
+                    .unwrap_or_default(),
+            };
+            let cfg = CampaignConfig {
+                out: out.clone(),
+                can: can
+                    .or_else(|| std::env::var("VCAN").ok())
+                    .unwrap_or_else(|| "vcan0".into()),
+                bin_dir,
+                repo: repo.unwrap_or_else(e2e_tests::repo_root),
+            };
+            let campaign = run_campaign(&cfg, &cases)?;
+            std::fs::create_dir_all(&out)?;
+            let path = out.join("campaign.json");
+            std::fs::write(&path, serde_json::to_string_pretty(&campaign)?)?;
+            println!(
+                "{}",
+                report_text(&campaign, load_fuzz(fuzz.as_ref())?.as_deref())
+            );
+            println!("campaign: {}", path.display());
+            Ok(campaign.cases.iter().all(|c| c.pass))
+        }
+        Cmd::Report { campaign, fuzz } => {
+            let text = std::fs::read_to_string(&campaign)
+                .with_context(|| format!("reading {}", campaign.display()))?;
+            let c: Campaign = serde_json::from_str(&text)
+                .with_context(|| format!("parsing {}", campaign.display()))?;
+            println!("{}", report_text(&c, load_fuzz(fuzz.as_ref())?.as_deref()));
+            Ok(c.cases.iter().all(|c| c.pass))
+        }
+    }
+}
