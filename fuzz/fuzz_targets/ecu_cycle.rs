@@ -208,18 +208,20 @@ impl Harness {
                 t.next_ns = now.saturating_add(OBJECT_PERIOD_NS);
                 t.sequence += 1;
                 let to_contact_s = (t.contact_ns as f64 - now as f64) * 1.0e-9;
-                let mut o = ipc::ObjectState::default();
-                o.timestamp_ns = now;
-                o.sequence = t.sequence;
-                o.object_id = 7;
-                // After contact the object sits at the bumper (small negative = overlap).
-                o.distance_m = (f64::from(t.closing_mps) * to_contact_s).max(-1.0) as f32;
-                o.closing_speed_mps = t.closing_mps;
-                o.relative_accel_mps2 = t.rel_accel_mps2;
-                o.opponent_mass_kg = t.opp_kg;
-                o.opponent_mass_sigma_kg = t.sigma_kg;
-                o.confidence = t.confidence;
-                o.valid = ipc::VALID;
+                let o = ipc::ObjectState {
+                    timestamp_ns: now,
+                    sequence: t.sequence,
+                    object_id: 7,
+                    // After contact the object sits at the bumper (small negative = overlap).
+                    distance_m: (f64::from(t.closing_mps) * to_contact_s).max(-1.0) as f32,
+                    closing_speed_mps: t.closing_mps,
+                    relative_accel_mps2: t.rel_accel_mps2,
+                    opponent_mass_kg: t.opp_kg,
+                    opponent_mass_sigma_kg: t.sigma_kg,
+                    confidence: t.confidence,
+                    valid: ipc::VALID,
+                    ..Default::default()
+                };
                 self.io.objects.push_back(o);
             }
         }
@@ -379,16 +381,19 @@ fuzz_target!(|data: &[u8]| {
         let now_ns = h.now_ns;
         match kind % 8 {
             0 => {
-                let mut o = ipc::ObjectState::default();
-                o.timestamp_ns = now_ns.saturating_sub(u64::from(r.u8().unwrap_or(0)) * 100_000);
-                o.sequence = u64::from(r.u8().unwrap_or(0));
-                o.distance_m = r.f32().unwrap_or(10.0);
-                o.closing_speed_mps = r.f32().unwrap_or(10.0);
-                o.relative_accel_mps2 = r.f32().unwrap_or(0.0);
-                o.opponent_mass_kg = r.f32().unwrap_or(1500.0);
-                o.opponent_mass_sigma_kg = r.f32().unwrap_or(100.0);
-                o.confidence = r.f32().unwrap_or(1.0);
-                o.valid = r.u8().unwrap_or(1) & 1;
+                // Fields are read in declaration order (the documented layout).
+                let o = ipc::ObjectState {
+                    timestamp_ns: now_ns.saturating_sub(u64::from(r.u8().unwrap_or(0)) * 100_000),
+                    sequence: u64::from(r.u8().unwrap_or(0)),
+                    distance_m: r.f32().unwrap_or(10.0),
+                    closing_speed_mps: r.f32().unwrap_or(10.0),
+                    relative_accel_mps2: r.f32().unwrap_or(0.0),
+                    opponent_mass_kg: r.f32().unwrap_or(1500.0),
+                    opponent_mass_sigma_kg: r.f32().unwrap_or(100.0),
+                    confidence: r.f32().unwrap_or(1.0),
+                    valid: r.u8().unwrap_or(1) & 1,
+                    ..Default::default()
+                };
                 h.io.objects.push_back(o);
             }
             1 => {
