@@ -169,9 +169,9 @@ fn scenario_seeds() {
     }
 }
 
-/// ecu_cycle: reserved byte, then records (see the target): an object closing in, the
-/// vehicle's CAN state, cycles, then a crash pulse on the accelerometer.
-fn cycle_seeds(frames: &[RawFrame]) {
+/// ecu_cycle, raw records only (see the target): flag byte 0 (no LUT), an object closing in,
+/// the vehicle's CAN state, cycles, then a crash pulse on the accelerometer.
+fn cycle_seed_raw(frames: &[RawFrame]) -> Vec<u8> {
     let mut b = vec![0u8];
     let f32s =
         |b: &mut Vec<u8>, v: &[f32]| v.iter().for_each(|x| b.extend_from_slice(&x.to_le_bytes()));
@@ -193,11 +193,104 @@ fn cycle_seeds(frames: &[RawFrame]) {
     for k in 0..5u8 {
         b.extend_from_slice(&[1, 0, k]);
         b.extend_from_slice(&100_000u32.to_le_bytes());
-        b.push(16);
-        f32s(&mut b, &[-300.0; 16]);
+        b.push(8);
+        f32s(&mut b, &[-300.0; 8]);
         b.extend_from_slice(&[3, 4]); // 1 ms
     }
-    write("ecu_cycle", "approach-crash", &b);
+    for _ in 0..3 {
+        b.extend_from_slice(&[3, 40]); // 10 ms: the scheduled fires happen
+    }
+    b
+}
+
+/// Record kinds of the ecu_cycle target's generators (see its header).
+const TRACK: u8 = 4;
+const CAN_GEN: u8 = 5;
+const PULSE: u8 = 6;
+const RUN_MS: u8 = 7;
+
+/// Appends "run `ms` cycles of 1 ms" records.
+fn run_ms(b: &mut Vec<u8>, mut ms: u32) {
+    while ms > 0 {
+        let n = ms.min(256);
+        b.extend_from_slice(&[RUN_MS, (n - 1) as u8]);
+        ms -= n;
+    }
+}
+
+/// ecu_cycle with the generators: a buckled 75 kg mid adult at 300 mm, ego at 15.2 m/s;
+/// an opponent of `opp_b` (800 + 9·b kg, σ 100 kg) closing at `speed_b` (10 + b·20/255 m/s)
+/// with contact 400 ms after the start; then either a 20 g crash pulse at contact (1 kHz,
+/// 3 × 8 samples: the detector confirms after 3 samples, Δv 0.2 m/s each) or, 150 ms before
+/// contact, the track ends (avoided); then 80 ms more.
+fn cycle_seed_generated(flags: u8, speed_b: u8, opp_b: u8, crash: bool) -> Vec<u8> {
+    let mut b = vec![flags];
+    // 15.2 m/s; 74.8 kg; 300 mm; flags: buckle 1 (buckled) | class 3 (mid adult) << 2.
+    b.extend_from_slice(&[CAN_GEN, 38, 112, 100, 1 | 3 << 2]);
+    b.push(TRACK);
+    b.extend_from_slice(&400u16.to_le_bytes());
+    b.extend_from_slice(&[speed_b, opp_b, 100, 0]);
+    if crash {
+        run_ms(&mut b, 400);
+        for _ in 0..3 {
+            // 40 · 0.5 g = 20 g, 8 samples, period (1 + 7) · 125 µs = 1 ms.
+            b.extend_from_slice(&[PULSE, 40, 7, 7]);
+            run_ms(&mut b, 8);
+        }
+    } else {
+        // 150 ms before contact (PRE-CRASH) the object turns away: its track stops.
+        run_ms(&mut b, 250);
+        b.extend_from_slice(&[TRACK, 0, 0, 0, 0, 0, 0]);
+        run_ms(&mut b, 300);
+    }
+    run_ms(&mut b, 80);
+    b
+}
+
+fn cycle_seeds(frames: &[RawFrame]) {
+    let raw = cycle_seed_raw(frames);
+    write("ecu_cycle", "approach-crash", &raw);
+    let mut raw_lut = raw;
+    raw_lut[0] = 1;
+    write("ecu_cycle", "approach-crash-lut", &raw_lut);
+    // 25.1 m/s (90 km/h), 1502 kg: PRE-CRASH with LUT lookups, crash confirmed, airbag fired
+    // with the adaptive settings.
+    write(
+        "ecu_cycle",
+        "lut-precrash-crash-fire",
+        &cycle_seed_generated(1, 192, 78, true),
+    );
+    // 20 m/s, 1502 kg: the table's optimum has no airbag (belt only) at this point.
+    write(
+        "ecu_cycle",
+        "lut-crash-belt-only",
+        &cycle_seed_generated(1, 128, 78, true),
+    );
+    // The same without a LUT: DEGRADED, reference restraint fires.
+    write(
+        "ecu_cycle",
+        "nolut-crash-fire",
+        &cycle_seed_generated(0, 128, 78, true),
+    );
+    // 30 m/s into 3095 kg (top of the table's speed axis, conservative mass beyond its
+    // opponent axis: out-of-range lookups → reference).
+    write(
+        "ecu_cycle",
+        "lut-fast-heavy-crash",
+        &cycle_seed_generated(1, 255, 255, true),
+    );
+    // 10 m/s into 800 kg: ego EBS ≈ 11 km/h < 20 km/h, low-speed no-fire.
+    write(
+        "ecu_cycle",
+        "lut-low-speed-crash",
+        &cycle_seed_generated(1, 0, 0, true),
+    );
+    // PRE-CRASH, then the object is lost: avoided, pretensioner released.
+    write(
+        "ecu_cycle",
+        "lut-precrash-avoided",
+        &cycle_seed_generated(1, 128, 78, false),
+    );
 }
 
 fn main() {

@@ -1,20 +1,95 @@
 //! The whole ECU decision cycle (`ecu::cycle::RestraintCycle` as an `Activity`) driven through
-//! `SimIo` with arbitrary inputs: object states, accelerometer batches and CAN frames (any
-//! values, NaN/inf included, any ids/lengths, time that jumps or stands still), cycle after cycle.
+//! `SimIo` with arbitrary inputs, cycle after cycle — on BOTH decision paths:
 //!
-//! Input: records of `[kind][fields…]`; kind % 4: 0 = object state (7 f32 + flags), 1 = accel
-//! batch (period, count, samples), 2 = CAN frame (id, len, 8 bytes), 3 = run one cycle (time
-//! step). Built once per input with the default cycle configuration, the built-in reference
-//! restraint and no LUT (the degraded path; the LUT path is covered by `lut_load`). The first
-//! byte is reserved.
+//! * the adaptive LUT path (input flag bit 0 = 1): the real table `data/default.lut` (9×12×7×6
+//!   cells), so prediction → LUT lookup → state machine → commands runs as on the bench;
+//! * the degraded path (bit 0 = 0): no LUT, built-in reference restraint only.
 //!
-//! Oracles: no panic, no hang; every CAN frame the ECU sends decodes with `bus::decode`
-//! (valid DBC frame, correct CRC, signals in range), whatever it was fed.
+//! Arbitrary raw values alone almost never make a coherent approach (an object track that
+//! stays plausible for 100 ms, genuine E2E-sealed occupant frames, a crash pulse that lasts), so
+//! besides raw records the input can switch on *generators* that produce plausible inputs from
+//! a few fuzzed parameters; the fuzzer mixes both freely.
+//!
+//! Input: flag byte (bit 0: with LUT; other bits reserved), then records `[kind][fields…]`,
+//! kind % 8:
+//! * 0 — raw object state (age, sequence, 6 × f32 LE, valid flag): any values, NaN/inf included;
+//! * 1 — raw accelerometer batch (age, sequence, period u32, count, count × f32);
+//! * 2 — raw CAN frame (id LE u16 → 11 bit, bit 15 = extended; len; 8 bytes);
+//! * 3 — run one cycle after `b × 0.25 ms` (b = 0: time stands still);
+//! * 4 — object track generator: contact in `u16 LE` ms from now (0 = track off: no more
+//!   samples, the track goes stale), closing speed `10 + b·20/255` m/s, opponent mass
+//!   `800 + 9·b` kg, σ `b` kg, flags (bit 0: confidence 0.3 instead of 1; bits 1–7: braking
+//!   `0.25·n` m/s²). While on, every 10 ms of cycle time a valid sample at distance
+//!   `v · (contact − now)` is published — a coherent approach from tens of metres;
+//! * 5 — vehicle / occupant CAN generator: ego speed `0.4·b` m/s, occupant mass `30 + 0.4·b` kg,
+//!   chest to wheel `150 + 1.5·b` mm, flags (bits 0–1 buckle, bits 2–4 class % 5, bit 5 off).
+//!   While on, genuine E2E-sealed `EgoVehicleState` every 10 ms and `OccupantClassification`
+//!   every 100 ms (own `E2eProtector`, so alive counters are consistent);
+//! * 6 — crash pulse: `n % 8 + 1` samples of `−0.5·b·g` at `(1 + p % 20) × 125 µs`, continuing
+//!   the accelerometer time line (what a real crash sensor delivers);
+//! * 7 — run `b + 1` cycles of 1 ms (long stretches of time from two bytes).
+//!
+//! At most 2 000 cycles per input. Generators emit just before a cycle is run.
+//!
+//! Oracles (every cycle, on the frames it sent): no panic, no hang;
+//! 1. every frame decodes with `bus::decode` (valid DBC frame, correct CRC, signals in range);
+//! 2. an `AirbagStageCmd` with `Fire` is only sent (a) in phase CRASH / POST-CRASH with
+//!    `airbag_fired()` set — the only way the state machine fires is through accelerometer
+//!    confirmation — and (b) only if the accelerometer data fed so far made a confirmation
+//!    POSSIBLE, checked independently of the detector: at least `confirm_samples` finite
+//!    samples with deceleration ≥ `confirm_decel_g` and a summed positive Δv ≥
+//!    `confirm_delta_v_mps` over all batches with a usable period (a necessary condition of
+//!    any confirmation: the detector's run and Δv are counted over a subset of these);
+//! 3. a command with source `Adaptive` is only sent with a LUT and after at least one LUT
+//!    lookup (the adaptive settings come from nowhere else).
 #![no_main]
 
-use ecu::cycle::RestraintCycle;
+use std::sync::OnceLock;
+
+use bus::codec::{
+    AirbagStageCmdCmdSource, AirbagStageCmdFire, BeltLimiterCmdCmdSource,
+    EgoVehicleStateBrakeState, OccupantClassificationBeltBuckle,
+    OccupantClassificationOccupantClass,
+};
+use bus::{E2eProtector, EgoVehicleState, Messages, OccupantClassification, RawFrame};
+use diagram::Diagram;
+use ecu::cycle::{CycleConfig, Phase, RestraintCycle, G_MPS2};
 use ecu::runtime::{Activity, CanFrame, CycleInfo, SimIo};
 use libfuzzer_sys::fuzz_target;
+use physics::reference::ReferenceSettings;
+
+const MS: u64 = 1_000_000;
+/// Object list period of the track generator (a 10–20 ms sensor), ns.
+const OBJECT_PERIOD_NS: u64 = 10 * MS;
+/// DBC cycle times of the generated vehicle / occupant frames, ns.
+const VEHICLE_PERIOD_NS: u64 = 10 * MS;
+const OCCUPANT_PERIOD_NS: u64 = 100 * MS;
+/// Longest sample period the crash detector integrates (its `MAX_SAMPLE_PERIOD_NS`), ns.
+const MAX_SAMPLE_PERIOD_NS: u32 = 10_000_000;
+/// Cycles per input (bounds the time per input).
+const MAX_CYCLES: u32 = 2_000;
+
+/// The real table and the reference restraint, loaded once per process: building them per
+/// input (163 kB file decode + validation + CRC, a TOML parse) would dominate the run time.
+/// Each input gets a clone of the table (a memcpy of its cells; `RestraintCycle` owns it).
+struct Fixture {
+    lut: Diagram,
+    reference: ReferenceSettings,
+}
+
+fn fixture() -> &'static Fixture {
+    static F: OnceLock<Fixture> = OnceLock::new();
+    F.get_or_init(|| {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../data/default.lut");
+        // A harness set-up failure, not a finding: without the table the LUT path is not
+        // fuzzed at all, so stop loudly.
+        let lut = Diagram::load(path).unwrap_or_else(|e| panic!("fuzz set-up: {path}: {e}"));
+        let reference = physics::reference::ReferenceRestraint::builtin()
+            .unwrap_or_else(|e| panic!("fuzz set-up: built-in reference restraint: {e}"))
+            .restraint;
+        Fixture { lut, reference }
+    })
+}
 
 struct Reader<'a>(&'a [u8]);
 
@@ -23,6 +98,12 @@ impl Reader<'_> {
         let (b, rest) = self.0.split_first()?;
         self.0 = rest;
         Some(*b)
+    }
+    fn u16(&mut self) -> Option<u16> {
+        let b = self.0.get(..2)?;
+        let v = u16::from_le_bytes([b[0], b[1]]);
+        self.0 = &self.0[2..];
+        Some(v)
     }
     fn u32(&mut self) -> Option<u32> {
         let b = self.0.get(..4)?;
@@ -35,42 +116,285 @@ impl Reader<'_> {
     }
 }
 
-fuzz_target!(|data: &[u8]| {
-    if data.is_empty() {
-        return;
+/// Plausible object track: a constant-speed (or braking) approach to a contact instant.
+struct Track {
+    contact_ns: u64,
+    closing_mps: f32,
+    opp_kg: f32,
+    sigma_kg: f32,
+    confidence: f32,
+    rel_accel_mps2: f32,
+    next_ns: u64,
+    sequence: u64,
+}
+
+/// Genuine vehicle / occupant CAN sender.
+struct CanGen {
+    ego_speed_mps: f32,
+    occ_kg: f32,
+    chest_mm: u16,
+    buckle: OccupantClassificationBeltBuckle,
+    class: OccupantClassificationOccupantClass,
+    next_vehicle_ns: u64,
+    next_occupant_ns: u64,
+}
+
+fn to_can(r: RawFrame) -> CanFrame {
+    CanFrame {
+        id: r.id,
+        extended: false,
+        len: r.len,
+        data: r.data,
     }
-    let Ok(reference) = physics::reference::ReferenceRestraint::builtin() else {
+}
+
+/// What the accelerometer input made possible so far (the independent fire oracle).
+#[derive(Default)]
+struct AccelFed {
+    /// Finite samples at or above the confirmation deceleration.
+    over_threshold: u64,
+    /// Σ max(decel, 0)·dt over finite samples of batches with a usable period, m/s.
+    delta_v_mps: f64,
+}
+
+impl AccelFed {
+    fn note(&mut self, cfg: &CycleConfig, a: &ipc::CrashAccelSample) {
+        if a.sample_period_ns == 0 || a.sample_period_ns > MAX_SAMPLE_PERIOD_NS {
+            return; // the detector drops the whole batch
+        }
+        let dt_s = f64::from(a.sample_period_ns) * 1.0e-9;
+        let decel_mps2 = cfg.confirm_decel_g * G_MPS2;
+        for &s in a.samples() {
+            if !s.is_finite() {
+                continue;
+            }
+            let decel = -f64::from(s);
+            if decel >= decel_mps2 {
+                self.over_threshold += 1;
+            }
+            if decel > 0.0 {
+                self.delta_v_mps += decel * dt_s;
+            }
+        }
+    }
+
+    fn confirmation_possible(&self, cfg: &CycleConfig) -> bool {
+        // The tolerance only absorbs summation-order rounding (≈ 1e-16 relative).
+        self.over_threshold >= u64::from(cfg.confirm_samples)
+            && self.delta_v_mps >= cfg.confirm_delta_v_mps * (1.0 - 1.0e-9)
+    }
+}
+
+struct Harness {
+    cycle: RestraintCycle,
+    io: SimIo,
+    info: CycleInfo,
+    now_ns: u64,
+    cycles: u32,
+    with_lut: bool,
+    track: Option<Track>,
+    can_gen: Option<CanGen>,
+    tx: E2eProtector,
+    accel_next_ns: u64,
+    accel_sequence: u64,
+    fed: AccelFed,
+}
+
+impl Harness {
+    fn emit_generated(&mut self) {
+        let now = self.now_ns;
+        if let Some(t) = self.track.as_mut() {
+            if now >= t.next_ns {
+                t.next_ns = now.saturating_add(OBJECT_PERIOD_NS);
+                t.sequence += 1;
+                let to_contact_s = (t.contact_ns as f64 - now as f64) * 1.0e-9;
+                let o = ipc::ObjectState {
+                    timestamp_ns: now,
+                    sequence: t.sequence,
+                    object_id: 7,
+                    // After contact the object sits at the bumper (small negative = overlap).
+                    distance_m: (f64::from(t.closing_mps) * to_contact_s).max(-1.0) as f32,
+                    closing_speed_mps: t.closing_mps,
+                    relative_accel_mps2: t.rel_accel_mps2,
+                    opponent_mass_kg: t.opp_kg,
+                    opponent_mass_sigma_kg: t.sigma_kg,
+                    confidence: t.confidence,
+                    valid: ipc::VALID,
+                    ..Default::default()
+                };
+                self.io.objects.push_back(o);
+            }
+        }
+        if let Some(g) = self.can_gen.as_mut() {
+            if now >= g.next_vehicle_ns {
+                g.next_vehicle_ns = now.saturating_add(VEHICLE_PERIOD_NS);
+                if let Ok(m) = EgoVehicleState::encode(
+                    EgoVehicleStateBrakeState::Released,
+                    g.ego_speed_mps,
+                    0.0,
+                ) {
+                    self.io.can_rx.push_back(to_can(self.tx.seal(m)));
+                }
+            }
+            if now >= g.next_occupant_ns {
+                g.next_occupant_ns = now.saturating_add(OCCUPANT_PERIOD_NS);
+                if let Ok(m) =
+                    OccupantClassification::encode(g.buckle, g.class, 90, g.occ_kg, g.chest_mm, 150)
+                {
+                    self.io.can_rx.push_back(to_can(self.tx.seal(m)));
+                }
+            }
+        }
+    }
+
+    /// Runs one cycle at `now_ns` and checks every frame it sent.
+    fn run_cycle(&mut self) {
+        self.emit_generated();
+        self.info.deadline_ns = self.now_ns;
+        self.info.now_ns = self.now_ns;
+        self.cycle.step(&self.info, &mut self.io);
+        self.info.cycle += 1;
+        self.info.slot += 1;
+        self.cycles += 1;
+        self.check_sent();
+        // Diagnostics records are not checked; dropping them keeps the per-cycle cost flat.
+        self.io.diagnostics.clear();
+    }
+
+    fn check_sent(&mut self) {
+        for f in &self.io.can_tx {
+            let msg = match bus::decode(f.id, f.payload()) {
+                Ok(m) => m,
+                // No SecOC sender is set, so every frame carries E2E and must decode.
+                Err(e) => panic!(
+                    "ECU sent an invalid frame {:#x} {:?}: {e}",
+                    f.id,
+                    f.payload()
+                ),
+            };
+            let adaptive = match &msg {
+                Messages::AirbagStageCmd(m) => {
+                    if m.fire() == AirbagStageCmdFire::Fire {
+                        let phase = self.cycle.phase();
+                        assert!(
+                            matches!(phase, Phase::Crash | Phase::PostCrash)
+                                && self.cycle.airbag_fired(),
+                            "airbag fire sent in phase {phase:?} (airbag_fired {})",
+                            self.cycle.airbag_fired()
+                        );
+                        let cfg = self.cycle.config();
+                        assert!(
+                            self.fed.confirmation_possible(cfg),
+                            "airbag fire sent although no accelerometer input could confirm a \
+                             crash: {} samples ≥ {} g (need {}), Δv {:.4} m/s (need {})",
+                            self.fed.over_threshold,
+                            cfg.confirm_decel_g,
+                            cfg.confirm_samples,
+                            self.fed.delta_v_mps,
+                            cfg.confirm_delta_v_mps
+                        );
+                    }
+                    m.cmd_source() == AirbagStageCmdCmdSource::Adaptive
+                }
+                Messages::BeltLimiterCmd(m) => m.cmd_source() == BeltLimiterCmdCmdSource::Adaptive,
+                _ => false,
+            };
+            if adaptive {
+                assert!(
+                    self.with_lut && self.cycle.counters().lut_lookups > 0,
+                    "adaptive command without a LUT lookup (LUT {}, lookups {})",
+                    self.with_lut,
+                    self.cycle.counters().lut_lookups
+                );
+            }
+        }
+        self.io.can_tx.clear();
+    }
+
+    fn push_accel(&mut self, a: ipc::CrashAccelSample) {
+        self.fed.note(self.cycle.config(), &a);
+        self.io.accel.push_back(a);
+    }
+}
+
+fn buckle_of(b: u8) -> OccupantClassificationBeltBuckle {
+    match b & 3 {
+        0 => OccupantClassificationBeltBuckle::Unbuckled,
+        1 => OccupantClassificationBeltBuckle::Buckled,
+        2 => OccupantClassificationBeltBuckle::SwitchFault,
+        _ => OccupantClassificationBeltBuckle::NotAvailable,
+    }
+}
+
+fn class_of(b: u8) -> OccupantClassificationOccupantClass {
+    match b % 5 {
+        0 => OccupantClassificationOccupantClass::Empty,
+        1 => OccupantClassificationOccupantClass::ChildSeat,
+        2 => OccupantClassificationOccupantClass::SmallAdult,
+        3 => OccupantClassificationOccupantClass::MidAdult,
+        _ => OccupantClassificationOccupantClass::LargeAdult,
+    }
+}
+
+fuzz_target!(|data: &[u8]| {
+    let Some((&flags, body)) = data.split_first() else {
         return;
     };
-    let cfg = ecu::cycle::CycleConfig::default();
-    let Ok((mut cycle, _notes)) = RestraintCycle::new(cfg, None, &reference.restraint) else {
+    let fx = fixture();
+    let with_lut = flags & 1 != 0;
+    let lut = with_lut.then(|| fx.lut.clone());
+    let Ok((mut cycle, notes)) = RestraintCycle::new(CycleConfig::default(), lut, &fx.reference)
+    else {
         panic!("default cycle config must build");
     };
-    let mut io = SimIo::new();
-    let mut now_ns: u64 = 1_000_000_000;
-    if cycle.startup(now_ns, &mut io).is_err() {
+    assert!(
+        !with_lut || notes.warnings.is_empty(),
+        "data/default.lut rejected by the default cycle config: {:?}",
+        notes.warnings
+    );
+    let now_ns: u64 = 1_000_000_000;
+    if cycle.startup(now_ns, &mut SimIo::new()).is_err() {
         return;
     }
-    let mut r = Reader(&data[1..]);
-    let mut info = CycleInfo {
-        period_ns: 1_000_000,
-        ..CycleInfo::default()
+    let mut h = Harness {
+        cycle,
+        io: SimIo::new(),
+        info: CycleInfo {
+            period_ns: MS,
+            ..CycleInfo::default()
+        },
+        now_ns,
+        cycles: 0,
+        with_lut,
+        track: None,
+        can_gen: None,
+        tx: E2eProtector::new(),
+        accel_next_ns: now_ns,
+        accel_sequence: 0,
+        fed: AccelFed::default(),
     };
-    let mut cycles = 0u32;
+    let mut r = Reader(body);
     while let Some(kind) = r.u8() {
-        match kind % 4 {
+        if h.cycles > MAX_CYCLES {
+            break;
+        }
+        let now_ns = h.now_ns;
+        match kind % 8 {
             0 => {
-                let mut o = ipc::ObjectState::default();
-                o.timestamp_ns = now_ns.saturating_sub(u64::from(r.u8().unwrap_or(0)) * 100_000);
-                o.sequence = u64::from(r.u8().unwrap_or(0));
-                o.distance_m = r.f32().unwrap_or(10.0);
-                o.closing_speed_mps = r.f32().unwrap_or(10.0);
-                o.relative_accel_mps2 = r.f32().unwrap_or(0.0);
-                o.opponent_mass_kg = r.f32().unwrap_or(1500.0);
-                o.opponent_mass_sigma_kg = r.f32().unwrap_or(100.0);
-                o.confidence = r.f32().unwrap_or(1.0);
-                o.valid = r.u8().unwrap_or(1) & 1;
-                io.objects.push_back(o);
+                // Fields are read in declaration order (the documented layout).
+                let o = ipc::ObjectState {
+                    timestamp_ns: now_ns.saturating_sub(u64::from(r.u8().unwrap_or(0)) * 100_000),
+                    sequence: u64::from(r.u8().unwrap_or(0)),
+                    distance_m: r.f32().unwrap_or(10.0),
+                    closing_speed_mps: r.f32().unwrap_or(10.0),
+                    relative_accel_mps2: r.f32().unwrap_or(0.0),
+                    opponent_mass_kg: r.f32().unwrap_or(1500.0),
+                    opponent_mass_sigma_kg: r.f32().unwrap_or(100.0),
+                    confidence: r.f32().unwrap_or(1.0),
+                    valid: r.u8().unwrap_or(1) & 1,
+                    ..Default::default()
+                };
+                h.io.objects.push_back(o);
             }
             1 => {
                 let mut a = ipc::CrashAccelSample::EMPTY;
@@ -79,11 +403,11 @@ fuzz_target!(|data: &[u8]| {
                 a.sequence = u64::from(r.u8().unwrap_or(0));
                 a.sample_period_ns = r.u32().unwrap_or(100_000);
                 a.count = u32::from(r.u8().unwrap_or(0));
-                let n = (a.count as usize).min(a.accel_mps2.len()).min(16);
+                let n = (a.count as usize).min(a.accel_mps2.len());
                 for s in a.accel_mps2.iter_mut().take(n) {
                     *s = r.f32().unwrap_or(-300.0);
                 }
-                io.accel.push_back(a);
+                h.push_accel(a);
             }
             2 => {
                 let id_lo = r.u8().unwrap_or(0xA0);
@@ -93,37 +417,82 @@ fuzz_target!(|data: &[u8]| {
                 for d in &mut data {
                     *d = r.u8().unwrap_or(0);
                 }
-                io.can_rx.push_back(CanFrame {
+                h.io.can_rx.push_back(CanFrame {
                     id: u32::from(u16::from_le_bytes([id_lo, id_hi]) & 0x7FF),
                     extended: id_hi & 0x80 != 0,
                     len,
                     data,
                 });
             }
-            _ => {
+            3 => {
                 let step = u64::from(r.u8().unwrap_or(1));
-                now_ns = now_ns.saturating_add(step * 250_000);
-                info.deadline_ns = now_ns;
-                info.now_ns = now_ns;
-                cycle.step(&info, &mut io);
-                info.cycle += 1;
-                info.slot += 1;
-                cycles += 1;
-                if cycles > 2_000 {
-                    break;
+                h.now_ns = now_ns.saturating_add(step * 250_000);
+                h.run_cycle();
+            }
+            4 => {
+                let contact_ms = r.u16().unwrap_or(0);
+                let v = r.u8().unwrap_or(128);
+                let m = r.u8().unwrap_or(80);
+                let sigma = r.u8().unwrap_or(100);
+                let f = r.u8().unwrap_or(0);
+                h.track = (contact_ms != 0).then(|| Track {
+                    contact_ns: now_ns.saturating_add(u64::from(contact_ms) * MS),
+                    closing_mps: 10.0 + f32::from(v) * (20.0 / 255.0),
+                    opp_kg: 800.0 + 9.0 * f32::from(m),
+                    sigma_kg: f32::from(sigma),
+                    confidence: if f & 1 != 0 { 0.3 } else { 1.0 },
+                    rel_accel_mps2: -0.25 * f32::from(f >> 1),
+                    next_ns: now_ns,
+                    sequence: h.track.as_ref().map_or(0, |t| t.sequence),
+                });
+            }
+            5 => {
+                let speed = r.u8().unwrap_or(38);
+                let occ = r.u8().unwrap_or(112);
+                let chest = r.u8().unwrap_or(100);
+                let f = r.u8().unwrap_or(0b1101);
+                h.can_gen = (f & 0x20 == 0).then(|| CanGen {
+                    ego_speed_mps: (0.4 * f32::from(speed)).min(100.0),
+                    occ_kg: 30.0 + 0.4 * f32::from(occ),
+                    chest_mm: 150 + u16::from(chest) * 3 / 2,
+                    buckle: buckle_of(f),
+                    class: class_of(f >> 2),
+                    next_vehicle_ns: now_ns,
+                    next_occupant_ns: now_ns,
+                });
+            }
+            6 => {
+                let level = r.u8().unwrap_or(40);
+                let n = usize::from(r.u8().unwrap_or(7) % 8) + 1;
+                let period_ns = (1 + u32::from(r.u8().unwrap_or(7) % 20)) * 125_000;
+                let span_ns = n as u64 * u64::from(period_ns);
+                // Continue the sensor's time line; never start in the future.
+                let first = h
+                    .accel_next_ns
+                    .max(now_ns.saturating_sub(span_ns))
+                    .min(now_ns);
+                h.accel_next_ns = first.saturating_add(span_ns);
+                h.accel_sequence += 1;
+                let mut a = ipc::CrashAccelSample::EMPTY;
+                a.first_timestamp_ns = first;
+                a.sequence = h.accel_sequence;
+                a.sample_period_ns = period_ns;
+                a.count = n as u32;
+                let accel = (-0.5 * f64::from(level) * G_MPS2) as f32;
+                a.accel_mps2.iter_mut().take(n).for_each(|s| *s = accel);
+                h.push_accel(a);
+            }
+            _ => {
+                let n = u32::from(r.u8().unwrap_or(0)) + 1;
+                for _ in 0..n {
+                    if h.cycles > MAX_CYCLES {
+                        break;
+                    }
+                    h.now_ns = h.now_ns.saturating_add(MS);
+                    h.run_cycle();
                 }
             }
         }
     }
-    cycle.step(&info, &mut io);
-    for f in &io.can_tx {
-        if let Err(e) = bus::decode(f.id, f.payload()) {
-            // The SecOC authenticators carry no E2E; everything else must decode.
-            panic!(
-                "ECU sent an invalid frame {:#x} {:?}: {e}",
-                f.id,
-                f.payload()
-            );
-        }
-    }
+    h.run_cycle();
 });
