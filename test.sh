@@ -27,10 +27,15 @@ totals=$(awk '/^test result:/ { p += $4; f += $6 } END { printf "%d passed, %d f
 
 step "fuzz smoke: every cargo-fuzz target for ${FUZZ_SECONDS:=4} s"
 cargo fuzz --version >/dev/null 2>&1 || cargo install --locked cargo-fuzz
-FUZZ_SECONDS=$FUZZ_SECONDS tests/fuzz-smoke.sh
+mkdir -p target/robustness
+FUZZ_SECONDS=$FUZZ_SECONDS FUZZ_REPORT_JSON=target/robustness/fuzz.json tests/fuzz-smoke.sh
 
 step "deterministic budget: instructions per worst-case ECU cycle (valgrind)"
 cargo run --release -q -p cycle-benches --bin budget -- --no-criterion
+
+step "robustness report (fault campaign of the tests above + fuzz smoke)"
+target/release/fault-campaign report --campaign target/robustness/campaign.json \
+  --fuzz target/robustness/fuzz.json
 
 echo
 echo "test.sh: all steps passed"

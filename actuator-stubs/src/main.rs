@@ -53,11 +53,12 @@ struct Cli {
     /// (user-mode Linux): the bench names the value in the report.
     #[arg(long, value_name = "MS", default_value_t = SecOcConfig::DEFAULT_PAIRING_TIMEOUT_US as f64 / 1e3)]
     secoc_pairing_timeout_ms: f64,
-    /// After the scenario is done, keep receiving until the bus has been quiet this long (at
-    /// most 5 s), so the commands the ECU sends until it is stopped are still received and
-    /// counted (the fault campaign compares them with what the ECU sent).
-    #[arg(long, value_name = "MS", default_value_t = 0.0)]
-    drain_quiet_ms: f64,
+    /// After the scenario is done, keep receiving until SIGTERM/SIGINT, then read what is
+    /// still queued and finish (stop reason "done"). For orchestrators that stop the ECU first
+    /// and then the stubs, so every command the ECU sent is received and counted (the fault
+    /// campaign compares them with what the ECU sent).
+    #[arg(long)]
+    until_signal: bool,
 }
 
 /// The ECU's default key file, for the default of `--secoc-keys`.
@@ -78,9 +79,6 @@ fn load_keys(cli: &Cli) -> Result<bus::secoc::SecOcKeys> {
 const RX_IDS: [u32; 5] = [0x030, 0x031, 0x040, 0x041, 0x110];
 
 static STOP: AtomicBool = AtomicBool::new(false);
-
-/// Upper bound of the post-scenario drain (--drain-quiet-ms), in case the bus never goes quiet.
-const MAX_DRAIN_NS: u64 = 5_000_000_000;
 
 extern "C" fn on_signal(_: nix::libc::c_int) {
     STOP.store(true, Ordering::Relaxed);
@@ -152,9 +150,6 @@ fn run(cli: &Cli) -> Result<()> {
     {
         anyhow::bail!("--secoc-pairing-timeout-ms must be within 0.1..=1000");
     }
-    if !(cli.drain_quiet_ms.is_finite() && (0.0..=5000.0).contains(&cli.drain_quiet_ms)) {
-        anyhow::bail!("--drain-quiet-ms must be within 0..=5000");
-    }
     let secoc_config = SecOcConfig {
         pairing_timeout_us: (cli.secoc_pairing_timeout_ms * 1e3).round() as u64,
         ..SecOcConfig::default()
@@ -169,21 +164,20 @@ fn run(cli: &Cli) -> Result<()> {
         "actuator-stubs: listening on {} for {}",
         cli.can, scenario.name
     );
-    // Set once the scenario is done: then run on until the bus is quiet (--drain-quiet-ms).
-    let mut done_at_ns: Option<u64> = None;
-    let mut last_rx_ns = started;
-    let quiet_ns = (cli.drain_quiet_ms * 1e6) as u64;
+    let mut done = false;
     let stop_reason = loop {
-        if STOP.load(Ordering::Relaxed) {
+        // Read before the drain: with --until-signal, everything queued before the signal is
+        // still read and acted on below.
+        let signalled = STOP.load(Ordering::Relaxed);
+        if signalled && !cli.until_signal {
             break "signal";
         }
-        if done_at_ns.is_none() && monotonic_ns() > deadline {
+        if monotonic_ns() > deadline {
             break "timeout";
         }
         let mut got_any = false;
         while let Some(rx) = sock.recv().context("CAN receive")? {
             got_any = true;
-            last_rx_ns = monotonic_ns();
             let read_mono = monotonic_ns();
             // Kernel arrival time mapped onto CLOCK_MONOTONIC (more exact than the read time);
             // fall back to the read time if absent or implausible.
@@ -224,24 +218,13 @@ fn run(cli: &Cli) -> Result<()> {
         });
         if let Some(t) = truth_sub.latest() {
             truth = t;
-            if truth.is_done() && done_at_ns.is_none() {
-                // Drain what is still queued (and, with --drain-quiet-ms, what follows), then
-                // finish.
-                done_at_ns = Some(monotonic_ns());
-                if quiet_ns == 0 {
-                    break "done";
-                }
-            }
-        }
-        if let (Some(done), false) = (done_at_ns, got_any) {
-            // Quiet only counts after a drain found the socket empty: a stubs process that was
-            // descheduled for a while must first read what queued up meanwhile.
-            let now = monotonic_ns();
-            if now.saturating_sub(last_rx_ns) >= quiet_ns
-                || now.saturating_sub(done) >= MAX_DRAIN_NS
-            {
+            done |= truth.is_done();
+            if done && !cli.until_signal {
                 break "done";
             }
+        }
+        if signalled {
+            break if done { "done" } else { "signal" };
         }
         if !got_any {
             std::thread::sleep(std::time::Duration::from_micros(200));

@@ -136,7 +136,8 @@ pub fn commanded(m: &crate::commands::Modules, contact_ns: u64) -> Commanded {
             _ => {}
         }
     }
-    let latch_ns = contact_ns + (LIMITER_LATCH_AFTER_CONTACT_S * 1e9) as u64;
+    // Saturating: without a contact the caller passes u64::MAX ("never").
+    let latch_ns = contact_ns.saturating_add((LIMITER_LATCH_AFTER_CONTACT_S * 1e9) as u64);
     Commanded {
         pretensioner_s: pret.map(rel),
         load_limiter_kn: m.limiter_at(latch_ns),
@@ -183,6 +184,17 @@ mod tests {
             load_limiter_kn: kn,
             pretensioner_fire_time_ms: 0.0,
         }
+    }
+
+    /// Without any contact (stubs stopped before the bench truth arrived) the caller passes
+    /// "never" = u64::MAX: no overflow, the last level counts.
+    #[test]
+    fn no_contact_is_never_and_does_not_overflow() {
+        let mut m = Modules::default();
+        m.apply(1_000, &belt("fire", 3.0));
+        let k = commanded(&m, u64::MAX);
+        assert_eq!(k.load_limiter_kn, Some(3.0));
+        assert!(k.pretensioner_s.is_some_and(|s| s < 0.0));
     }
 
     #[test]

@@ -574,6 +574,22 @@ impl E2eChecker {
         r
     }
 
+    /// [`check`](Self::check) for the first frame of a message after its sender timed out:
+    /// the alive counter of that message is forgotten first, so a restarted sender (whose
+    /// counter starts anew) is accepted at once instead of costing one more rejected frame.
+    /// CRC, length and ranges are checked as always. (AUTOSAR E2E re-initialises its state
+    /// machine after "no new data" the same way.) Never panics, never allocates.
+    pub fn check_resync(&mut self, id: u32, data: &[u8]) -> Result<Messages, RxError> {
+        if let Ok(msg) = decode_layout(id, data) {
+            if let Some(v) = meta::e2e_view(&msg) {
+                if let Some(last) = self.last_counter.get_mut(v.slot) {
+                    *last = NO_COUNTER;
+                }
+            }
+        }
+        self.check(id, data)
+    }
+
     /// [`check`](Self::check) for a [`RawFrame`].
     pub fn check_frame(&mut self, frame: &RawFrame) -> Result<Messages, RxError> {
         self.check(frame.id, frame.payload())

@@ -405,3 +405,60 @@ fn nan_object_fields_degrade_until_a_valid_sample_arrives() {
     run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
     assert_eq!(b.ecu.phase(), Phase::Monitoring);
 }
+
+/// A vehicle gateway that restarts (its alive counter starts again at 0) after a silence
+/// longer than the vehicle timeout: the ECU takes its first new frame at once (the stream is
+/// resynchronised after the timeout), so it is fresh again on that frame — no E2E rejection,
+/// no extra period of staleness. The same counter jump WITHOUT a preceding timeout is still
+/// rejected.
+#[test]
+fn restarted_sender_is_accepted_after_its_timeout_but_a_counter_jump_is_not() {
+    let mut b = Bench::new(Some(test_lut()));
+    // "No track" object samples keep the object input fresh throughout.
+    let idle = |b: &mut Bench, ms: u64| {
+        let end = b.now + ms * MS;
+        run_scenario(b, end, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    };
+    idle(&mut b, 300);
+    assert_eq!(b.mode_at(b.now - MS), EcuMode::Monitoring as u8);
+    b.send_vehicle = false;
+    idle(&mut b, 150); // > 100 ms vehicle timeout
+    let stale_at = b.now - MS;
+    assert_ne!(
+        b.io.diagnostics.last().unwrap().degraded_reasons & degraded::CAN_STALE,
+        0
+    );
+    // The restarted gateway: a fresh protector, counter 0.
+    let mut restarted = bus::E2eProtector::new();
+    let m =
+        bus::EgoVehicleState::encode(bus::codec::EgoVehicleStateBrakeState::Released, 15.0, 0.0)
+            .unwrap();
+    b.io.can_rx.push_back(to_can(restarted.seal(m)));
+    let resumed = b.now;
+    idle(&mut b, 1);
+    let d = *b.io.diagnostics.last().unwrap();
+    assert_eq!(
+        d.degraded_reasons & degraded::CAN_STALE,
+        0,
+        "vehicle fresh on the first frame after the restart (stale since {stale_at})"
+    );
+    assert_eq!(b.mode_at(resumed), EcuMode::Monitoring as u8);
+    assert_eq!(
+        b.ecu
+            .e2e_stats()
+            .rejected_for(bus::RejectReason::CounterSkipped),
+        0
+    );
+    // Live stream (not timed out): a jump of the counter is rejected as before.
+    for _ in 0..5 {
+        let _ = restarted.seal(m); // counters 1..=5 never sent
+    }
+    b.io.can_rx.push_back(to_can(restarted.seal(m)));
+    idle(&mut b, 1);
+    assert_eq!(
+        b.ecu
+            .e2e_stats()
+            .rejected_for(bus::RejectReason::CounterSkipped),
+        1
+    );
+}

@@ -50,10 +50,10 @@ pub fn in_uml_guest() -> bool {
     std::env::var_os("VCAN_IN_UML").is_some()
 }
 
-/// The stubs' bench arguments: drain the bus until the ECU has stopped (so every command it
-/// sent is received and counted), and the user-mode-Linux pairing timeout where it applies.
+/// The stubs' bench arguments: receive until stopped after the ECU (so every command it sent
+/// is received and counted), and the user-mode-Linux pairing timeout where it applies.
 pub fn default_stubs_args() -> Vec<String> {
-    let mut v = vec!["--drain-quiet-ms".to_owned(), "200".to_owned()];
+    let mut v = vec!["--until-signal".to_owned()];
     if in_uml_guest() {
         v.push("--secoc-pairing-timeout-ms".to_owned());
         v.push(format!("{UML_SECOC_PAIRING_TIMEOUT_MS}"));
@@ -105,9 +105,10 @@ pub trait Disturbance {
         Ok(())
     }
     /// Processes started once the feeds have fixed the time base (bus injectors, floods),
-    /// stdout piped. They are given 5 s to end by themselves after the feeds, then SIGTERM;
-    /// their stdout is returned in [`RunResult::disturbance_output`].
-    fn start(&mut self, _ctx: &RunCtx) -> Result<Vec<(String, Child)>> {
+    /// stdout piped. After the feeds, the ECU is stopped; then each is given 5 s to end by
+    /// itself (or stopped at once if it runs until stopped), then SIGTERM; their stdout is
+    /// returned in [`RunResult::disturbance_output`].
+    fn start(&mut self, _ctx: &RunCtx) -> Result<Vec<SideProcess>> {
         Ok(Vec::new())
     }
     /// While the feeds play (`feeds` is running); the default waits for them to finish.
@@ -118,6 +119,16 @@ pub trait Disturbance {
     ) -> Result<std::process::ExitStatus> {
         feeds.wait().context("waiting for sensor-feeds")
     }
+}
+
+/// A process a [`Disturbance`] runs beside the bench.
+pub struct SideProcess {
+    /// Name for messages and [`RunResult::disturbance_output`].
+    pub name: String,
+    /// The process (stdout piped if its output matters).
+    pub child: Child,
+    /// Runs until stopped (e.g. `cangen`): SIGTERM as soon as the feeds are done.
+    pub until_stopped: bool,
 }
 
 /// The plain bench run.
@@ -341,18 +352,8 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
         Ok(st) => problems.push(format!("sensor-feeds: {st}")),
         Err(e) => problems.push(format!("sensor-feeds: {e:#}")),
     }
-    let mut disturbance_output = Vec::new();
-    for (name, child) in side.iter_mut() {
-        if wait_timeout(child, Duration::from_secs(5))?.is_none() {
-            terminate(child, name, Duration::from_secs(2))?;
-        }
-    }
-    for (name, child) in side {
-        let o = child.wait_with_output()?;
-        disturbance_output.push((name, String::from_utf8_lossy(&o.stdout).into_owned()));
-    }
-    // The ECU stops first; the stubs drain the bus until it is quiet (--drain-quiet-ms), so
-    // they see every command the ECU sent.
+    // The ECU stops first, then the side processes, then the stubs (which read everything the
+    // ECU sent before they judge: --until-signal).
     let st = terminate(&mut ecu, "ecu", Duration::from_secs(5))?;
     if !st.success() {
         problems.push(format!("ecu: {st}"));
@@ -360,15 +361,26 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     if let Some(t) = ecu_stderr {
         let _ = t.join();
     }
-    match wait_timeout(&mut stubs, Duration::from_secs(20))? {
-        Some(st) if st.success() => {}
-        Some(st) => problems.push(format!("actuator-stubs: {st}")),
-        None => {
-            let st = terminate(&mut stubs, "actuator-stubs", Duration::from_secs(5))?;
-            problems.push(format!(
-                "actuator-stubs did not finish after the feeds ({st})"
-            ));
+    let mut disturbance_output = Vec::new();
+    for p in side.iter_mut() {
+        let grace = if p.until_stopped {
+            Duration::ZERO
+        } else {
+            Duration::from_secs(5)
+        };
+        if wait_timeout(&mut p.child, grace)?.is_none() {
+            terminate(&mut p.child, &p.name, Duration::from_secs(2))?;
         }
+    }
+    for p in side {
+        let o = p.child.wait_with_output()?;
+        disturbance_output.push((p.name, String::from_utf8_lossy(&o.stdout).into_owned()));
+    }
+    // The ECU is gone, so everything it sent is queued at the stubs: stop them (with
+    // --until-signal they read the queue first and judge).
+    let st = terminate(&mut stubs, "actuator-stubs", Duration::from_secs(20))?;
+    if !st.success() {
+        problems.push(format!("actuator-stubs: {st}"));
     }
     std::thread::sleep(Duration::from_millis(50));
     let _ = terminate(&mut candump, "candump", Duration::from_secs(2))?;

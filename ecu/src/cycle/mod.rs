@@ -485,7 +485,24 @@ impl RestraintCycle {
         if f.extended {
             return; // never ours; the kernel filter drops them on a real bus
         }
-        match self.checker.check(f.id, f.payload()) {
+        // A stream that timed out starts a new counter sequence (e.g. its sender restarted):
+        // resynchronise on its first frame instead of rejecting it.
+        let stale = |rx: Option<u64>, limit: u64| rx.is_none_or(|t| now.saturating_sub(t) > limit);
+        let resync = match f.id {
+            id if id == raw_id(bus::EgoVehicleState::MESSAGE_ID) => {
+                stale(self.vehicle_rx_ns, self.vehicle_timeout_ns)
+            }
+            id if id == raw_id(bus::OccupantClassification::MESSAGE_ID) => {
+                stale(self.occupant_rx_ns, self.occupant_timeout_ns)
+            }
+            _ => false,
+        };
+        let checked = if resync {
+            self.checker.check_resync(f.id, f.payload())
+        } else {
+            self.checker.check(f.id, f.payload())
+        };
+        match checked {
             Ok(Messages::EgoVehicleState(m)) => {
                 self.ego_speed_mps = m.ego_speed();
                 self.vehicle_rx_ns = Some(now);

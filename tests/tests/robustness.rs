@@ -1,0 +1,172 @@
+//! The fault-injection campaign (tests/src/faults.rs) end to end: real ecu, sensor-feeds,
+//! actuator-stubs, candump, cansend, cangen and bus-inject on vcan — on the host if its kernel
+//! has vcan, else inside ONE user-mode-Linux boot; with neither the tests FAIL (never skipped).
+//! The campaign runs once (first test to get here) and writes `target/robustness/campaign.json`,
+//! which `test.sh` prints as the robustness report together with the fuzzing figures.
+
+use e2e_tests::faults::{cases, report_text, Campaign, Fault};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+
+fn root() -> PathBuf {
+    e2e_tests::repo_root()
+}
+
+/// target/<profile>/ of this test binary (target/<profile>/deps/robustness-…).
+fn bin_dir() -> PathBuf {
+    let exe = std::env::current_exe().expect("current exe");
+    exe.parent()
+        .and_then(Path::parent)
+        .expect("target/<profile>")
+        .to_path_buf()
+}
+
+/// Runs the campaign once; returns it.
+fn campaign() -> &'static Campaign {
+    static RUN: OnceLock<Campaign> = OnceLock::new();
+    RUN.get_or_init(|| {
+        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+        let st = Command::new(cargo)
+            .args(["build", "--release", "--bins", "-p", "ecu", "-p", "sensor-feeds"])
+            .args(["-p", "actuator-stubs", "-p", "e2e-tests"])
+            .current_dir(root())
+            .status()
+            .expect("cargo build");
+        assert!(st.success(), "building the bench binaries failed");
+        let script = root().join("vcan-setup.sh");
+        let check = Command::new(&script)
+            .arg("--check")
+            .status()
+            .expect("vcan-setup.sh --check");
+        match check.code() {
+            Some(0) => eprintln!("robustness: host vcan"),
+            Some(3) => eprintln!("robustness: no SocketCAN in this kernel — user-mode Linux"),
+            other => panic!(
+                "neither host vcan nor user-mode Linux is available (vcan-setup.sh --check → {other:?}); \
+                 install user-mode-linux (tests/setup-host.sh) — these tests are never skipped"
+            ),
+        }
+        let out = bin_dir().join("robustness");
+        let _ = std::fs::remove_dir_all(&out);
+        let o = Command::new(&script)
+            .args(["--run", "--"])
+            .arg(bin_dir().join("fault-campaign"))
+            .arg("run")
+            .arg("--out")
+            .arg(&out)
+            .arg("--repo")
+            .arg(root())
+            .current_dir(root())
+            .output()
+            .expect("vcan-setup.sh --run fault-campaign");
+        eprintln!(
+            "--- fault-campaign ---\n{}\n--- stderr ---\n{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let path = out.join("campaign.json");
+        let text = std::fs::read_to_string(&path)
+            .unwrap_or_else(|e| panic!("{}: {e} (fault-campaign exit {})", path.display(), o.status));
+        // test.sh prints the robustness report with the fuzzing figures from here.
+        let keep = root().join("target/robustness");
+        std::fs::create_dir_all(&keep).expect("target/robustness");
+        std::fs::write(keep.join("campaign.json"), &text).expect("write campaign.json");
+        serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+    })
+}
+
+#[test]
+fn every_fault_case_ran_and_passed_its_checks() {
+    let c = campaign();
+    let names: Vec<&str> = c.cases.iter().map(|r| r.name.as_str()).collect();
+    let want: Vec<&str> = cases().iter().map(|k| k.name).collect();
+    assert_eq!(names, want, "every case of the campaign ran, in order");
+    let failed: Vec<String> = c
+        .cases
+        .iter()
+        .filter(|r| !r.pass)
+        .map(|r| {
+            let why: Vec<String> = r
+                .checks
+                .iter()
+                .filter(|k| !k.ok)
+                .map(|k| format!("{}: {}", k.what, k.detail))
+                .collect();
+            format!("{}: {}", r.name, why.join("; "))
+        })
+        .collect();
+    assert!(failed.is_empty(), "failed cases:\n{}", failed.join("\n"));
+}
+
+#[test]
+fn no_genuine_command_is_lost_and_nothing_forged_is_acted_on() {
+    for r in &campaign().cases {
+        assert!(
+            r.commands_sent > 100,
+            "{}: {} commands",
+            r.name,
+            r.commands_sent
+        );
+        assert!(
+            r.commands_authenticated <= r.commands_sent,
+            "{}: acted on {} commands, the ECU sent {}",
+            r.name,
+            r.commands_authenticated,
+            r.commands_sent
+        );
+        assert_eq!(
+            r.commands_lost - r.commands_denied_by_attack,
+            0,
+            "{}: genuine commands lost",
+            r.name
+        );
+    }
+}
+
+#[test]
+fn forged_and_replayed_fire_commands_never_fire_the_airbag() {
+    let c = campaign();
+    for name in ["forged-fire", "replayed-fire"] {
+        let r = c.cases.iter().find(|r| r.name == name).expect(name);
+        assert!(!r.airbag_fired, "{name}: the airbag fired");
+        assert!(
+            r.frames_injected >= 2,
+            "{name}: {} frames sent with cansend",
+            r.frames_injected
+        );
+        let secoc: u64 = r
+            .frames_rejected
+            .iter()
+            .filter(|(k, _)| k.starts_with("stubs:secoc:"))
+            .map(|(_, n)| n)
+            .sum();
+        assert!(
+            secoc > 0,
+            "{name}: SecOC rejected nothing: {:?}",
+            r.frames_rejected
+        );
+    }
+}
+
+#[test]
+fn the_robustness_report_names_every_figure() {
+    let c = campaign();
+    let text = report_text(c, None);
+    eprintln!("{text}");
+    for figure in [
+        "cases tried",
+        "faults survived",
+        "commands lost      0",
+        "deadline misses",
+        "frames rejected by reason",
+        "inputs fuzzed",
+    ] {
+        assert!(text.contains(figure), "report lacks {figure:?}:\n{text}");
+    }
+    let faults = cases().iter().filter(|k| k.fault != Fault::None).count();
+    assert!(
+        text.contains(&format!("faults survived    {faults} of {faults}")),
+        "{text}"
+    );
+}
