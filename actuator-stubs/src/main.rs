@@ -19,7 +19,7 @@ use sensor_feeds::{monotonic_ns, Scenario, Truth};
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 
 /// Belt retractor + airbag module stubs: validate, log, act on and judge commands.
 #[derive(Parser, Debug)]
@@ -78,26 +78,6 @@ fn load_keys(cli: &Cli) -> Result<bus::secoc::SecOcKeys> {
 /// Ids the modules listen to (kernel filter): airbag cmd + auth, belt cmd + auth, ECU status.
 const RX_IDS: [u32; 5] = [0x030, 0x031, 0x040, 0x041, 0x110];
 
-static STOP: AtomicBool = AtomicBool::new(false);
-
-extern "C" fn on_signal(_: nix::libc::c_int) {
-    STOP.store(true, Ordering::Relaxed);
-}
-
-fn install_stop_signals() -> Result<()> {
-    use nix::sys::signal::{sigaction, SaFlags, SigAction, SigHandler, SigSet, Signal};
-    let action = SigAction::new(
-        SigHandler::Handler(on_signal),
-        SaFlags::empty(),
-        SigSet::empty(),
-    );
-    for sig in [Signal::SIGTERM, Signal::SIGINT] {
-        // SAFETY: the handler only performs an atomic store.
-        unsafe { sigaction(sig, &action) }.context("installing signal handler")?;
-    }
-    Ok(())
-}
-
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     match run(&cli) {
@@ -126,7 +106,7 @@ fn run(cli: &Cli) -> Result<()> {
     .map_err(|e| anyhow::anyhow!("reference restraint: {e}"))?;
     let keys = load_keys(cli)?;
     std::fs::create_dir_all(&cli.out).with_context(|| format!("creating {}", cli.out.display()))?;
-    install_stop_signals()?;
+    let stop = ipc::install_stop_signals().context("installing signal handler")?;
     let mut sock = BusSocket::open(&cli.can, &RX_IDS).with_context(|| {
         format!(
             "CAN interface {} (bring it up with ./vcan-setup.sh)",
@@ -168,7 +148,7 @@ fn run(cli: &Cli) -> Result<()> {
     let stop_reason = loop {
         // Read before the drain: with --until-signal, everything queued before the signal is
         // still read and acted on below.
-        let signalled = STOP.load(Ordering::Relaxed);
+        let signalled = stop.load(Ordering::Relaxed);
         if signalled && !cli.until_signal {
             break "signal";
         }

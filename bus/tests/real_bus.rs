@@ -5,66 +5,19 @@
 //! On a host without SocketCAN the visible test re-runs the `#[ignore]`d worker inside a
 //! user-mode Linux guest through `vcan-setup.sh --run`; with neither host vcan nor UML it FAILS.
 
-use std::path::{Path, PathBuf};
+#[path = "support/vcan_rerun.rs"]
+mod vcan_rerun;
+
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant, SystemTime};
 
-use bus::socket::{interface_usable, BusSocket};
+use bus::socket::BusSocket;
 use bus::{encode_values, message_info, signal_values, signals_of, E2eChecker, RawFrame, MESSAGES};
-
-fn iface() -> String {
-    std::env::var("VCAN").unwrap_or_else(|_| "vcan0".into())
-}
-
-fn repo_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
+use vcan_rerun::{iface, repo_root, run_here_or_in_uml};
 
 #[test]
 fn real_bus_candump_cantools_cansend() {
-    if interface_usable(&iface()) {
-        real_bus_worker_body();
-        return;
-    }
-    assert!(
-        std::env::var_os("VCAN_IN_UML").is_none(),
-        "inside the UML guest but {} is not usable",
-        iface()
-    );
-    let script = repo_root().join("vcan-setup.sh");
-    let exe = std::env::current_exe().unwrap();
-    eprintln!(
-        "host has no usable {}; re-running the worker inside user-mode Linux",
-        iface()
-    );
-    let out = Command::new(&script)
-        .args(["--iface", &iface(), "--run", "--"])
-        .arg(&exe)
-        .args([
-            "--exact",
-            "inner_real_bus_worker",
-            "--ignored",
-            "--nocapture",
-            "--test-threads=1",
-        ])
-        .stdin(Stdio::null())
-        .output()
-        .expect("run vcan-setup.sh");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    eprintln!("--- guest stdout ---\n{stdout}\n--- vcan-setup stderr ---\n{stderr}");
-    assert!(
-        out.status.success(),
-        "real-bus worker failed (neither host vcan nor a working UML guest?): {:?}",
-        out.status
-    );
-    assert!(
-        stdout.contains("1 passed"),
-        "the worker did not run inside the guest"
-    );
+    run_here_or_in_uml("inner_real_bus_worker", real_bus_worker_body);
 }
 
 #[test]

@@ -76,7 +76,7 @@ fn load_reference(cfg: &EcuConfig) -> anyhow::Result<ReferenceRestraint> {
 
 fn run(cli: &Cli) -> anyhow::Result<()> {
     let cfg = EcuConfig::resolve(&cli.run)?;
-    let stop = app::install_stop_signals()?;
+    let stop = ipc::install_stop_signals()?;
     let lut = load_lut(&cfg);
     let reference = load_reference(&cfg)?;
     let (mut activity, notes) = RestraintCycle::new(cfg.cycle.clone(), lut, &reference.restraint)

@@ -8,27 +8,18 @@
 //! user-mode Linux guest through `vcan-setup.sh --run`; with neither it FAILS (never skipped).
 
 mod cycle_support;
+#[path = "../../bus/tests/support/vcan_rerun.rs"]
+mod vcan_rerun;
 
-use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use bus::codec::BeltLimiterCmdCmdSource;
-use bus::socket::{interface_usable, BusSocket};
+use bus::socket::BusSocket;
 use ipc::{ObjectPublisher, ObjectState, ServiceNames, VALID};
+use vcan_rerun::{iface, repo_root, run_here_or_in_uml};
 
 const ECU: &str = env!("CARGO_BIN_EXE_ecu");
-
-fn iface() -> String {
-    std::env::var("VCAN").unwrap_or_else(|_| "vcan0".into())
-}
-
-fn repo_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
 
 fn monotonic_ns() -> u64 {
     let t = nix::time::clock_gettime(nix::time::ClockId::CLOCK_MONOTONIC).unwrap();
@@ -37,41 +28,7 @@ fn monotonic_ns() -> u64 {
 
 #[test]
 fn ecu_process_on_vcan_sends_e2e_valid_commands() {
-    if interface_usable(&iface()) {
-        worker_body();
-        return;
-    }
-    assert!(
-        std::env::var_os("VCAN_IN_UML").is_none(),
-        "inside the UML guest but {} is not usable",
-        iface()
-    );
-    eprintln!(
-        "host has no usable {}; re-running inside user-mode Linux",
-        iface()
-    );
-    let out = Command::new(repo_root().join("vcan-setup.sh"))
-        .args(["--iface", &iface(), "--run", "--"])
-        .arg(std::env::current_exe().unwrap())
-        .args([
-            "--exact",
-            "inner_vcan_worker",
-            "--ignored",
-            "--nocapture",
-            "--test-threads=1",
-        ])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .stdin(Stdio::null())
-        .output()
-        .expect("run vcan-setup.sh");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    eprintln!("--- guest stdout ---\n{stdout}\n--- vcan-setup stderr ---\n{stderr}");
-    assert!(
-        out.status.success(),
-        "worker failed inside UML (or UML unavailable)"
-    );
-    assert!(stdout.contains("1 passed"), "worker did not run: {stdout}");
+    run_here_or_in_uml("inner_vcan_worker", worker_body);
 }
 
 #[test]

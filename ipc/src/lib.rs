@@ -24,6 +24,9 @@ use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubFac
 
 pub use iceoryx2;
 
+mod stop;
+pub use stop::install_stop_signals;
+
 /// The iceoryx2 service flavour used by the bench: inter-process shared memory.
 pub type IpcService = iceoryx2::service::ipc::Service;
 /// A node of the bench's iceoryx2 flavour.

@@ -2,7 +2,8 @@
 //! edges lie halfway to its neighbours (non-uniform axes stay honest), coloured blue (low) →
 //! red (high), with the value written in it. SVG if the name ends in `.svg`, else PNG.
 
-use anyhow::{anyhow, Context, Result};
+use crate::plot::{render, Figure};
+use anyhow::{anyhow, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -47,21 +48,16 @@ fn colour(t: f64) -> HSLColor {
 /// Draw panels side by side into `path`.
 pub fn draw(path: &Path, panels: &[HeatPanel]) -> Result<()> {
     let size = (720 * panels.len().max(1) as u32, 600);
-    let svg = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
-    if svg {
-        let root = SVGBackend::new(path, size).into_drawing_area();
-        draw_on(&root, panels)?;
-        root.present()
-            .with_context(|| format!("writing {}", path.display()))?;
-    } else {
-        let root = BitMapBackend::new(path, size).into_drawing_area();
-        draw_on(&root, panels)?;
-        root.present()
-            .with_context(|| format!("writing {}", path.display()))?;
+    render(path, size, panels)
+}
+
+impl Figure for [HeatPanel] {
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw_on(root, self)
     }
-    Ok(())
 }
 
 fn draw_on<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, panels: &[HeatPanel]) -> Result<()>

@@ -22,24 +22,49 @@ pub struct Panel<'a> {
 
 const SIZE: (u32, u32) = (1000, 420);
 
-/// Draw panels stacked vertically into `path`.
-pub fn draw(path: &Path, panels: &[Panel<'_>]) -> Result<()> {
-    let size = (SIZE.0, SIZE.1 * panels.len().max(1) as u32);
+/// Something drawable on any plotters backend. A trait rather than a closure because the
+/// drawing code must be generic over the backend (SVG and bitmap are different types), and
+/// closures cannot be generic.
+pub trait Figure {
+    /// Draws the whole figure on `root` (already sized; not yet presented).
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static;
+}
+
+/// Renders `figure` into `path` at `size` pixels: SVG when the file name ends in `.svg`
+/// (any case), PNG otherwise. The one place that picks the backend for every plot of `lut`.
+pub fn render(path: &Path, size: (u32, u32), figure: &(impl Figure + ?Sized)) -> Result<()> {
     let is_svg = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
     if is_svg {
         let root = SVGBackend::new(path, size).into_drawing_area();
-        draw_on(&root, panels)?;
+        figure.draw_on(&root)?;
         root.present()
             .with_context(|| format!("writing {}", path.display()))?;
     } else {
         let root = BitMapBackend::new(path, size).into_drawing_area();
-        draw_on(&root, panels)?;
+        figure.draw_on(&root)?;
         root.present()
             .with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(())
+}
+
+/// Draw panels stacked vertically into `path`.
+pub fn draw(path: &Path, panels: &[Panel<'_>]) -> Result<()> {
+    let size = (SIZE.0, SIZE.1 * panels.len().max(1) as u32);
+    render(path, size, panels)
+}
+
+impl Figure for [Panel<'_>] {
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw_on(root, self)
+    }
 }
 
 fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {

@@ -15,7 +15,7 @@ use ipc::{
 use sensor_feeds::scenario::DropoutTarget;
 use sensor_feeds::{monotonic_ns, sleep_until_ns, Scenario, SensorModelSim, Truth};
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 
 /// Scenario player: object, vehicle, occupant and crash-accelerometer feeds.
 #[derive(Parser, Debug)]
@@ -95,7 +95,7 @@ fn run(cli: &Cli) -> Result<()> {
     let mut model = SensorModelSim::new(truth);
     let sensor = scenario.sensor.clone();
 
-    install_stop_signals()?;
+    let stop = ipc::install_stop_signals().context("installing signal handler")?;
 
     let names = ServiceNames::with_prefix(&cli.service_prefix);
     let node_name = format!("sensor-feeds-{}", std::process::id());
@@ -171,7 +171,7 @@ fn run(cli: &Cli) -> Result<()> {
     let mut contact_announced = false;
 
     for tick in first_tick..=total_ticks {
-        if STOP_FLAG.load(Ordering::Relaxed) {
+        if stop.load(Ordering::Relaxed) {
             eprintln!("sensor-feeds: stopped by signal at t = {} ms", tick);
             break;
         }
@@ -317,25 +317,4 @@ struct Counts {
     can_frames: u64,
     can_errors: u64,
     ipc_errors: u64,
-}
-
-static STOP_FLAG: AtomicBool = AtomicBool::new(false);
-
-extern "C" fn on_signal(_: nix::libc::c_int) {
-    STOP_FLAG.store(true, Ordering::Relaxed);
-}
-
-/// SIGTERM/SIGINT only store a flag (async-signal-safe); the tick loop polls it.
-fn install_stop_signals() -> Result<()> {
-    use nix::sys::signal::{sigaction, SaFlags, SigAction, SigHandler, SigSet, Signal};
-    let action = SigAction::new(
-        SigHandler::Handler(on_signal),
-        SaFlags::empty(),
-        SigSet::empty(),
-    );
-    for sig in [Signal::SIGTERM, Signal::SIGINT] {
-        // SAFETY: the handler only performs an atomic store.
-        unsafe { sigaction(sig, &action) }.context("installing signal handler")?;
-    }
-    Ok(())
 }

@@ -14,28 +14,6 @@ use super::report::{CanStatus, IpcStatus, TimingReport};
 use super::rt;
 use super::run::{run_activity, LoopConfig, LoopStats};
 
-static STOP: AtomicBool = AtomicBool::new(false);
-
-extern "C" fn on_stop_signal(_: nix::libc::c_int) {
-    // Async-signal-safe: a single atomic store, nothing else.
-    STOP.store(true, Ordering::Relaxed);
-}
-
-/// Installs SIGINT/SIGTERM handlers that only set the returned flag.
-pub fn install_stop_signals() -> anyhow::Result<&'static AtomicBool> {
-    use nix::sys::signal::{sigaction, SaFlags, SigAction, SigHandler, SigSet, Signal};
-    let action = SigAction::new(
-        SigHandler::Handler(on_stop_signal),
-        SaFlags::empty(), // no SA_RESTART: interrupt clock_nanosleep so we stop promptly
-        SigSet::empty(),
-    );
-    for sig in [Signal::SIGINT, Signal::SIGTERM] {
-        // SAFETY: the handler only performs an atomic store (async-signal-safe).
-        unsafe { sigaction(sig, &action) }?;
-    }
-    Ok(&STOP)
-}
-
 /// Decides whether the CAN side runs. `Err` when CAN is requested but the interface is
 /// missing (the operator must bring up vcan0 or pass `--no-can`: never silently off).
 pub fn can_decision(cfg: &EcuConfig, can_port_available: bool) -> anyhow::Result<CanStatus> {
