@@ -174,7 +174,7 @@ fn run(cli: &Cli) -> Result<()> {
                 .map_or("unknown", |i| i.name)
                 .to_owned();
             *frames.entry(name.clone()).or_default() += 1;
-            let v = receiver.on_frame(&f, rx_ns);
+            let v = receiver.on_frame(&f, rx_ns, actuator_stubs::rx::sync_now_us());
             if let Some(d) = &v.act {
                 modules.apply(rx_ns, d);
             }

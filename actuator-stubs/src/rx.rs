@@ -13,6 +13,11 @@
 //!   the bytes the MAC covered, not a later frame — is decoded and acted on at this frame's
 //!   receive time;
 //! * anything else (`EcuStatus`, foreign frames): E2E only, as before.
+//!
+//! Two clocks: the pairing timeout runs on the receive time (CLOCK_MONOTONIC), the SecOC
+//! freshness check on the synchronized time ([`sync_now_us`], CLOCK_REALTIME — the ECU stamps
+//! its authenticators with the same clock), so a genuine pair recorded in an earlier session
+//! and replayed later is stale.
 
 use std::collections::BTreeMap;
 
@@ -46,15 +51,15 @@ pub struct Receiver {
 }
 
 impl Receiver {
-    /// Receiver with the stream keys and the default SecOC configuration; freshness starts
-    /// above 0 (the ECU's first is 1).
+    /// Receiver with the stream keys and the default SecOC configuration (100-ms freshness
+    /// window around the synchronized time).
     pub fn new(keys: &SecOcKeys) -> Self {
         Self::with_config(keys, SecOcConfig::default())
     }
 
-    /// Receiver with an explicit SecOC configuration (acceptance window, pairing timeout).
+    /// Receiver with an explicit SecOC configuration (freshness window, pairing timeout).
     pub fn with_config(keys: &SecOcKeys, config: SecOcConfig) -> Self {
-        let v = |s| keys.verifier(s, config, 0);
+        let v = |s| keys.verifier(s, config);
         Self {
             checker: E2eChecker::new(),
             verifiers: [v(SecOcStream::AirbagStage), v(SecOcStream::BeltLimiter)],
@@ -69,11 +74,15 @@ impl Receiver {
         }
     }
 
-    /// Handles one frame received at `rx_ns` (CLOCK_MONOTONIC).
-    pub fn on_frame(&mut self, f: &RawFrame, rx_ns: u64) -> Verdict {
+    /// Handles one frame received at `rx_ns` (CLOCK_MONOTONIC) and read at synchronized time
+    /// `sync_now_us` ([`sync_now_us`]; only authenticators use it).
+    pub fn on_frame(&mut self, f: &RawFrame, rx_ns: u64, sync_now_us: u64) -> Verdict {
         let now_us = rx_ns / 1_000;
         if let Some(stream) = SecOcStream::for_auth_id(f.id) {
-            let (secoc, decoded) = match self.verifier(stream).verify_auth(f.payload(), now_us) {
+            let verdict = self
+                .verifier(stream)
+                .verify_auth(f.payload(), now_us, sync_now_us);
+            let (secoc, decoded) = match verdict {
                 Ok(cmd) => match bus::decode(stream.command_id(), &cmd.payload) {
                     Ok(msg) => ("ok".to_owned(), Some(decode(&msg))),
                     // The payload passed E2E when it was held, so this cannot happen; never
@@ -165,4 +174,13 @@ impl Receiver {
             .filter(|(_, n)| *n > 0)
             .collect()
     }
+}
+
+/// The synchronized time of the bench, µs: CLOCK_REALTIME since the UNIX epoch, the clock the
+/// ECU stamps its SecOC authenticators with (one machine, one clock; a vehicle would use its
+/// StbM/gPTP time). 0 if the clock is before 1970 (then nothing is fresh).
+pub fn sync_now_us() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| u64::try_from(d.as_micros()).unwrap_or(u64::MAX))
 }

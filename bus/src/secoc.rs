@@ -14,7 +14,7 @@
 //! | [`SecOcStream::BeltLimiter`] | `BeltLimiterCmd` 0x040 | `BeltLimiterAuth` 0x041 | 0x1440 |
 //!
 //! The data id is the command's E2E data id (`E2EDataId` in the DBC); each stream has its own
-//! 128-bit key and its own freshness counter.
+//! 128-bit key and its own freshness sequence.
 //!
 //! # What the MAC covers (the "data to authenticate")
 //!
@@ -22,14 +22,14 @@
 //! preimage (20 bytes) = data id      (u16, big-endian)
 //!                     ‖ command id   (u16, big-endian, the 11-bit CAN id)
 //!                     ‖ command payload (all 8 bytes as sent: E2E CRC, alive counter, signals)
-//!                     ‖ freshness    (u64, big-endian, the FULL counter, not the 24 sent bits)
+//!                     ‖ freshness    (u64, big-endian, the FULL value in µs, not the 24 sent bits)
 //! tag   = AES-128-CMAC(stream key, preimage)            (RFC 4493, 16 bytes)
 //! Mac   = tag[0..5] read as a big-endian integer          (the 40 most significant bits)
 //! ```
 //!
 //! Big-endian ("network order") is what AUTOSAR SecOC uses for the data id and the freshness
 //! value. Truncating to the *leftmost* bits is the SecOC/NIST SP 800-38B rule. The frame
-//! carries `FreshnessValue` = low 24 bits of the counter and `Mac` as DBC signals (Intel byte
+//! carries `FreshnessValue` = low 24 bits of the freshness value and `Mac` as DBC signals (Intel byte
 //! order, via the generated codec), so `cantools` shows both.
 //!
 //! # Pairing a command with its authenticator
@@ -56,27 +56,62 @@
 //! MAC check does *not* discard the held command, so a forged authenticator cannot block the
 //! genuine one that follows.
 //!
-//! # Freshness
+//! # Freshness: a synchronized time stamp
 //!
-//! A monotonic 64-bit counter per stream: the sender uses each value once (+1 per
-//! authenticator). The receiver keeps the last accepted value `last` and rebuilds the full value
-//! from the 24 received bits as the smallest `v > last` with `v mod 2^24 = FreshnessValue`.
-//! It accepts only `v − last <= max_forward_jump` (the acceptance window: that many lost
-//! authenticators are tolerated). Outside the window it classifies the frame (spending at most
-//! two more CMACs):
-//! - the MAC verifies for the already-used value `v − 2^24 <= last` → [`SecOcError::Replay`]
-//!   (a genuine old frame sent again);
-//! - the MAC verifies for `v` → [`SecOcError::FreshnessOutOfWindow`] (genuine, but too far ahead:
-//!   sender and receiver lost sync);
-//! - otherwise → [`SecOcError::MacMismatch`] (forged, wrong key, corrupted).
+//! The full freshness value is a `u64` count of microseconds on a *synchronized global time
+//! base* (AUTOSAR SecOC with StbM time; on the bench CLOCK_REALTIME µs since the UNIX epoch —
+//! all processes run on one machine; a vehicle would use its StbM/gPTP time). The sender
+//! ([`SecOcSender::authenticate`]) uses `fv = max(previous fv + 1, sync_now_us)`: the current
+//! time, but strictly increasing even for two authenticators in one microsecond or after a
+//! backwards step of the clock.
 //!
-//! A replayed frame can never be accepted later either: its MAC binds the full 64-bit value,
-//! and the receiver only ever verifies values above `last`.
+//! The receiver ([`SecOcVerifier::verify_auth`]) reconstructs `v` = the value congruent to the
+//! received 24 bits (mod 2^24) that is nearest to its *own* `sync_now_us`, and accepts iff
 //!
-//! Start-up: sender and receiver agree on the start ([`SecOcSender::new`]'s `first_freshness`,
-//! [`SecOcVerifier::new`]'s `last_accepted`, both 1 / 0 on the bench, which restarts all
-//! processes per scenario). A production ECU would persist the counter across power cycles (or
-//! run a freshness-value manager); [`SecOcSender::next_freshness`] is what to persist.
+//! 1. the MAC verifies for `v`, and
+//! 2. `|v − sync_now_us| <= `[`SecOcConfig::freshness_window_us`] (default 100 ms: bus latency
+//!    plus scheduling stalls and the clock difference of sender and receiver), and
+//! 3. `v > last_accepted` (each value is used at most once).
+//!
+//! On a failure it classifies the frame, spending at most two more CMACs:
+//! - the MAC verifies for `v` but `v` is outside the window → [`SecOcError::FreshnessStale`]
+//!   (genuine but old — a recording replayed later, a delayed frame — or from a clock that is
+//!   too far off);
+//! - the MAC verifies for `v` inside the window but `v <= last_accepted` →
+//!   [`SecOcError::Replay`] (a genuine frame sent again right after the original);
+//! - the MAC does not verify for `v` but for `v ∓ 2^24` (a genuine frame between ~8 s and ~25 s
+//!   old or ahead, whose 24 bits reconstruct to the wrong span) → [`SecOcError::FreshnessStale`];
+//! - otherwise → [`SecOcError::MacMismatch`]: forged, wrong key, corrupted — *or* a genuine
+//!   frame recorded more than ~25 s earlier: the frame does not carry the upper 40 bits of its
+//!   old time stamp, so without searching further spans (CMACs an attacker could make the
+//!   receiver spend) it cannot be told apart from a forgery. It is rejected either way.
+//!
+//! Why time and not a counter: a counter restarts with every ECU start unless it is persisted,
+//! and a receiver that accepts any value ahead of its own accepts a genuine fire command
+//! recorded in an *earlier* session (its counter is ahead of the new session's), so a
+//! `candump` from a crash test replayed with `cansend` later fired the airbag. A time stamp
+//! needs no persistence: whatever was recorded earlier than the window is stale, and within the
+//! window `last_accepted` rejects each value's second use.
+//!
+//! Limits (say them out loud):
+//! - 2^24 µs ≈ 16.8 s: the nearest-congruent reconstruction is right while the sender's and the
+//!   receiver's clocks (plus the latency) differ by less than 2^23 µs ≈ 8.4 s; the window is
+//!   clamped below that ([`MAX_FRESHNESS_WINDOW_US`]), so whatever is accepted was
+//!   reconstructed unambiguously. Beyond 8.4 s offset nothing is accepted (the MAC binds the
+//!   full 64-bit value).
+//! - A sender clock stepping back by more than the window makes the sender's values run ahead
+//!   of the time (`previous + 1`) until the clock has caught up; the receiver rejects them as
+//!   stale meanwhile. A small step (inside the window) is harmless. A synchronized time base
+//!   does not step back in operation; on the bench, a CLOCK_REALTIME step would need NTP
+//!   `step` — the bench never sets the clock while running.
+//! - The security rests on the time base: whoever can set the receiver's clock back can make
+//!   a recording fresh again (as with any time-based SecOC freshness; StbM time is itself
+//!   authenticated in a vehicle).
+//!
+//! Start-up: nothing to agree on and nothing to persist. A new sender starts at the current
+//! time, a new receiver with `last_accepted = 0` accepts whatever is fresh in the window.
+//! A frame from an earlier session is outside the window (stale or MAC mismatch, as above);
+//! within the window but already used it is a [`SecOcError::Replay`].
 //!
 //! # no_std
 //!
@@ -99,9 +134,11 @@ pub const MAC_TX_BITS: u32 = 40;
 pub const MAC_TX_BYTES: usize = 5;
 /// Length of the data the MAC is computed over (see the module docs).
 pub const PREIMAGE_LEN: usize = 20;
-/// Largest allowed acceptance window: below half the transmitted freshness space, so that "just
-/// ahead" and "already used" can never be confused.
-pub const MAX_FORWARD_JUMP_LIMIT: u64 = (1 << (FRESHNESS_TX_BITS - 1)) - 1;
+/// Span of the transmitted freshness bits: 2^24 µs ≈ 16.8 s.
+pub const FRESHNESS_TX_SPAN: u64 = 1 << FRESHNESS_TX_BITS;
+/// Largest allowed freshness window, µs: below half the transmitted span (2^23 µs ≈ 8.4 s), so
+/// that every value inside the window is reconstructed unambiguously from its 24 bits.
+pub const MAX_FRESHNESS_WINDOW_US: u64 = FRESHNESS_TX_SPAN / 2 - 1;
 
 /// An authenticated command stream.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -395,22 +432,25 @@ pub enum SecOcError {
         /// Time from command to authenticator.
         age_us: u64,
     },
-    /// A genuine authenticator whose freshness was already used (a replayed frame).
+    /// A genuine authenticator inside the freshness window whose freshness value was already
+    /// used (a replayed frame).
     Replay {
         /// The (already used) full freshness value it verified with.
         freshness: u64,
     },
-    /// A genuine authenticator too far ahead of the last accepted freshness.
-    FreshnessOutOfWindow {
-        /// Full freshness value it verified with.
+    /// A genuine authenticator whose time stamp is outside the freshness window around the
+    /// receiver's synchronized time: an old frame replayed (e.g. recorded in an earlier session),
+    /// a delayed one, or sender and receiver clocks too far apart.
+    FreshnessStale {
+        /// Full freshness value (µs) it verified with.
         freshness: u64,
-        /// Last accepted freshness.
-        last: u64,
+        /// The receiver's synchronized time (µs) when it checked.
+        sync_now_us: u64,
     },
     /// The MAC does not verify: forged, wrong key, or command/authenticator corrupted or
     /// mismatched.
     MacMismatch,
-    /// Sender: the 64-bit freshness counter is exhausted (never in practice).
+    /// Sender: the 64-bit freshness value is exhausted (never in practice: year 586 524).
     FreshnessExhausted,
     /// Sender: the authenticator could not be encoded (cannot happen with masked fields).
     Encode,
@@ -434,9 +474,13 @@ impl core::fmt::Display for SecOcError {
                     "SecOC: replayed authenticator (freshness {freshness} already used)"
                 )
             }
-            Self::FreshnessOutOfWindow { freshness, last } => write!(
+            Self::FreshnessStale {
+                freshness,
+                sync_now_us,
+            } => write!(
                 f,
-                "SecOC: freshness {freshness} outside the acceptance window (last accepted {last})"
+                "SecOC: stale freshness {freshness} us, receiver time {sync_now_us} us \
+                 (outside the freshness window)"
             ),
             Self::MacMismatch => f.write_str("SecOC: MAC mismatch (forged or corrupted)"),
             Self::FreshnessExhausted => f.write_str("SecOC: freshness counter exhausted"),
@@ -456,12 +500,12 @@ pub enum SecOcReject {
     Malformed = 0,
     /// [`SecOcError::NoPendingCommand`]
     NoPendingCommand = 1,
-    /// [`SecOcError::Stale`]
+    /// [`SecOcError::Stale`] (authenticator too late after its command: pairing timeout)
     Stale = 2,
     /// [`SecOcError::Replay`]
     Replay = 3,
-    /// [`SecOcError::FreshnessOutOfWindow`]
-    OutOfWindow = 4,
+    /// [`SecOcError::FreshnessStale`]
+    FreshnessStale = 4,
     /// [`SecOcError::MacMismatch`]
     MacMismatch = 5,
 }
@@ -475,7 +519,7 @@ impl SecOcReject {
         Self::NoPendingCommand,
         Self::Stale,
         Self::Replay,
-        Self::OutOfWindow,
+        Self::FreshnessStale,
         Self::MacMismatch,
     ];
     /// Stable short name for reports.
@@ -486,7 +530,7 @@ impl SecOcReject {
             Self::NoPendingCommand => "no_pending_command",
             Self::Stale => "stale",
             Self::Replay => "replay",
-            Self::OutOfWindow => "out_of_window",
+            Self::FreshnessStale => "freshness_stale",
             Self::MacMismatch => "mac_mismatch",
         }
     }
@@ -503,7 +547,7 @@ impl SecOcError {
             Self::NoPendingCommand => SecOcReject::NoPendingCommand,
             Self::Stale { .. } => SecOcReject::Stale,
             Self::Replay { .. } => SecOcReject::Replay,
-            Self::FreshnessOutOfWindow { .. } => SecOcReject::OutOfWindow,
+            Self::FreshnessStale { .. } => SecOcReject::FreshnessStale,
             Self::MacMismatch => SecOcReject::MacMismatch,
         }
     }
@@ -512,32 +556,32 @@ impl SecOcError {
 // ---------------------------------------------------------------------------------------------
 // Sender
 
-/// Sender side of one stream: holds the keyed CMAC and the freshness counter.
+/// Sender side of one stream: holds the keyed CMAC and the last freshness value used.
 #[derive(Clone)]
 pub struct SecOcSender {
     stream: SecOcStream,
     mac: Cmac<Aes128>,
-    next_freshness: u64,
+    last_freshness: u64,
 }
 
 impl core::fmt::Debug for SecOcSender {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.debug_struct("SecOcSender")
             .field("stream", &self.stream)
-            .field("next_freshness", &self.next_freshness)
+            .field("last_freshness", &self.last_freshness)
             .finish_non_exhaustive()
     }
 }
 
 impl SecOcSender {
-    /// Sender whose first authenticator uses `first_freshness` (1 on the bench, whose receivers
-    /// start with `last_accepted = 0`).
+    /// Sender of `stream`. There is no start value to agree on: the first authenticator takes
+    /// its freshness from the synchronized clock.
     #[must_use]
-    pub fn new(stream: SecOcStream, key: &SecOcKey, first_freshness: u64) -> Self {
+    pub fn new(stream: SecOcStream, key: &SecOcKey) -> Self {
         Self {
             stream,
             mac: key.cmac(),
-            next_freshness: first_freshness,
+            last_freshness: 0,
         }
     }
 
@@ -547,25 +591,34 @@ impl SecOcSender {
         self.stream
     }
 
-    /// Freshness value the next authenticator will use (persist this to survive restarts).
+    /// Freshness value (µs) of the last authenticator (0 before the first).
     #[must_use]
-    pub const fn next_freshness(&self) -> u64 {
-        self.next_freshness
+    pub const fn last_freshness(&self) -> u64 {
+        self.last_freshness
     }
 
     /// Authenticator frame for `command` (the exact frame that is sent, E2E fields already
-    /// filled in); send it right after the command. Uses up one freshness value.
+    /// filled in); send it right after the command. `sync_now_us` is the synchronized time
+    /// (µs; CLOCK_REALTIME since the UNIX epoch on the bench); the freshness value used is
+    /// `max(last + 1, sync_now_us)`, strictly increasing whatever the clock does.
     /// No allocation, no panic.
-    pub fn authenticate(&mut self, command: &RawFrame) -> Result<RawFrame, SecOcError> {
+    pub fn authenticate(
+        &mut self,
+        command: &RawFrame,
+        sync_now_us: u64,
+    ) -> Result<RawFrame, SecOcError> {
         if command.id != self.stream.command_id() {
             return Err(SecOcError::WrongId(command.id));
         }
         let payload = payload8(command.payload())?;
-        let fv = self.next_freshness;
-        let next = fv.checked_add(1).ok_or(SecOcError::FreshnessExhausted)?;
+        let fv = self
+            .last_freshness
+            .checked_add(1)
+            .ok_or(SecOcError::FreshnessExhausted)?
+            .max(sync_now_us);
         let mac = mac40(self.mac.clone(), self.stream, &payload, fv);
         let frame = auth_frame(self.stream, fv, mac)?;
-        self.next_freshness = next;
+        self.last_freshness = fv;
         Ok(frame)
     }
 }
@@ -577,26 +630,31 @@ pub struct SecOcTx {
 }
 
 impl SecOcTx {
-    /// Both senders, each starting at `first_freshness`.
+    /// Both senders.
     #[must_use]
-    pub fn new(airbag_key: &SecOcKey, belt_key: &SecOcKey, first_freshness: u64) -> Self {
+    pub fn new(airbag_key: &SecOcKey, belt_key: &SecOcKey) -> Self {
         Self {
             senders: [
-                SecOcSender::new(SecOcStream::AirbagStage, airbag_key, first_freshness),
-                SecOcSender::new(SecOcStream::BeltLimiter, belt_key, first_freshness),
+                SecOcSender::new(SecOcStream::AirbagStage, airbag_key),
+                SecOcSender::new(SecOcStream::BeltLimiter, belt_key),
             ],
         }
     }
 
-    /// Authenticator for a command frame of either stream (dispatch by CAN id); `WrongId` for
-    /// any other frame.
-    pub fn authenticate(&mut self, command: &RawFrame) -> Result<RawFrame, SecOcError> {
+    /// Authenticator for a command frame of either stream (dispatch by CAN id) at the
+    /// synchronized time `sync_now_us` (see [`SecOcSender::authenticate`]); `WrongId` for any
+    /// other frame.
+    pub fn authenticate(
+        &mut self,
+        command: &RawFrame,
+        sync_now_us: u64,
+    ) -> Result<RawFrame, SecOcError> {
         let stream =
             SecOcStream::for_command_id(command.id).ok_or(SecOcError::WrongId(command.id))?;
         self.senders
             .get_mut(stream.index())
             .ok_or(SecOcError::WrongId(command.id))?
-            .authenticate(command)
+            .authenticate(command, sync_now_us)
     }
 
     /// The sender of one stream.
@@ -612,17 +670,26 @@ impl SecOcTx {
 /// Receiver tuning.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SecOcConfig {
-    /// Acceptance window: the largest accepted jump of the freshness value over the last
-    /// accepted one (1 = no authenticator may be lost). Clamped to [`MAX_FORWARD_JUMP_LIMIT`].
-    pub max_forward_jump: u64,
-    /// Longest time from a command frame to its authenticator.
+    /// Freshness window, µs: the largest accepted difference between an authenticator's time
+    /// stamp and the receiver's synchronized time, either way. Covers bus latency, scheduling
+    /// stalls and the clock difference of sender and receiver. Clamped to
+    /// `1..=`[`MAX_FRESHNESS_WINDOW_US`].
+    ///
+    /// (This replaces the counter scheme's `max_forward_jump`: with time stamps, lost
+    /// authenticators only leave gaps in time, there is no count of them to bound.)
+    pub freshness_window_us: u64,
+    /// Longest time from a command frame to its authenticator (receiver's monotonic time).
     pub pairing_timeout_us: u64,
 }
 
 impl SecOcConfig {
-    /// *Default* window: 1000 lost authenticators (10 s of 10-ms commands) before the receiver
-    /// demands a resync — the MAC binds the full counter, so a wide window costs no security.
-    pub const DEFAULT_MAX_FORWARD_JUMP: u64 = 1000;
+    /// *Default* freshness window: 100 ms. On the bench sender and receiver read the same
+    /// CLOCK_REALTIME, so the difference is the bus latency (< 1 ms) plus scheduling stalls
+    /// (tens of ms under user-mode Linux); a vehicle's synchronized time base is good to well
+    /// under a millisecond. A replay needs a recording younger than this *and* an unused
+    /// freshness value — the latter is impossible (`last_accepted`), so the window only bounds
+    /// how long a *suppressed* genuine pair (held back from the receiver) stays usable.
+    pub const DEFAULT_FRESHNESS_WINDOW_US: u64 = 100_000;
     /// *Default* pairing timeout: one 10-ms command cycle. The sender puts the authenticator
     /// on the bus right after the command, so anything later is a delayed or injected frame.
     pub const DEFAULT_PAIRING_TIMEOUT_US: u64 = 10_000;
@@ -631,7 +698,7 @@ impl SecOcConfig {
 impl Default for SecOcConfig {
     fn default() -> Self {
         Self {
-            max_forward_jump: Self::DEFAULT_MAX_FORWARD_JUMP,
+            freshness_window_us: Self::DEFAULT_FRESHNESS_WINDOW_US,
             pairing_timeout_us: Self::DEFAULT_PAIRING_TIMEOUT_US,
         }
     }
@@ -683,7 +750,8 @@ struct Pending {
 }
 
 /// Receiver side of one stream: holds the last command until its authenticator verifies.
-/// No allocation, no panic; at most three CMACs per authenticator.
+/// No allocation, no panic; at most three CMACs per authenticator (one to accept, two more
+/// to classify a rejection).
 #[derive(Clone)]
 pub struct SecOcVerifier {
     stream: SecOcStream,
@@ -707,22 +775,18 @@ impl core::fmt::Debug for SecOcVerifier {
 }
 
 impl SecOcVerifier {
-    /// Verifier that accepts freshness values above `last_accepted` (0 on the bench).
+    /// Verifier of `stream`. It starts with `last_accepted = 0`: with time-stamp freshness
+    /// there is no start value to agree on (the window rejects earlier sessions' frames).
     #[must_use]
-    pub fn new(
-        stream: SecOcStream,
-        key: &SecOcKey,
-        config: SecOcConfig,
-        last_accepted: u64,
-    ) -> Self {
+    pub fn new(stream: SecOcStream, key: &SecOcKey, config: SecOcConfig) -> Self {
         Self {
             stream,
             mac: key.cmac(),
             config: SecOcConfig {
-                max_forward_jump: config.max_forward_jump.clamp(1, MAX_FORWARD_JUMP_LIMIT),
+                freshness_window_us: config.freshness_window_us.clamp(1, MAX_FRESHNESS_WINDOW_US),
                 ..config
             },
-            last_accepted,
+            last_accepted: 0,
             pending: None,
             stats: SecOcStats::default(),
         }
@@ -734,7 +798,13 @@ impl SecOcVerifier {
         self.stream
     }
 
-    /// Last accepted full freshness value.
+    /// The configuration in use (window clamped).
+    #[must_use]
+    pub const fn config(&self) -> &SecOcConfig {
+        &self.config
+    }
+
+    /// Last accepted full freshness value (µs; 0 before the first).
     #[must_use]
     pub const fn last_accepted(&self) -> u64 {
         self.last_accepted
@@ -784,13 +854,16 @@ impl SecOcVerifier {
     }
 
     /// Verifies an authenticator frame's payload against the held command (rules in the module
-    /// docs). On success the command is consumed and returned.
+    /// docs). `now_us` is the receiver's monotonic time (pairing timeout, same clock as
+    /// [`Self::hold_command`]); `sync_now_us` its synchronized time (freshness, same time base
+    /// as the sender's). On success the command is consumed and returned.
     pub fn verify_auth(
         &mut self,
         auth_payload: &[u8],
         now_us: u64,
+        sync_now_us: u64,
     ) -> Result<AuthenticatedCommand, SecOcError> {
-        match self.verify_inner(auth_payload, now_us) {
+        match self.verify_inner(auth_payload, now_us, sync_now_us) {
             Ok(c) => {
                 self.stats.accepted = self.stats.accepted.saturating_add(1);
                 Ok(c)
@@ -801,17 +874,19 @@ impl SecOcVerifier {
 
     /// Routes one received frame of this stream: a command is held (`Ok(None)`), an
     /// authenticator verified (`Ok(Some(..))` = act now). The caller must have E2E-checked a
-    /// command frame before. Other ids: [`SecOcError::WrongId`].
+    /// command frame before. Other ids: [`SecOcError::WrongId`]. Times as in
+    /// [`Self::verify_auth`].
     pub fn on_frame(
         &mut self,
         id: u32,
         payload: &[u8],
         now_us: u64,
+        sync_now_us: u64,
     ) -> Result<Option<AuthenticatedCommand>, SecOcError> {
         if id == self.stream.command_id() {
             self.hold_command(payload, now_us).map(|()| None)
         } else if id == self.stream.auth_id() {
-            self.verify_auth(payload, now_us).map(Some)
+            self.verify_auth(payload, now_us, sync_now_us).map(Some)
         } else {
             Err(self.count(SecOcError::WrongId(id)))
         }
@@ -828,6 +903,7 @@ impl SecOcVerifier {
         &mut self,
         auth_payload: &[u8],
         now_us: u64,
+        sync_now_us: u64,
     ) -> Result<AuthenticatedCommand, SecOcError> {
         let (fv_tx, mac_rx) = auth_fields(self.stream, auth_payload)?;
         let pending = self.pending.ok_or(SecOcError::NoPendingCommand)?;
@@ -837,46 +913,57 @@ impl SecOcVerifier {
             self.stats.commands_dropped = self.stats.commands_dropped.saturating_add(1);
             return Err(SecOcError::Stale { age_us });
         }
-        let last = self.last_accepted;
-        // Same 2^24 epoch as `last`; if that is not above `last`, the next epoch.
-        let same_epoch = (last & !FRESHNESS_TX_MASK) | fv_tx;
-        let (candidate, used) = if same_epoch > last {
-            (Some(same_epoch), None)
-        } else {
-            (
-                same_epoch.checked_add(1 << FRESHNESS_TX_BITS),
-                Some(same_epoch),
-            )
-        };
         let ok = |fv: u64| mac40_ok(&self.mac, self.stream, &pending.payload, fv, mac_rx);
-        if let Some(fv) = candidate {
-            if fv - last <= self.config.max_forward_jump {
-                if !ok(fv) {
-                    return Err(SecOcError::MacMismatch);
-                }
-                self.last_accepted = fv;
-                self.pending = None;
-                return Ok(AuthenticatedCommand {
-                    stream: self.stream,
-                    payload: pending.payload,
-                    freshness: fv,
-                    pairing_delay_us: age_us,
-                });
+        let stale = |freshness: u64| SecOcError::FreshnessStale {
+            freshness,
+            sync_now_us,
+        };
+        let v = nearest_freshness(fv_tx, sync_now_us);
+        if ok(v) {
+            if v.abs_diff(sync_now_us) > self.config.freshness_window_us {
+                return Err(stale(v));
             }
-        }
-        if let Some(old) = used {
-            if ok(old) {
-                return Err(SecOcError::Replay { freshness: old });
+            if v <= self.last_accepted {
+                return Err(SecOcError::Replay { freshness: v });
             }
+            self.last_accepted = v;
+            self.pending = None;
+            return Ok(AuthenticatedCommand {
+                stream: self.stream,
+                payload: pending.payload,
+                freshness: v,
+                pairing_delay_us: age_us,
+            });
         }
-        match candidate {
-            Some(fv) if ok(fv) => Err(SecOcError::FreshnessOutOfWindow {
-                freshness: fv,
-                last,
-            }),
-            _ => Err(SecOcError::MacMismatch),
+        // Classification only (the frame is rejected whatever comes out): a genuine frame
+        // from the neighbouring 2^24-µs spans (8.4 s .. 25 s away) is stale, not forged.
+        let neighbours = [
+            v.checked_sub(FRESHNESS_TX_SPAN),
+            v.checked_add(FRESHNESS_TX_SPAN),
+        ];
+        match neighbours.into_iter().flatten().find(|fv| ok(*fv)) {
+            Some(fv) => Err(stale(fv)),
+            None => Err(SecOcError::MacMismatch),
         }
     }
+}
+
+/// The full freshness value congruent to the received bits `fv_tx` (mod 2^24) nearest to
+/// `sync_now_us`; at exactly 2^23 µs either way the earlier one. Correct while sender and
+/// receiver clocks (plus latency) differ by less than 2^23 µs ≈ 8.4 s.
+fn nearest_freshness(fv_tx: u64, sync_now_us: u64) -> u64 {
+    // Distance forward from `sync_now_us` to the next value with these low bits, < 2^24.
+    let ahead = fv_tx.wrapping_sub(sync_now_us) & FRESHNESS_TX_MASK;
+    let behind = FRESHNESS_TX_SPAN - ahead;
+    let later = sync_now_us.checked_add(ahead);
+    let earlier = sync_now_us.checked_sub(behind);
+    let preferred = if ahead < FRESHNESS_TX_SPAN / 2 {
+        later.or(earlier)
+    } else {
+        earlier.or(later)
+    };
+    // Both `None` would need a u64 range below 2^24: impossible; fall back to the bits.
+    preferred.unwrap_or(fv_tx)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1088,10 +1175,10 @@ mod keyfile {
             }
         }
 
-        /// Sender side of both streams (ECU), starting at `first_freshness`.
+        /// Sender side of both streams (ECU); freshness comes from the synchronized clock.
         #[must_use]
-        pub fn tx(&self, first_freshness: u64) -> super::SecOcTx {
-            super::SecOcTx::new(&self.keys[0], &self.keys[1], first_freshness)
+        pub fn tx(&self) -> super::SecOcTx {
+            super::SecOcTx::new(&self.keys[0], &self.keys[1])
         }
 
         /// Receiver of one stream (actuator stub).
@@ -1100,9 +1187,8 @@ mod keyfile {
             &self,
             stream: SecOcStream,
             config: super::SecOcConfig,
-            last_accepted: u64,
         ) -> super::SecOcVerifier {
-            super::SecOcVerifier::new(stream, self.get(stream), config, last_accepted)
+            super::SecOcVerifier::new(stream, self.get(stream), config)
         }
     }
 }

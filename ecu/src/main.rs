@@ -52,8 +52,9 @@ fn load_secoc(cfg: &EcuConfig) -> Option<bus::secoc::SecOcTx> {
     match bus::secoc::SecOcKeys::load(&cfg.cycle.secoc_keys) {
         Ok(keys) => {
             eprintln!("ecu: secoc keys   {}", cfg.cycle.secoc_keys.display());
-            // Freshness starts at 1: the actuators start with last accepted = 0.
-            Some(keys.tx(1))
+            // Freshness = CLOCK_REALTIME µs per cycle (CycleInfo::sync_time_us): nothing to
+            // agree on with the actuators, nothing to persist across restarts.
+            Some(keys.tx())
         }
         Err(e) => {
             eprintln!(

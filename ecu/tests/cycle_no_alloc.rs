@@ -70,7 +70,7 @@ fn no_allocation_in_precrash_and_crash_cycles() {
     let (mut ecu, _) = RestraintCycle::new(CycleConfig::default(), Some(lut), &REFERENCE).unwrap();
     let keys =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/secoc-keys.example.toml");
-    ecu.set_secoc(Some(bus::secoc::SecOcKeys::load(&keys).unwrap().tx(1)));
+    ecu.set_secoc(Some(bus::secoc::SecOcKeys::load(&keys).unwrap().tx()));
     let mut bench = cycle_support::Bench::new(None); // only for its sealed CAN frames
     let mut io = FixedIo {
         object: None,
@@ -125,6 +125,7 @@ fn no_allocation_in_precrash_and_crash_cycles() {
             period_ns: MS,
             deadline_ns: now,
             now_ns: now,
+            sync_time_us: cycle_support::sync_time_us(now),
             ..CycleInfo::default()
         };
         if k == 1_000 {

@@ -30,6 +30,9 @@ struct Counted {
     inner: PassthroughActivity,
     objects_at_start: u64,
     accel_at_start: u64,
+    /// `CycleInfo::sync_time_us` of the last cycle (read from CLOCK_REALTIME inside the
+    /// counted loop).
+    last_sync_time_us: u64,
 }
 
 impl Activity for Counted {
@@ -45,6 +48,7 @@ impl Activity for Counted {
             self.accel_at_start = self.inner.accel_batches_rx();
             set_counting(true);
         }
+        self.last_sync_time_us = info.sync_time_us;
         self.inner.step(info, io);
     }
     fn shutdown(&mut self, now_ns: u64, io: &mut dyn CycleIo) {
@@ -102,6 +106,7 @@ fn steady_state_loop_with_iceoryx2_allocates_nothing() {
         inner: PassthroughActivity::new(),
         objects_at_start: 0,
         accel_at_start: 0,
+        last_sync_time_us: 0,
     };
     let mut stats = LoopStats::default();
     run_activity(
@@ -128,6 +133,15 @@ fn steady_state_loop_with_iceoryx2_allocates_nothing() {
     assert!(io.diagnostics_written() >= MEASURED_CYCLES);
     assert!(io.diagnostics_counters().sent > 0);
     assert!(diag_seen > 0);
+    let wall_us = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .as_micros() as u64;
+    assert!(
+        wall_us.abs_diff(activity.last_sync_time_us) < 10_000_000,
+        "sync time {} vs wall clock {wall_us}",
+        activity.last_sync_time_us
+    );
     assert_eq!(
         allocations, 0,
         "{allocations} heap allocations in {MEASURED_CYCLES} steady-state cycles"

@@ -988,10 +988,12 @@ impl RestraintCycle {
     /// receiver pairs them within one command cycle). `authenticate` is allocation-free.
     /// Complete pairs are counted: an actuator that acts on fewer authenticated commands
     /// than this lost some (the fault campaign's "commands lost").
-    fn send_authenticated(&mut self, io: &mut dyn CycleIo, raw: RawFrame) {
+    /// The authenticator's freshness is the cycle's synchronized time `sync_time_us`
+    /// ([`CycleInfo::sync_time_us`]), made strictly increasing by the sender.
+    fn send_authenticated(&mut self, io: &mut dyn CycleIo, raw: RawFrame, sync_time_us: u64) {
         let cmd_sent = self.send(io, raw);
         if let Some(tx) = self.secoc.as_mut() {
-            match tx.authenticate(&raw) {
+            match tx.authenticate(&raw, sync_time_us) {
                 Ok(auth) => {
                     if self.send(io, auth) && cmd_sent {
                         self.counters.secoc_commands_tx =
@@ -1031,7 +1033,7 @@ impl RestraintCycle {
             match BeltLimiterCmd::encode(belt.cmd, belt.source, belt.level_kn, belt.time_ms) {
                 Ok(m) => {
                     let raw = self.protector.seal(m);
-                    self.send_authenticated(io, raw);
+                    self.send_authenticated(io, raw, info.sync_time_us);
                     self.last_belt = Some(belt);
                     self.last_belt_tx_ns = now;
                 }
@@ -1058,7 +1060,7 @@ impl RestraintCycle {
             ) {
                 Ok(m) => {
                     let raw = self.protector.seal(m);
-                    self.send_authenticated(io, raw);
+                    self.send_authenticated(io, raw, info.sync_time_us);
                     self.last_airbag = Some(bag);
                     self.last_airbag_tx_ns = now;
                 }

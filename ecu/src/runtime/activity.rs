@@ -28,6 +28,12 @@ pub struct CycleInfo {
     pub overruns: u64,
     /// Skipped slots so far.
     pub skipped_slots: u64,
+    /// Synchronized global time at the start of the cycle, µs (CLOCK_REALTIME since the UNIX
+    /// epoch under the real runtime; a fixed epoch plus the simulated time under
+    /// [`super::SimClock`]). Only for SecOC freshness, which must mean the same on the sender
+    /// and the receivers; the cycle's own timing uses the monotonic `now_ns`. Handed in, not
+    /// read, so that the cycle stays deterministic and clock-agnostic.
+    pub sync_time_us: u64,
 }
 
 /// A classic CAN frame as seen by the cycle (independent of the socket library).

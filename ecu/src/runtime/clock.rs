@@ -13,6 +13,9 @@ pub trait Clock {
     /// Sleeps until the absolute time `deadline_ns` (or returns early when a signal
     /// interrupts the sleep; the loop re-checks its stop flag and sleeps again).
     fn sleep_until_ns(&mut self, deadline_ns: u64) -> SleepOutcome;
+    /// Current synchronized global time, µs (SecOC freshness; see
+    /// [`super::CycleInfo::sync_time_us`]). Allocation-free.
+    fn sync_time_us(&self) -> u64;
 }
 
 /// How a sleep ended.
@@ -57,6 +60,16 @@ impl Clock for MonotonicClock {
             Err(_) => SleepOutcome::Interrupted,
         }
     }
+
+    /// CLOCK_REALTIME in µs since the UNIX epoch: the bench's synchronized time base (every
+    /// process on the machine reads the same clock; a vehicle would use StbM/gPTP time).
+    /// `clock_gettime` goes through the vDSO: no system call, no allocation.
+    fn sync_time_us(&self) -> u64 {
+        match clock_gettime(ClockId::CLOCK_REALTIME) {
+            Ok(ts) => timespec_to_ns(&ts) / 1_000,
+            Err(_) => 0,
+        }
+    }
 }
 
 fn timespec_to_ns(ts: &TimeSpec) -> u64 {
@@ -76,6 +89,10 @@ pub struct SimClock {
 }
 
 impl SimClock {
+    /// Synchronized time at simulated time 0, µs since the UNIX epoch (2025-06-15 15:06:40
+    /// UTC): a fixed value, so simulated runs are reproducible.
+    pub const SYNC_EPOCH_US: u64 = 1_750_000_000_000_000;
+
     /// A clock at `start_ns`.
     pub fn new(start_ns: u64) -> Self {
         let c = Self::default();
@@ -97,6 +114,12 @@ impl SimClock {
 impl Clock for SimClock {
     fn now_ns(&self) -> u64 {
         self.now.get()
+    }
+
+    /// [`SimClock::SYNC_EPOCH_US`] plus the simulated time: deterministic, and a plausible
+    /// wall-clock value so that SecOC freshness behaves as on the bench.
+    fn sync_time_us(&self) -> u64 {
+        Self::SYNC_EPOCH_US.saturating_add(self.now.get() / 1_000)
     }
 
     fn sleep_until_ns(&mut self, deadline_ns: u64) -> SleepOutcome {
@@ -124,6 +147,24 @@ mod tests {
     }
 
     #[test]
+    fn real_sync_time_is_the_wall_clock() {
+        let c = MonotonicClock;
+        let before = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap()
+            .as_micros();
+        let sync = u128::from(c.sync_time_us());
+        let after = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap()
+            .as_micros();
+        assert!(
+            before <= sync && sync <= after,
+            "{before} <= {sync} <= {after}"
+        );
+    }
+
+    #[test]
     fn sim_clock_jumps_to_deadline_plus_latency() {
         let mut c = SimClock::new(100);
         c.set_wake_latency_ns(7);
@@ -135,5 +176,7 @@ mod tests {
         let shared = c.clone();
         shared.advance_ns(3);
         assert_eq!(c.now_ns(), 1_010);
+        shared.advance_ns(5_000);
+        assert_eq!(c.sync_time_us(), 1_750_000_000_000_006);
     }
 }

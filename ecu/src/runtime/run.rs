@@ -80,6 +80,7 @@ where
             }
         }
         let wake_ns = clock.now_ns();
+        let sync_time_us = clock.sync_time_us();
         let wake_latency_ns = wake_ns.saturating_sub(deadline_ns);
         let info = CycleInfo {
             cycle: stats.cycles,
@@ -91,6 +92,7 @@ where
             last_exec_ns,
             overruns: stats.overruns,
             skipped_slots: stats.skipped_slots,
+            sync_time_us,
         };
         activity.step(&info, io);
         let end_ns = clock.now_ns();
@@ -185,6 +187,11 @@ mod tests {
             assert_eq!(info.slot, k as u64);
             assert_eq!(info.deadline_ns, 5_000 + (k as u64 + 1) * 1_000_000);
             assert_eq!(info.wake_latency_ns, 20_000);
+            // The simulated synchronized time: fixed epoch + simulated time at wake-up.
+            assert_eq!(
+                info.sync_time_us,
+                SimClock::SYNC_EPOCH_US + (info.deadline_ns + 20_000) / 1_000
+            );
         }
         let w = stats.wake_latency.percentiles();
         assert!(w.p50_ns.abs_diff(20_000) <= 20, "{w:?}");

@@ -10,7 +10,7 @@ use bus::codec::{
 use bus::{E2eProtector, EgoVehicleState, OccupantClassification};
 use diagram::{AirbagThresholds, Axes, BuildInfo, Cell, Diagram, EgoVehicle, Header};
 use ecu::cycle::{CycleConfig, RestraintCycle};
-use ecu::runtime::{Activity, CanFrame, CycleInfo, SimIo};
+use ecu::runtime::{Activity, CanFrame, CycleInfo, SimClock, SimIo};
 use ipc::{CrashAccelSample, ObjectState, VALID};
 use physics::reference::ReferenceSettings;
 
@@ -92,6 +92,12 @@ pub struct Bench {
 
 pub const T0: u64 = 10_000 * MS;
 
+/// The synchronized time (µs) the bench hands the cycle at monotonic `now_ns`, as the
+/// simulated clock defines it.
+pub fn sync_time_us(now_ns: u64) -> u64 {
+    SimClock::SYNC_EPOCH_US + now_ns / 1_000
+}
+
 impl Bench {
     pub fn new(lut: Option<Diagram>) -> Self {
         Self::with_config(CycleConfig::default(), lut)
@@ -151,6 +157,7 @@ impl Bench {
             period_ns: MS,
             deadline_ns: self.now,
             now_ns: self.now,
+            sync_time_us: sync_time_us(self.now),
             ..CycleInfo::default()
         };
         let before = self.io.can_tx.len();
