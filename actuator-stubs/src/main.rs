@@ -53,6 +53,11 @@ struct Cli {
     /// (user-mode Linux): the bench names the value in the report.
     #[arg(long, value_name = "MS", default_value_t = SecOcConfig::DEFAULT_PAIRING_TIMEOUT_US as f64 / 1e3)]
     secoc_pairing_timeout_ms: f64,
+    /// SecOC freshness window, ms: an authenticator whose time stamp is further than this
+    /// from our synchronized clock is rejected as stale (replays of earlier sessions). Wider
+    /// only where the kernel stalls processes (user-mode Linux); the bench names the value.
+    #[arg(long, value_name = "MS", default_value_t = SecOcConfig::default().freshness_window_us as f64 / 1e3)]
+    secoc_freshness_window_ms: f64,
     /// After the scenario is done, keep receiving until SIGTERM/SIGINT, then read what is
     /// still queued and finish (stop reason "done"). For orchestrators that stop the ECU first
     /// and then the stubs, so every command the ECU sent is received and counted (the fault
@@ -130,9 +135,15 @@ fn run(cli: &Cli) -> Result<()> {
     {
         anyhow::bail!("--secoc-pairing-timeout-ms must be within 0.1..=1000");
     }
+    let window_limit_ms = bus::secoc::MAX_FRESHNESS_WINDOW_US as f64 / 1e3;
+    if !(cli.secoc_freshness_window_ms.is_finite()
+        && (0.1..=window_limit_ms).contains(&cli.secoc_freshness_window_ms))
+    {
+        anyhow::bail!("--secoc-freshness-window-ms must be within 0.1..={window_limit_ms}");
+    }
     let secoc_config = SecOcConfig {
         pairing_timeout_us: (cli.secoc_pairing_timeout_ms * 1e3).round() as u64,
-        ..SecOcConfig::default()
+        freshness_window_us: (cli.secoc_freshness_window_ms * 1e3).round() as u64,
     };
     let mut receiver = Receiver::with_config(&keys, secoc_config);
     let mut modules = Modules::default();
@@ -174,7 +185,11 @@ fn run(cli: &Cli) -> Result<()> {
                 .map_or("unknown", |i| i.name)
                 .to_owned();
             *frames.entry(name.clone()).or_default() += 1;
-            let v = receiver.on_frame(&f, rx_ns, actuator_stubs::rx::sync_now_us());
+            // The synchronized time at arrival, on the same arrival instant as rx_ns (a stubs
+            // process that was descheduled must not see a genuine authenticator as stale).
+            let sync_rx_us = actuator_stubs::rx::sync_now_us()
+                .saturating_sub(read_mono.saturating_sub(rx_ns) / 1_000);
+            let v = receiver.on_frame(&f, rx_ns, sync_rx_us);
             if let Some(d) = &v.act {
                 modules.apply(rx_ns, d);
             }
@@ -303,6 +318,7 @@ fn build_report(
         secoc_rejected: receiver.secoc_rejected(),
         secoc_commands_dropped: receiver.secoc_commands_dropped(),
         secoc_pairing_timeout_ms: cli.secoc_pairing_timeout_ms,
+        secoc_freshness_window_ms: cli.secoc_freshness_window_ms,
         e2e_rejected,
         actions: modules
             .actions

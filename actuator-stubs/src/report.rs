@@ -80,6 +80,9 @@ pub struct Report {
     /// SecOC pairing timeout the stubs ran with [ms] (default 10; longer under user-mode Linux).
     #[serde(default)]
     pub secoc_pairing_timeout_ms: f64,
+    /// SecOC freshness window the stubs ran with [ms] (default 100; wider under user-mode Linux).
+    #[serde(default)]
+    pub secoc_freshness_window_ms: f64,
     /// Module actions in order.
     pub actions: Vec<TimedAction>,
     /// First armed airbag command [ms rel. contact].

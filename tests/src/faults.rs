@@ -246,6 +246,8 @@ pub struct CampaignConfig {
     pub bin_dir: PathBuf,
     /// Repository root.
     pub repo: PathBuf,
+    /// Extra ECU arguments for every case.
+    pub ecu_args: Vec<String>,
 }
 
 /// One check of a case.
@@ -655,7 +657,7 @@ fn run_case(
     let out = cfg.out.join(case.name);
     let _ = std::fs::remove_dir_all(&out);
     let mut scenario = scenario_path(cfg, case.scenario);
-    let mut ecu_args = Vec::new();
+    let mut ecu_args = cfg.ecu_args.clone();
     let mut frames = Vec::new();
     match &case.fault {
         Fault::StaleObjects { from_s, to_s } => {

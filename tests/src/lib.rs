@@ -45,6 +45,21 @@ pub struct RunConfig {
 /// payload and a fresh counter); it only bounds how old a held command may be when acted on.
 pub const UML_SECOC_PAIRING_TIMEOUT_MS: f64 = 50.0;
 
+/// SecOC freshness window the stubs get inside user-mode Linux, ms (default 100): the ECU
+/// stamps an authenticator with the synchronized time of its cycle, and an emulator stall
+/// inside that cycle delays the frame. A replay of an earlier session is still far outside.
+pub const UML_SECOC_FRESHNESS_WINDOW_MS: f64 = 250.0;
+
+/// The ECU as it is meant to run: SCHED_FIFO 80 and locked memory. Without the privileges
+/// it says so on stderr and in its report (`rt`) and runs on. On the one emulated CPU of the
+/// user-mode-Linux guest this is what keeps a busy neighbour (candump writing a flooded bus
+/// to disk) from delaying the cycle, exactly as on a real bench.
+pub fn default_ecu_args() -> Vec<String> {
+    ["--sched-fifo", "80", "--mlockall"]
+        .map(str::to_owned)
+        .to_vec()
+}
+
 /// True inside the user-mode-Linux guest of `vcan-setup.sh --run` (it sets `VCAN_IN_UML`).
 pub fn in_uml_guest() -> bool {
     std::env::var_os("VCAN_IN_UML").is_some()
@@ -57,6 +72,8 @@ pub fn default_stubs_args() -> Vec<String> {
     if in_uml_guest() {
         v.push("--secoc-pairing-timeout-ms".to_owned());
         v.push(format!("{UML_SECOC_PAIRING_TIMEOUT_MS}"));
+        v.push("--secoc-freshness-window-ms".to_owned());
+        v.push(format!("{UML_SECOC_FRESHNESS_WINDOW_MS}"));
     }
     v
 }
@@ -536,14 +553,15 @@ pub fn summarise(
     );
     let _ = writeln!(
         s,
-        "SecOC: {} commands authenticated (ECU sent {}), rejected {:?}, unpaired {}; pairing timeout {} ms",
+        "SecOC: {} commands authenticated (ECU sent {}), rejected {:?}, unpaired {}; pairing timeout {} ms, freshness window {} ms",
         r.secoc_accepted,
         ecu.and_then(|e| e.pointer("/counters/secoc_commands_tx"))
             .and_then(|v| v.as_u64())
             .map_or("?".to_owned(), |n| n.to_string()),
         r.secoc_rejected,
         r.secoc_commands_dropped,
-        r.secoc_pairing_timeout_ms
+        r.secoc_pairing_timeout_ms,
+        r.secoc_freshness_window_ms
     );
     if let Some(o) = &r.outcome {
         let _ = writeln!(
@@ -621,6 +639,18 @@ pub fn summarise(
             p("exec_us", "p99"),
             p("exec_us", "max"),
             e.get("activity").and_then(|v| v.as_str()).unwrap_or("?")
+        );
+        let rt = |k: &str| {
+            e.pointer(&format!("/rt/{k}/detail"))
+                .and_then(|v| v.as_str())
+                .unwrap_or("?")
+                .to_owned()
+        };
+        let _ = writeln!(
+            s,
+            "  real-time settings: {}; {}",
+            rt("sched"),
+            rt("mlockall")
         );
         if std::env::var_os("VCAN_IN_UML").is_some() {
             let _ = writeln!(s, "  (inside user-mode Linux: syscalls are emulated, these timings are meaningless — measure on a real kernel)");

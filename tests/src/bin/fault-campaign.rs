@@ -46,6 +46,10 @@ enum Cmd {
         /// Also print the robustness report with these fuzzing figures.
         #[arg(long)]
         fuzz: Option<PathBuf>,
+        /// Extra ECU argument for every case (repeatable; after the bench's own
+        /// `--sched-fifo 80 --mlockall`).
+        #[arg(long, allow_hyphen_values = true)]
+        ecu_arg: Vec<String>,
     },
     /// Print the robustness report of a finished campaign.
     Report {
@@ -87,6 +91,7 @@ fn run() -> Result<bool> {
             bin_dir,
             repo,
             fuzz,
+            ecu_arg,
         } => {
             let bin_dir = match bin_dir {
                 Some(d) => d,
@@ -102,6 +107,7 @@ fn run() -> Result<bool> {
                     .unwrap_or_else(|| "vcan0".into()),
                 bin_dir,
                 repo: repo.unwrap_or_else(e2e_tests::repo_root),
+                ecu_args: [e2e_tests::default_ecu_args(), ecu_arg].concat(),
             };
             let campaign = run_campaign(&cfg, &cases)?;
             std::fs::create_dir_all(&out)?;

@@ -23,7 +23,8 @@ struct Cli {
     /// Folder of the bench binaries (default: this binary's folder).
     #[arg(long)]
     bin_dir: Option<PathBuf>,
-    /// Extra ECU argument (repeatable), e.g. --ecu-arg=--config --ecu-arg=ecu.toml.
+    /// Extra ECU argument (repeatable), e.g. --ecu-arg=--config --ecu-arg=ecu.toml (after
+    /// the bench's own `--sched-fifo 80 --mlockall`).
     #[arg(long, allow_hyphen_values = true)]
     ecu_arg: Vec<String>,
     /// Repository root (the ECU's working directory; default: where this crate was built).
@@ -66,7 +67,7 @@ fn run() -> Result<bool> {
             can: can.clone(),
             bin_dir: bin_dir.clone(),
             service_prefix: format!("hil-bench-{}-{i}", std::process::id()),
-            ecu_args: cli.ecu_arg.clone(),
+            ecu_args: [e2e_tests::default_ecu_args(), cli.ecu_arg.clone()].concat(),
             ecu_cwd: cli.repo.clone().unwrap_or_else(e2e_tests::repo_root),
             stubs_args: e2e_tests::default_stubs_args(),
         };
