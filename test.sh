@@ -35,7 +35,7 @@ cargo run --release -q -p cycle-benches --bin budget -- --no-criterion
 
 step "robustness report (fault campaign of the tests above + fuzz smoke)"
 target/release/fault-campaign report --campaign target/robustness/campaign.json \
-  --fuzz target/robustness/fuzz.json
+  --fuzz target/robustness/fuzz.json --host-timing target/robustness/host-timing.json
 
 echo
 echo "test.sh: all steps passed"

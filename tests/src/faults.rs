@@ -389,10 +389,10 @@ fn scenario_path(cfg: &CampaignConfig, stem: &str) -> PathBuf {
 }
 
 /// The disturbance of one case.
-struct CaseDisturbance<'a> {
-    fault: &'a Fault,
+pub(crate) struct CaseDisturbance<'a> {
+    pub(crate) fault: &'a Fault,
     /// cansend arguments (forged or recorded frames) for the attack cases.
-    frames: Vec<String>,
+    pub(crate) frames: Vec<String>,
 }
 
 fn spawn_piped(cmd: &mut Command, what: &str) -> Result<Child> {
@@ -564,7 +564,7 @@ fn damaged_lut(repo: &Path, dir: &Path, truncated: bool) -> Result<PathBuf> {
 }
 
 /// The stale-objects variant of a scenario (adds a `freezes` window), written to `dir`.
-fn frozen_scenario(src: &Path, dir: &Path, from_s: f64, to_s: f64) -> Result<PathBuf> {
+pub(crate) fn frozen_scenario(src: &Path, dir: &Path, from_s: f64, to_s: f64) -> Result<PathBuf> {
     let text =
         std::fs::read_to_string(src).with_context(|| format!("reading {}", src.display()))?;
     let mut doc: toml::Table = text.parse().context("scenario TOML")?;

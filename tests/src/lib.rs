@@ -8,6 +8,7 @@
 //! leftovers of an earlier (killed) run can never be mistaken for this run's samples.
 
 pub mod faults;
+pub mod host_timing;
 
 use actuator_stubs::report::Report;
 use anyhow::{bail, Context, Result};
@@ -23,7 +24,7 @@ pub struct RunConfig {
     pub scenario: PathBuf,
     /// Output root (the run writes `out/<scenario name>/`).
     pub out: PathBuf,
-    /// CAN interface.
+    /// CAN interface ("" = no CAN: only the host-timing runs, which have no stubs).
     pub can: String,
     /// Folder with the `ecu`, `sensor-feeds` and `actuator-stubs` binaries.
     pub bin_dir: PathBuf,
@@ -99,10 +100,13 @@ impl RunCtx<'_> {
     /// The sensor-feeds command of this run (on the run's epoch, so a restart resumes).
     pub fn feeds_command(&self) -> Command {
         let mut c = Command::new(self.bin("sensor-feeds"));
-        c.arg("--scenario")
-            .arg(&self.cfg.scenario)
-            .args(["--can", &self.cfg.can])
-            .args(["--service-prefix", &self.cfg.service_prefix])
+        c.arg("--scenario").arg(&self.cfg.scenario);
+        if self.cfg.can.is_empty() {
+            c.arg("--no-can");
+        } else {
+            c.args(["--can", &self.cfg.can]);
+        }
+        c.args(["--service-prefix", &self.cfg.service_prefix])
             .arg("--epoch-ns")
             .arg(self.epoch_ns.to_string());
         c

@@ -4,13 +4,18 @@
 //!   CAN interface that must exist — start it through
 //!   `./vcan-setup.sh --run -- target/release/fault-campaign run …` — and writes
 //!   `DIR/campaign.json`; exit 1 if a case failed.
-//! * `fault-campaign report --campaign DIR/campaign.json [--fuzz fuzz.json]` prints the
-//!   robustness report: cases tried, faults survived, commands lost, deadline misses, frames
-//!   rejected by reason, and the fuzzing figures of `tests/fuzz-smoke.sh` (FUZZ_REPORT_JSON).
+//! * `fault-campaign host-timing [--out DIR]` runs the iceoryx2 faults on the host kernel (CAN
+//!   side off, named in the output) with the ECU at SCHED_FIFO 80: deadline misses where
+//!   timers are real (tests/src/host_timing.rs).
+//! * `fault-campaign report --campaign DIR/campaign.json [--fuzz fuzz.json]
+//!   [--host-timing host-timing.json]` prints the robustness report: cases tried, faults
+//!   survived, commands lost, deadline misses, frames rejected by reason, and the fuzzing
+//!   figures of `tests/fuzz-smoke.sh` (FUZZ_REPORT_JSON).
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use e2e_tests::faults::{report_text, run_campaign, Campaign, CampaignConfig, FuzzTarget};
+use e2e_tests::host_timing::{host_timing_text, run_host_timing, HostTiming, HostTimingConfig};
 use std::path::PathBuf;
 
 #[derive(Parser, Debug)]
@@ -51,6 +56,22 @@ enum Cmd {
         #[arg(long, allow_hyphen_values = true)]
         ecu_arg: Vec<String>,
     },
+    /// Deadline misses of the iceoryx2 faults on the host kernel (no CAN: `--no-can`), ECU at
+    /// SCHED_FIFO 80 pinned to `--cpu`; writes OUT/host-timing.json. Needs root (or rtprio).
+    HostTiming {
+        /// Output root.
+        #[arg(long, default_value = "out/host-timing")]
+        out: PathBuf,
+        /// CPU the ECU is pinned to.
+        #[arg(long, default_value_t = 1)]
+        cpu: u32,
+        /// Folder of the bench binaries (default: this binary's folder).
+        #[arg(long)]
+        bin_dir: Option<PathBuf>,
+        /// Repository root (default: where this crate was built).
+        #[arg(long)]
+        repo: Option<PathBuf>,
+    },
     /// Print the robustness report of a finished campaign.
     Report {
         /// campaign.json of a run.
@@ -59,6 +80,9 @@ enum Cmd {
         /// Fuzzing figures (tests/fuzz-smoke.sh with FUZZ_REPORT_JSON).
         #[arg(long)]
         fuzz: Option<PathBuf>,
+        /// Host timing of the iceoryx2 faults (`fault-campaign host-timing`).
+        #[arg(long)]
+        host_timing: Option<PathBuf>,
     },
 }
 
@@ -71,6 +95,14 @@ fn main() -> std::process::ExitCode {
             std::process::ExitCode::from(2)
         }
     }
+}
+
+/// The folder of this binary (where the other bench binaries are built).
+fn this_dir() -> Result<PathBuf> {
+    Ok(std::env::current_exe()?
+        .parent()
+        .map(PathBuf::from)
+        .unwrap_or_default())
 }
 
 fn load_fuzz(path: Option<&PathBuf>) -> Result<Option<Vec<FuzzTarget>>> {
@@ -95,10 +127,7 @@ fn run() -> Result<bool> {
         } => {
             let bin_dir = match bin_dir {
                 Some(d) => d,
-                None => std::env::current_exe()?
-                    .parent()
-                    .map(PathBuf::from)
-                    .unwrap_or_default(),
+                None => this_dir()?,
             };
             let cfg = CampaignConfig {
                 out: out.clone(),
@@ -120,12 +149,46 @@ fn run() -> Result<bool> {
             println!("campaign: {}", path.display());
             Ok(campaign.cases.iter().all(|c| c.pass))
         }
-        Cmd::Report { campaign, fuzz } => {
+        Cmd::HostTiming {
+            out,
+            cpu,
+            bin_dir,
+            repo,
+        } => {
+            let cfg = HostTimingConfig {
+                out: out.clone(),
+                bin_dir: match bin_dir {
+                    Some(d) => d,
+                    None => this_dir()?,
+                },
+                repo: repo.unwrap_or_else(e2e_tests::repo_root),
+                cpu,
+            };
+            let h = run_host_timing(&cfg)?;
+            std::fs::create_dir_all(&out)?;
+            let path = out.join("host-timing.json");
+            std::fs::write(&path, serde_json::to_string_pretty(&h)?)?;
+            println!("{}", host_timing_text(&h));
+            println!("host timing: {}", path.display());
+            Ok(true)
+        }
+        Cmd::Report {
+            campaign,
+            fuzz,
+            host_timing,
+        } => {
             let text = std::fs::read_to_string(&campaign)
                 .with_context(|| format!("reading {}", campaign.display()))?;
             let c: Campaign = serde_json::from_str(&text)
                 .with_context(|| format!("parsing {}", campaign.display()))?;
             println!("{}", report_text(&c, load_fuzz(fuzz.as_ref())?.as_deref()));
+            if let Some(p) = host_timing {
+                let text = std::fs::read_to_string(&p)
+                    .with_context(|| format!("reading {}", p.display()))?;
+                let h: HostTiming = serde_json::from_str(&text)
+                    .with_context(|| format!("parsing {}", p.display()))?;
+                println!("{}", host_timing_text(&h));
+            }
             Ok(c.cases.iter().all(|c| c.pass))
         }
     }
