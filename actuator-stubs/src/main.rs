@@ -80,6 +80,9 @@ fn load_keys(cli: &Cli) -> Result<bus::secoc::SecOcKeys> {
     .map_err(|e| anyhow::anyhow!("SecOC keys: {e}"))
 }
 
+/// Receive queue the stubs ask for (≈ 8 000 CAN frames at the kernel's per-frame cost).
+const RX_QUEUE_BYTES: usize = 8 << 20;
+
 /// Ids the modules listen to (kernel filter): airbag cmd + auth, belt cmd + auth, ECU status.
 const RX_IDS: [u32; 5] = [0x030, 0x031, 0x040, 0x041, 0x110];
 
@@ -118,6 +121,13 @@ fn run(cli: &Cli) -> Result<()> {
             cli.can
         )
     })?;
+    // A deep receive queue: the stubs log every frame and may be descheduled for a while on a
+    // loaded bench (a flooded bus, one emulated CPU); the ECU's commands must still all arrive.
+    match sock.set_receive_buffer(RX_QUEUE_BYTES) {
+        Ok(n) if n >= RX_QUEUE_BYTES => {}
+        Ok(n) => eprintln!("actuator-stubs: CAN receive queue {n} bytes (asked {RX_QUEUE_BYTES})"),
+        Err(e) => eprintln!("actuator-stubs: CAN receive queue not enlarged: {e}"),
+    }
     let names = ServiceNames::with_prefix(&cli.service_prefix);
     let (node, _) = ipc::create_node(&format!("actuator-stubs-{}", std::process::id()), false)?;
     let mut truth_sub = BenchTruthSubscriber::new(&node, &names)?;

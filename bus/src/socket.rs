@@ -101,6 +101,21 @@ impl BusSocket {
         })
     }
 
+    /// Asks for a kernel receive queue of `bytes` (SO_RCVBUFFORCE where permitted, else
+    /// SO_RCVBUF, which the kernel caps at `net.core.rmem_max`) and returns what the kernel
+    /// granted (it counts its own overhead: a CAN frame costs several hundred bytes). A process
+    /// that may be descheduled for a while under load (a logger, the actuator stubs) needs a
+    /// deeper queue than the default ≈ 200 KiB, or frames queued meanwhile are dropped.
+    pub fn set_receive_buffer(&self, bytes: usize) -> io::Result<usize> {
+        use nix::sys::socket::{getsockopt, setsockopt, sockopt};
+        use std::os::fd::AsFd;
+        let fd = self.sock.as_fd();
+        if setsockopt(&fd, sockopt::RcvBufForce, &bytes).is_err() {
+            setsockopt(&fd, sockopt::RcvBuf, &bytes).map_err(io::Error::from)?;
+        }
+        getsockopt(&fd, sockopt::RcvBuf).map_err(io::Error::from)
+    }
+
     /// The interface name.
     #[must_use]
     pub fn iface(&self) -> &str {

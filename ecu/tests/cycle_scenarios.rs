@@ -462,3 +462,40 @@ fn restarted_sender_is_accepted_after_its_timeout_but_a_counter_jump_is_not() {
         1
     );
 }
+
+/// A stuck sensor that keeps repeating its last "no track" record (old timestamp): the record
+/// is as stale as any sample, so the ECU degrades (OBJECT_INVALID) once it is older than the
+/// object timeout, and recovers on the first fresh record.
+#[test]
+fn stuck_no_track_records_degrade_like_stale_samples() {
+    let mut b = Bench::new(Some(test_lut()));
+    let end = b.now + 300 * MS;
+    run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    assert_eq!(b.mode_at(b.now - MS), EcuMode::Monitoring as u8);
+    let mut stuck = ObjectState::INVALID;
+    stuck.timestamp_ns = b.now;
+    let frozen_at = b.now;
+    for _ in 0..30 {
+        b.io.objects.push_back(stuck); // the same record every 10 ms
+        b.run_ms(10);
+    }
+    let first_degraded = b
+        .step_times
+        .iter()
+        .zip(&b.io.diagnostics)
+        .find(|(t, d)| **t >= frozen_at && d.degraded_reasons & degraded::OBJECT_INVALID != 0)
+        .map(|(t, _)| *t)
+        .expect("degraded while the record is stuck");
+    let after_ms = (first_degraded - frozen_at) / MS;
+    assert!(
+        (100..=111).contains(&after_ms),
+        "degraded {after_ms} ms after the record was taken (timeout 100 ms, records every 10 ms)"
+    );
+    // Fresh again.
+    let end = b.now + 20 * MS;
+    run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    assert_eq!(
+        b.io.diagnostics.last().unwrap().degraded_reasons & degraded::OBJECT_INVALID,
+        0
+    );
+}

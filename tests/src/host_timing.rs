@@ -70,7 +70,7 @@ pub fn host_cases() -> Vec<(&'static str, Fault)> {
             "feeds-killed",
             Fault::FeedsKilled {
                 kill_s: 0.4,
-                restart_s: 0.7,
+                restart_s: 0.7, // the host starts a process in milliseconds
             },
         ),
         (
@@ -145,10 +145,7 @@ pub fn run_host_timing(cfg: &HostTimingConfig) -> Result<HostTiming> {
         std::thread::sleep(Duration::from_millis(300));
         let scenario =
             sensor_feeds::Scenario::load(&run.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
-        let mut feeds = Command::new(cfg.bin_dir.join("sensor-feeds"))
-            .arg("--scenario")
-            .arg(&run.scenario)
-            .args(["--no-can", "--service-prefix", &run.service_prefix])
+        let mut feeds = crate::feeds_command(&run, None)
             .stdout(Stdio::piped())
             .spawn()
             .context("starting sensor-feeds")?;

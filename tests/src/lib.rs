@@ -99,17 +99,7 @@ impl RunCtx<'_> {
 
     /// The sensor-feeds command of this run (on the run's epoch, so a restart resumes).
     pub fn feeds_command(&self) -> Command {
-        let mut c = Command::new(self.bin("sensor-feeds"));
-        c.arg("--scenario").arg(&self.cfg.scenario);
-        if self.cfg.can.is_empty() {
-            c.arg("--no-can");
-        } else {
-            c.args(["--can", &self.cfg.can]);
-        }
-        c.args(["--service-prefix", &self.cfg.service_prefix])
-            .arg("--epoch-ns")
-            .arg(self.epoch_ns.to_string());
-        c
+        feeds_command(self.cfg, Some(self.epoch_ns))
     }
 
     /// Sleeps until scenario time `t_s`.
@@ -174,6 +164,8 @@ pub struct RunResult {
     pub problems: Vec<String>,
     /// CLOCK_MONOTONIC ns of scenario t = 0.
     pub epoch_ns: u64,
+    /// The scenario file played.
+    pub scenario: PathBuf,
     /// What the disturbance processes printed, by name.
     pub disturbance_output: Vec<(String, String)>,
 }
@@ -219,6 +211,23 @@ fn wait_timeout(child: &mut Child, timeout: Duration) -> Result<Option<std::proc
         std::thread::sleep(Duration::from_millis(10));
     }
     Ok(None)
+}
+
+/// The sensor-feeds command of a run: CAN or `--no-can`, the run's services, and the time
+/// base (`None`: the feeds choose it and announce it).
+pub fn feeds_command(cfg: &RunConfig, epoch_ns: Option<u64>) -> Command {
+    let mut c = Command::new(cfg.bin_dir.join("sensor-feeds"));
+    c.arg("--scenario").arg(&cfg.scenario);
+    if cfg.can.is_empty() {
+        c.arg("--no-can");
+    } else {
+        c.args(["--can", &cfg.can]);
+    }
+    c.args(["--service-prefix", &cfg.service_prefix]);
+    if let Some(e) = epoch_ns {
+        c.arg("--epoch-ns").arg(e.to_string());
+    }
+    c
 }
 
 /// Reads the feeds' "epoch_ns N" line (their first line on stdout).
@@ -337,11 +346,7 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     }
     // The feeds fix scenario t = 0 when they are ready and print it ("epoch_ns N").
     let mut feeds = spawn(
-        Command::new(bin("sensor-feeds"))
-            .arg("--scenario")
-            .arg(&cfg.scenario)
-            .args(["--can", &cfg.can, "--service-prefix", &cfg.service_prefix])
-            .stdout(Stdio::piped()),
+        feeds_command(cfg, None).stdout(Stdio::piped()),
         "sensor-feeds",
     )?;
     let epoch_ns = match read_epoch(&mut feeds) {
@@ -425,6 +430,7 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
         summary,
         problems,
         epoch_ns,
+        scenario: cfg.scenario.clone(),
         disturbance_output,
     })
 }

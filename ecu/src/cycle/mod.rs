@@ -583,6 +583,13 @@ impl RestraintCycle {
     fn on_object(&mut self, o: &ObjectState, now: u64) {
         self.counters.objects_rx = self.counters.objects_rx.saturating_add(1);
         if !o.is_valid() {
+            // A "no track" record is information too, and can be as old as any other: a
+            // stuck sensor repeating its last "nothing ahead" must go stale like any sample.
+            if now.abs_diff(o.timestamp_ns) > self.object_timeout_ns {
+                self.counters.objects_invalid = self.counters.objects_invalid.saturating_add(1);
+                self.object_invalid = true;
+                return;
+            }
             // A fresh "no track" sample: the sensor is alive, nothing ahead.
             self.object_present = false;
             self.object_invalid = false;
