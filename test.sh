@@ -28,7 +28,7 @@ totals=$(awk '/^test result:/ { p += $4; f += $6 } END { printf "%d passed, %d f
 step "fuzz smoke: every cargo-fuzz target for ${FUZZ_SECONDS:=4} s"
 cargo fuzz --version >/dev/null 2>&1 || cargo install --locked cargo-fuzz
 mkdir -p target/robustness
-FUZZ_SECONDS=$FUZZ_SECONDS FUZZ_REPORT_JSON=target/robustness/fuzz.json tests/fuzz-smoke.sh
+FUZZ_SECONDS=$FUZZ_SECONDS FUZZ_REPORT_JSON="$PWD/target/robustness/fuzz.json" tests/fuzz-smoke.sh
 
 step "deterministic budget: instructions per worst-case ECU cycle (valgrind)"
 cargo run --release -q -p cycle-benches --bin budget -- --no-criterion

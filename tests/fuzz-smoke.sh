@@ -15,7 +15,8 @@
 #   FUZZ_SANITIZER    none | address (default none: fastest; address for long runs)
 #   FUZZ_TARGET_DIR   cargo target dir of the fuzz build (default: $CARGO_TARGET_DIR-fuzz or
 #                     target/fuzz under the repo)
-#   FUZZ_REPORT_JSON  if set, also write the per-target figures there as JSON
+#   FUZZ_REPORT_JSON  if set, also write the per-target figures there as JSON (a relative
+#                     path is taken from the directory the script was started in)
 #   FUZZ_KEEP         if 1, keep the scratch directory (grown corpus, crash artifacts)
 # Exit: 0 all clean, 1 a target crashed/hung/OOMed, 2 setup error (cargo-fuzz missing, build).
 set -euo pipefail
@@ -39,6 +40,9 @@ if ! cargo fuzz --version >/dev/null 2>&1; then
   exit 2
 fi
 
+if [[ -n "${FUZZ_REPORT_JSON:-}" && "$FUZZ_REPORT_JSON" != /* ]]; then
+  FUZZ_REPORT_JSON="$PWD/$FUZZ_REPORT_JSON"
+fi
 cd "$fuzz_dir"
 if [[ $# -gt 0 ]]; then
   targets=("$@")
