@@ -15,7 +15,7 @@
 # WSL2, many containers). A user-mode Linux kernel (Debian package `user-mode-linux`) has the
 # vcan module; it mounts the host's / as its root (hostfs), so host-built binaries run unchanged.
 # Inside the guest /tmp and /dev/shm are fresh tmpfs (host paths under /tmp that matter — the
-# working directory — are mounted back). Timing measured inside UML is meaningless (syscalls are
+# checkout, the working directory, the command's directory, CARGO_TARGET_DIR — are mounted back). Timing measured inside UML is meaningless (syscalls are
 # emulated): use it for function, not for latency.
 set -eu
 
@@ -106,6 +106,10 @@ ensure_uml() {
 run_uml() {
   ensure_uml || exit 4
   work=$(mktemp -d "${TMPDIR:-/tmp}/vcan-uml.XXXXXX")
+  # Host directories under /tmp the guest must see again (its /tmp is a fresh tmpfs): this
+  # script's checkout, the working directory, the command's own directory, the cargo target.
+  repo_dir=$(cd "$(dirname "$0")" && pwd)
+  cmd_dir=$(cd "$(dirname "$1")" 2>/dev/null && pwd || true)
   trap 'rm -rf "$work"' EXIT INT TERM
   printf '%s\n' "$@" > "$work/argv"
   # Environment for the guest: the kernel's init starts with an empty one.
@@ -125,7 +129,7 @@ export PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin
 mount -t proc proc /proc; mount -t sysfs sys /sys
 mount -t tmpfs tmpfs /tmp; mkdir -p /dev/shm; mount -t tmpfs tmpfs /dev/shm
 # the fresh /tmp hides host paths under it: mount back the ones we need
-for d in "$work" "$PWD"; do
+for d in "$work" "$repo_dir" "$PWD" "$cmd_dir" "${CARGO_TARGET_DIR:-}"; do
   case "\$d" in /tmp/*) mkdir -p "\$d"; mount -t hostfs none "\$d" -o "\$d" ;; esac
 done
 M=/usr/lib/uml/modules/\$(uname -r)/kernel
