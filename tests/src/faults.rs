@@ -64,6 +64,11 @@ pub const UML_SLACK_MS: f64 = 100.0;
 /// A fire command may arrive this much after its planned time (same as the bench tests).
 pub const FIRE_LATE_ALLOWANCE_MS: f64 = 15.0;
 
+/// Runs a case may take inside user-mode Linux when only time limits fail: its emulated
+/// timers stall processes for 100 ms and more now and then (a stall before the fault leaves the
+/// ECU already degraded, and the detection cannot be measured). Function checks never retry.
+const UML_ATTEMPTS: u32 = 3;
+
 /// Checks that are time limits (see [`Check::timing`]).
 const TIMING_CHECKS: [&str; 4] = [
     "fire command on time",
@@ -313,11 +318,23 @@ pub struct CaseResult {
     pub checks: Vec<Check>,
     /// All checks passed.
     pub pass: bool,
-    /// Runs it took (2: the first failed only timing checks inside user-mode Linux).
+    /// Runs it took (> 1: the earlier ones failed only time limits inside user-mode Linux).
     #[serde(default)]
     pub attempts: u32,
     /// Output folder.
     pub dir: String,
+    /// True contact [scenario s] (None: no contact).
+    #[serde(default)]
+    pub contact_s: Option<f64>,
+    /// Airbag fire command received [scenario s].
+    #[serde(default)]
+    pub fire_s: Option<f64>,
+    /// The fault's extent as measured [scenario s] (window faults only).
+    #[serde(default)]
+    pub fault_s: Option<(f64, f64)>,
+    /// Scenario duration [s].
+    #[serde(default)]
+    pub duration_s: f64,
 }
 
 /// Fuzzing figures (tests/fuzz-smoke.sh FUZZ_REPORT_JSON).
@@ -365,15 +382,20 @@ pub fn run_campaign(cfg: &CampaignConfig, only: &[String]) -> Result<Campaign> {
             case.what
         );
         let (mut run, mut result) = run_case(cfg, case, i, baseline.as_ref().map(|b| &b.0))?;
-        let timing_only = !result.pass && result.checks.iter().all(|c| c.ok || c.timing);
-        if timing_only && out.in_uml {
+        let mut attempts = 1;
+        while out.in_uml
+            && attempts < UML_ATTEMPTS
+            && !result.pass
+            && result.checks.iter().all(|c| c.ok || c.timing)
+        {
             eprintln!(
-                "fault-campaign: {}: only time limits failed inside user-mode Linux (emulated timers); running it once more",
+                "fault-campaign: {}: only time limits failed inside user-mode Linux (emulated timers); running it again",
                 case.name
             );
             (run, result) = run_case(cfg, case, i, baseline.as_ref().map(|b| &b.0))?;
-            result.attempts = 2;
+            attempts += 1;
         }
+        result.attempts = attempts;
         eprintln!(
             "fault-campaign: {}: {}",
             case.name,
@@ -1206,15 +1228,18 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
         pass,
         attempts: 1,
         dir: run.dir.display().to_string(),
+        contact_s: (r.contact_ns != 0 && r.start_ns != 0)
+            .then(|| (r.contact_ns as f64 - r.start_ns as f64) * 1e-9),
+        fire_s: fire.and_then(|a| a.t_ms).map(|t| scenario_s(r, t)),
+        fault_s: window,
+        duration_s: sensor_feeds::Scenario::load(run_cfg_scenario(run))
+            .map_or(0.0, |s| s.duration_s),
     }
 }
 
+/// The scenario file the run played (a campaign variant where the case made one).
 fn run_cfg_scenario(run: &RunResult) -> PathBuf {
-    // The stubs' report names the scenario; the run folder holds its name.
-    let name = &run.report.scenario;
-    crate::repo_root()
-        .join("scenarios")
-        .join(format!("{name}.toml"))
+    run.scenario.clone()
 }
 
 fn describe_reaction(
@@ -1228,6 +1253,9 @@ fn describe_reaction(
     if let Some(d) = degraded {
         let _ = write!(s, "degraded after {d:.0} ms");
         match recovered {
+            Some(r) if matches!(case.fault, Fault::FeedsKilled { .. }) => {
+                let _ = write!(s, ", recovered {r:.0} ms after the feeds were back");
+            }
             Some(r) => {
                 let _ = write!(s, ", recovered {r:.0} ms after the fault ended");
             }
@@ -1288,9 +1316,9 @@ pub fn report_text(c: &Campaign, fuzz: Option<&[FuzzTarget]>) -> String {
                 .map_or("—".to_owned(), |l| format!("{l:+.1}")),
             r.reaction,
             if r.attempts > 1 {
-                " (2nd run: the 1st missed a time limit)"
+                format!(" (run {}: the earlier missed a time limit)", r.attempts)
             } else {
-                ""
+                String::new()
             }
         );
         for ch in r.checks.iter().filter(|c| !c.ok) {

@@ -9,6 +9,7 @@
 
 pub mod faults;
 pub mod host_timing;
+pub mod timeline;
 
 use actuator_stubs::report::Report;
 use anyhow::{bail, Context, Result};

@@ -121,6 +121,18 @@ fn every_fault_case_ran_and_passed_its_checks() {
 }
 
 #[test]
+fn the_campaign_timeline_is_drawn() {
+    campaign();
+    let png = bin_dir().join("robustness/campaign.png");
+    let bytes = std::fs::metadata(&png)
+        .unwrap_or_else(|e| panic!("{}: {e}", png.display()))
+        .len();
+    assert!(bytes > 10_000, "{}: {bytes} bytes", png.display());
+    let keep = root().join("target/robustness/campaign.png");
+    std::fs::copy(&png, &keep).expect("copy campaign.png");
+}
+
+#[test]
 fn no_genuine_command_is_lost_and_nothing_forged_is_acted_on() {
     for r in &campaign().cases {
         assert!(

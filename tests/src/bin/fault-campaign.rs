@@ -3,7 +3,7 @@
 //! * `fault-campaign run [--out DIR] [--case NAME …]` runs the cases (tests/src/faults.rs) on a
 //!   CAN interface that must exist — start it through
 //!   `./vcan-setup.sh --run -- target/release/fault-campaign run …` — and writes
-//!   `DIR/campaign.json`; exit 1 if a case failed.
+//!   `DIR/campaign.json` and the timeline picture `DIR/campaign.png`; exit 1 if a case failed.
 //! * `fault-campaign host-timing [--out DIR]` runs the iceoryx2 faults on the host kernel (CAN
 //!   side off, named in the output) with the ECU at SCHED_FIFO 80: deadline misses where
 //!   timers are real (tests/src/host_timing.rs).
@@ -83,6 +83,9 @@ enum Cmd {
         /// Host timing of the iceoryx2 faults (`fault-campaign host-timing`).
         #[arg(long)]
         host_timing: Option<PathBuf>,
+        /// Also draw the campaign timeline into this PNG.
+        #[arg(long)]
+        plot: Option<PathBuf>,
     },
 }
 
@@ -142,11 +145,13 @@ fn run() -> Result<bool> {
             std::fs::create_dir_all(&out)?;
             let path = out.join("campaign.json");
             std::fs::write(&path, serde_json::to_string_pretty(&campaign)?)?;
+            let png = out.join("campaign.png");
+            e2e_tests::timeline::draw_timeline(&campaign, &png)?;
             println!(
                 "{}",
                 report_text(&campaign, load_fuzz(fuzz.as_ref())?.as_deref())
             );
-            println!("campaign: {}", path.display());
+            println!("campaign: {}\ntimeline: {}", path.display(), png.display());
             Ok(campaign.cases.iter().all(|c| c.pass))
         }
         Cmd::HostTiming {
@@ -176,12 +181,17 @@ fn run() -> Result<bool> {
             campaign,
             fuzz,
             host_timing,
+            plot,
         } => {
             let text = std::fs::read_to_string(&campaign)
                 .with_context(|| format!("reading {}", campaign.display()))?;
             let c: Campaign = serde_json::from_str(&text)
                 .with_context(|| format!("parsing {}", campaign.display()))?;
             println!("{}", report_text(&c, load_fuzz(fuzz.as_ref())?.as_deref()));
+            if let Some(p) = plot {
+                e2e_tests::timeline::draw_timeline(&c, &p)?;
+                println!("timeline: {}", p.display());
+            }
             if let Some(p) = host_timing {
                 let text = std::fs::read_to_string(&p)
                     .with_context(|| format!("reading {}", p.display()))?;
