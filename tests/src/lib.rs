@@ -171,6 +171,72 @@ pub struct RunResult {
     pub disturbance_output: Vec<(String, String)>,
 }
 
+/// Shared by the integration tests in `tests/tests/` (bench.rs, robustness.rs): where the
+/// built binaries are, building them once, and how vcan is reached.
+pub mod harness {
+    use std::path::{Path, PathBuf};
+    use std::process::Command;
+    use std::sync::OnceLock;
+
+    /// target/<profile>/ of the running test binary (it lives in target/<profile>/deps/).
+    pub fn bin_dir() -> PathBuf {
+        let exe = std::env::current_exe().expect("current exe");
+        exe.parent()
+            .and_then(Path::parent)
+            .expect("target/<profile>")
+            .to_path_buf()
+    }
+
+    /// Builds the bench binaries once per test process (a no-op when test.sh already did).
+    pub fn build_bench_bins() {
+        static BUILT: OnceLock<()> = OnceLock::new();
+        BUILT.get_or_init(|| {
+            let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+            let st = Command::new(cargo)
+                .args([
+                    "build",
+                    "--release",
+                    "--bins",
+                    "-p",
+                    "ecu",
+                    "-p",
+                    "sensor-feeds",
+                ])
+                .args(["-p", "actuator-stubs", "-p", "e2e-tests"])
+                .current_dir(super::repo_root())
+                .status()
+                .expect("cargo build");
+            assert!(st.success(), "building the bench binaries failed");
+        });
+    }
+
+    /// How these tests reach vcan, checked once: `false` = the host kernel has it, `true` =
+    /// inside user-mode Linux. With neither the test PANICS: these tests are never skipped.
+    pub fn vcan_in_uml() -> bool {
+        static IN_UML: OnceLock<bool> = OnceLock::new();
+        *IN_UML.get_or_init(|| {
+            let check = Command::new(super::repo_root().join("vcan-setup.sh"))
+                .arg("--check")
+                .status()
+                .expect("vcan-setup.sh --check");
+            match check.code() {
+                Some(0) => {
+                    eprintln!("e2e: host vcan");
+                    false
+                }
+                Some(3) => {
+                    eprintln!("e2e: no SocketCAN in this kernel — running inside user-mode Linux");
+                    true
+                }
+                other => panic!(
+                    "neither host vcan nor user-mode Linux is available (vcan-setup.sh --check → {other:?}); \
+                     install user-mode-linux (tests/setup-host.sh) — these tests are never skipped"
+                ),
+            }
+        })
+    }
+}
+
 /// The repository root (this crate lives in `<root>/tests`).
 pub fn repo_root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -184,7 +250,11 @@ fn spawn(cmd: &mut Command, what: &str) -> Result<Child> {
         .with_context(|| format!("starting {what} ({cmd:?})"))
 }
 
-fn terminate(child: &mut Child, what: &str, grace: Duration) -> Result<std::process::ExitStatus> {
+pub(crate) fn terminate(
+    child: &mut Child,
+    what: &str,
+    grace: Duration,
+) -> Result<std::process::ExitStatus> {
     if let Ok(Some(st)) = child.try_wait() {
         return Ok(st);
     }

@@ -9,6 +9,7 @@
 //! UML's receive timestamps (see [`adaptive_outcome_is_no_worse_than_the_reference_for_every_scenario`]).
 
 use actuator_stubs::report::Report;
+use e2e_tests::harness;
 use sensor_feeds::Scenario;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -24,16 +25,7 @@ const FALLBACK_ALLOWANCE_MS: f64 = 100.0;
 
 /// True when this kernel has no SocketCAN and the bench runs inside user-mode Linux.
 fn in_uml() -> bool {
-    static IN_UML: OnceLock<bool> = OnceLock::new();
-    *IN_UML.get_or_init(|| {
-        let script = root().join("vcan-setup.sh");
-        Command::new(&script)
-            .arg("--check")
-            .status()
-            .expect("vcan-setup.sh --check")
-            .code()
-            == Some(3)
-    })
+    harness::vcan_in_uml()
 }
 
 fn root() -> PathBuf {
@@ -50,50 +42,38 @@ fn library() -> Vec<PathBuf> {
     v
 }
 
-/// target/<profile>/ of this test binary (target/<profile>/deps/bench-…).
-fn bin_dir() -> PathBuf {
-    let exe = std::env::current_exe().expect("current exe");
-    exe.parent()
-        .and_then(Path::parent)
-        .expect("target/<profile>")
-        .to_path_buf()
-}
-
 /// Runs the library once; returns the output root.
 fn bench_run() -> &'static Path {
     static RUN: OnceLock<PathBuf> = OnceLock::new();
     RUN.get_or_init(|| {
-        // Fresh release binaries (no-op when test.sh already built them).
-        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-        let st = Command::new(cargo)
-            .args(["build", "--release", "--bins", "-p", "ecu", "-p", "sensor-feeds", "-p", "actuator-stubs", "-p", "e2e-tests"])
-            .current_dir(root())
-            .status()
-            .expect("cargo build");
-        assert!(st.success(), "building the bench binaries failed");
-        let bins = bin_dir();
+        harness::build_bench_bins();
+        harness::vcan_in_uml();
+        let bins = harness::bin_dir();
         let script = root().join("vcan-setup.sh");
-        let check = Command::new(&script).arg("--check").status().expect("vcan-setup.sh --check");
-        match check.code() {
-            Some(0) => eprintln!("bench: host vcan"),
-            Some(3) => eprintln!("bench: no SocketCAN in this kernel — running inside user-mode Linux"),
-            other => panic!(
-                "neither host vcan nor user-mode Linux is available (vcan-setup.sh --check → {other:?}); \
-                 install user-mode-linux (tests/setup-host.sh) — these tests are never skipped"
-            ),
-        }
         let out = bins.join("e2e-bench-out");
         let _ = std::fs::remove_dir_all(&out);
         let mut cmd = Command::new(&script);
-        cmd.args(["--run", "--"]).arg(bins.join("hil-bench")).arg("--out").arg(&out).arg("--repo").arg(root());
+        cmd.args(["--run", "--"])
+            .arg(bins.join("hil-bench"))
+            .arg("--out")
+            .arg(&out)
+            .arg("--repo")
+            .arg(root());
         for s in library() {
             cmd.arg("--scenario").arg(s);
         }
-        let o = cmd.current_dir(root()).output().expect("vcan-setup.sh --run hil-bench");
+        let o = cmd
+            .current_dir(root())
+            .output()
+            .expect("vcan-setup.sh --run hil-bench");
         let stdout = String::from_utf8_lossy(&o.stdout);
         let stderr = String::from_utf8_lossy(&o.stderr);
         eprintln!("--- hil-bench (all summaries) ---\n{stdout}\n--- stderr ---\n{stderr}");
-        assert!(o.status.success(), "hil-bench failed ({}); see the output above", o.status);
+        assert!(
+            o.status.success(),
+            "hil-bench failed ({}); see the output above",
+            o.status
+        );
         out
     })
 }

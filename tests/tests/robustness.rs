@@ -5,7 +5,8 @@
 //! which `test.sh` prints as the robustness report together with the fuzzing figures.
 
 use e2e_tests::faults::{cases, report_text, Campaign, Fault};
-use std::path::{Path, PathBuf};
+use e2e_tests::harness::{bin_dir, build_bench_bins};
+use std::path::PathBuf;
 use std::process::Command;
 use std::sync::{Mutex, OnceLock};
 
@@ -17,57 +18,23 @@ fn root() -> PathBuf {
     e2e_tests::repo_root()
 }
 
-/// target/<profile>/ of this test binary (target/<profile>/deps/robustness-…).
-fn bin_dir() -> PathBuf {
-    let exe = std::env::current_exe().expect("current exe");
-    exe.parent()
-        .and_then(Path::parent)
-        .expect("target/<profile>")
-        .to_path_buf()
-}
-
-/// Fresh release binaries, once (a no-op when test.sh already built them).
-fn build_bins() {
-    static BUILT: OnceLock<()> = OnceLock::new();
-    BUILT.get_or_init(|| {
-        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-        let st = Command::new(cargo)
-            .args([
-                "build",
-                "--release",
-                "--bins",
-                "-p",
-                "ecu",
-                "-p",
-                "sensor-feeds",
-            ])
-            .args(["-p", "actuator-stubs", "-p", "e2e-tests"])
-            .current_dir(root())
-            .status()
-            .expect("cargo build");
-        assert!(st.success(), "building the bench binaries failed");
-    });
+/// Keeps an artefact in `target/robustness/`, where test.sh's robustness report reads it.
+fn keep(name: &str, bytes: &[u8]) {
+    let dir = root().join("target/robustness");
+    std::fs::create_dir_all(&dir).expect("target/robustness");
+    std::fs::write(dir.join(name), bytes).unwrap_or_else(|e| panic!("writing {name}: {e}"));
 }
 
 /// Runs the campaign once; returns it.
 fn campaign() -> &'static Campaign {
     static RUN: OnceLock<Campaign> = OnceLock::new();
     RUN.get_or_init(|| {
-        let _turn = SERIAL.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-        build_bins();
+        let _turn = SERIAL
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        build_bench_bins();
+        e2e_tests::harness::vcan_in_uml();
         let script = root().join("vcan-setup.sh");
-        let check = Command::new(&script)
-            .arg("--check")
-            .status()
-            .expect("vcan-setup.sh --check");
-        match check.code() {
-            Some(0) => eprintln!("robustness: host vcan"),
-            Some(3) => eprintln!("robustness: no SocketCAN in this kernel — user-mode Linux"),
-            other => panic!(
-                "neither host vcan nor user-mode Linux is available (vcan-setup.sh --check → {other:?}); \
-                 install user-mode-linux (tests/setup-host.sh) — these tests are never skipped"
-            ),
-        }
         let out = bin_dir().join("robustness");
         let _ = std::fs::remove_dir_all(&out);
         let o = Command::new(&script)
@@ -87,12 +54,10 @@ fn campaign() -> &'static Campaign {
             String::from_utf8_lossy(&o.stderr)
         );
         let path = out.join("campaign.json");
-        let text = std::fs::read_to_string(&path)
-            .unwrap_or_else(|e| panic!("{}: {e} (fault-campaign exit {})", path.display(), o.status));
-        // test.sh prints the robustness report with the fuzzing figures from here.
-        let keep = root().join("target/robustness");
-        std::fs::create_dir_all(&keep).expect("target/robustness");
-        std::fs::write(keep.join("campaign.json"), &text).expect("write campaign.json");
+        let text = std::fs::read_to_string(&path).unwrap_or_else(|e| {
+            panic!("{}: {e} (fault-campaign exit {})", path.display(), o.status)
+        });
+        keep("campaign.json", text.as_bytes());
         serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
     })
 }
@@ -128,8 +93,10 @@ fn the_campaign_timeline_is_drawn() {
         .unwrap_or_else(|e| panic!("{}: {e}", png.display()))
         .len();
     assert!(bytes > 10_000, "{}: {bytes} bytes", png.display());
-    let keep = root().join("target/robustness/campaign.png");
-    std::fs::copy(&png, &keep).expect("copy campaign.png");
+    keep(
+        "campaign.png",
+        &std::fs::read(&png).expect("read campaign.png"),
+    );
 }
 
 #[test]
@@ -249,7 +216,5 @@ fn host_timing_runs_the_ipc_faults_with_real_timers() {
             base.object_faults
         );
     }
-    let keep = root().join("target/robustness");
-    std::fs::create_dir_all(&keep).expect("target/robustness");
-    std::fs::write(keep.join("host-timing.json"), text).expect("write");
+    keep("host-timing.json", text.as_bytes());
 }
