@@ -824,25 +824,39 @@ fn flood_frames(run: &RunResult) -> u64 {
     total.saturating_sub(feeds + counter(run.ecu_report.as_ref(), "can_tx"))
 }
 
+/// What the disturbance measured about itself, as JSON: the restarted feeds' resumption
+/// (`feeds-restart.json`), else the last JSON line a side process printed (bus-inject's
+/// `injected`, `first_s`, `last_s`).
+fn disturbance_summary(run: &RunResult) -> Option<serde_json::Value> {
+    let from_file = std::fs::read_to_string(run.dir.join("feeds-restart.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok());
+    from_file.or_else(|| {
+        run.disturbance_output
+            .iter()
+            .find_map(|(_, out)| out.lines().rev().find_map(|l| serde_json::from_str(l).ok()))
+    })
+}
+
 /// Frames the disturbance put on the bus: bus-inject's JSON summary, or one "sent" line per
 /// successful cansend.
-fn injected(run: &RunResult) -> u64 {
-    run.disturbance_output
-        .iter()
-        .map(|(_, out)| {
-            let json = out
-                .lines()
-                .rev()
-                .find_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
-                .and_then(|v| v.get("injected").and_then(serde_json::Value::as_u64));
-            json.unwrap_or_else(|| out.lines().filter(|l| *l == "sent").count() as u64)
+fn injected(run: &RunResult, summary: Option<&serde_json::Value>) -> u64 {
+    summary
+        .and_then(|v| v.get("injected"))
+        .and_then(serde_json::Value::as_u64)
+        .unwrap_or_else(|| {
+            run.disturbance_output
+                .iter()
+                .map(|(_, out)| out.lines().filter(|l| *l == "sent").count() as u64)
+                .sum()
         })
-        .sum()
 }
 
 /// Judges one run.
 pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> CaseResult {
     let r = &run.report;
+    // The scenario file the run played (the campaign's variant where the case made one).
+    let played = sensor_feeds::Scenario::load(&run.scenario).ok();
     let ecu = run.ecu_report.as_ref();
     let mut checks: Vec<Check> = Vec::new();
     let mut check = |what: &str, ok: bool, detail: String| {
@@ -923,10 +937,11 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
     let lost = sent
         .saturating_sub(authenticated)
         .saturating_sub(excused_late);
+    let summary = disturbance_summary(run);
     let frames_injected = if case.fault == Fault::Flood {
         flood_frames(run)
     } else {
-        injected(run)
+        injected(run, summary.as_ref())
     };
     let attack = matches!(
         case.fault,
@@ -982,11 +997,8 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
     );
 
     // Airbag.
-    let scenario = sensor_feeds::Scenario::load(run_cfg_scenario(run))
-        .ok()
-        .map(|s| s.expect.airbag_fires);
     let fire = r.actions.iter().find(|a| a.action.what == "airbag_fire");
-    let must_fire = scenario.flatten();
+    let must_fire = played.as_ref().and_then(|s| s.expect.airbag_fires);
     if let Some(want) = must_fire {
         check(
             "airbag fires exactly when the scenario requires",
@@ -1025,19 +1037,11 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
     };
     // The fault's real extent where the disturbance measured it: the injector's first and
     // last frame, the restarted feeds' actual resumption.
-    let measured = |key: &str| -> Option<f64> {
-        let from_file = std::fs::read_to_string(run.dir.join("feeds-restart.json"))
-            .ok()
-            .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-            .and_then(|v| v.get(key).and_then(serde_json::Value::as_f64));
-        from_file.or_else(|| {
-            run.disturbance_output.iter().find_map(|(_, out)| {
-                out.lines()
-                    .rev()
-                    .find_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
-                    .and_then(|v| v.get(key).and_then(serde_json::Value::as_f64))
-            })
-        })
+    let measured = |key: &str| {
+        summary
+            .as_ref()
+            .and_then(|v| v.get(key))
+            .and_then(serde_json::Value::as_f64)
     };
     let window = window.map(|(from_s, to_s)| match case.fault {
         Fault::FeedsKilled { .. } => (from_s, measured("resumed_s").unwrap_or(to_s).max(to_s)),
@@ -1189,8 +1193,7 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
         }
         Fault::Flood => {
             let rx = counter(ecu, "can_frames_rx");
-            let duration_s = sensor_feeds::Scenario::load(run_cfg_scenario(run))
-                .map_or(f64::NAN, |s| s.duration_s);
+            let duration_s = played.as_ref().map_or(f64::NAN, |s| s.duration_s);
             check(
                 "ECU kept receiving its inputs under the flood",
                 rx > 0,
@@ -1269,14 +1272,8 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
             .then_some((r.contact_ns as f64 - r.start_ns as f64) * 1e-9),
         fire_s: fire.and_then(|a| a.t_ms).map(|t| scenario_s(r, t)),
         fault_s: window,
-        duration_s: sensor_feeds::Scenario::load(run_cfg_scenario(run))
-            .map_or(0.0, |s| s.duration_s),
+        duration_s: played.as_ref().map_or(0.0, |s| s.duration_s),
     }
-}
-
-/// The scenario file the run played (a campaign variant where the case made one).
-fn run_cfg_scenario(run: &RunResult) -> PathBuf {
-    run.scenario.clone()
 }
 
 fn describe_reaction(

@@ -160,9 +160,7 @@ pub fn run_host_timing(cfg: &HostTimingConfig) -> Result<HostTiming> {
         if !st.success() {
             bail!("{name}: sensor-feeds {st}");
         }
-        let pid = nix::unistd::Pid::from_raw(ecu.id() as i32);
-        let _ = nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGTERM);
-        let st = ecu.wait()?;
+        let st = crate::terminate(&mut ecu, "ecu", Duration::from_secs(5))?;
         if !st.success() {
             bail!("{name}: ecu {st}");
         }
