@@ -71,6 +71,10 @@ pub enum Decoded {
         /// ECU mode raw value (DBC EcuMode: 0 Init, 1 Normal, 2 ReferenceFallback,
         /// 3 CrashDetected, 4 Deployed, 5 Fault).
         mode: u8,
+        /// The frame's fault flags (why the ECU degraded), bit i = [`ECU_FAULT_NAMES`]`[i]`.
+        ///
+        /// [`ECU_FAULT_NAMES`]: crate::report::ECU_FAULT_NAMES
+        faults: u8,
     },
     /// Any other accepted frame (authenticators, foreign frames).
     Other,
@@ -108,6 +112,19 @@ pub fn decode(msg: &Messages) -> Decoded {
         },
         Messages::EcuStatus(m) => Decoded::Status {
             mode: u8::from(m.ecu_mode()),
+            faults: [
+                m.fault_vehicle_input(),
+                m.fault_occupant_input(),
+                m.fault_object_input(),
+                m.fault_accel_sensor(),
+                m.fault_e2e(),
+                m.fault_lut(),
+                m.fault_overrun(),
+                m.fault_config(),
+            ]
+            .iter()
+            .enumerate()
+            .fold(0, |bits, (i, on)| bits | (u8::from(*on) << i)),
         },
         _ => Decoded::Other,
     }
@@ -148,6 +165,8 @@ pub struct Modules {
     pub adaptive_belt_cmds: Vec<u64>,
     /// ECU mode changes seen on EcuStatus: (t_ns, mode).
     pub ecu_modes: Vec<(u64, u8)>,
+    /// ECU fault-flag changes seen on EcuStatus: (t_ns, flags as in [`Decoded::Status`]).
+    pub ecu_faults: Vec<(u64, u8)>,
     /// First command (belt or airbag) whose source is the reference restraint [ns].
     pub first_reference_cmd_ns: Option<u64>,
     /// First airbag command with `Arm = Armed` [ns].
@@ -229,9 +248,12 @@ impl Modules {
                     }
                 }
             }
-            Decoded::Status { mode } => {
+            Decoded::Status { mode, faults } => {
                 if self.ecu_modes.last().map(|m| m.1) != Some(*mode) {
                     self.ecu_modes.push((t_ns, *mode));
+                }
+                if self.ecu_faults.last().map_or(0, |f| f.1) != *faults {
+                    self.ecu_faults.push((t_ns, *faults));
                 }
             }
             Decoded::Other => {}
@@ -371,5 +393,42 @@ mod tests {
             }
             other => panic!("{other:?}"),
         }
+    }
+
+    #[test]
+    fn status_frames_carry_the_fault_flags_in_name_order() {
+        use bus::codec::*;
+        let mut p = bus::E2eProtector::new();
+        // object input (bit 2) and overrun (bit 6), as the ECU encodes them.
+        let f = p.seal(
+            bus::EcuStatus::encode(
+                EcuStatusEcuMode::ReferenceFallback,
+                false,
+                false,
+                true,
+                false,
+                false,
+                false,
+                true,
+                false,
+                3,
+                0x2ec7,
+            )
+            .unwrap(),
+        );
+        let msg = bus::decode(f.id, f.payload()).expect("valid");
+        let Decoded::Status { mode, faults } = decode(&msg) else {
+            panic!("not a status frame")
+        };
+        assert_eq!(mode, 2);
+        assert_eq!(
+            crate::report::ecu_fault_names(faults),
+            ["object_input", "overrun"]
+        );
+        let mut m = Modules::default();
+        m.apply(5, &Decoded::Status { mode, faults });
+        m.apply(6, &Decoded::Status { mode, faults });
+        m.apply(7, &Decoded::Status { mode, faults: 0 });
+        assert_eq!(m.ecu_faults, [(5, faults), (7, 0)]);
     }
 }

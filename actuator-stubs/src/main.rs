@@ -7,7 +7,9 @@
 use actuator_stubs::commands::{CommandRecord, Modules};
 use actuator_stubs::outcome::{self, judge, no_worse, reference_as_fired};
 use actuator_stubs::plot;
-use actuator_stubs::report::{ecu_mode_name, Outcome, Report, TimedAction, TrueCrash};
+use actuator_stubs::report::{
+    ecu_fault_names, ecu_mode_name, Outcome, Report, TimedAction, TrueCrash,
+};
 use actuator_stubs::rx::Receiver;
 use anyhow::{Context, Result};
 use bus::secoc::SecOcConfig;
@@ -345,6 +347,11 @@ fn build_report(
             .ecu_modes
             .iter()
             .map(|(t, m)| (rel_or_start_ms(*t), ecu_mode_name(*m).to_owned()))
+            .collect(),
+        ecu_faults: modules
+            .ecu_faults
+            .iter()
+            .map(|(t, f)| (rel_or_start_ms(*t), ecu_fault_names(*f)))
             .collect(),
         ecu_diag_modes: diag_modes
             .iter()

@@ -93,6 +93,10 @@ pub struct Report {
     pub first_reference_cmd_s: Option<f64>,
     /// ECU mode changes from EcuStatus: (ms rel. contact or since start, mode name).
     pub ecu_modes: Vec<(f64, String)>,
+    /// ECU fault-flag changes from EcuStatus (why it degraded): (ms rel. contact or since
+    /// start, flags set, named as in [`ECU_FAULT_NAMES`]; empty = no fault).
+    #[serde(default)]
+    pub ecu_faults: Vec<(f64, Vec<String>)>,
     /// ECU mode changes from its iceoryx2 diagnostics: (ms rel. contact or since start, mode).
     pub ecu_diag_modes: Vec<(f64, String)>,
     /// ECU entered pre-crash (diagnostics) [ms rel. contact].
@@ -109,6 +113,28 @@ pub struct Report {
     pub outcome: Option<Outcome>,
     /// Plot file (relative to the report), if drawn.
     pub plot: Option<String>,
+}
+
+/// EcuStatus fault flags in bit order (DBC `FaultVehicleInput` … `FaultConfig`).
+pub const ECU_FAULT_NAMES: [&str; 8] = [
+    "vehicle_input",
+    "occupant_input",
+    "object_input",
+    "accel_sensor",
+    "e2e",
+    "lut",
+    "overrun",
+    "config",
+];
+
+/// The names of the fault flags set in `bits` (see [`ECU_FAULT_NAMES`]).
+pub fn ecu_fault_names(bits: u8) -> Vec<String> {
+    ECU_FAULT_NAMES
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| bits & (1 << i) != 0)
+        .map(|(_, n)| (*n).to_owned())
+        .collect()
 }
 
 /// DBC EcuMode names.

@@ -77,6 +77,46 @@ const TIMING_CHECKS: [&str; 4] = [
     "recovers after the fault",
 ];
 
+const FIRES_CHECK: &str = "airbag fires exactly when the scenario requires";
+
+/// Checks that fail when the ECU fell back to the reference restraint at the crash (see
+/// [`starved_inputs_at_fire`]).
+const STARVATION_CHECKS: [&str; 4] = [
+    FIRES_CHECK,
+    "crash handled by the adaptive path after recovery",
+    "services usable after a killed process (crash handled adaptively)",
+    "same airbag plan as the baseline",
+];
+
+/// EcuStatus fault flags of the inputs (missing, stale or out of range) and of overruns: what
+/// a stalled machine causes, as opposed to E2E failures, a bad LUT or a bad configuration.
+const STARVED_INPUT_FLAGS: [&str; 5] = [
+    "vehicle_input",
+    "occupant_input",
+    "object_input",
+    "accel_sensor",
+    "overrun",
+];
+
+/// If the airbag was fired by the reference restraint while the ECU's only active faults were
+/// stale inputs (see [`STARVED_INPUT_FLAGS`]): those faults, joined with "+".
+fn starved_inputs_at_fire(
+    actions: &[actuator_stubs::report::TimedAction],
+    ecu_faults: &[(f64, Vec<String>)],
+) -> Option<String> {
+    let fire = actions.iter().find(|a| a.action.what == "airbag_fire")?;
+    let t = fire.t_ms?;
+    if fire.action.source != "reference" {
+        return None;
+    }
+    let (_, flags) = ecu_faults.iter().rev().find(|(tf, _)| *tf <= t)?;
+    (!flags.is_empty()
+        && flags
+            .iter()
+            .all(|f| STARVED_INPUT_FLAGS.contains(&f.as_str())))
+    .then(|| flags.join("+"))
+}
+
 /// What is done to a run.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Fault {
@@ -858,13 +898,25 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
     // The scenario file the run played (the campaign's variant where the case made one).
     let played = sensor_feeds::Scenario::load(&run.scenario).ok();
     let ecu = run.ecu_report.as_ref();
+    let starved = starved_inputs_at_fire(&r.actions, &r.ecu_faults);
     let mut checks: Vec<Check> = Vec::new();
     let mut check = |what: &str, ok: bool, detail: String| {
+        // A fire of the reference restraint with the ECU degraded only by inputs that went
+        // stale is the specified fallback; inside user-mode Linux the emulator's stalls starve
+        // the inputs now and then, so a check it fails is a timing failure there (run again)
+        // and a function failure on a real kernel.
+        let starved_fire = STARVATION_CHECKS.contains(&what) && starved.is_some();
+        let detail = match (&starved, starved_fire && !ok) {
+            (Some(f), true) => format!(
+                "{detail} (reference restraint: the ECU's only faults at the fire were {f})"
+            ),
+            _ => detail,
+        };
         checks.push(Check {
             what: what.to_owned(),
             ok,
             detail,
-            timing: TIMING_CHECKS.contains(&what),
+            timing: TIMING_CHECKS.contains(&what) || (starved_fire && crate::in_uml_guest()),
         });
     };
     let uml_slack = if crate::in_uml_guest() {
@@ -1001,7 +1053,7 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
     let must_fire = played.as_ref().and_then(|s| s.expect.airbag_fires);
     if let Some(want) = must_fire {
         check(
-            "airbag fires exactly when the scenario requires",
+            FIRES_CHECK,
             r.airbag_fired == want,
             format!("expected {want}, fired {}", r.airbag_fired),
         );
@@ -1060,7 +1112,17 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
             .find(|(t, m)| *t >= from_ms - 5.0 && m == "ReferenceFallback")
             .map(|(t, _)| *t);
         degraded_after_ms = deg.map(|t| t - from_ms);
-        let rec = deg.and_then(|d| {
+        // Recovery counts from the last degradation that began inside the fault window: a fault
+        // with gaps (an injector slowed down by a loaded host) may let the ECU recover and
+        // degrade again before its end.
+        let last_deg = deg.and_then(|d| {
+            modes
+                .iter()
+                .rev()
+                .find(|(t, m)| *t >= d && *t <= to_ms + 5.0 && m == "ReferenceFallback")
+                .map(|(t, _)| *t)
+        });
+        let rec = last_deg.and_then(|d| {
             modes
                 .iter()
                 .find(|(t, m)| *t > d && m == "Normal")
@@ -1452,6 +1514,30 @@ pub fn report_text(c: &Campaign, fuzz: Option<&[FuzzTarget]>) -> String {
             );
         }
     }
+    // The verdict last, where a truncated log still shows it.
+    let failed: Vec<String> = c
+        .cases
+        .iter()
+        .filter(|r| !r.pass)
+        .map(|r| {
+            let what: Vec<&str> = r
+                .checks
+                .iter()
+                .filter(|k| !k.ok)
+                .map(|k| k.what.as_str())
+                .collect();
+            format!("{} ({})", r.name, what.join("; "))
+        })
+        .collect();
+    let _ = writeln!(
+        s,
+        "verdict            {}",
+        if failed.is_empty() {
+            "every case passed".to_owned()
+        } else {
+            format!("FAILED: {}", failed.join(", "))
+        }
+    );
     s
 }
 
@@ -1553,6 +1639,45 @@ mod tests {
             let e = diagram::Diagram::load(&p).expect_err("damaged LUT must not load");
             eprintln!("truncated={truncated}: {e}");
         }
+    }
+
+    #[test]
+    fn a_reference_fire_with_only_stale_inputs_is_told_apart_from_other_faults() {
+        let fire = |source: &str| actuator_stubs::report::TimedAction {
+            action: actuator_stubs::commands::Action {
+                t_ns: 0,
+                what: "airbag_fire".into(),
+                level_kn: 12.0,
+                planned_ms: 10.0,
+                source: source.into(),
+            },
+            t_ms: Some(14.0),
+        };
+        let faults = |names: &[&str]| -> Vec<(f64, Vec<String>)> {
+            vec![
+                (-900.0, vec!["e2e".to_owned()]),
+                (-500.0, Vec::new()),
+                (-30.0, names.iter().map(|n| (*n).to_owned()).collect()),
+                (20.0, Vec::new()),
+            ]
+        };
+        let stale = faults(&["vehicle_input", "object_input"]);
+        assert_eq!(
+            starved_inputs_at_fire(&[fire("reference")], &stale).as_deref(),
+            Some("vehicle_input+object_input")
+        );
+        // The adaptive path fired: not a fallback.
+        assert_eq!(starved_inputs_at_fire(&[fire("adaptive")], &stale), None);
+        // Corrupt data or a bad LUT is not starvation.
+        for other in [&["object_input", "e2e"][..], &["lut"], &["config"], &[]] {
+            assert_eq!(
+                starved_inputs_at_fire(&[fire("reference")], &faults(other)),
+                None,
+                "{other:?}"
+            );
+        }
+        // No fire, no verdict.
+        assert_eq!(starved_inputs_at_fire(&[], &stale), None);
     }
 
     #[test]

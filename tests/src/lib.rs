@@ -273,6 +273,57 @@ pub(crate) fn terminate(
     Ok(st)
 }
 
+/// The line the stubs print once their CAN socket is open and they receive.
+const STUBS_READY: &str = "actuator-stubs: listening on";
+
+/// Forwards a child's piped stderr to ours line by line (and to `log` if given); if `ready`
+/// is given, the returned receiver gets a message when a line starting with it was seen.
+fn forward_stderr(
+    child: &mut Child,
+    log: Option<PathBuf>,
+    ready: Option<&'static str>,
+) -> (
+    Option<std::thread::JoinHandle<()>>,
+    std::sync::mpsc::Receiver<()>,
+) {
+    let (tx, rx) = std::sync::mpsc::channel();
+    let thread = child.stderr.take().map(|pipe| {
+        std::thread::spawn(move || {
+            use std::io::{BufRead, Write};
+            let mut file = log.and_then(|p| std::fs::File::create(p).ok());
+            for line in std::io::BufReader::new(pipe).lines().map_while(Result::ok) {
+                eprintln!("{line}");
+                if let Some(f) = file.as_mut() {
+                    let _ = writeln!(f, "{line}");
+                }
+                if ready.is_some_and(|r| line.starts_with(r)) {
+                    let _ = tx.send(());
+                }
+            }
+        })
+    });
+    (thread, rx)
+}
+
+/// Waits for a child's ready line (see [`forward_stderr`]); an error if it exits first or
+/// takes longer than a slow user-mode-Linux start could explain.
+fn wait_ready(ready: std::sync::mpsc::Receiver<()>, child: &mut Child, what: &str) -> Result<()> {
+    let until = Instant::now() + Duration::from_secs(30);
+    while Instant::now() < until {
+        match ready.recv_timeout(Duration::from_millis(20)) {
+            Ok(()) => return Ok(()),
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                bail!("{what} exited before it was ready: {:?}", child.wait()?)
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+        }
+        if let Some(st) = child.try_wait()? {
+            bail!("{what} exited before it was ready: {st}");
+        }
+    }
+    bail!("{what} did not get ready within 30 s")
+}
+
 fn wait_timeout(child: &mut Child, timeout: Duration) -> Result<Option<std::process::ExitStatus>> {
     let until = Instant::now() + timeout;
     while Instant::now() < until {
@@ -372,9 +423,19 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
             .arg(format!("{}", scenario.duration_s + 30.0))
             .arg("--out")
             .arg(&dir)
-            .args(&cfg.stubs_args),
+            .args(&cfg.stubs_args)
+            .stderr(Stdio::piped()),
         "actuator-stubs",
     )?;
+    // The ECU starts only once the stubs listen on the bus: its first commands would otherwise
+    // go out before the receiver's socket exists (under load, or inside user-mode Linux where
+    // a process takes up to a second to start, that was several cycles of commands).
+    let (stubs_stderr, stubs_ready) = forward_stderr(&mut stubs, None, Some(STUBS_READY));
+    if let Err(e) = wait_ready(stubs_ready, &mut stubs, "actuator-stubs") {
+        let _ = terminate(&mut stubs, "actuator-stubs", Duration::from_secs(2));
+        let _ = terminate(&mut candump, "candump", Duration::from_secs(2));
+        return Err(e);
+    }
     let ecu_log = std::fs::File::create(dir.join("ecu-stdout.txt"))?;
     let mut ecu = spawn(
         Command::new(bin("ecu"))
@@ -397,19 +458,7 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     )?;
     // The ECU's start-up messages (LUT/keys accepted or rejected) go to the console as before
     // and into ecu-stderr.txt, where the fault campaign reads them.
-    let ecu_stderr = ecu.stderr.take().map(|pipe| {
-        let path = dir.join("ecu-stderr.txt");
-        std::thread::spawn(move || {
-            use std::io::{BufRead, Write};
-            let mut file = std::fs::File::create(path).ok();
-            for line in std::io::BufReader::new(pipe).lines().map_while(Result::ok) {
-                eprintln!("{line}");
-                if let Some(f) = file.as_mut() {
-                    let _ = writeln!(f, "{line}");
-                }
-            }
-        })
-    });
+    let (ecu_stderr, _) = forward_stderr(&mut ecu, Some(dir.join("ecu-stderr.txt")), None);
     // Let the ECU and the stubs come up (nodes, services, CAN sockets) before the scenario.
     std::thread::sleep(Duration::from_millis(400));
     if let Ok(Some(st)) = ecu.try_wait() {
@@ -455,9 +504,7 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     if !st.success() {
         problems.push(format!("ecu: {st}"));
     }
-    if let Some(t) = ecu_stderr {
-        let _ = t.join();
-    }
+    let _ = ecu_stderr.map(std::thread::JoinHandle::join);
     let mut disturbance_output = Vec::new();
     for p in side.iter_mut() {
         let grace = if p.until_stopped {
@@ -479,6 +526,7 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     if !st.success() {
         problems.push(format!("actuator-stubs: {st}"));
     }
+    let _ = stubs_stderr.map(std::thread::JoinHandle::join);
     std::thread::sleep(Duration::from_millis(50));
     let _ = terminate(&mut candump, "candump", Duration::from_secs(2))?;
 
@@ -623,6 +671,20 @@ pub fn summarise(
             .map(|(t, m)| format!("{m}@{t:+.0}"))
             .collect();
         let _ = writeln!(s, "  ECU modes (EcuStatus): {}", modes.join(" → "));
+    }
+    if !r.ecu_faults.is_empty() {
+        let faults: Vec<String> = r
+            .ecu_faults
+            .iter()
+            .map(|(t, f)| {
+                if f.is_empty() {
+                    format!("none@{t:+.0}")
+                } else {
+                    format!("{}@{t:+.0}", f.join("+"))
+                }
+            })
+            .collect();
+        let _ = writeln!(s, "  ECU faults (EcuStatus): {}", faults.join(" → "));
     }
     let frames: Vec<String> = r.frames.iter().map(|(k, v)| format!("{k} {v}")).collect();
     let _ = writeln!(
