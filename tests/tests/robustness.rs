@@ -1,4 +1,4 @@
-//! The fault-injection campaign (tests/src/faults.rs) end to end: real ecu, sensor-feeds,
+//! The fault-injection campaign (tests/src/faults/) end to end: real ecu, sensor-feeds,
 //! actuator-stubs, candump, cansend, cangen and bus-inject on vcan — on the host if its kernel
 //! has vcan, else inside ONE user-mode-Linux boot; with neither the tests FAIL (never skipped).
 //! The campaign runs once (first test to get here) and writes `target/robustness/campaign.json`,

@@ -1,6 +1,6 @@
 //! `fault-campaign`: the fault-injection campaign and the robustness report (issue 8).
 //!
-//! * `fault-campaign run [--out DIR] [--case NAME …]` runs the cases (tests/src/faults.rs) on a
+//! * `fault-campaign run [--out DIR] [--case NAME …]` runs the cases (tests/src/faults/) on a
 //!   CAN interface that must exist — start it through
 //!   `./vcan-setup.sh --run -- target/release/fault-campaign run …` — and writes
 //!   `DIR/campaign.json` and the timeline picture `DIR/campaign.png`; exit 1 if a case failed.

@@ -1,0 +1,768 @@
+//! Judging one run of the campaign: every check of [`judge`], and which of them are time
+//! limits (retried inside user-mode Linux) rather than function checks.
+
+use super::{Case, CaseResult, Check, Fault, DELAY_MS};
+use crate::RunResult;
+use actuator_stubs::report::{Report, TimedAction};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+/// ECU configuration the limits below come from (ecu/ecu.toml defaults).
+const OBJECT_TIMEOUT_MS: f64 = 100.0;
+const VEHICLE_TIMEOUT_MS: f64 = 100.0;
+const E2E_HOLD_MS: f64 = 500.0;
+/// EgoVehicleState period (DBC) times the E2E burst count (3): worst time to a burst.
+const E2E_BURST_MS: f64 = 30.0;
+/// Object-list period of the scenarios (20 ms): a fresh sample after a fault ends.
+const OBJECT_PERIOD_MS: f64 = 20.0;
+/// OccupantClassification period (DBC).
+const OCCUPANT_PERIOD_MS: f64 = 100.0;
+/// Allowance on top of documented times inside user-mode Linux (emulated timers).
+pub const UML_SLACK_MS: f64 = 100.0;
+/// A fire command may arrive this much after its planned time (same as the bench tests).
+pub const FIRE_LATE_ALLOWANCE_MS: f64 = 15.0;
+
+/// Checks that are time limits (see [`Check::timing`]).
+const TIMING_CHECKS: [&str; 4] = [
+    "fire command on time",
+    "ECU in Normal when the fault began",
+    "fault detected: ECU degrades to the reference restraint",
+    "recovers after the fault",
+];
+
+const FIRES_CHECK: &str = "airbag fires exactly when the scenario requires";
+
+/// Checks that fail when the ECU fell back to the reference restraint at the crash (see
+/// [`starved_inputs_at_fire`]).
+const STARVATION_CHECKS: [&str; 4] = [
+    FIRES_CHECK,
+    "crash handled by the adaptive path after recovery",
+    "services usable after a killed process (crash handled adaptively)",
+    "same airbag plan as the baseline",
+];
+
+/// EcuStatus fault flags of the inputs (missing, stale or out of range) and of overruns: what
+/// a stalled machine causes, as opposed to E2E failures, a bad LUT or a bad configuration.
+const STARVED_INPUT_FLAGS: [&str; 5] = [
+    "vehicle_input",
+    "occupant_input",
+    "object_input",
+    "accel_sensor",
+    "overrun",
+];
+
+/// If the airbag was fired by the reference restraint while the ECU's only active faults were
+/// stale inputs (see [`STARVED_INPUT_FLAGS`]): those faults, joined with "+".
+fn starved_inputs_at_fire(
+    actions: &[TimedAction],
+    ecu_faults: &[(f64, Vec<String>)],
+) -> Option<String> {
+    let fire = actions.iter().find(|a| a.action.what == "airbag_fire")?;
+    let t = fire.t_ms?;
+    if fire.action.source != "reference" {
+        return None;
+    }
+    let (_, flags) = ecu_faults.iter().rev().find(|(tf, _)| *tf <= t)?;
+    (!flags.is_empty()
+        && flags
+            .iter()
+            .all(|f| STARVED_INPUT_FLAGS.contains(&f.as_str())))
+    .then(|| flags.join("+"))
+}
+
+/// Scenario time [s] of a report time (ms rel. contact, or since start without contact).
+fn scenario_s(r: &Report, t_ms: f64) -> f64 {
+    if r.contact_ns != 0 && r.start_ns != 0 {
+        (r.contact_ns as f64 - r.start_ns as f64) * 1e-9 + t_ms * 1e-3
+    } else {
+        t_ms * 1e-3
+    }
+}
+
+fn counter(ecu: Option<&serde_json::Value>, name: &str) -> u64 {
+    ecu.and_then(|e| e.get("counters"))
+        .and_then(|c| c.get(name))
+        .and_then(serde_json::Value::as_u64)
+        .unwrap_or(0)
+}
+
+/// Flood frames on the bus: everything candump saw minus what the ECU sent and the vehicle
+/// and occupant frames of the feeds (a random frame with one of those two ids is counted as
+/// the feeds'; 2 of 2048 ids).
+fn flood_frames(run: &RunResult) -> u64 {
+    let Ok(text) = std::fs::read_to_string(run.dir.join("candump.log")) else {
+        return 0;
+    };
+    let (mut total, mut feeds) = (0u64, 0u64);
+    for l in text.lines() {
+        let Some(frame) = l.split_whitespace().nth(2) else {
+            continue;
+        };
+        total += 1;
+        if frame.starts_with("0A0#") || frame.starts_with("0C0#") {
+            feeds += 1;
+        }
+    }
+    total.saturating_sub(feeds + counter(run.ecu_report.as_ref(), "can_tx"))
+}
+
+/// What the disturbance measured about itself, as JSON: the restarted feeds' resumption
+/// (`feeds-restart.json`), else the last JSON line a side process printed (bus-inject's
+/// `injected`, `first_s`, `last_s`).
+fn disturbance_summary(run: &RunResult) -> Option<serde_json::Value> {
+    let from_file = std::fs::read_to_string(run.dir.join("feeds-restart.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok());
+    from_file.or_else(|| {
+        run.disturbance_output
+            .iter()
+            .find_map(|(_, out)| out.lines().rev().find_map(|l| serde_json::from_str(l).ok()))
+    })
+}
+
+/// Frames the disturbance put on the bus: bus-inject's JSON summary, or one "sent" line per
+/// successful cansend.
+fn injected(run: &RunResult, summary: Option<&serde_json::Value>) -> u64 {
+    summary
+        .and_then(|v| v.get("injected"))
+        .and_then(serde_json::Value::as_u64)
+        .unwrap_or_else(|| {
+            run.disturbance_output
+                .iter()
+                .map(|(_, out)| out.lines().filter(|l| *l == "sent").count() as u64)
+                .sum()
+        })
+}
+
+/// The checks of one case, each a function check or a time limit ([`Check::timing`]).
+struct Checks {
+    list: Vec<Check>,
+    /// See [`starved_inputs_at_fire`].
+    starved: Option<String>,
+}
+
+impl Checks {
+    fn new(r: &Report) -> Self {
+        Self {
+            list: Vec::new(),
+            starved: starved_inputs_at_fire(&r.actions, &r.ecu_faults),
+        }
+    }
+
+    fn check(&mut self, what: &str, ok: bool, detail: String) {
+        // A fire of the reference restraint with the ECU degraded only by inputs that went
+        // stale is the specified fallback; inside user-mode Linux the emulator's stalls starve
+        // the inputs now and then, so a check it fails is a timing failure there (run again)
+        // and a function failure on a real kernel.
+        let starved_fire = STARVATION_CHECKS.contains(&what) && self.starved.is_some();
+        let detail = match (&self.starved, starved_fire && !ok) {
+            (Some(f), true) => format!(
+                "{detail} (reference restraint: the ECU's only faults at the fire were {f})"
+            ),
+            _ => detail,
+        };
+        self.list.push(Check {
+            what: what.to_owned(),
+            ok,
+            detail,
+            timing: TIMING_CHECKS.contains(&what) || (starved_fire && crate::in_uml_guest()),
+        });
+    }
+}
+
+/// Judges one run.
+pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> CaseResult {
+    let r = &run.report;
+    // The scenario file the run played (the campaign's variant where the case made one).
+    let played = sensor_feeds::Scenario::load(&run.scenario).ok();
+    let ecu = run.ecu_report.as_ref();
+    let mut checks = Checks::new(r);
+
+    checks.check(
+        "bench processes ran and stopped cleanly",
+        run.problems.is_empty(),
+        if run.problems.is_empty() {
+            "ecu, sensor-feeds, actuator-stubs exit 0".into()
+        } else {
+            run.problems.join("; ")
+        },
+    );
+    checks.check(
+        "ECU report written",
+        ecu.is_some(),
+        "ecu-report.json".into(),
+    );
+    let rejected = rejections_by_reason(ecu, r);
+    let summary = disturbance_summary(run);
+    let frames_injected = if case.fault == Fault::Flood {
+        flood_frames(run)
+    } else {
+        injected(run, summary.as_ref())
+    };
+    let commands = judge_commands(&mut checks, case, run, frames_injected);
+
+    let fire = r.actions.iter().find(|a| a.action.what == "airbag_fire");
+    let must_fire = played.as_ref().and_then(|s| s.expect.airbag_fires);
+    if let Some(want) = must_fire {
+        checks.check(
+            FIRES_CHECK,
+            r.airbag_fired == want,
+            format!("expected {want}, fired {}", r.airbag_fired),
+        );
+    }
+    let late = fire.and_then(|a| a.t_ms.map(|t| t - a.action.planned_ms));
+    if let (Some(a), Some(l)) = (fire, late) {
+        checks.check(
+            "fire command on time",
+            (-1.0..=FIRE_LATE_ALLOWANCE_MS).contains(&l) && a.t_ms.is_some_and(|t| t >= 0.0),
+            format!(
+                "received {:+.1} ms after its planned {:+.1} ms (allowance {FIRE_LATE_ALLOWANCE_MS} ms)",
+                l, a.action.planned_ms
+            ),
+        );
+    }
+    let modes: Vec<(f64, String)> = r
+        .ecu_modes
+        .iter()
+        .map(|(t, m)| (scenario_s(r, *t) * 1e3, m.clone()))
+        .collect();
+
+    let window = fault_window(case, summary.as_ref());
+    let reaction = window.map_or_else(Reaction::default, |w| {
+        judge_reaction(&mut checks, case, w, &modes, &rejected)
+    });
+    if window.is_some() && must_fire == Some(true) {
+        checks.check(
+            "crash handled by the adaptive path after recovery",
+            fire.is_some_and(|a| a.action.source == "adaptive"),
+            fire.map_or("no fire".into(), |a| format!("source {}", a.action.source)),
+        );
+    }
+    judge_fault(
+        &mut checks,
+        case,
+        run,
+        &modes,
+        fire,
+        frames_injected,
+        played.as_ref().map_or(f64::NAN, |s| s.duration_s),
+    );
+    // Same decision as without the fault where the fault is over before the threat.
+    if window.is_some() || case.fault == Fault::StaleService {
+        judge_same_plan(&mut checks, baseline, fire);
+    }
+
+    let overruns = ecu
+        .and_then(|e| e.get("overruns"))
+        .and_then(serde_json::Value::as_u64)
+        .unwrap_or(0);
+    let cycles = ecu
+        .and_then(|e| e.get("cycles"))
+        .and_then(serde_json::Value::as_u64)
+        .unwrap_or(0);
+    let description = describe_reaction(
+        case,
+        &modes,
+        reaction.degraded_after_ms,
+        reaction.recovered_after_ms,
+        fire,
+    );
+    let pass = checks.list.iter().all(|c| c.ok);
+    CaseResult {
+        name: case.name.to_owned(),
+        scenario: case.scenario.to_owned(),
+        fault: case.what.to_owned(),
+        reaction: description,
+        ecu_modes: modes,
+        degraded_after_ms: reaction.degraded_after_ms,
+        recovered_after_ms: reaction.recovered_after_ms,
+        airbag_fired: r.airbag_fired,
+        airbag_source: fire.map(|a| a.action.source.clone()),
+        airbag_late_ms: late,
+        commands_sent: commands.sent,
+        commands_authenticated: commands.authenticated,
+        commands_lost: commands.lost,
+        commands_denied_by_attack: commands.denied,
+        commands_late: commands.late,
+        frames_injected,
+        frames_rejected: rejected,
+        cycles,
+        overruns,
+        checks: checks.list,
+        pass,
+        attempts: 1,
+        dir: run.dir.display().to_string(),
+        contact_s: (r.contact_ns != 0 && r.start_ns != 0)
+            .then_some((r.contact_ns as f64 - r.start_ns as f64) * 1e-9),
+        fire_s: fire.and_then(|a| a.t_ms).map(|t| scenario_s(r, t)),
+        fault_s: window,
+        duration_s: played.as_ref().map_or(0.0, |s| s.duration_s),
+    }
+}
+
+/// Rejections by the ECU (`ecu:`) and the stubs (`stubs:e2e:`, `stubs:secoc:`) by reason.
+fn rejections_by_reason(ecu: Option<&serde_json::Value>, r: &Report) -> BTreeMap<String, u64> {
+    let mut rejected: BTreeMap<String, u64> = BTreeMap::new();
+    if let Some(c) = ecu
+        .and_then(|e| e.get("counters"))
+        .and_then(|c| c.as_object())
+    {
+        for (k, v) in c {
+            if let (Some(reason), Some(n)) = (k.strip_prefix("can_rejected_"), v.as_u64()) {
+                if n > 0 {
+                    rejected.insert(format!("ecu:e2e:{reason}"), n);
+                }
+            }
+        }
+        for k in ["objects_invalid", "accel_invalid_batches"] {
+            let n = c.get(k).and_then(|v| v.as_u64()).unwrap_or(0);
+            if n > 0 {
+                rejected.insert(format!("ecu:{k}"), n);
+            }
+        }
+    }
+    for (k, n) in &r.e2e_rejected {
+        rejected.insert(format!("stubs:e2e:{k}"), *n);
+    }
+    for (k, n) in &r.secoc_rejected {
+        rejected.insert(format!("stubs:secoc:{k}"), *n);
+    }
+    rejected
+}
+
+/// What became of the commands the ECU sent.
+struct Commands {
+    sent: u64,
+    authenticated: u64,
+    lost: u64,
+    denied: u64,
+    late: u64,
+}
+
+/// Checks that every genuine command was acted on and nothing else.
+fn judge_commands(
+    checks: &mut Checks,
+    case: &Case,
+    run: &RunResult,
+    frames_injected: u64,
+) -> Commands {
+    let r = &run.report;
+    let sent = counter(run.ecu_report.as_ref(), "secoc_commands_tx");
+    let authenticated = r.secoc_accepted;
+    // Genuine commands the stubs refused because they arrived too late (freshness window or
+    // pairing timeout). Inside user-mode Linux that is the emulator delivering frames late
+    // (its softirq backlog stalls for up to a second now and then, worst under the flood), and
+    // refusing a late command is the correct behaviour: they are reported as "late", not
+    // lost. On a real kernel a late command counts as lost. (The replay case's stale frames
+    // are the attacker's, not genuine.)
+    let late = if matches!(case.fault, Fault::ReplayedFire { .. }) {
+        0
+    } else {
+        ["freshness_stale", "stale"]
+            .iter()
+            .map(|k| r.secoc_rejected.get(*k).copied().unwrap_or(0))
+            .sum::<u64>()
+    };
+    let excused_late = if crate::in_uml_guest() { late } else { 0 };
+    let lost = sent
+        .saturating_sub(authenticated)
+        .saturating_sub(excused_late);
+    let attack = matches!(
+        case.fault,
+        Fault::ForgedFire { .. } | Fault::ReplayedFire { .. } | Fault::Flood
+    );
+    checks.check(
+        "ECU sent authenticated commands",
+        sent > 0,
+        format!("{sent} command + authenticator pairs"),
+    );
+    checks.check(
+        "nothing acted on that the ECU did not send",
+        authenticated <= sent,
+        format!("stubs authenticated {authenticated}, ECU sent {sent}"),
+    );
+    // Attacker frames on the command ids: each can displace at most one genuine command (it
+    // either replaces the held command or desynchronises the E2E counter for the next one).
+    let e2e_passing_attacks = match case.fault {
+        // cansend pairs: command + authenticator; only the command frames can displace.
+        Fault::ForgedFire { .. } | Fault::ReplayedFire { .. } => frames_injected / 2,
+        // Random frames: every one the stubs saw on their ids failed E2E (or, if it passed,
+        // displaced the held command, counted as unpaired) — a rejection is an attacker frame
+        // or the genuine frame right after one, so this bounds the attacker frames from above.
+        Fault::Flood => r.e2e_rejected.values().sum::<u64>() + r.secoc_commands_dropped,
+        _ => 0,
+    };
+    let denied = lost.min(e2e_passing_attacks);
+    checks.check(
+        "no genuine command lost",
+        lost <= e2e_passing_attacks,
+        format!(
+            "{lost} of {sent} not acted on{}{}",
+            if attack {
+                format!(
+                    "; ≤ {e2e_passing_attacks} allowed (one per attacker frame that can collide)"
+                )
+            } else {
+                String::new()
+            },
+            if late > 0 {
+                format!(
+                    "; {late} arrived late and were refused as stale{}",
+                    if excused_late > 0 {
+                        " (user-mode Linux delivery delay, not counted as lost)"
+                    } else {
+                        ""
+                    }
+                )
+            } else {
+                String::new()
+            }
+        ),
+    );
+    Commands {
+        sent,
+        authenticated,
+        lost,
+        denied,
+        late,
+    }
+}
+
+/// The fault's extent [scenario s] for the faults with a window: as planned, or as the
+/// disturbance measured it (the injector's first and last frame, the restarted feeds' actual
+/// resumption).
+fn fault_window(case: &Case, summary: Option<&serde_json::Value>) -> Option<(f64, f64)> {
+    let planned = match case.fault {
+        Fault::FeedsKilled { kill_s, restart_s } => (kill_s, restart_s),
+        Fault::StaleObjects { from_s, to_s } => (from_s, to_s),
+        Fault::Bus {
+            mode: "delay",
+            from_s,
+            to_s,
+        } => (from_s + DELAY_MS * 1e-3, to_s + DELAY_MS * 1e-3),
+        Fault::Bus { from_s, to_s, .. } => (from_s, to_s),
+        _ => return None,
+    };
+    let measured = |key: &str| {
+        summary
+            .and_then(|v| v.get(key))
+            .and_then(serde_json::Value::as_f64)
+    };
+    let (from_s, to_s) = planned;
+    Some(match case.fault {
+        Fault::FeedsKilled { .. } => (from_s, measured("resumed_s").unwrap_or(to_s).max(to_s)),
+        Fault::Bus { .. } => (
+            measured("first_s").unwrap_or(from_s),
+            measured("last_s").unwrap_or(to_s),
+        ),
+        _ => planned,
+    })
+}
+
+/// How fast the ECU reacted to a fault with a window.
+#[derive(Default)]
+struct Reaction {
+    degraded_after_ms: Option<f64>,
+    recovered_after_ms: Option<f64>,
+}
+
+/// Checks that the ECU degraded within the documented time after the fault began, for the
+/// right reason, and recovered within the documented time after it ended.
+fn judge_reaction(
+    checks: &mut Checks,
+    case: &Case,
+    (from_s, to_s): (f64, f64),
+    modes: &[(f64, String)],
+    rejected: &BTreeMap<String, u64>,
+) -> Reaction {
+    let uml_slack = if crate::in_uml_guest() {
+        UML_SLACK_MS
+    } else {
+        20.0
+    };
+    let from_ms = from_s * 1e3;
+    let to_ms = to_s * 1e3;
+    let deg = modes
+        .iter()
+        .find(|(t, m)| *t >= from_ms - 5.0 && m == "ReferenceFallback")
+        .map(|(t, _)| *t);
+    let degraded_after_ms = deg.map(|t| t - from_ms);
+    // Recovery counts from the last degradation that began inside the fault window: a fault
+    // with gaps (an injector slowed down by a loaded host) may let the ECU recover and
+    // degrade again before its end.
+    let last_deg = deg.and_then(|d| {
+        modes
+            .iter()
+            .rev()
+            .find(|(t, m)| *t >= d && *t <= to_ms + 5.0 && m == "ReferenceFallback")
+            .map(|(t, _)| *t)
+    });
+    let rec = last_deg.and_then(|d| {
+        modes
+            .iter()
+            .find(|(t, m)| *t > d && m == "Normal")
+            .map(|(t, m)| (*t, m.clone()))
+    });
+    let recovered_after_ms = rec.as_ref().map(|(t, _)| t - to_ms);
+    let mode_at_start = modes
+        .iter()
+        .rev()
+        .find(|(t, _)| *t < from_ms)
+        .map_or("none", |(_, m)| m.as_str());
+    checks.check(
+        "ECU in Normal when the fault began",
+        mode_at_start == "Normal",
+        format!("{mode_at_start} at {from_ms:.0} ms"),
+    );
+    let (detect_limit_ms, recover_limit_ms, reason) = match case.fault {
+        // Back when the first sample of every timed-out input arrives: the occupant frame
+        // (100 ms period) is the slowest.
+        Fault::FeedsKilled { .. } => (
+            OBJECT_TIMEOUT_MS.max(VEHICLE_TIMEOUT_MS),
+            OCCUPANT_PERIOD_MS,
+            None,
+        ),
+        Fault::StaleObjects { .. } => (
+            OBJECT_TIMEOUT_MS + OBJECT_PERIOD_MS,
+            OBJECT_PERIOD_MS,
+            Some("ecu:objects_invalid"),
+        ),
+        Fault::Bus { mode, .. } => (
+            E2E_BURST_MS,
+            E2E_HOLD_MS,
+            Some(match mode {
+                "crc" => "ecu:e2e:crc_mismatch",
+                "replay" => "ecu:e2e:counter_repeated",
+                _ => "ecu:e2e:counter_skipped",
+            }),
+        ),
+        _ => (0.0, 0.0, None),
+    };
+    checks.check(
+        "fault detected: ECU degrades to the reference restraint",
+        degraded_after_ms.is_some_and(|d| d <= detect_limit_ms + uml_slack),
+        degraded_after_ms.map_or("never degraded".into(), |d| {
+            format!(
+                "ReferenceFallback {d:.0} ms after the fault began (documented ≤ {detect_limit_ms:.0} ms + {uml_slack:.0} ms slack)"
+            )
+        }),
+    );
+    checks.check(
+        "recovers after the fault",
+        recovered_after_ms.is_some_and(|d| d <= recover_limit_ms + uml_slack),
+        rec.as_ref().map_or("never recovered".into(), |(t, m)| {
+            format!(
+                "{m} {:.0} ms after the fault ended (documented ≤ {recover_limit_ms:.0} ms + {uml_slack:.0} ms slack; at {:.0} ms)",
+                t - to_ms,
+                t
+            )
+        }),
+    );
+    if let Some(reason) = reason {
+        let n = rejected.get(reason).copied().unwrap_or(0);
+        checks.check(
+            "the ECU rejected the faulty input for the right reason",
+            n > 0,
+            format!("{reason} = {n}"),
+        );
+    }
+    Reaction {
+        degraded_after_ms,
+        recovered_after_ms,
+    }
+}
+
+/// The checks only some faults have: the LUT faults' start-up fallback, the stale service's
+/// usable services, the attacks' rejected frames, the flood's inputs.
+fn judge_fault(
+    checks: &mut Checks,
+    case: &Case,
+    run: &RunResult,
+    modes: &[(f64, String)],
+    fire: Option<&TimedAction>,
+    frames_injected: u64,
+    duration_s: f64,
+) {
+    let ecu = run.ecu_report.as_ref();
+    match case.fault {
+        Fault::Lut { .. } => {
+            let stderr =
+                std::fs::read_to_string(run.dir.join("ecu-stderr.txt")).unwrap_or_default();
+            let said = stderr
+                .lines()
+                .find(|l| l.to_lowercase().contains("lut"))
+                .unwrap_or("")
+                .to_owned();
+            checks.check(
+                "the ECU names the bad LUT file",
+                said.contains("DEGRADED")
+                    || said.to_lowercase().contains("error")
+                    || said.to_lowercase().contains("reject"),
+                said,
+            );
+            checks.check(
+                "never Normal without a valid LUT",
+                !modes.iter().any(|(_, m)| m == "Normal"),
+                format!("{} mode changes", modes.len()),
+            );
+            checks.check(
+                "still protected: the reference restraint fires",
+                fire.is_some_and(|a| a.action.source == "reference"),
+                fire.map_or("no fire".into(), |a| format!("source {}", a.action.source)),
+            );
+        }
+        Fault::StaleService => {
+            let cleaned = ecu
+                .and_then(|e| e.pointer("/ipc/stale_nodes_cleaned"))
+                .and_then(serde_json::Value::as_u64)
+                .unwrap_or(0);
+            checks.check(
+                "services usable after a killed process (crash handled adaptively)",
+                fire.is_some_and(|a| a.action.source == "adaptive"),
+                format!(
+                    "{}; stale nodes removed by the ECU's explicit clean-up: {cleaned} (iceoryx2 also cleans dead nodes at node creation)",
+                    fire.map_or("no fire".into(), |a| format!("source {}", a.action.source))
+                ),
+            );
+        }
+        Fault::ForgedFire { .. } | Fault::ReplayedFire { .. } => {
+            let r = &run.report;
+            let secoc_rejected: u64 = r.secoc_rejected.values().sum();
+            checks.check(
+                "attacker frames were on the bus",
+                frames_injected > 0,
+                format!("{frames_injected} frames via cansend"),
+            );
+            checks.check(
+                "SecOC rejected the attacker's authenticators",
+                secoc_rejected > 0,
+                format!("{:?}", r.secoc_rejected),
+            );
+        }
+        Fault::Flood => {
+            let rx = counter(ecu, "can_frames_rx");
+            checks.check(
+                "ECU kept receiving its inputs under the flood",
+                rx > 0,
+                format!(
+                    "{rx} input frames received (kernel filter drops the rest); flood ≈ {frames_injected} frames, {:.0} frames/s (a 500 kbit/s bus carries ≈ 4 000 frames/s)",
+                    frames_injected as f64 / duration_s
+                ),
+            );
+            checks.check(
+                "the flood was on the bus",
+                frames_injected > 0,
+                format!("{frames_injected} frames"),
+            );
+        }
+        Fault::None
+        | Fault::FeedsKilled { .. }
+        | Fault::StaleObjects { .. }
+        | Fault::Bus { .. } => {}
+    }
+}
+
+/// The airbag plan (fire time, level) is the baseline's: a fault that is over before the
+/// threat leaves no trace in the decision.
+fn judge_same_plan(checks: &mut Checks, baseline: Option<&RunResult>, fire: Option<&TimedAction>) {
+    let base_fire = baseline.and_then(|b| {
+        b.report
+            .actions
+            .iter()
+            .find(|a| a.action.what == "airbag_fire")
+    });
+    if let (Some(b), Some(a)) = (base_fire, fire) {
+        let dt = a.action.planned_ms - b.action.planned_ms;
+        let dl = a.action.level_kn - b.action.level_kn;
+        checks.check(
+            "same airbag plan as the baseline",
+            dt.abs() <= 5.0 && dl.abs() <= 1.0,
+            format!(
+                "planned {:+.1} ms / {:.2} kN vs baseline {:+.1} ms / {:.2} kN",
+                a.action.planned_ms, a.action.level_kn, b.action.planned_ms, b.action.level_kn
+            ),
+        );
+    }
+}
+
+fn describe_reaction(
+    case: &Case,
+    modes: &[(f64, String)],
+    degraded: Option<f64>,
+    recovered: Option<f64>,
+    fire: Option<&TimedAction>,
+) -> String {
+    let mut s = String::new();
+    if let Some(d) = degraded {
+        let _ = write!(s, "degraded after {d:.0} ms");
+        match recovered {
+            Some(r) if matches!(case.fault, Fault::FeedsKilled { .. }) => {
+                let _ = write!(s, ", recovered {r:.0} ms after the feeds were back");
+            }
+            Some(r) => {
+                let _ = write!(s, ", recovered {r:.0} ms after the fault ended");
+            }
+            None => s.push_str(", did not recover"),
+        }
+        s.push_str("; ");
+    } else if matches!(case.fault, Fault::Lut { .. }) {
+        s.push_str("reference restraint from start; ");
+    }
+    match fire {
+        Some(a) => {
+            let _ = write!(
+                s,
+                "airbag fired ({}) at {:+.1} ms",
+                a.action.source,
+                a.t_ms.unwrap_or(f64::NAN)
+            );
+        }
+        None => s.push_str("airbag not fired"),
+    }
+    let _ = write!(s, "; {} mode changes", modes.len());
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_reference_fire_with_only_stale_inputs_is_told_apart_from_other_faults() {
+        let fire = |source: &str| TimedAction {
+            action: actuator_stubs::commands::Action {
+                t_ns: 0,
+                what: "airbag_fire".into(),
+                level_kn: 12.0,
+                planned_ms: 10.0,
+                source: source.into(),
+            },
+            t_ms: Some(14.0),
+        };
+        let faults = |names: &[&str]| -> Vec<(f64, Vec<String>)> {
+            vec![
+                (-900.0, vec!["e2e".to_owned()]),
+                (-500.0, Vec::new()),
+                (-30.0, names.iter().map(|n| (*n).to_owned()).collect()),
+                (20.0, Vec::new()),
+            ]
+        };
+        let stale = faults(&["vehicle_input", "object_input"]);
+        assert_eq!(
+            starved_inputs_at_fire(&[fire("reference")], &stale).as_deref(),
+            Some("vehicle_input+object_input")
+        );
+        // The adaptive path fired: not a fallback.
+        assert_eq!(starved_inputs_at_fire(&[fire("adaptive")], &stale), None);
+        // Corrupt data or a bad LUT is not starvation.
+        for other in [&["object_input", "e2e"][..], &["lut"], &["config"], &[]] {
+            assert_eq!(
+                starved_inputs_at_fire(&[fire("reference")], &faults(other)),
+                None,
+                "{other:?}"
+            );
+        }
+        // No fire, no verdict.
+        assert_eq!(starved_inputs_at_fire(&[], &stale), None);
+    }
+}

@@ -1,0 +1,170 @@
+//! The robustness report: the campaign's figures, the fuzzing figures, the verdict last.
+
+use super::{Campaign, FuzzTarget};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+/// The robustness report: the campaign's figures and the fuzzing figures.
+pub fn report_text(c: &Campaign, fuzz: Option<&[FuzzTarget]>) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "=== robustness report ===");
+    let _ = writeln!(
+        s,
+        "fault campaign on vcan ({}):",
+        if c.in_uml {
+            "inside user-mode Linux: timing emulated"
+        } else {
+            "host kernel"
+        }
+    );
+    let _ = writeln!(
+        s,
+        "  {:<14} {:<5} {:>6} {:>7} {:>6} {:>8} {:>9}  reaction",
+        "case", "", "sent", "lost", "inj", "overrun", "late ms"
+    );
+    for r in &c.cases {
+        let _ = writeln!(
+            s,
+            "  {:<14} {:<5} {:>6} {:>7} {:>6} {:>8} {:>9}  {}{}",
+            r.name,
+            if r.pass { "PASS" } else { "FAIL" },
+            r.commands_sent,
+            match (r.commands_denied_by_attack, r.commands_late) {
+                (0, 0) => r.commands_lost.to_string(),
+                (a, 0) => format!("{}({a}a)", r.commands_lost),
+                (0, l) => format!("{}({l}L)", r.commands_lost),
+                (a, l) => format!("{}({a}a,{l}L)", r.commands_lost),
+            },
+            r.frames_injected,
+            r.overruns,
+            r.airbag_late_ms
+                .map_or("—".to_owned(), |l| format!("{l:+.1}")),
+            r.reaction,
+            if r.attempts > 1 {
+                format!(" (run {}: the earlier missed a time limit)", r.attempts)
+            } else {
+                String::new()
+            }
+        );
+        for ch in r.checks.iter().filter(|c| !c.ok) {
+            let _ = writeln!(s, "      FAILED: {}: {}", ch.what, ch.detail);
+        }
+    }
+    let tried = c.cases.len();
+    let faults = c.cases.iter().filter(|r| r.name != "baseline").count();
+    let survived = c
+        .cases
+        .iter()
+        .filter(|r| r.name != "baseline" && r.pass)
+        .count();
+    let mut by_reason: BTreeMap<&str, u64> = BTreeMap::new();
+    for r in &c.cases {
+        for (k, n) in &r.frames_rejected {
+            *by_reason.entry(k).or_default() += n;
+        }
+    }
+    let lost: u64 = c
+        .cases
+        .iter()
+        .map(|r| r.commands_lost - r.commands_denied_by_attack)
+        .sum();
+    let denied: u64 = c.cases.iter().map(|r| r.commands_denied_by_attack).sum();
+    let late: u64 = c.cases.iter().map(|r| r.commands_late).sum();
+    let base_overruns = c
+        .cases
+        .iter()
+        .find(|r| r.name == "baseline")
+        .map_or(0, |r| r.overruns);
+    let extra_overruns: u64 = c
+        .cases
+        .iter()
+        .filter(|r| r.name != "baseline")
+        .map(|r| r.overruns.saturating_sub(base_overruns))
+        .sum();
+    let _ = writeln!(
+        s,
+        "\ncases tried        {tried} ({faults} faults + baseline)"
+    );
+    let _ = writeln!(s, "faults survived    {survived} of {faults}");
+    let _ = writeln!(
+        s,
+        "commands lost      {lost}   (genuine commands not acted on, attacks excluded)"
+    );
+    let _ = writeln!(s, "denied by attack   {denied}   (genuine frames displaced by attacker frames; resent next cycle)");
+    let _ = writeln!(
+        s,
+        "arrived late       {late}   (genuine commands refused as stale: delivered after the freshness window{})",
+        if c.in_uml {
+            "; user-mode Linux delivery delays, not counted as lost"
+        } else {
+            "; counted as lost"
+        }
+    );
+    let _ = writeln!(
+        s,
+        "deadline misses    {extra_overruns} beyond the baseline's {base_overruns} (sum over fault cases){}",
+        if c.in_uml {
+            " — user-mode Linux: emulated timers, not a real-time figure"
+        } else {
+            ""
+        }
+    );
+    let _ = writeln!(s, "frames rejected by reason:");
+    for (k, n) in &by_reason {
+        let _ = writeln!(s, "  {k:<40} {n}");
+    }
+    match fuzz {
+        Some(f) => {
+            let execs: u64 = f.iter().map(|t| t.execs).sum();
+            let ms: u64 = f.iter().map(|t| t.time_ms).sum();
+            let _ = writeln!(
+                s,
+                "inputs fuzzed      {execs} in {:.1} s over {} targets ({} clean)",
+                ms as f64 / 1e3,
+                f.len(),
+                f.iter().filter(|t| t.ok).count()
+            );
+            for t in f {
+                let _ = writeln!(
+                    s,
+                    "  {:<16} {:>10} execs {:>6.1} s {}",
+                    t.target,
+                    t.execs,
+                    t.time_ms as f64 / 1e3,
+                    if t.ok { "clean" } else { "FAILED" }
+                );
+            }
+        }
+        None => {
+            let _ = writeln!(
+                s,
+                "inputs fuzzed      (no fuzz figures given: tests/fuzz-smoke.sh writes them)"
+            );
+        }
+    }
+    // The verdict last, where a truncated log still shows it.
+    let failed: Vec<String> = c
+        .cases
+        .iter()
+        .filter(|r| !r.pass)
+        .map(|r| {
+            let what: Vec<&str> = r
+                .checks
+                .iter()
+                .filter(|k| !k.ok)
+                .map(|k| k.what.as_str())
+                .collect();
+            format!("{} ({})", r.name, what.join("; "))
+        })
+        .collect();
+    let _ = writeln!(
+        s,
+        "verdict            {}",
+        if failed.is_empty() {
+            "every case passed".to_owned()
+        } else {
+            format!("FAILED: {}", failed.join(", "))
+        }
+    );
+    s
+}
