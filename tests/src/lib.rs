@@ -403,8 +403,11 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     dist.prepare(cfg, &dir)?;
     let candump_log = std::fs::File::create(dir.join("candump.log"))?;
     let mut candump = spawn(
+        // An 8 MiB receive queue like the stubs': with the default one candump drops frames
+        // under the campaign's flood (it recorded ~ 1/4 of them), and its log is what the
+        // flood and the recorded fire pair are counted from.
         Command::new("candump")
-            .args(["-L", &cfg.can])
+            .args(["-L", "-r", "8388608", &cfg.can])
             .stdout(candump_log)
             .stderr(Stdio::inherit()),
         "candump (install can-utils)",

@@ -106,6 +106,19 @@ fn flood_frames(run: &RunResult) -> u64 {
     total.saturating_sub(feeds + counter(run.ecu_report.as_ref(), "can_tx"))
 }
 
+/// Frames on the SecOC command and authenticator ids that the ECU did not send: what the stubs
+/// received there − 2 × what the ECU sent (a command + authenticator pair each). Exact when
+/// every genuine frame reached the stubs; genuine frames missing at the stubs make it smaller,
+/// so the "no genuine command lost" bound it sets only gets stricter.
+fn flood_frames_on_command_ids(frames: &BTreeMap<String, u64>, sent: u64) -> u64 {
+    let received: u64 = bus::secoc::SecOcStream::ALL
+        .iter()
+        .flat_map(|s| [s.command_id(), s.auth_id()])
+        .filter_map(|id| bus::message_info(id).and_then(|m| frames.get(m.name)))
+        .sum();
+    received.saturating_sub(2 * sent)
+}
+
 /// What the disturbance measured about itself, as JSON: the restarted feeds' resumption
 /// (`feeds-restart.json`), else the last JSON line a side process printed (bus-inject's
 /// `injected`, `first_s`, `last_s`).
@@ -386,10 +399,8 @@ fn judge_commands(
     let e2e_passing_attacks = match case.fault {
         // cansend pairs: command + authenticator; only the command frames can displace.
         Fault::ForgedFire { .. } | Fault::ReplayedFire { .. } => frames_injected / 2,
-        // Random frames: every one the stubs saw on their ids failed E2E (or, if it passed,
-        // displaced the held command, counted as unpaired) — a rejection is an attacker frame
-        // or the genuine frame right after one, so this bounds the attacker frames from above.
-        Fault::Flood => r.e2e_rejected.values().sum::<u64>() + r.secoc_commands_dropped,
+        // Random frames that landed on a command or authenticator id.
+        Fault::Flood => flood_frames_on_command_ids(&r.frames, sent),
         _ => 0,
     };
     let denied = lost.min(e2e_passing_attacks);
@@ -726,6 +737,25 @@ fn describe_reaction(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn flood_frames_on_the_command_ids_are_the_receptions_beyond_the_genuine_pairs() {
+        let frames: BTreeMap<String, u64> = [
+            ("AirbagStageCmd", 103),
+            ("AirbagStageAuth", 101),
+            ("BeltLimiterCmd", 100),
+            ("BeltLimiterAuth", 102),
+            ("EcuStatus", 999),
+            ("EgoVehicleState", 999),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_owned(), v))
+        .collect();
+        // 200 genuine pairs = 400 frames on the four ids; 6 more arrived there.
+        assert_eq!(flood_frames_on_command_ids(&frames, 200), 6);
+        // Fewer receptions than genuine frames: no attacker frame is assumed.
+        assert_eq!(flood_frames_on_command_ids(&frames, 300), 0);
+    }
 
     #[test]
     fn a_reference_fire_with_only_stale_inputs_is_told_apart_from_other_faults() {
