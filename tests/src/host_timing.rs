@@ -47,6 +47,9 @@ pub struct HostTiming {
     pub can: String,
     /// Runs in order (baseline first and last).
     pub runs: Vec<TimedRun>,
+    /// Where the other bench processes ran, e.g. "CPU 1 to the ECU alone; feeds on CPUs 0".
+    #[serde(default)]
+    pub cpus: String,
 }
 
 /// Where the runs happen.
@@ -100,6 +103,7 @@ pub fn run_host_timing(cfg: &HostTimingConfig) -> Result<HostTiming> {
     let mut out = HostTiming {
         can: "off (--no-can): this host kernel has no SocketCAN".into(),
         runs: Vec::new(),
+        cpus: keep_off_cpu(cfg.cpu),
     };
     for (i, (name, fault)) in host_cases().into_iter().enumerate() {
         eprintln!("host-timing: {name}");
@@ -189,13 +193,49 @@ pub fn run_host_timing(cfg: &HostTimingConfig) -> Result<HostTiming> {
     Ok(out)
 }
 
+/// Moves this process (and so every process it starts: the feeds, a restarted feed, the stale
+/// service's victims) off the ECU's CPU, as a bench isolates the CPU of the device under test:
+/// a fault then reaches the ECU only through what it shares with the feeds (IPC, the kernel),
+/// not through a process start or exit on its CPU. The ECU pins itself back (`--cpu`).
+/// Returns the arrangement in words.
+fn keep_off_cpu(ecu_cpu: u32) -> String {
+    use nix::sched::{sched_getaffinity, sched_setaffinity, CpuSet};
+    use nix::unistd::Pid;
+    let Ok(mine) = sched_getaffinity(Pid::from_raw(0)) else {
+        return "not isolated (affinity unreadable)".into();
+    };
+    let mut others = CpuSet::new();
+    let mut names = Vec::new();
+    for c in 0..CpuSet::count() {
+        if c != ecu_cpu as usize && mine.is_set(c).unwrap_or(false) {
+            let _ = others.set(c);
+            names.push(c.to_string());
+        }
+    }
+    if names.is_empty() {
+        return format!("CPU {ecu_cpu} shared with the feeds (no other CPU)");
+    }
+    match sched_setaffinity(Pid::from_raw(0), &others) {
+        Ok(()) => format!(
+            "CPU {ecu_cpu} to the ECU alone; feeds and bench on CPU {}",
+            names.join(",")
+        ),
+        Err(e) => format!("CPU {ecu_cpu} shared with the feeds (affinity: {e})"),
+    }
+}
+
 /// The table of the runs.
 pub fn host_timing_text(h: &HostTiming) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "deadline misses on the host kernel (1 kHz, ECU CAN side {}):",
-        h.can
+        "deadline misses on the host kernel (1 kHz, ECU CAN side {}; {}):",
+        h.can,
+        if h.cpus.is_empty() {
+            "CPUs not recorded"
+        } else {
+            &h.cpus
+        }
     );
     let _ = writeln!(
         s,
@@ -239,4 +279,35 @@ pub fn host_timing_text(h: &HostTiming) -> String {
         "  deadline misses beyond the clean runs' worst ({worst_base}): {extra}"
     );
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_bench_leaves_the_ecus_cpu_to_the_ecu() {
+        use nix::sched::sched_getaffinity;
+        use nix::unistd::Pid;
+        // Affinity is per thread: a thread of its own keeps the test runner as it was.
+        std::thread::spawn(|| {
+            let before = sched_getaffinity(Pid::from_raw(0)).expect("affinity");
+            let n = (0..nix::sched::CpuSet::count())
+                .filter(|c| before.is_set(*c).unwrap_or(false))
+                .count();
+            let said = keep_off_cpu(0);
+            let after = sched_getaffinity(Pid::from_raw(0)).expect("affinity");
+            if n > 1 && before.is_set(0).unwrap_or(false) {
+                assert!(!after.is_set(0).unwrap(), "{said}");
+                assert!(said.starts_with("CPU 0 to the ECU alone"), "{said}");
+            } else {
+                assert!(
+                    said.contains("shared") || !before.is_set(0).unwrap(),
+                    "{said}"
+                );
+            }
+        })
+        .join()
+        .expect("thread");
+    }
 }
