@@ -304,6 +304,7 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
         checks: checks.list,
         pass,
         attempts: 1,
+        earlier_runs: Vec::new(),
         dir: run.dir.display().to_string(),
         contact_s: (r.contact_ns != 0 && r.start_ns != 0)
             .then_some((r.contact_ns as f64 - r.start_ns as f64) * 1e-9),

@@ -307,6 +307,9 @@ pub struct CaseResult {
     /// Runs it took (> 1: the earlier ones failed only time limits inside user-mode Linux).
     #[serde(default)]
     pub attempts: u32,
+    /// What the earlier runs missed ("run N: check: detail; …"), one entry per earlier run.
+    #[serde(default)]
+    pub earlier_runs: Vec<String>,
     /// Output folder.
     pub dir: String,
     /// True contact [scenario s] (None: no contact).
@@ -369,19 +372,29 @@ pub fn run_campaign(cfg: &CampaignConfig, only: &[String]) -> Result<Campaign> {
         );
         let (mut run, mut result) = run_case(cfg, case, i, baseline.as_ref().map(|b| &b.0))?;
         let mut attempts = 1;
+        let mut earlier = Vec::new();
         while out.in_uml
             && attempts < UML_ATTEMPTS
             && !result.pass
             && result.checks.iter().all(|c| c.ok || c.timing)
         {
+            let missed: Vec<String> = result
+                .checks
+                .iter()
+                .filter(|c| !c.ok)
+                .map(|c| format!("{}: {}", c.what, c.detail))
+                .collect();
             eprintln!(
-                "fault-campaign: {}: only time limits failed inside user-mode Linux (emulated timers); running it again",
-                case.name
+                "fault-campaign: {}: only time limits failed inside user-mode Linux (emulated timers): {}; running it again",
+                case.name,
+                missed.join("; ")
             );
+            earlier.push(format!("run {attempts}: {}", missed.join("; ")));
             (run, result) = run_case(cfg, case, i, baseline.as_ref().map(|b| &b.0))?;
             attempts += 1;
         }
         result.attempts = attempts;
+        result.earlier_runs = earlier;
         eprintln!(
             "fault-campaign: {}: {}",
             case.name,

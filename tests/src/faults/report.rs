@@ -49,6 +49,9 @@ pub fn report_text(c: &Campaign, fuzz: Option<&[FuzzTarget]>) -> String {
         for ch in r.checks.iter().filter(|c| !c.ok) {
             let _ = writeln!(s, "      FAILED: {}: {}", ch.what, ch.detail);
         }
+        for e in &r.earlier_runs {
+            let _ = writeln!(s, "      time limit missed in {e}");
+        }
     }
     let tried = c.cases.len();
     let faults = c.cases.iter().filter(|r| r.name != "baseline").count();
@@ -167,4 +170,62 @@ pub fn report_text(c: &Campaign, fuzz: Option<&[FuzzTarget]>) -> String {
         }
     );
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::faults::{CaseResult, Check};
+
+    fn case(name: &str, pass: bool) -> CaseResult {
+        CaseResult {
+            name: name.into(),
+            pass,
+            commands_sent: 900,
+            commands_authenticated: 900,
+            ..CaseResult::default()
+        }
+    }
+
+    #[test]
+    fn the_report_ends_with_the_verdict_and_shows_earlier_runs() {
+        let mut flood = case("cangen-flood", true);
+        flood.attempts = 2;
+        flood.earlier_runs = vec!["run 1: fire command on time: received +31.0 ms".into()];
+        let mut bad = case("can-crc", false);
+        bad.checks = vec![
+            Check {
+                what: "ECU report written".into(),
+                ok: true,
+                detail: String::new(),
+                timing: false,
+            },
+            Check {
+                what: "recovers after the fault".into(),
+                ok: false,
+                detail: "never recovered".into(),
+                timing: true,
+            },
+        ];
+        let c = Campaign {
+            in_uml: true,
+            cases: vec![case("baseline", true), flood, bad],
+        };
+        let text = report_text(&c, None);
+        assert!(
+            text.contains("time limit missed in run 1: fire command on time"),
+            "{text}"
+        );
+        assert!(text.contains("faults survived    1 of 2"), "{text}");
+        let last = text.lines().last().unwrap_or("");
+        assert_eq!(
+            last,
+            "verdict            FAILED: can-crc (recovers after the fault)"
+        );
+        let ok = Campaign {
+            in_uml: true,
+            cases: vec![case("baseline", true)],
+        };
+        assert!(report_text(&ok, None).ends_with("verdict            every case passed\n"));
+    }
 }
