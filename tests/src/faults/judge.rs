@@ -95,7 +95,13 @@ fn flood_frames(run: &RunResult) -> u64 {
     };
     let (mut total, mut feeds) = (0u64, 0u64);
     for l in text.lines() {
-        let Some(frame) = l.split_whitespace().nth(2) else {
+        // Only frame lines count: `(time) iface ID#DATA`.
+        let Some(frame) = l
+            .starts_with('(')
+            .then(|| l.split_whitespace().nth(2))
+            .flatten()
+            .filter(|f| f.contains('#'))
+        else {
             continue;
         };
         total += 1;
