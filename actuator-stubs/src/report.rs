@@ -115,6 +115,14 @@ pub struct Report {
     pub plot: Option<String>,
 }
 
+impl Report {
+    /// The first action of this kind ("airbag_fire", "pretensioner_fire", …), as
+    /// [`crate::commands::Modules::action`] is during the run.
+    pub fn action(&self, what: &str) -> Option<&TimedAction> {
+        self.actions.iter().find(|a| a.action.what == what)
+    }
+}
+
 /// EcuStatus fault flags in bit order (DBC `FaultVehicleInput` … `FaultConfig`).
 pub const ECU_FAULT_NAMES: [&str; 8] = [
     "vehicle_input",

@@ -585,7 +585,6 @@ pub fn summarise(
         }
     }
     let _ = writeln!(s, "\ntimeline (ms relative to TRUE contact):");
-    let action = |w: &str| r.actions.iter().find(|a| a.action.what == w);
     let _ = writeln!(
         s,
         "  threat detected (ECU pre-crash)                  {}",
@@ -596,7 +595,7 @@ pub fn summarise(
         "  settings preset (limiter level sent)             {}",
         ms(r.settings_preset_ms)
     );
-    if let Some(a) = action("pretensioner_fire") {
+    if let Some(a) = r.action("pretensioner_fire") {
         let _ = writeln!(
             s,
             "  pretensioner fire                                {}  (planned {:+.1} ms, limiter {:.2} kN, {})",
@@ -621,7 +620,7 @@ pub fn summarise(
     } else {
         let _ = writeln!(s, "  contact                                          none");
     }
-    if let Some(a) = action("airbag_fire") {
+    if let Some(a) = r.action("airbag_fire") {
         let _ = writeln!(
             s,
             "  airbag fire                                      {}  (planned {:+.1} ms, level {:.2} kN, {})",
@@ -644,7 +643,7 @@ pub fn summarise(
             ms(None)
         );
     }
-    if let Some(a) = action("pretensioner_release") {
+    if let Some(a) = r.action("pretensioner_release") {
         let _ = writeln!(
             s,
             "  pretensioner release                             {}",

@@ -96,10 +96,6 @@ fn all() -> Vec<(Scenario, Report)> {
         .collect()
 }
 
-fn action<'a>(r: &'a Report, what: &str) -> Option<&'a actuator_stubs::report::TimedAction> {
-    r.actions.iter().find(|a| a.action.what == what)
-}
-
 #[test]
 fn every_scenario_meets_its_declared_expectations() {
     let mut failures = Vec::new();
@@ -150,13 +146,14 @@ fn pre_crash_cases_preset_before_contact_and_fire_at_the_planned_time() {
             "{}: settings preset at {preset:+.1} ms, after contact",
             s.name
         );
-        let p = action(&r, "pretensioner_fire")
+        let p = r
+            .action("pretensioner_fire")
             .unwrap_or_else(|| panic!("{}: pretensioner never fired", s.name));
         let pt = p.t_ms.expect("contact");
         assert!(pt < 0.0, "{}: pretensioner at {pt:+.1} ms", s.name);
         // Whether the bag fires is the table's decision (declared per scenario where fixed);
         // when it fires, it must fire at its planned time.
-        let Some(a) = action(&r, "airbag_fire") else {
+        let Some(a) = r.action("airbag_fire") else {
             assert!(
                 s.expect.airbag_fires != Some(true),
                 "{}: airbag never fired",
@@ -195,7 +192,7 @@ fn low_speed_case_fires_no_airbag() {
         r.actions
     );
     assert!(
-        action(&r, "airbag_fire_ignored_disarmed").is_none(),
+        r.action("airbag_fire_ignored_disarmed").is_none(),
         "a fire request was sent: {:?}",
         r.actions
     );
@@ -206,10 +203,12 @@ fn avoided_collision_fires_no_airbag_and_releases_the_pretensioner() {
     let (_, r) = load("avoided-last-moment");
     assert_eq!(r.contact_ns, 0);
     assert!(!r.airbag_fired, "{:?}", r.actions);
-    let fire = action(&r, "pretensioner_fire")
+    let fire = r
+        .action("pretensioner_fire")
         .expect("the threat was real until 40 ms before: pretensioner pre-fired");
-    let release =
-        action(&r, "pretensioner_release").expect("pretensioner released after the avoidance");
+    let release = r
+        .action("pretensioner_release")
+        .expect("pretensioner released after the avoidance");
     assert!(release.action.t_ns > fire.action.t_ns);
     assert!(
         !r.ecu_diag_modes
@@ -242,7 +241,9 @@ fn dropout_degrades_to_the_reference_restraint_within_the_documented_time() {
         delay <= DOCUMENTED_FALLBACK_MS + FALLBACK_ALLOWANCE_MS,
         "fallback {delay:.1} ms after the dropout (documented {DOCUMENTED_FALLBACK_MS} ms + {FALLBACK_ALLOWANCE_MS} ms slack)"
     );
-    let a = action(&r, "airbag_fire").expect("still protected: airbag fired");
+    let a = r
+        .action("airbag_fire")
+        .expect("still protected: airbag fired");
     assert_eq!(a.action.source, "reference", "{a:?}");
     let t = a.t_ms.expect("contact");
     assert!(

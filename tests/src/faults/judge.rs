@@ -54,10 +54,10 @@ const STARVED_INPUT_FLAGS: [&str; 5] = [
 /// If the airbag was fired by the reference restraint while the ECU's only active faults were
 /// stale inputs (see [`STARVED_INPUT_FLAGS`]): those faults, joined with "+".
 fn starved_inputs_at_fire(
-    actions: &[TimedAction],
+    fire: Option<&TimedAction>,
     ecu_faults: &[(f64, Vec<String>)],
 ) -> Option<String> {
-    let fire = actions.iter().find(|a| a.action.what == "airbag_fire")?;
+    let fire = fire?;
     let t = fire.t_ms?;
     if fire.action.source != "reference" {
         return None;
@@ -161,10 +161,10 @@ struct Checks {
 }
 
 impl Checks {
-    fn new(r: &Report) -> Self {
+    fn new(starved: Option<String>) -> Self {
         Self {
             list: Vec::new(),
-            starved: starved_inputs_at_fire(&r.actions, &r.ecu_faults),
+            starved,
         }
     }
 
@@ -195,7 +195,8 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
     // The scenario file the run played (the campaign's variant where the case made one).
     let played = sensor_feeds::Scenario::load(&run.scenario).ok();
     let ecu = run.ecu_report.as_ref();
-    let mut checks = Checks::new(r);
+    let fire = r.action("airbag_fire");
+    let mut checks = Checks::new(starved_inputs_at_fire(fire, &r.ecu_faults));
 
     checks.check(
         "bench processes ran and stopped cleanly",
@@ -220,7 +221,6 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
     };
     let commands = judge_commands(&mut checks, case, run, frames_injected);
 
-    let fire = r.actions.iter().find(|a| a.action.what == "airbag_fire");
     let must_fire = played.as_ref().and_then(|s| s.expect.airbag_fires);
     if let Some(want) = must_fire {
         checks.check(
@@ -683,12 +683,7 @@ fn judge_fault(
 /// The airbag plan (fire time, level) is the baseline's: a fault that is over before the
 /// threat leaves no trace in the decision.
 fn judge_same_plan(checks: &mut Checks, baseline: Option<&RunResult>, fire: Option<&TimedAction>) {
-    let base_fire = baseline.and_then(|b| {
-        b.report
-            .actions
-            .iter()
-            .find(|a| a.action.what == "airbag_fire")
-    });
+    let base_fire = baseline.and_then(|b| b.report.action("airbag_fire"));
     if let (Some(b), Some(a)) = (base_fire, fire) {
         let dt = a.action.planned_ms - b.action.planned_ms;
         let dl = a.action.level_kn - b.action.level_kn;
@@ -786,20 +781,23 @@ mod tests {
         };
         let stale = faults(&["vehicle_input", "object_input"]);
         assert_eq!(
-            starved_inputs_at_fire(&[fire("reference")], &stale).as_deref(),
+            starved_inputs_at_fire(Some(&fire("reference")), &stale).as_deref(),
             Some("vehicle_input+object_input")
         );
         // The adaptive path fired: not a fallback.
-        assert_eq!(starved_inputs_at_fire(&[fire("adaptive")], &stale), None);
+        assert_eq!(
+            starved_inputs_at_fire(Some(&fire("adaptive")), &stale),
+            None
+        );
         // Corrupt data or a bad LUT is not starvation.
         for other in [&["object_input", "e2e"][..], &["lut"], &["config"], &[]] {
             assert_eq!(
-                starved_inputs_at_fire(&[fire("reference")], &faults(other)),
+                starved_inputs_at_fire(Some(&fire("reference")), &faults(other)),
                 None,
                 "{other:?}"
             );
         }
         // No fire, no verdict.
-        assert_eq!(starved_inputs_at_fire(&[], &stale), None);
+        assert_eq!(starved_inputs_at_fire(None, &stale), None);
     }
 }
