@@ -7,8 +7,9 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 
 # can-utils: candump/cansend/cangen; kmod+iproute2: vcan; user-mode-linux: vcan where the
-# host kernel has no SocketCAN; rt-tests: cyclictest; valgrind: instruction-count gate.
-pkgs=(can-utils kmod iproute2 user-mode-linux rt-tests valgrind python3-venv)
+# host kernel has no SocketCAN; rt-tests: cyclictest; valgrind: instruction-count gate;
+# slurm-wlm + munge: the one-node Slurm cluster of lut/tests/slurm.rs (tests/slurm-cluster.sh).
+pkgs=(can-utils kmod iproute2 user-mode-linux rt-tests valgrind python3-venv slurm-wlm munge)
 missing=()
 for p in "${pkgs[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
