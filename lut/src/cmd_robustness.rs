@@ -124,7 +124,7 @@ pub fn run(a: &RobustnessArgs) -> Result<()> {
 
 fn draw(r: &StudyResult, path: &Path) -> Result<()> {
     let bins = |h: &robustness::Histogram| -> (Vec<f64>, Vec<f64>) {
-        let n: u64 = h.counts.iter().sum();
+        let n: u64 = h.counts.iter().sum::<u64>() + h.above;
         h.counts
             .iter()
             .enumerate()
@@ -161,7 +161,10 @@ fn draw(r: &StudyResult, path: &Path) -> Result<()> {
                 ],
             },
             plot::Panel {
-                title: "occupant peak acceleration".into(),
+                title: format!(
+                    "occupant peak acceleration ({} samples above the 99th percentile, max {:.1} g, not drawn; {} of {} bottom out)",
+                    r.a_max_histogram.above, r.a_max_g.max, r.bottoming_out_samples, r.study.samples
+                ),
                 x_label: "occupant a_max [g]",
                 y_label: "samples [%]",
                 series: vec![

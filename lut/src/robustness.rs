@@ -161,30 +161,45 @@ impl Spread {
     }
 }
 
-/// A histogram with equal bins (for the plot).
+/// A histogram with equal bins from the minimum to the 99th percentile (for the plot; a
+/// bottoming-out tail would otherwise squeeze the bulk into one bin).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Histogram {
-    /// Left edge of the first bin.
+    /// Left edge of the first bin (the minimum).
     pub from: f64,
     /// Bin width.
     pub width: f64,
     /// Counts.
     pub counts: Vec<u64>,
+    /// Samples above the last bin (above the 99th percentile).
+    pub above: u64,
 }
 
 impl Histogram {
     fn of(v: &[f64], bins: usize) -> Self {
-        let s = Spread::of(v);
-        let width = ((s.max - s.min) / bins as f64).max(1e-9);
+        let mut s = v.to_vec();
+        s.sort_by(f64::total_cmp);
+        let from = s.first().copied().unwrap_or(0.0);
+        let p99 = s
+            .get((s.len() * 99).div_ceil(100).saturating_sub(1))
+            .copied()
+            .unwrap_or(from);
+        let width = ((p99 - from) / bins as f64).max(1e-9);
         let mut counts = vec![0u64; bins];
+        let mut above = 0;
         for x in v {
-            let i = (((x - s.min) / width) as usize).min(bins - 1);
-            counts[i] += 1;
+            let i = ((x - from) / width) as usize;
+            match counts.get_mut(i) {
+                Some(c) => *c += 1,
+                None if *x <= p99 => counts[bins - 1] += 1,
+                None => above += 1,
+            }
         }
         Histogram {
-            from: s.min,
+            from,
             width,
             counts,
+            above,
         }
     }
 }
@@ -561,6 +576,7 @@ mod tests {
         assert!((s.mean - 50.5).abs() < 1e-12);
         assert!((s.sd - 29.011_491_975_882_016).abs() < 1e-9);
         let h = Histogram::of(&v, 4);
-        assert_eq!(h.counts.iter().sum::<u64>(), 100);
+        assert_eq!((h.from, h.above), (1.0, 1));
+        assert_eq!(h.counts, vec![25, 24, 25, 25]);
     }
 }
