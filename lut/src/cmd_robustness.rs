@@ -70,9 +70,8 @@ impl RobustnessArgs {
             measurement_ttc_ms: self.measurement_ttc_ms,
         };
         let ok = |v: f64| v.is_finite() && v >= 0.0;
-        if !(ok(e.mass_error_kg) && ok(e.speed_sigma_kph) && ok(e.distance_sigma_m))
-            || !(e.measurement_ttc_ms.is_finite() && e.measurement_ttc_ms > 0.0)
-        {
+        let sizes_ok = ok(e.mass_error_kg) && ok(e.speed_sigma_kph) && ok(e.distance_sigma_m);
+        if !(sizes_ok && e.measurement_ttc_ms.is_finite() && e.measurement_ttc_ms > 0.0) {
             return Err(anyhow!(
                 "error sizes must be finite and ≥ 0, --measurement-ttc-ms > 0"
             ));

@@ -26,7 +26,12 @@ pub struct SlurmArgs {
     pub work_dir: Option<PathBuf>,
     /// Extra sbatch option, passed as given (repeatable), e.g. --sbatch-arg=--mem=2G.
     /// SBATCH_* variables of the environment apply too.
-    #[arg(long = "sbatch-arg", value_name = "OPT", allow_hyphen_values = true, requires = "slurm")]
+    #[arg(
+        long = "sbatch-arg",
+        value_name = "OPT",
+        allow_hyphen_values = true,
+        requires = "slurm"
+    )]
     pub sbatch_args: Vec<String>,
     /// Re-submit failed shards this many times before giving up.
     #[arg(long, default_value_t = 0, requires = "slurm")]
@@ -118,14 +123,18 @@ pub fn run(cmd: &SlurmCommand) -> Result<()> {
                 .state()?
                 .submissions
                 .last()
-                .map(|s| s.array_job.iter().chain([&s.collect_job]).cloned().collect())
+                .map(|s| {
+                    s.array_job
+                        .iter()
+                        .chain([&s.collect_job])
+                        .cloned()
+                        .collect()
+                })
                 .unwrap_or_default();
             slurm::scancel(&ids)?;
             eprintln!("cancelled jobs {}", ids.join(", "));
             Ok(())
         }
-        SlurmCommand::Shard { dir, k } => {
-            Work::open(dir)?.run_shard(*k, slurm::cpus_per_task())
-        }
+        SlurmCommand::Shard { dir, k } => Work::open(dir)?.run_shard(*k, slurm::cpus_per_task()),
     }
 }

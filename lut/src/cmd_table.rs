@@ -1,10 +1,10 @@
 //! `lut build | merge | verify | inspect | plot | export-json`: the characteristic diagram.
 
+use crate::cmd_slurm::SlurmArgs;
 use crate::heatmap::{self, HeatPanel};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use diagram::{AxisId, Cell, Diagram, Query};
-use crate::cmd_slurm::SlurmArgs;
 use lut::distributed::{Job, TableJob};
 use lut::progress::Progress;
 use lut::table::{self, Grid, GridFile};
@@ -53,7 +53,10 @@ pub fn run_build(a: &BuildArgs) -> Result<()> {
         if a.shard.is_some() {
             bail!("--slurm splits the grid itself; drop --shard");
         }
-        let out = a.out.clone().unwrap_or_else(|| PathBuf::from("data/default.lut"));
+        let out = a
+            .out
+            .clone()
+            .unwrap_or_else(|| PathBuf::from("data/default.lut"));
         let spec = GridFile::load(&a.grid)?;
         Grid::from_spec(&a.grid.display().to_string(), spec.clone())?;
         let job = Job::Table(TableJob {

@@ -72,8 +72,7 @@ impl TableJob {
         let name = out.display().to_string();
         let bytes = d.to_bytes();
         let back = Diagram::from_bytes(&name, &bytes).map_err(|e| anyhow!("merged table: {e}"))?;
-        if back.checksum() != d.checksum() || back.cells().len() != self.grid()?.axes.cell_count()
-        {
+        if back.checksum() != d.checksum() || back.cells().len() != self.grid()?.axes.cell_count() {
             bail!("merged table does not survive its own file format (checksum or cell count)");
         }
         if table::table_identity(back.header(), back.axes())? != identity {
@@ -86,7 +85,10 @@ impl TableJob {
             .map(|r| format!("cell {}: {}", r.index, r.problem.as_deref().unwrap_or("?")))
             .collect();
         if !bad.is_empty() {
-            bail!("merged table fails the spot re-optimisation: {}", bad.join("; "));
+            bail!(
+                "merged table fails the spot re-optimisation: {}",
+                bad.join("; ")
+            );
         }
         diagram::write_atomically(out, &bytes).map_err(|e| anyhow!("{e}"))?;
         Ok(format!(
@@ -171,7 +173,12 @@ impl Job {
     }
 
     /// Combine all shards into the checked output, written atomically to `out`; a summary.
-    pub fn collect(&self, identity: &str, shards: &[(String, Vec<u8>)], out: &Path) -> Result<String> {
+    pub fn collect(
+        &self,
+        identity: &str,
+        shards: &[(String, Vec<u8>)],
+        out: &Path,
+    ) -> Result<String> {
         match self {
             Job::Table(t) => t.collect(identity, shards, out),
             Job::Robustness(r) => r.collect(identity, shards, out),
@@ -287,7 +294,10 @@ impl Work {
     pub fn open(dir: &Path) -> Result<Self> {
         let dir = absolute(dir)?;
         let spec: Spec = read_json(&dir.join(SPEC_FILE)).with_context(|| {
-            format!("{} is not a work directory of a distributed run", dir.display())
+            format!(
+                "{} is not a work directory of a distributed run",
+                dir.display()
+            )
         })?;
         Ok(Work { dir, spec })
     }
@@ -340,7 +350,12 @@ impl Work {
             );
         }
         if (h.k, h.n) != (k, self.spec.n) {
-            bail!("{origin}: holds shard {}/{}, not {k}/{}", h.k, h.n, self.spec.n);
+            bail!(
+                "{origin}: holds shard {}/{}, not {k}/{}",
+                h.k,
+                h.n,
+                self.spec.n
+            );
         }
         Ok(Some(h))
     }
@@ -359,7 +374,10 @@ impl Work {
         );
         let progress = Progress::new(range.len(), "computing", self.spec.job.unit(), false)
             .with_file(&self.progress_path(k));
-        let bytes = self.spec.job.compute_shard(k as usize, n, threads, &progress)?;
+        let bytes = self
+            .spec
+            .job
+            .compute_shard(k as usize, n, threads, &progress)?;
         progress.finish();
         let path = self.shard_path(k);
         diagram::write_atomically(&path, &bytes).map_err(|e| anyhow!("{e}"))?;
@@ -470,7 +488,13 @@ impl Work {
         let state = self.state()?;
         let last = state.submissions.last();
         let ids: Vec<String> = last
-            .map(|s| s.array_job.iter().chain([&s.collect_job]).cloned().collect())
+            .map(|s| {
+                s.array_job
+                    .iter()
+                    .chain([&s.collect_job])
+                    .cloned()
+                    .collect()
+            })
             .unwrap_or_default();
         let queue = slurm::squeue(&ids)?;
         let array_records: Vec<Record> = match (records, last.and_then(|s| s.array_job.as_ref())) {
@@ -480,7 +504,8 @@ impl Work {
         let n = self.spec.n;
         let mut shards = Vec::new();
         for k in 1..=n {
-            let range = crate::shard::shard_range(self.spec.items as usize, k as usize, n as usize)?;
+            let range =
+                crate::shard::shard_range(self.spec.items as usize, k as usize, n as usize)?;
             let items = range.len();
             let queued: Option<&Queued> = last.and_then(|s| {
                 queue
@@ -495,7 +520,11 @@ impl Work {
                         let done = read_progress_file(&self.progress_path(k)).map_or(0, |p| p.0);
                         (ShardState::Running, done.min(items), q.state.clone())
                     }
-                    Some(q) => (ShardState::Pending, 0, format!("{} ({})", q.state, q.reason)),
+                    Some(q) => (
+                        ShardState::Pending,
+                        0,
+                        format!("{} ({})", q.state, q.reason),
+                    ),
                     None => match last {
                         Some(s) if s.tasks.contains(&k) => {
                             let job = s.array_job.as_deref().unwrap_or("?");
@@ -526,7 +555,9 @@ impl Work {
             });
         }
         let collect = last.map(|s| {
-            let q = queue.iter().find(|q| q.job == s.collect_job && q.task.is_none());
+            let q = queue
+                .iter()
+                .find(|q| q.job == s.collect_job && q.task.is_none());
             CollectStatus {
                 job: s.collect_job.clone(),
                 queued: q.map(|q| format!("{} ({})", q.state, q.reason)),
@@ -539,7 +570,10 @@ impl Work {
             unit: self.spec.job.unit().to_string(),
             items: self.spec.items,
             n,
-            output_complete: self.spec.job.output_matches(&self.spec.out, &self.spec.identity),
+            output_complete: self
+                .spec
+                .job
+                .output_matches(&self.spec.out, &self.spec.identity),
             jobs_queued: !queue.is_empty(),
             shards,
             collect,
@@ -663,7 +697,11 @@ impl Status {
             "work dir {}\noutput   {} ({})\n{}\n",
             self.dir.display(),
             self.out.display(),
-            if self.output_complete { "complete" } else { "not written yet" },
+            if self.output_complete {
+                "complete"
+            } else {
+                "not written yet"
+            },
             self.summary()
         );
         for sh in &self.shards {
@@ -742,7 +780,8 @@ impl Watcher {
                 b.set_message(format!("{shards}, {rate}"));
             }
             None => {
-                if shards != self.last_summary || self.last_line.elapsed() >= Duration::from_secs(10)
+                if shards != self.last_summary
+                    || self.last_line.elapsed() >= Duration::from_secs(10)
                 {
                     eprintln!(
                         "slurm: {shards}; {done}/{} {}, {rate}, {el:.0} s",
@@ -821,11 +860,18 @@ pub fn run(job: Job, out: &Path, work_dir: &Path, opts: &RunOptions) -> Result<(
     let identity = job.identity()?;
     let items = job.items()?;
     if opts.n == 0 || opts.n > items {
-        bail!("--slurm {}: need 1 ≤ N ≤ {items} (one shard per {} at most)", opts.n, job.unit().trim_end_matches('s'));
+        bail!(
+            "--slurm {}: need 1 ≤ N ≤ {items} (one shard per {} at most)",
+            opts.n,
+            job.unit().trim_end_matches('s')
+        );
     }
     let out_abs = absolute(out)?;
     if job.output_matches(&out_abs, &identity) {
-        eprintln!("{} is complete and up to date (nothing submitted)", out_abs.display());
+        eprintln!(
+            "{} is complete and up to date (nothing submitted)",
+            out_abs.display()
+        );
         return Ok(());
     }
     let dir = absolute(work_dir)?;
@@ -902,7 +948,9 @@ pub fn run(job: Job, out: &Path, work_dir: &Path, opts: &RunOptions) -> Result<(
             Ok(()) => return Ok(()),
             Err(e) if retries > 0 => {
                 retries -= 1;
-                eprintln!("slurm: {e:#}\nslurm: re-submitting what is missing ({retries} retries left)");
+                eprintln!(
+                    "slurm: {e:#}\nslurm: re-submitting what is missing ({retries} retries left)"
+                );
             }
             Err(e) => return Err(e),
         }
@@ -916,6 +964,9 @@ mod tests {
     #[test]
     fn quoting_and_default_dir() {
         assert_eq!(sh_quote("a'b c"), r"'a'\''b c'");
-        assert_eq!(default_work_dir(Path::new("x/t.lut")), PathBuf::from("x/t.lut.slurm"));
+        assert_eq!(
+            default_work_dir(Path::new("x/t.lut")),
+            PathBuf::from("x/t.lut.slurm")
+        );
     }
 }

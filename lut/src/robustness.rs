@@ -302,7 +302,12 @@ impl Sampler {
     }
 
     /// Outcome with the given estimate errors.
-    pub fn evaluate(&self, mass_err_kg: f64, speed_err_kph: f64, dist_err_m: f64) -> Result<Sample> {
+    pub fn evaluate(
+        &self,
+        mass_err_kg: f64,
+        speed_err_kph: f64,
+        dist_err_m: f64,
+    ) -> Result<Sample> {
         let s = &self.job.situation;
         let est_kph = s.closing_speed_kph + speed_err_kph;
         let q = Query {
@@ -459,13 +464,20 @@ impl RobustnessJob {
     }
 
     /// Merge shards, summarise, write the result atomically.
-    pub fn collect(&self, identity: &str, shards: &[(String, Vec<u8>)], out: &Path) -> Result<String> {
+    pub fn collect(
+        &self,
+        identity: &str,
+        shards: &[(String, Vec<u8>)],
+        out: &Path,
+    ) -> Result<String> {
         let decoded = shards
             .iter()
             .map(|(o, b)| Ok((o.clone(), read_shard(o, b)?)))
             .collect::<Result<Vec<_>>>()?;
-        let heads: Vec<(&str, &ShardHeader)> =
-            decoded.iter().map(|(o, s)| (o.as_str(), &s.header)).collect();
+        let heads: Vec<(&str, &ShardHeader)> = decoded
+            .iter()
+            .map(|(o, s)| (o.as_str(), &s.header))
+            .collect();
         let order = shard::check_tiling(&heads, Some(identity))?;
         let samples: Vec<Sample> = order
             .iter()
@@ -493,10 +505,14 @@ pub fn write_result(r: &StudyResult, out: &Path) -> Result<()> {
 pub fn read_result(path: &Path) -> Result<StudyResult> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let r: StudyResult =
-        serde_json::from_str(&text).with_context(|| format!("{}: not a study result", path.display()))?;
+    let r: StudyResult = serde_json::from_str(&text)
+        .with_context(|| format!("{}: not a study result", path.display()))?;
     if r.format != RESULT_FORMAT {
-        bail!("{}: format {:?}, not {RESULT_FORMAT:?}", path.display(), r.format);
+        bail!(
+            "{}: format {:?}, not {RESULT_FORMAT:?}",
+            path.display(),
+            r.format
+        );
     }
     Ok(r)
 }
@@ -557,9 +573,15 @@ mod tests {
         assert!(mm.abs() < 4.0 * 173.2 * se, "{mm}");
         assert!((ms / (300.0 / 3f64.sqrt()) - 1.0).abs() < 4.0 * se, "{ms}");
         let (vm, vs) = moments(&v);
-        assert!(vm.abs() < 4.0 * 2.0 * se && (vs / 2.0 - 1.0).abs() < 4.0 * se * 0.71 + 0.01, "{vm} {vs}");
+        assert!(
+            vm.abs() < 4.0 * 2.0 * se && (vs / 2.0 - 1.0).abs() < 4.0 * se * 0.71 + 0.01,
+            "{vm} {vs}"
+        );
         let (xm, xs) = moments(&x);
-        assert!(xm.abs() < 4.0 * 0.1 * se && (xs / 0.1 - 1.0).abs() < 0.03, "{xm} {xs}");
+        assert!(
+            xm.abs() < 4.0 * 0.1 * se && (xs / 0.1 - 1.0).abs() < 0.03,
+            "{xm} {xs}"
+        );
         // About 68.3 % of normal draws within one σ.
         let within = v.iter().filter(|v| v.abs() < 2.0).count() as f64 / n as f64;
         assert!((within - 0.6827).abs() < 0.015, "{within}");
@@ -572,7 +594,10 @@ mod tests {
     fn spread_uses_nearest_rank() {
         let v: Vec<f64> = (1..=100).rev().map(f64::from).collect();
         let s = Spread::of(&v);
-        assert_eq!((s.min, s.p05, s.p50, s.p95, s.max), (1.0, 5.0, 50.0, 95.0, 100.0));
+        assert_eq!(
+            (s.min, s.p05, s.p50, s.p95, s.max),
+            (1.0, 5.0, 50.0, 95.0, 100.0)
+        );
         assert!((s.mean - 50.5).abs() < 1e-12);
         assert!((s.sd - 29.011_491_975_882_016).abs() < 1e-9);
         let h = Histogram::of(&v, 4);

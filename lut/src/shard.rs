@@ -87,7 +87,10 @@ impl ShardHeader {
 
     /// "shard K/N (items a..b)".
     pub fn describe(&self) -> String {
-        format!("shard {}/{} (items {}..{})", self.k, self.n, self.start, self.end)
+        format!(
+            "shard {}/{} (items {}..{})",
+            self.k, self.n, self.start, self.end
+        )
     }
 }
 
@@ -261,7 +264,11 @@ mod tests {
         let mut s = shard("abc", 2, 3, 10);
         s.payload.0.pop();
         let e = ShardFile::<Items>::from_bytes("f", "t", &s.to_bytes().unwrap()).unwrap_err();
-        assert!(e.to_string().contains("holds 2 items, its range 3..6 needs 3"), "{e}");
+        assert!(
+            e.to_string()
+                .contains("holds 2 items, its range 3..6 needs 3"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -274,16 +281,23 @@ mod tests {
             vec![1, 2, 0]
         );
         let e = check_tiling(&[("a", &a), ("c", &c)], None).unwrap_err();
-        assert_eq!(e.to_string(), "items 3..6 missing: no shard covers them (between a and c)");
+        assert_eq!(
+            e.to_string(),
+            "items 3..6 missing: no shard covers them (between a and c)"
+        );
         let e = check_tiling(&[("a", &a), ("b", &b)], None).unwrap_err();
         assert!(e.to_string().contains("items 6..10 missing"), "{e}");
         // Shards of two different N that overlap.
         let half = shard("id", 1, 2, 10).header;
-        let e = check_tiling(&[("a", &a), ("half", &half), ("b", &b), ("c", &c)], None).unwrap_err();
+        let e =
+            check_tiling(&[("a", &a), ("half", &half), ("b", &b), ("c", &c)], None).unwrap_err();
         assert!(e.to_string().contains("overlaps"), "{e}");
         let other = shard("other", 2, 3, 10).header;
         let e = check_tiling(&[("a", &a), ("o.bin", &other), ("c", &c)], Some("id")).unwrap_err();
-        assert!(e.to_string().starts_with("o.bin: shard of another grid"), "{e}");
+        assert!(
+            e.to_string().starts_with("o.bin: shard of another grid"),
+            "{e}"
+        );
         // Shards of different N that tile exactly are fine.
         let h2 = shard("id", 2, 2, 10).header;
         let q1 = shard("id", 1, 4, 10).header;

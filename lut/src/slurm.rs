@@ -125,7 +125,10 @@ pub struct Queued {
 impl Queued {
     /// Running in the broad sense (started, not yet gone).
     pub fn is_running(&self) -> bool {
-        matches!(self.state.as_str(), "RUNNING" | "COMPLETING" | "CONFIGURING")
+        matches!(
+            self.state.as_str(),
+            "RUNNING" | "COMPLETING" | "CONFIGURING"
+        )
     }
 }
 
@@ -151,7 +154,12 @@ pub fn squeue(ids: &[String]) -> Result<Vec<Queued>> {
         if stderr.contains("Invalid job id") {
             return Ok(Vec::new());
         }
-        bail!("squeue {} failed ({}): {}", args.join(" "), out.status, stderr.trim());
+        bail!(
+            "squeue {} failed ({}): {}",
+            args.join(" "),
+            out.status,
+            stderr.trim()
+        );
     }
     Ok(parse_squeue(&String::from_utf8_lossy(&out.stdout)))
 }
@@ -213,7 +221,12 @@ pub fn scontrol_show(id: &str) -> Result<Vec<Record>> {
         if stderr.contains("Invalid job id") {
             return Ok(Vec::new());
         }
-        bail!("scontrol {} failed ({}): {}", args.join(" "), out.status, stderr.trim());
+        bail!(
+            "scontrol {} failed ({}): {}",
+            args.join(" "),
+            out.status,
+            stderr.trim()
+        );
     }
     Ok(parse_scontrol(&String::from_utf8_lossy(&out.stdout)))
 }
@@ -309,7 +322,10 @@ mod tests {
         assert_eq!(r[0].task, Some(3));
         assert_eq!(r[0].array_job.as_deref(), Some("1"));
         assert!(!r[0].succeeded());
-        assert_eq!(r[0].describe(), "JobState=FAILED Reason=NonZeroExitCode ExitCode=1:0");
+        assert_eq!(
+            r[0].describe(),
+            "JobState=FAILED Reason=NonZeroExitCode ExitCode=1:0"
+        );
         assert_eq!(r[1].task, None);
         assert_eq!(r[1].reason, "DependencyNeverSatisfied");
         assert!(r[2].succeeded());
@@ -328,7 +344,9 @@ mod tests {
             script: "/w/shard.sh".into(),
         };
         let a = s.args();
-        assert!(a.contains(&"--array=1-2".to_string()) && a.contains(&"--cpus-per-task=2".to_string()));
+        assert!(
+            a.contains(&"--array=1-2".to_string()) && a.contains(&"--cpus-per-task=2".to_string())
+        );
         assert_eq!(a.last().map(String::as_str), Some("/w/shard.sh"));
         let c = Submit {
             after_ok: Some("12".into()),

@@ -7,9 +7,9 @@
 
 use crate::optimise::{self, Case, OptimiserConfig, SearchSpace};
 use crate::progress::Progress;
+use crate::scenario::{Ego, Opponent, Pulse};
 pub use crate::shard::shard_range;
 use crate::shard::{self, Payload, ShardFile, ShardHeader};
-use crate::scenario::{Ego, Opponent, Pulse};
 use anyhow::{anyhow, bail, Context, Result};
 use diagram::{AirbagThresholds, Axes, BuildInfo, Cell, Diagram, EgoVehicle, GridPoint, Header};
 use physics::{
@@ -507,8 +507,10 @@ pub fn read_shard(origin: &str, bytes: &[u8]) -> Result<Shard> {
 /// table. Refuses shards of another grid (`expected` identity, or the first shard's),
 /// overlapping or missing ranges, naming the files.
 pub fn merge_shards(shards: &[(String, Shard)], expected: Option<&str>) -> Result<Diagram> {
-    let heads: Vec<(&str, &ShardHeader)> =
-        shards.iter().map(|(o, s)| (o.as_str(), &s.header)).collect();
+    let heads: Vec<(&str, &ShardHeader)> = shards
+        .iter()
+        .map(|(o, s)| (o.as_str(), &s.header))
+        .collect();
     shard::check_tiling(&heads, expected)?;
     let first = &shards[0].1.payload;
     let cells = shards.iter().flat_map(|(_, s)| {

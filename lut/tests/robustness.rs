@@ -72,7 +72,10 @@ fn sharded_study_equals_the_local_run() {
         other.compute_shard(4, 4, Some(1), &quiet).unwrap(),
     );
     let e = j.collect(&id, &shards, &out).unwrap_err().to_string();
-    assert!(e.starts_with("seed6.bin: shard of another grid or configuration"), "{e}");
+    assert!(
+        e.starts_with("seed6.bin: shard of another grid or configuration"),
+        "{e}"
+    );
     // A missing shard is named as a gap.
     let e = j.collect(&id, &shards[1..], &out).unwrap_err().to_string();
     assert!(e.contains("items 675..900 missing"), "{e}");
@@ -89,7 +92,12 @@ fn a_perfect_estimate_reproduces_the_table_and_has_no_spread() {
     };
     let j = job(zero, 50, 1);
     let r = j.run_local(Some(2), true).unwrap();
-    for s in [&r.a_max_g, &r.a_mean_g, &r.excursion_mm, &r.objective_increase_g] {
+    for s in [
+        &r.a_max_g,
+        &r.a_mean_g,
+        &r.excursion_mm,
+        &r.objective_increase_g,
+    ] {
         // Identical samples (the mean of equal numbers may round in the last bit).
         assert_eq!(s.min, s.max);
         assert!(s.sd < 1e-12, "{s:?}");

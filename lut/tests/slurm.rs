@@ -125,7 +125,10 @@ fn run_ok(c: &mut Command, work: &Path) -> Output {
 }
 
 fn local_table(grid: &Grid) -> Vec<u8> {
-    table::build_table(grid, Some(2), true).unwrap().0.to_bytes()
+    table::build_table(grid, Some(2), true)
+        .unwrap()
+        .0
+        .to_bytes()
 }
 
 fn state(work: &Path) -> serde_json::Value {
@@ -159,16 +162,20 @@ fn distributed_build_and_study_on_a_one_node_slurm_cluster() {
     let work = tmp.join("ci.lut.slurm");
     let build = |grid: &Path, out: &Path| {
         let mut c = cluster.lut();
-        c.args(["build", "--grid"]).arg(grid).arg("--out").arg(out).args([
-            "--slurm",
-            "2",
-            "--cpus-per-task",
-            "1",
-            "--verify-cells",
-            "2",
-            "--poll-seconds",
-            "0.2",
-        ]);
+        c.args(["build", "--grid"])
+            .arg(grid)
+            .arg("--out")
+            .arg(out)
+            .args([
+                "--slurm",
+                "2",
+                "--cpus-per-task",
+                "1",
+                "--verify-cells",
+                "2",
+                "--poll-seconds",
+                "0.2",
+            ]);
         c
     };
     let t = Instant::now();
@@ -187,7 +194,11 @@ fn distributed_build_and_study_on_a_one_node_slurm_cluster() {
     // Again: up to date, nothing submitted.
     let before = state(&work);
     let o = run_ok(&mut build(&ci_grid, &out), &work);
-    assert!(String::from_utf8_lossy(&o.stderr).contains("up to date"), "{}", text(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("up to date"),
+        "{}",
+        text(&o)
+    );
     assert_eq!(state(&work), before);
 
     // 2. Kill one array task mid-run; the resume recomputes only that shard. A grid with the CI
@@ -208,9 +219,16 @@ fn distributed_build_and_study_on_a_one_node_slurm_cluster() {
     // Wait until shard 2 has finished some cells but not all of them.
     let deadline = Instant::now() + Duration::from_secs(120);
     let victim = loop {
-        assert!(Instant::now() < deadline, "shard 2 never ran\n{}", logs(&work));
+        assert!(
+            Instant::now() < deadline,
+            "shard 2 never ran\n{}",
+            logs(&work)
+        );
         let p = std::fs::read_to_string(work.join("progress/2")).unwrap_or_default();
-        let v: Vec<usize> = p.split_whitespace().filter_map(|x| x.parse().ok()).collect();
+        let v: Vec<usize> = p
+            .split_whitespace()
+            .filter_map(|x| x.parse().ok())
+            .collect();
         if let [done, total] = v[..] {
             assert!(
                 done < total,
@@ -230,7 +248,10 @@ fn distributed_build_and_study_on_a_one_node_slurm_cluster() {
     assert!(o.status.success(), "{}", text(&o));
     let o = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success(), "the build did not notice the killed task:\n{err}");
+    assert!(
+        !o.status.success(),
+        "the build did not notice the killed task:\n{err}"
+    );
     eprintln!("killed array task {victim}; the build reported:\n{err}");
     assert!(
         err.contains("shard 2/2 (Failed)") && err.contains("CANCELLED"),
@@ -249,8 +270,16 @@ fn distributed_build_and_study_on_a_one_node_slurm_cluster() {
     assert_eq!(st["submissions"].as_array().unwrap().len(), 2);
     assert_eq!(st["submissions"][1]["tasks"], serde_json::json!([2]));
     assert_eq!(std::fs::read(&shard1).unwrap(), shard1_bytes);
-    assert_eq!(std::fs::metadata(&shard1).unwrap().modified().unwrap(), shard1_mtime);
-    assert_eq!(shard_logs(&work, 1), 1, "shard 1 ran again\n{}", logs(&work));
+    assert_eq!(
+        std::fs::metadata(&shard1).unwrap().modified().unwrap(),
+        shard1_mtime
+    );
+    assert_eq!(
+        shard_logs(&work, 1),
+        1,
+        "shard 1 ran again\n{}",
+        logs(&work)
+    );
     assert_eq!(shard_logs(&work, 2), 2);
     let t = Instant::now();
     let local = local_table(&Grid::load(&slow_grid).unwrap());
@@ -291,10 +320,16 @@ fn distributed_build_and_study_on_a_one_node_slurm_cluster() {
     let local_json = tmp.join("mc-local.json");
     let slurm_json = tmp.join("mc-slurm.json");
     run_ok(&mut study(&local_json, false), &tmp);
-    run_ok(&mut study(&slurm_json, true), &tmp.join("mc-slurm.json.slurm"));
+    run_ok(
+        &mut study(&slurm_json, true),
+        &tmp.join("mc-slurm.json.slurm"),
+    );
     let a = std::fs::read_to_string(&local_json).unwrap();
     let b = std::fs::read_to_string(&slurm_json).unwrap();
-    assert!(a == b, "local and Slurm study results differ:\n{a}\n---\n{b}");
+    assert!(
+        a == b,
+        "local and Slurm study results differ:\n{a}\n---\n{b}"
+    );
     let r = lut::robustness::read_result(&local_json).unwrap();
     assert_eq!(r.study.samples, 3000);
     assert!(r.a_mean_g.sd > 0.0 && r.a_mean_g.min <= r.exact_estimate.a_mean_g);

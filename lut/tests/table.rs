@@ -48,7 +48,9 @@ fn ci_grid_end_to_end() {
         "merged shards differ from the full build"
     );
     // A missing shard is an error naming the gap, not a silently smaller table.
-    let e = table::merge_shards(&decoded[..2], None).unwrap_err().to_string();
+    let e = table::merge_shards(&decoded[..2], None)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("items 0..8 missing"), "{e}");
     // A shard of another grid (other seed) is refused, naming the file.
     let mut other = grid.clone();
@@ -62,8 +64,13 @@ fn ci_grid_end_to_end() {
     let mut bad = shard_bytes[0].clone();
     let mid = bad.len() / 2;
     bad[mid] ^= 1;
-    let e = table::read_shard("dir/shard-3-of-3.bin", &bad).unwrap_err().to_string();
-    assert!(e.starts_with("dir/shard-3-of-3.bin: corrupt shard file: checksum mismatch"), "{e}");
+    let e = table::read_shard("dir/shard-3-of-3.bin", &bad)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("dir/shard-3-of-3.bin: corrupt shard file: checksum mismatch"),
+        "{e}"
+    );
 
     // Every cell's optimum lies inside the hardware bounds and its prediction is self-consistent.
     for c in full.cells() {
