@@ -121,60 +121,81 @@ pub fn run(a: &RobustnessArgs) -> Result<()> {
     Ok(())
 }
 
+/// Percentage of all samples per histogram bin, at the bins' centres.
+fn percent_bins(h: &robustness::Histogram) -> (Vec<f64>, Vec<f64>) {
+    let n: u64 = h.counts.iter().sum::<u64>() + h.above;
+    h.counts
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| {
+            (
+                h.from + (i as f64 + 0.5) * h.width,
+                100.0 * c as f64 / n.max(1) as f64,
+            )
+        })
+        .unzip()
+}
+
+/// One histogram panel with the exact-estimate value marked.
+fn histogram_panel<'a>(
+    title: String,
+    x_label: &'a str,
+    name: &str,
+    bins: &'a (Vec<f64>, Vec<f64>),
+    marker: &'a [[f64; 2]; 2],
+) -> plot::Panel<'a> {
+    plot::Panel {
+        title,
+        x_label,
+        y_label: "samples [%]",
+        series: vec![
+            plot::Series {
+                label: name.into(),
+                x: &bins.0,
+                y: &bins.1,
+            },
+            plot::Series {
+                label: format!("exact estimate {:.2} g", marker[0][0]),
+                x: &marker[0],
+                y: &marker[1],
+            },
+        ],
+    }
+}
+
 fn draw(r: &StudyResult, path: &Path) -> Result<()> {
-    let bins = |h: &robustness::Histogram| -> (Vec<f64>, Vec<f64>) {
-        let n: u64 = h.counts.iter().sum::<u64>() + h.above;
-        h.counts
-            .iter()
-            .enumerate()
-            .map(|(i, &c)| {
-                (
-                    h.from + (i as f64 + 0.5) * h.width,
-                    100.0 * c as f64 / n.max(1) as f64,
-                )
-            })
-            .unzip()
-    };
-    let (xm, ym) = bins(&r.a_mean_histogram);
-    let (xx, yx) = bins(&r.a_max_histogram);
+    let mean = percent_bins(&r.a_mean_histogram);
+    let max = percent_bins(&r.a_max_histogram);
+    let top = |b: &(Vec<f64>, Vec<f64>)| b.1.iter().copied().fold(0.0, f64::max);
+    let (xm, xx) = (r.exact_estimate.a_mean_g, r.exact_estimate.a_max_g);
+    let mean_marker = [[xm, xm], [0.0, top(&mean)]];
+    let max_marker = [[xx, xx], [0.0, top(&max)]];
     let s = &r.study.situation;
     let e = &r.study.errors;
     plot::draw(
         path,
         &[
-            plot::Panel {
-                title: format!(
+            histogram_panel(
+                format!(
                     "{} samples: {} km/h, {} kg opponent, {} kg occupant, {} mm; mass ±{} kg, speed σ {} km/h, distance σ {} m",
-                    r.study.samples, s.closing_speed_kph, s.opponent_mass_kg, s.occupant_mass_kg, s.seat_distance_mm,
-                    e.mass_error_kg, e.speed_sigma_kph, e.distance_sigma_m
+                    r.study.samples, s.closing_speed_kph, s.opponent_mass_kg, s.occupant_mass_kg,
+                    s.seat_distance_mm, e.mass_error_kg, e.speed_sigma_kph, e.distance_sigma_m
                 ),
-                x_label: "occupant a_mean [g] (exact estimate: marked)",
-                y_label: "samples [%]",
-                series: vec![
-                    plot::Series { label: "a_mean".into(), x: &xm, y: &ym },
-                    plot::Series {
-                        label: format!("exact estimate {:.2} g", r.exact_estimate.a_mean_g),
-                        x: &[r.exact_estimate.a_mean_g, r.exact_estimate.a_mean_g],
-                        y: &[0.0, ym.iter().copied().fold(0.0, f64::max)],
-                    },
-                ],
-            },
-            plot::Panel {
-                title: format!(
+                "occupant a_mean [g]",
+                "a_mean",
+                &mean,
+                &mean_marker,
+            ),
+            histogram_panel(
+                format!(
                     "occupant peak acceleration ({} samples above the 99th percentile, max {:.1} g, not drawn; {} of {} bottom out)",
                     r.a_max_histogram.above, r.a_max_g.max, r.bottoming_out_samples, r.study.samples
                 ),
-                x_label: "occupant a_max [g]",
-                y_label: "samples [%]",
-                series: vec![
-                    plot::Series { label: "a_max".into(), x: &xx, y: &yx },
-                    plot::Series {
-                        label: format!("exact estimate {:.2} g", r.exact_estimate.a_max_g),
-                        x: &[r.exact_estimate.a_max_g, r.exact_estimate.a_max_g],
-                        y: &[0.0, yx.iter().copied().fold(0.0, f64::max)],
-                    },
-                ],
-            },
+                "occupant a_max [g]",
+                "a_max",
+                &max,
+                &max_marker,
+            ),
         ],
     )
 }

@@ -119,17 +119,11 @@ pub fn run(cmd: &SlurmCommand) -> Result<()> {
         }
         SlurmCommand::Cancel { dir } => {
             let w = Work::open(dir)?;
-            let ids: Vec<String> = w
+            let ids = w
                 .state()?
                 .submissions
                 .last()
-                .map(|s| {
-                    s.array_job
-                        .iter()
-                        .chain([&s.collect_job])
-                        .cloned()
-                        .collect()
-                })
+                .map(lut::distributed::Submission::job_ids)
                 .unwrap_or_default();
             slurm::scancel(&ids)?;
             eprintln!("cancelled jobs {}", ids.join(", "));

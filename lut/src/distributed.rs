@@ -228,6 +228,17 @@ pub struct Submission {
     pub unix_time: u64,
 }
 
+impl Submission {
+    /// The array's and the collect job's ids.
+    pub fn job_ids(&self) -> Vec<String> {
+        self.array_job
+            .iter()
+            .chain([&self.collect_job])
+            .cloned()
+            .collect()
+    }
+}
+
 /// Every submission of the work directory.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct State {
@@ -487,15 +498,7 @@ impl Work {
     pub fn status(&self, records: bool) -> Result<Status> {
         let state = self.state()?;
         let last = state.submissions.last();
-        let ids: Vec<String> = last
-            .map(|s| {
-                s.array_job
-                    .iter()
-                    .chain([&s.collect_job])
-                    .cloned()
-                    .collect()
-            })
-            .unwrap_or_default();
+        let ids = last.map(Submission::job_ids).unwrap_or_default();
         let queue = slurm::squeue(&ids)?;
         let array_records: Vec<Record> = match (records, last.and_then(|s| s.array_job.as_ref())) {
             (true, Some(a)) => slurm::scontrol_show(a)?,
