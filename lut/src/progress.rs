@@ -81,7 +81,8 @@ impl Progress {
             Err(p) => p.into_inner(),
         };
         if let Some(f) = &self.file {
-            if finished || now.duration_since(last.1) >= FILE_EVERY {
+            // The first item too: a watcher sees at once that the task computes.
+            if finished || done == 1 || now.duration_since(last.1) >= FILE_EVERY {
                 last.1 = now;
                 write_progress_file(f, done, self.total);
             }
