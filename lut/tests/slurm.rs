@@ -2,7 +2,8 @@
 //! cluster (tests/slurm-cluster.sh: slurmctld + slurmd + munged, job arrays, dependencies).
 //!
 //! 1. `lut build --grid data/ci-grid.toml --slurm 2` gives a table byte-identical to a local
-//!    build; running the command again submits nothing.
+//!    build (an `SBATCH_TIMELIMIT` of the caller reaches the jobs); running the command again
+//!    submits nothing.
 //! 2. One array task is killed (scancel) mid-run: the build fails naming that shard; the same
 //!    command again recomputes only that shard (the other's file and log stay untouched) and
 //!    the result is byte-identical to a local build.
@@ -179,8 +180,22 @@ fn distributed_build_and_study_on_a_one_node_slurm_cluster() {
         c
     };
     let t = Instant::now();
-    let o = run_ok(&mut build(&ci_grid, &out), &work);
+    // sbatch's own environment variables pass through (here: a time limit).
+    let o = run_ok(
+        build(&ci_grid, &out).env("SBATCH_TIMELIMIT", "00:07:00"),
+        &work,
+    );
     eprintln!("CI grid through Slurm: {:.1} s", t.elapsed().as_secs_f64());
+    let array = state(&work)["submissions"][0]["array_job"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    let rec = cluster.tool("scontrol", &["-o", "show", "job", &array]);
+    assert!(
+        String::from_utf8_lossy(&rec.stdout).contains("TimeLimit=00:07:00"),
+        "{}",
+        text(&rec)
+    );
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("shards 2/2 done"), "{err}");
     let local = local_table(&Grid::load(&ci_grid).unwrap());
