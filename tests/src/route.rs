@@ -1,0 +1,175 @@
+//! Where the bench runs — the route `vcan-setup.sh` chose — and the only allowances the
+//! end-to-end verdicts make for it. One place for all of them, each with its measured reason,
+//! so every report can name the route and what was allowed.
+//!
+//! On the host kernel and in a QEMU/KVM guest the timers are real: no allowance. Under QEMU's
+//! software emulation (TCG) the kernel, vcan, iceoryx2 and the processes are real but time is
+//! not: the guest's clock runs at host speed while its CPUs run 5–50× slower and stall when the
+//! host is busy, so a time limit measures the emulator and the host's load. Verdicts there
+//! separate the logic (what was commanded, for when: never relaxed) from delivery times
+//! (allowed for, and named).
+
+use serde::{Deserialize, Serialize};
+
+/// The vcan route of `vcan-setup.sh`: `$VCAN_ROUTE` in the command it runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Route {
+    /// The host kernel has vcan: real timing.
+    #[default]
+    Host,
+    /// A QEMU/KVM guest with a real Debian kernel: real timers.
+    QemuKvm,
+    /// A QEMU guest under software emulation (TCG): emulated timing.
+    QemuTcg,
+}
+
+impl Route {
+    /// The route of this process: `$VCAN_ROUTE` as `vcan-setup.sh` sets it (host when unset:
+    /// a process started by hand on a kernel with vcan).
+    pub fn current() -> Self {
+        std::env::var("VCAN_ROUTE")
+            .ok()
+            .and_then(|s| Self::parse(&s))
+            .unwrap_or_default()
+    }
+
+    /// `host`, `qemu-kvm`, `qemu-tcg` (what `vcan-setup.sh --check` prints).
+    pub fn parse(s: &str) -> Option<Self> {
+        match s.trim() {
+            "host" => Some(Self::Host),
+            "qemu-kvm" => Some(Self::QemuKvm),
+            "qemu-tcg" => Some(Self::QemuTcg),
+            _ => None,
+        }
+    }
+
+    /// The route's name as `vcan-setup.sh` prints it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Host => "host",
+            Self::QemuKvm => "qemu-kvm",
+            Self::QemuTcg => "qemu-tcg",
+        }
+    }
+
+    /// One line for reports: where, and whether its timing means anything.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Host => "host kernel (native): real timing",
+            Self::QemuKvm => "QEMU/KVM guest, Debian kernel: real timers",
+            Self::QemuTcg => {
+                "QEMU guest under software emulation (TCG), Debian kernel: timing EMULATED"
+            }
+        }
+    }
+
+    /// True where time limits measure the emulator rather than the bench.
+    pub fn timing_emulated(self) -> bool {
+        self == Self::QemuTcg
+    }
+
+    /// The host's 1-minute load average when the guest started (`$VCAN_HOST_LOADAVG`; on the
+    /// host route, the current one). Emulated timing follows it, so reports print it.
+    pub fn host_load() -> Option<f64> {
+        std::env::var("VCAN_HOST_LOADAVG")
+            .ok()
+            .or_else(|| std::fs::read_to_string("/proc/loadavg").ok())
+            .and_then(|s| s.split_whitespace().next()?.parse().ok())
+    }
+
+    /// One line for reports: the route, what it means, the host's load.
+    pub fn describe_with_load(self) -> String {
+        match Self::host_load() {
+            Some(l) => format!("{} (host load {l:.2} at the start)", self.describe()),
+            None => self.describe().to_owned(),
+        }
+    }
+
+    /// The allowances of this route.
+    pub fn allowances(self) -> Allowances {
+        if self.timing_emulated() {
+            Allowances::EMULATED
+        } else {
+            Allowances::REAL
+        }
+    }
+}
+
+/// What the end-to-end verdicts allow for on a route. Logic checks (what was commanded, which
+/// commands were authenticated, whether the airbag fired) are never relaxed, and the time
+/// limits themselves are the same on every route (the documented limits + 20 ms).
+///
+/// Measured in the TCG guest on this 2-vCPU VM (fault campaign judged by the real-timer rules):
+/// on a quiet host 12 of 12 faults passed at the first run, no command late or lost, with the
+/// default SecOC windows (10 ms pairing, 100 ms freshness) — the widened windows, the 100 ms
+/// slack and the "late, not lost" excuse that user-mode Linux needed are gone. With a niced
+/// `cargo build` beside it the same campaign failed 13 of 13 cases on time limits (fires
+/// +55…+1 800 ms late, inputs starved into the reference restraint): emulated timing follows
+/// the host's load, which a CI run does not choose. What remains is what absorbs that.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Allowances {
+    /// Runs a fault case may take when only time limits failed (1 = no retry).
+    pub time_limit_attempts: u32,
+    /// A reference-restraint fire while the ECU's only faults were stale inputs and overruns
+    /// counts as a time limit (the emulator starved the inputs), not a function failure.
+    pub starved_fire_is_timing: bool,
+}
+
+impl Allowances {
+    /// Real timers: none.
+    pub const REAL: Self = Self {
+        time_limit_attempts: 1,
+        starved_fire_is_timing: false,
+    };
+
+    /// Emulated timing (QEMU TCG).
+    pub const EMULATED: Self = Self {
+        time_limit_attempts: 3,
+        starved_fire_is_timing: true,
+    };
+
+    /// Every allowance in force, with its reason, for the reports (empty: none).
+    pub fn named(&self) -> Vec<String> {
+        let mut v = Vec::new();
+        if self.time_limit_attempts > 1 {
+            v.push(format!(
+                "a fault case that misses only time limits runs again (≤ {} runs): emulated timing follows the host's load",
+                self.time_limit_attempts
+            ));
+        }
+        if self.starved_fire_is_timing {
+            v.push(
+                "a reference fire caused only by starved inputs (stale-input/overrun flags) counts as a time limit"
+                    .to_owned(),
+            );
+        }
+        v
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn routes_parse_as_vcan_setup_prints_them() {
+        for r in [Route::Host, Route::QemuKvm, Route::QemuTcg] {
+            assert_eq!(Route::parse(r.name()), Some(r));
+            assert_eq!(Route::parse(&format!("{}\n", r.name())), Some(r));
+        }
+        assert_eq!(Route::parse("uml"), None);
+        assert_eq!(
+            serde_json::to_string(&Route::QemuTcg).unwrap(),
+            "\"qemu-tcg\""
+        );
+    }
+
+    #[test]
+    fn only_emulated_timing_gets_allowances() {
+        assert!(Route::Host.allowances().named().is_empty());
+        assert!(Route::QemuKvm.allowances().named().is_empty());
+        assert!(!Route::QemuTcg.allowances().named().is_empty());
+        assert!(Route::QemuTcg.timing_emulated() && !Route::QemuKvm.timing_emulated());
+    }
+}
