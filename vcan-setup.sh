@@ -27,8 +27,9 @@
 # Environment: VCAN (interface, default vcan0); VCAN_NO_INSTALL=1 (never apt-get);
 #   VCAN_GUEST_CACHE (default /var/tmp/vcan-guest), VCAN_GUEST_ACCEL (auto|kvm|tcg, default auto),
 #   VCAN_GUEST_FLAVOUR (rt|std, default rt), VCAN_GUEST_CPUS (2), VCAN_GUEST_MEM (MiB, 1024),
-#   VCAN_GUEST_TIMEOUT (s for the whole run, 3600), VCAN_GUEST_RW, VCAN_GUEST_VERBOSE=1 (boot
-#   timing, keep the run directory).
+#   VCAN_GUEST_TIMEOUT (s for the whole run, 3600), VCAN_GUEST_BOOT_TIMEOUT (s until the command
+#   runs under KVM, 60; a KVM guest that misses it falls back to TCG), VCAN_GUEST_RW,
+#   VCAN_GUEST_VERBOSE=1 (boot timing, keep the run directory).
 set -euo pipefail
 
 IFACE=${VCAN:-vcan0}
@@ -364,8 +365,8 @@ run_guest() {
   mkfifo "$run/out" "$run/err"
   cat "$run/out" & opid=$!
   cat "$run/err" >&2 & epid=$!
-  local boot_timeout=60
-  [ "$ACCEL" = tcg ] && boot_timeout=240
+  local boot_timeout=${VCAN_GUEST_BOOT_TIMEOUT:-60}
+  [ "$ACCEL" = tcg ] && boot_timeout=${VCAN_GUEST_BOOT_TIMEOUT_TCG:-240}
   t0=$(date +%s.%N)
   "${QEMU[@]}" "${acc[@]}" -m "$MEM" -smp "$CPUS" \
     -nodefaults -no-user-config -display none -no-reboot -nic none \
@@ -385,7 +386,7 @@ run_guest() {
               tail -n 5 "$run/qemu.err" >&2 2>/dev/null || true; }
   while [ ! -s "$run/booted" ]; do
     if ! kill -0 "$qpid" 2>/dev/null; then
-      wait "$qpid" || true; qpid=
+      wait "$qpid" 2>/dev/null || true; qpid=
       console
       [ "$ACCEL" = kvm ] && return 77
       no_route "QEMU exited before the guest started the command"
@@ -405,7 +406,7 @@ run_guest() {
     fi
     sleep 0.1
   done
-  wait "$qpid" || true; qpid=
+  wait "$qpid" 2>/dev/null || true; qpid=
   wait "$opid" "$epid" 2>/dev/null || true
   [ -s "$run/rc" ] || { console; say "the guest did not finish the command"; return 125; }
   return "$(cat "$run/rc")"
@@ -418,7 +419,9 @@ guest() {
   say "route=$(route_name): $why; running inside a $(route_words)"
   run_guest "$@" || rc=$?
   if [ "$rc" = 77 ]; then
-    touch "$CACHE/kvm-failed.$(cat /proc/sys/kernel/random/boot_id 2>/dev/null || echo unknown)"
+    # auto's choice is remembered for this host boot; a forced kvm is not a probe
+    [ "${VCAN_GUEST_ACCEL:-auto}" != auto ] ||
+      touch "$CACHE/kvm-failed.$(cat /proc/sys/kernel/random/boot_id 2>/dev/null || echo unknown)"
     ACCEL=tcg; ACCEL_WHY="KVM could not boot the guest"
     say "KVM could not boot the guest; route=$(route_name): $(route_words)"
     rc=0; run_guest "$@" || rc=$?

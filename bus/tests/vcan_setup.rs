@@ -141,6 +141,28 @@ fn guest_mode_runs_a_real_kernel_with_vcan_and_shares_the_working_directory() {
 }
 
 #[test]
+fn a_kvm_that_cannot_boot_the_guest_falls_back_to_tcg() {
+    // Forced KVM: where /dev/kvm runs a stock kernel the guest boots under KVM; where it does
+    // not (no /dev/kvm, a PVM /dev/kvm as on this project's CI VMs) the script must say so and
+    // run the command under TCG instead — never fail or skip.
+    let o = Command::new(script())
+        .args(["--guest", "--", "sh", "-c", "echo \"$VCAN_ROUTE\""])
+        .env("VCAN_GUEST_ACCEL", "kvm")
+        .env("VCAN_GUEST_BOOT_TIMEOUT", "30")
+        .stdin(Stdio::null())
+        .output()
+        .unwrap();
+    let (out, err) = (text(&o.stdout), text(&o.stderr));
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    if err.contains("KVM could not boot the guest") {
+        assert_eq!(out.trim(), "qemu-tcg", "{err}");
+        assert!(err.contains("route=qemu-tcg"), "{err}");
+    } else {
+        assert_eq!(out.trim(), "qemu-kvm", "{err}");
+    }
+}
+
+#[test]
 fn no_route_fails_loudly_with_the_reason_and_the_fix() {
     // A guest that cannot be prepared (its cache cannot be created): exit 4, said why.
     let o = Command::new(script())
