@@ -53,6 +53,10 @@ pub fn default_ecu_args() -> Vec<String> {
         .to_vec()
 }
 
+/// A fire command may arrive this much after its planned time: crash confirmation needs a few
+/// accelerometer samples (≈ 5.5 ms after contact), plus the ECU cycle and the CAN hop.
+pub const FIRE_LATE_ALLOWANCE_MS: f64 = 15.0;
+
 /// The stubs' bench arguments: receive until stopped after the ECU, so every command it sent
 /// is received and counted. The SecOC windows are the defaults on every route (10 ms pairing,
 /// 100 ms freshness): the QEMU guest's real kernel delivers in time (see [`route`]).

@@ -134,7 +134,7 @@ impl Allowances {
         let mut v = Vec::new();
         if self.time_limit_attempts > 1 {
             v.push(format!(
-                "a fault case that misses only time limits runs again (≤ {} runs): emulated timing follows the host's load",
+                "a fault case that misses only time limits, or a scenario run whose inputs were starved or whose fire came late, runs again (≤ {} runs): emulated timing follows the host's load",
                 self.time_limit_attempts
             ));
         }
@@ -146,6 +146,61 @@ impl Allowances {
         }
         v
     }
+}
+
+/// EcuStatus fault flags of the inputs (missing, stale or out of range) and of overruns: what
+/// a stalled machine causes, as opposed to E2E failures, a bad LUT or a bad configuration.
+pub const STARVED_INPUT_FLAGS: [&str; 5] = [
+    "vehicle_input",
+    "occupant_input",
+    "object_input",
+    "accel_sensor",
+    "overrun",
+];
+
+/// Why a scenario run did not measure the bench because the machine starved it, if it did not:
+/// between the ECU's first Normal and the contact it raised a stale-input fault that the
+/// scenario does not inject (no dropout or freeze declared), or the airbag fired more than
+/// [`crate::FIRE_LATE_ALLOWANCE_MS`] after its plan. Under emulated timing such a run is run
+/// again ([`Allowances::time_limit_attempts`]); with real timers it is a failure like any other.
+pub fn starved_run(
+    scenario: &sensor_feeds::Scenario,
+    r: &actuator_stubs::report::Report,
+) -> Option<String> {
+    let mut why = Vec::new();
+    let injects = !scenario.sensor.dropouts.is_empty() || !scenario.sensor.freezes.is_empty();
+    let first_normal = r
+        .ecu_modes
+        .iter()
+        .find(|(_, m)| m == "Normal")
+        .map(|(t, _)| *t);
+    let contact = if r.contact_ns != 0 { 0.0 } else { f64::MAX };
+    if let (false, Some(from)) = (injects, first_normal) {
+        if let Some((t, flags)) = r.ecu_faults.iter().find(|(t, flags)| {
+            *t > from
+                && *t < contact
+                && flags
+                    .iter()
+                    .any(|f| f != "overrun" && STARVED_INPUT_FLAGS.contains(&f.as_str()))
+        }) {
+            why.push(format!(
+                "inputs starved at {t:+.0} ms ({})",
+                flags.join("+")
+            ));
+        }
+    }
+    if let Some(a) = r.action("airbag_fire") {
+        if let Some(t) = a.t_ms {
+            let late = t - a.action.planned_ms;
+            if late > crate::FIRE_LATE_ALLOWANCE_MS {
+                why.push(format!(
+                    "airbag fired {late:+.1} ms after its plan ({:+.1} ms)",
+                    a.action.planned_ms
+                ));
+            }
+        }
+    }
+    (!why.is_empty()).then(|| why.join("; "))
 }
 
 #[cfg(test)]
@@ -171,5 +226,49 @@ mod tests {
         assert!(Route::QemuKvm.allowances().named().is_empty());
         assert!(!Route::QemuTcg.allowances().named().is_empty());
         assert!(Route::QemuTcg.timing_emulated() && !Route::QemuKvm.timing_emulated());
+    }
+
+    fn report(faults: &str, fire: &str) -> actuator_stubs::report::Report {
+        serde_json::from_str(&format!(
+            r#"{{"scenario": "x", "stop_reason": "done", "start_ns": 1, "contact_ns": 5,
+                "frames": {{}}, "e2e_accepted": 0, "e2e_rejected": {{}},
+                "actions": [{fire}], "ecu_modes": [[-2000.0, "ReferenceFallback"], [-1600.0, "Normal"]],
+                "ecu_faults": {faults}, "ecu_diag_modes": [],
+                "pretensioner_before_contact": true, "pretensioner_released": false, "airbag_fired": true}}"#
+        ))
+        .expect("report JSON")
+    }
+
+    fn scenario(name: &str) -> sensor_feeds::Scenario {
+        sensor_feeds::Scenario::load(crate::repo_root().join(format!("scenarios/{name}.toml")))
+            .expect("scenario")
+    }
+
+    const FIRE_AT_7: &str = r#"{"t_ns": 9, "what": "airbag_fire", "level_kn": 4.5, "planned_ms": 3.0, "source": "adaptive", "t_ms": 7.0}"#;
+
+    #[test]
+    fn a_run_is_starved_by_stale_inputs_before_contact_or_a_late_fire_only() {
+        let s = scenario("taurus-48-48-abs");
+        // start-up faults before the first Normal and the object list ending after contact
+        // are the scenario's own course
+        let clean = r#"[[-2000.0, ["object_input"]], [-1600.0, []], [30.0, ["object_input"]]]"#;
+        assert_eq!(starved_run(&s, &report(clean, FIRE_AT_7)), None);
+        // overruns alone do not starve anything
+        let overrun = r#"[[-2000.0, ["object_input"]], [-1600.0, ["overrun"]]]"#;
+        assert_eq!(starved_run(&s, &report(overrun, FIRE_AT_7)), None);
+        let starved = r#"[[-2000.0, ["object_input"]], [-1600.0, []], [-894.0, ["object_input", "overrun"]]]"#;
+        let why = starved_run(&s, &report(starved, FIRE_AT_7)).expect("starved");
+        assert!(
+            why.contains("-894 ms") && why.contains("object_input"),
+            "{why}"
+        );
+        let late = FIRE_AT_7.replace(r#""t_ms": 7.0"#, r#""t_ms": 19.9"#);
+        let why = starved_run(&s, &report(clean, &late)).expect("late fire");
+        assert!(why.contains("+16.9 ms after its plan"), "{why}");
+        // a scenario that injects a dropout owns its input faults
+        assert_eq!(
+            starved_run(&scenario("sensor-dropout"), &report(starved, FIRE_AT_7)),
+            None
+        );
     }
 }

@@ -9,15 +9,12 @@
 //! [`adaptive_outcome_is_no_worse_than_the_reference_for_every_scenario`]).
 
 use actuator_stubs::report::Report;
-use e2e_tests::harness;
+use e2e_tests::{harness, FIRE_LATE_ALLOWANCE_MS};
 use sensor_feeds::Scenario;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
-/// A fire command may arrive this much after its planned time: crash confirmation needs a few
-/// accelerometer samples (≈ 5.5 ms after contact), plus the ECU cycle and the CAN hop.
-const FIRE_LATE_ALLOWANCE_MS: f64 = 15.0;
 /// ECU `object_timeout_ms` (ecu/ecu.toml default) + one EcuStatus period (20 ms).
 const DOCUMENTED_FALLBACK_MS: f64 = 120.0;
 /// Scheduling slack on top (one period of a loaded 2-vCPU host; the QEMU TCG guest measured

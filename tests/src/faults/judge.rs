@@ -2,7 +2,8 @@
 //! limits (retried where the route's timing is emulated) rather than function checks.
 
 use super::{Case, CaseResult, Check, Fault, DELAY_MS};
-use crate::RunResult;
+use crate::route::STARVED_INPUT_FLAGS;
+use crate::{RunResult, FIRE_LATE_ALLOWANCE_MS};
 use actuator_stubs::report::{Report, TimedAction};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -17,8 +18,6 @@ const E2E_BURST_MS: f64 = 30.0;
 const OBJECT_PERIOD_MS: f64 = 20.0;
 /// OccupantClassification period (DBC).
 const OCCUPANT_PERIOD_MS: f64 = 100.0;
-/// A fire command may arrive this much after its planned time (same as the bench tests).
-pub const FIRE_LATE_ALLOWANCE_MS: f64 = 15.0;
 
 /// Checks that are time limits (see [`Check::timing`]).
 const TIMING_CHECKS: [&str; 4] = [
@@ -37,16 +36,6 @@ const STARVATION_CHECKS: [&str; 4] = [
     "crash handled by the adaptive path after recovery",
     "services usable after a killed process (crash handled adaptively)",
     "same airbag plan as the baseline",
-];
-
-/// EcuStatus fault flags of the inputs (missing, stale or out of range) and of overruns: what
-/// a stalled machine causes, as opposed to E2E failures, a bad LUT or a bad configuration.
-const STARVED_INPUT_FLAGS: [&str; 5] = [
-    "vehicle_input",
-    "occupant_input",
-    "object_input",
-    "accel_sensor",
-    "overrun",
 ];
 
 /// If the airbag was fired by the reference restraint while the ECU's only active faults were

@@ -27,7 +27,7 @@
 mod judge;
 mod report;
 
-pub use judge::{judge, FIRE_LATE_ALLOWANCE_MS};
+pub use judge::judge;
 pub use report::report_text;
 
 use crate::{Disturbance, RunConfig, RunCtx, RunResult, SideProcess};
