@@ -104,6 +104,32 @@ pub struct CollisionSummary {
     pub samples_written: usize,
 }
 
+impl VehicleResult {
+    /// All zero (no collision).
+    pub const ZERO: VehicleResult = VehicleResult {
+        crush_m: 0.0,
+        a_max_mps2: 0.0,
+        a_mean_mps2: 0.0,
+        delta_v_mps: 0.0,
+    };
+}
+
+impl CollisionSummary {
+    /// All zero (no collision) — `Default` as a const, for statics and const constructors.
+    pub const ZERO: CollisionSummary = CollisionSummary {
+        vehicle: VehicleResult::ZERO,
+        opponent: VehicleResult::ZERO,
+        contact_duration_s: 0.0,
+        reversal_time_s: 0.0,
+        max_deflection_m: 0.0,
+        peak_force_n: 0.0,
+        unloading_stiffness_n_per_m: 0.0,
+        separation_speed_mps: 0.0,
+        absorbed_energy_j: 0.0,
+        samples_written: 0,
+    };
+}
+
 /// Caller-owned, fixed-capacity storage of both compartment pulses (structure of arrays so that
 /// each channel is a plain slice, e.g. for the occupant model or the accelerometer feed).
 #[derive(Clone, Debug)]
@@ -270,6 +296,18 @@ pub struct PulseSample {
     pub opp_crush_m: f64,
 }
 
+impl PulseSample {
+    /// At rest, no force, no crush (the state at first contact and without a collision).
+    pub const ZERO: PulseSample = PulseSample {
+        ego_accel_mps2: 0.0,
+        ego_vel_mps: 0.0,
+        ego_crush_m: 0.0,
+        opp_accel_mps2: 0.0,
+        opp_vel_mps: 0.0,
+        opp_crush_m: 0.0,
+    };
+}
+
 /// The mass terms of one collision and what follows from them alone: the reduced mass, each
 /// vehicle's share of the relative velocity change (momentum conservation), the per-vehicle
 /// pulse sample of a relative state and the summary. Shared by the integrator and the exact
@@ -305,6 +343,16 @@ pub(crate) struct Unloading {
 }
 
 impl Masses {
+    pub const ZERO: Masses = Masses {
+        inv_m_ego: 0.0,
+        inv_m_opp: 0.0,
+        mu: 0.0,
+        inv_mu: 0.0,
+        ratio_ego: 0.0,
+        ratio_opp: 0.0,
+        v0: 0.0,
+    };
+
     pub fn new(input: &CollisionInput<'_>) -> Self {
         let inv_m_ego = 1.0 / input.ego_mass_kg;
         let inv_m_opp = if input.opp_mass_kg.is_infinite() {

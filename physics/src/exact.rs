@@ -72,6 +72,17 @@ pub struct Segment {
 }
 
 impl Segment {
+    const ZERO: Segment = Segment {
+        start_s: 0.0,
+        end_s: 0.0,
+        x0_m: 0.0,
+        closing_speed0_mps: 0.0,
+        decel0_mps2: 0.0,
+        stiffness_per_mass_per_s2: 0.0,
+        ego0_m: 0.0,
+        ego_share: 0.0,
+    };
+
     /// Deflection change, closing speed and deceleration τ after entry (see module docs).
     #[inline]
     fn advance(&self, tau_s: f64) -> (f64, f64, f64) {
@@ -293,44 +304,70 @@ pub struct ExactCollision {
     after: PulseSample,
 }
 
+impl Default for ExactCollision {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl ExactCollision {
+    /// No collision (no contact: zero summary, zero states). The starting value of a kept,
+    /// reused solution (see [`ExactCollision::solve_in_place`]).
+    pub const fn new() -> Self {
+        ExactCollision {
+            segments: [Segment::ZERO; CURVE_CAPACITY],
+            len: 0,
+            masses: Masses::ZERO,
+            summary: CollisionSummary::ZERO,
+            after: PulseSample::ZERO,
+        }
+    }
+
     /// Solve the collision (`input.step_s` / `duration_s` are not used). Never panics.
     pub fn solve(input: &CollisionInput<'_>) -> Result<Self, PhysicsError> {
-        let mut segments = [Segment::default(); CURVE_CAPACITY];
-        let mut len = 0usize;
-        let sol = walk(input, |seg| {
-            if let Some(slot) = segments.get_mut(len) {
+        let mut sol = ExactCollision::new();
+        sol.solve_in_place(input)?;
+        Ok(sol)
+    }
+
+    /// Solve into this (caller-owned, reused) value without copying it — the form for a
+    /// per-cycle prediction that is kept for later sampling. On `Err` it holds no collision.
+    pub fn solve_in_place(
+        &mut self,
+        input: &CollisionInput<'_>,
+    ) -> Result<&CollisionSummary, PhysicsError> {
+        self.len = 0;
+        self.summary = CollisionSummary::ZERO;
+        self.after = PulseSample::ZERO;
+        let (segments, len) = (&mut self.segments, &mut self.len);
+        let walked = walk(input, |seg| {
+            if let Some(slot) = segments.get_mut(*len) {
                 *slot = *seg;
-                len += 1;
+                *len += 1;
             }
-        })?;
-        let Some(sol) = sol else {
-            return Ok(ExactCollision {
-                segments,
-                len: 0,
-                masses: Masses::new(input),
-                summary: CollisionSummary::default(),
-                after: PulseSample::default(),
-            });
+        });
+        let sol = match walked {
+            Ok(Some(sol)) => sol,
+            Ok(None) => return Ok(&self.summary),
+            Err(e) => {
+                self.len = 0;
+                return Err(e);
+            }
         };
         // Loading segments ≤ CURVE_CAPACITY − 1, so the unloading always fits.
         if sol.unloading.end_s > sol.unloading.start_s {
-            if let Some(slot) = segments.get_mut(len) {
+            if let Some(slot) = self.segments.get_mut(self.len) {
                 *slot = sol.unloading;
-                len += 1;
+                self.len += 1;
             }
         }
         let x_ego = sol.ego_frac * sol.x_perm_m;
-        let after = sol
+        self.after = sol
             .masses
             .sample(0.0, sol.after_closing_mps, x_ego, sol.x_perm_m - x_ego);
-        Ok(ExactCollision {
-            segments,
-            len,
-            masses: sol.masses,
-            summary: sol.summary,
-            after,
-        })
+        self.masses = sol.masses;
+        self.summary = sol.summary;
+        Ok(&self.summary)
     }
 
     /// The summary (identical to [`predict_summary`]; `samples_written` = 0).
@@ -388,9 +425,11 @@ impl ExactCollision {
         }
         Ok(Samples {
             sol: self,
+            segs: self.segments(),
             step_s,
             k: 0,
-            seg: usize::MAX,
+            seg: 0,
+            fresh: true,
             sn: 0.0,
             cn: 0.0,
             state: (0.0, 0.0, 0.0),
@@ -419,11 +458,15 @@ impl ExactCollision {
 #[derive(Clone, Debug)]
 pub struct Samples<'a> {
     sol: &'a ExactCollision,
+    segs: &'a [Segment],
     step_s: f64,
-    k: u64,
-    /// Segment of the previous sample (`usize::MAX` before the first).
+    /// Index of the next sample (signed: one-instruction conversion to f64).
+    k: i64,
+    /// Segment of the next sample (cursor; = `segs.len()` after separation).
     seg: usize,
-    /// Propagator (S, C) of one step in that segment.
+    /// The cursor moved since the last sample: evaluate from the segment's start state.
+    fresh: bool,
+    /// Propagator (S, C) of one step in the current segment.
     sn: f64,
     cn: f64,
     /// (Δx from the segment's entry, closing speed, deceleration) at the previous sample.
@@ -433,40 +476,36 @@ pub struct Samples<'a> {
 impl Iterator for Samples<'_> {
     type Item = PulseSample;
 
-    #[inline]
+    // Inlined into the caller's loop so that channels the caller does not read are never
+    // computed (the ECU's diagnostics read only the ego acceleration).
+    #[inline(always)]
     fn next(&mut self) -> Option<PulseSample> {
         let t = self.k as f64 * self.step_s;
         self.k = self.k.saturating_add(1);
-        let segs = self.sol.segments();
-        if segs.is_empty() {
-            return Some(PulseSample::default());
-        }
-        // Same segment as the previous sample: one step of its exact flow map.
-        if let Some(seg) = segs.get(self.seg) {
-            if t < seg.end_s {
-                let (dx0, u, a) = self.state;
-                let (ddx, u1, a1) = step(u, a, seg.stiffness_per_mass_per_s2, self.sn, self.cn);
-                self.state = (dx0 + ddx, u1, a1);
-                return Some(self.sol.sample_of(seg, self.state.0, u1, a1));
+        loop {
+            let Some(seg) = self.segs.get(self.seg) else {
+                // After separation (or no contact at all).
+                return Some(self.sol.after);
+            };
+            if t >= seg.end_s {
+                self.seg += 1;
+                self.fresh = true;
+                continue;
             }
+            let s = seg.stiffness_per_mass_per_s2;
+            if self.fresh {
+                // Enter the segment from its exact start state; then step with its flow map.
+                self.state = seg.advance(t - seg.start_s);
+                (self.sn, self.cn) = propagator(s, self.step_s);
+                self.fresh = false;
+            } else {
+                let (dx0, u, a) = self.state;
+                let (ddx, u1, a1) = step(u, a, s, self.sn, self.cn);
+                self.state = (dx0 + ddx, u1, a1);
+            }
+            let (dx, u, a) = self.state;
+            return Some(self.sol.sample_of(seg, dx, u, a));
         }
-        // Enter the segment containing t from its exact start state.
-        let from = if self.seg == usize::MAX { 0 } else { self.seg };
-        let Some(i) = segs
-            .iter()
-            .skip(from)
-            .position(|s| t < s.end_s)
-            .map(|p| p + from)
-        else {
-            self.seg = segs.len();
-            return Some(self.sol.after);
-        };
-        let seg = &segs[i];
-        let (dx, u, a) = seg.advance(t - seg.start_s);
-        (self.sn, self.cn) = propagator(seg.stiffness_per_mass_per_s2, self.step_s);
-        self.seg = i;
-        self.state = (dx, u, a);
-        Some(self.sol.sample_of(seg, dx, u, a))
     }
 }
 

@@ -372,6 +372,21 @@ fn summary_paths_agree_and_ignore_the_step() {
     })
     .unwrap();
     assert_eq!(a, c);
+    // A kept, reused solution gives the same; a refused input leaves it without a collision.
+    let mut kept = Box::new(ExactCollision::new());
+    assert_eq!(*kept.solve_in_place(&inp).unwrap(), a);
+    assert_eq!(
+        kept.segments(),
+        ExactCollision::solve(&inp).unwrap().segments()
+    );
+    let bad = CollisionInput {
+        closing_speed_mps: f64::NAN,
+        ..inp
+    };
+    assert!(kept.solve_in_place(&bad).is_err());
+    assert!(kept.segments().is_empty());
+    assert_eq!(*kept.summary(), CollisionSummary::default());
+    assert_eq!(kept.state_at(0.05), Default::default());
     let mut buf = Box::new(PulseBuffer::<2048>::new());
     let d = simulate_collision_exact(&inp, &mut buf).unwrap();
     assert_eq!(d.samples_written, 1501);
