@@ -343,6 +343,29 @@ mod tests {
     use super::*;
 
     #[test]
+    fn prediction_workload_spans_the_default_axes_with_valid_inputs() {
+        let w = PredictionWorkload::new();
+        assert_eq!(w.len(), 108);
+        let mut seen = std::collections::BTreeSet::new();
+        for i in 0..w.len() {
+            let input = w.input(i, 5e-4);
+            assert_eq!(input.ego_mass_kg, PredictionWorkload::EGO_KG);
+            assert!((800.0..=3000.0).contains(&input.opp_mass_kg));
+            let kph = input.closing_speed_mps * 3.6;
+            assert!((40.0 - 1e-9..=108.0 + 1e-9).contains(&kph), "{kph}");
+            let s = physics::predict_summary(&input).expect("valid prediction input");
+            assert!(s.vehicle.a_mean_mps2 > 0.0);
+            seen.insert((input.opp_mass_kg as u32, (kph * 10.0).round() as u32));
+        }
+        assert_eq!(seen.len(), 108, "cases are distinct");
+        // Cycled: case 108 is case 0 again.
+        assert_eq!(
+            w.input(108, 5e-4).closing_speed_mps,
+            w.input(0, 5e-4).closing_speed_mps
+        );
+    }
+
+    #[test]
     fn input_frames_decode_to_what_was_sealed_for_many_cycles() {
         let mut f = CycleInputFrames::new().unwrap();
         // 40 cycles wrap the 4-bit alive counter twice: the replayed stream must stay valid.

@@ -535,6 +535,22 @@ mod tests {
         (a - b).abs() / b.abs()
     }
 
+    /// (Δx, u, a) τ after a segment entry at (u₀, a₀) with slope s.
+    fn advance(u0: f64, a0: f64, s: f64, tau: f64) -> (f64, f64, f64) {
+        Segment {
+            closing_speed0_mps: u0,
+            decel0_mps2: a0,
+            stiffness_per_mass_per_s2: s,
+            ..Segment::default()
+        }
+        .advance(tau)
+    }
+
+    /// Time between two states (speed, deceleration) of one segment: P and D as in the walk.
+    fn time_between(s: f64, (u0, a0): (f64, f64), (u1, a1): (f64, f64)) -> f64 {
+        segment_time_s(s, a1 * u0 - a0 * u1, a0 * a1 + s * u0 * u1)
+    }
+
     #[test]
     fn uniform_deceleration_segment() {
         // s = 0, a = 200 m/s²: u = u₀ − aτ, x = u₀τ − aτ²/2; time from 20 to 10 m/s is 50 ms.
@@ -555,20 +571,13 @@ mod tests {
         // x'' = −(a₀ + s (x − x₀)): x − x₀ = u₀ sin(ωτ)/ω − a₀ (1 − cos ωτ)/ω².
         let (u0, a0, s, tau): (f64, f64, f64, f64) = (15.0, 300.0, 4.0e3, 0.012);
         let w: f64 = s.sqrt();
-        let (dx, u, a) = Segment {
-            closing_speed0_mps: u0,
-            decel0_mps2: a0,
-            stiffness_per_mass_per_s2: s,
-            ..Segment::default()
-        }
-        .advance(tau);
+        let (dx, u, a) = advance(u0, a0, s, tau);
         let dx_ref = u0 * (w * tau).sin() / w - a0 * (1.0 - (w * tau).cos()) / s;
         let u_ref = u0 * (w * tau).cos() - a0 * (w * tau).sin() / w;
         assert!(rel(dx, dx_ref) < 1e-13 && rel(u, u_ref) < 1e-13);
         assert!(rel(a, a0 + s * dx_ref) < 1e-13);
         // Time back from the two states: phase difference.
-        let p = a * u0 - a0 * u;
-        let t = segment_time_s(s, p, a0 * a + s * u0 * u);
+        let t = time_between(s, (u0, a0), (u, a));
         assert!(rel(t, tau) < 1e-12, "{t}");
     }
 
@@ -577,17 +586,11 @@ mod tests {
         // Falling force (s < 0): x − x₀ = u₀ sinh(κτ)/κ − a₀ (cosh κτ − 1)/κ².
         let (u0, a0, s, tau): (f64, f64, f64, f64) = (15.0, 300.0, -900.0, 0.02);
         let k: f64 = (-s).sqrt();
-        let (dx, u, a) = Segment {
-            closing_speed0_mps: u0,
-            decel0_mps2: a0,
-            stiffness_per_mass_per_s2: s,
-            ..Segment::default()
-        }
-        .advance(tau);
+        let (dx, u, a) = advance(u0, a0, s, tau);
         let dx_ref = u0 * (k * tau).sinh() / k - a0 * ((k * tau).cosh() - 1.0) / (k * k);
         let u_ref = u0 * (k * tau).cosh() - a0 * (k * tau).sinh() / k;
         assert!(rel(dx, dx_ref) < 1e-13 && rel(u, u_ref) < 1e-13);
-        let t = segment_time_s(s, a * u0 - a0 * u, a0 * a + s * u0 * u);
+        let t = time_between(s, (u0, a0), (u, a));
         assert!(rel(t, tau) < 1e-12, "{t}");
     }
 
@@ -599,14 +602,8 @@ mod tests {
         // s r² ≈ 5e-6 for s = ±2e-3 (inside the series branch, near its limit).
         for s in [1e-12, -1e-12, 1e-6, -1e-6, 2e-3, -2e-3, 1e-2, -1e-2] {
             let tau = 0.05;
-            let (_, u, a1) = Segment {
-                closing_speed0_mps: u0,
-                decel0_mps2: a,
-                stiffness_per_mass_per_s2: s,
-                ..Segment::default()
-            }
-            .advance(tau);
-            let t = segment_time_s(s, a1 * u0 - a * u, a * a1 + s * u0 * u);
+            let (_, u, a1) = advance(u0, a, s, tau);
+            let t = time_between(s, (u0, a), (u, a1));
             assert!(rel(t, tau) < 1e-13, "s {s}: {t}");
         }
     }

@@ -25,16 +25,21 @@ fn paper_module_matches_spec() {
     }
 }
 
+/// Row i of Table 5: class i + 1 against itself (i < 6) or the combined curve (i = 6).
+fn table5_spring(i: usize) -> CombinedSpring {
+    let curve = if i < 6 {
+        &stiffness::CLASS_CURVES[i]
+    } else {
+        &stiffness::COMBINED_CURVE
+    };
+    CombinedSpring::series(curve, Some(curve)).unwrap()
+}
+
 #[test]
 fn every_class_reproduces_table5_within_tolerance() {
     let mut buf = Box::new(DefaultPulseBuffer::new());
     for (i, &(class, crush_mm, a_max_g, a_mean_g)) in PUBLISHED.iter().enumerate() {
-        let curve = if i < 6 {
-            &stiffness::CLASS_CURVES[i]
-        } else {
-            &stiffness::COMBINED_CURVE
-        };
-        let spring = CombinedSpring::series(curve, Some(curve)).unwrap();
+        let spring = table5_spring(i);
         let input = CollisionInput::with_defaults(&spring, 1785.0, 1785.0, kph_to_mps(108.0));
         let s = simulate_collision(&input, &mut buf).unwrap();
         let got = (
@@ -72,12 +77,7 @@ fn exact_solution_reproduces_table5_within_tolerance() {
     // The closed-form solution of the same model (what the ECU predicts with) meets the same
     // published numbers; it differs from the 0.1 ms integration by < 0.01 % (tests/exact.rs).
     for (i, &(class, crush_mm, a_max_g, a_mean_g)) in PUBLISHED.iter().enumerate() {
-        let curve = if i < 6 {
-            &stiffness::CLASS_CURVES[i]
-        } else {
-            &stiffness::COMBINED_CURVE
-        };
-        let spring = CombinedSpring::series(curve, Some(curve)).unwrap();
+        let spring = table5_spring(i);
         let input = CollisionInput::with_defaults(&spring, 1785.0, 1785.0, kph_to_mps(108.0));
         let s = predict_summary(&input).unwrap();
         let err = |a: f64, b: f64| (a / b - 1.0).abs();
