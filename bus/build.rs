@@ -284,6 +284,8 @@ fn generate_meta(dbc: &Dbc) -> String {
         writeln!(
             o,
             "impl {ty} {{
+    /// Linux `can_id` of this message (11-bit id, no flags; generated from the DBC).
+    pub const RAW_ID: u32 = {id:#05x};
     /// Builds the frame from physical values (generated from the DBC): scaled values are
     /// rounded to the nearest step (not truncated), NaN/inf and values outside the DBC range are
     /// rejected with the signal's name.{e2e_note}

@@ -1,0 +1,105 @@
+//! A restraint plan (levels + trigger times) and where it came from.
+
+use diagram::{AirbagStage, AirbagThresholds, Lookup};
+
+/// The conventional reference restraint as numbers (the shell reads them from
+/// `data/reference-restraint.toml`; levels kN, times ms relative to first contact).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReferenceSettings {
+    /// Belt load-limiter level, kN.
+    pub belt_limiter_kn: f64,
+    /// Airbag + column force level, kN.
+    pub airbag_level_kn: f64,
+    /// Pretensioner trigger time after contact, ms.
+    pub pretensioner_time_ms: f64,
+    /// Airbag trigger time after contact, ms.
+    pub airbag_time_ms: f64,
+}
+
+/// Where the settings of a plan came from (sent as `CmdSource` on CAN).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PlanSource {
+    /// Interpolated from the characteristic diagram for the predicted situation.
+    Adaptive,
+    /// The conventional reference restraint (fallback, or situation outside the table).
+    Reference,
+}
+
+/// Restraint settings to apply. Times relative to first contact, ms.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RestraintPlan {
+    /// Belt load-limiter level, kN.
+    pub belt_limiter_kn: f32,
+    /// Airbag / column force level, kN (0 when `airbag_stage` is `NoFire`).
+    pub airbag_level_kn: f32,
+    /// Discrete inflator decision.
+    pub airbag_stage: AirbagStage,
+    /// Pretensioner trigger, ms relative to contact (negative = pre-crash, reversible).
+    pub pretensioner_time_ms: f32,
+    /// Airbag trigger, ms after contact (never before crash confirmation).
+    pub airbag_time_ms: f32,
+    /// Source of the numbers.
+    pub source: PlanSource,
+}
+
+impl RestraintPlan {
+    /// The conventional reference restraint (levels kN, times ms), its stage derived with
+    /// the same thresholds as the LUT's (so a reference level below the no-fire threshold
+    /// does not fire).
+    pub fn reference(
+        belt_limiter_kn: f32,
+        airbag_level_kn: f32,
+        pretensioner_time_ms: f32,
+        airbag_time_ms: f32,
+        thresholds: &AirbagThresholds,
+    ) -> Self {
+        let stage = thresholds.stage(airbag_level_kn);
+        Self {
+            belt_limiter_kn,
+            airbag_level_kn: if stage == AirbagStage::NoFire {
+                0.0
+            } else {
+                airbag_level_kn
+            },
+            airbag_stage: stage,
+            pretensioner_time_ms,
+            airbag_time_ms,
+            source: PlanSource::Reference,
+        }
+    }
+
+    /// From the reference-restraint settings.
+    pub fn from_reference_settings(r: &ReferenceSettings, thresholds: &AirbagThresholds) -> Self {
+        Self::reference(
+            r.belt_limiter_kn as f32,
+            r.airbag_level_kn as f32,
+            r.pretensioner_time_ms as f32,
+            r.airbag_time_ms as f32,
+            thresholds,
+        )
+    }
+
+    /// From one LUT interpolation.
+    pub fn from_lookup(l: &Lookup) -> Self {
+        Self {
+            belt_limiter_kn: l.values.belt_limiter_kn,
+            airbag_level_kn: l.airbag_command_kn(),
+            airbag_stage: l.airbag_stage,
+            pretensioner_time_ms: l.values.pretensioner_time_ms,
+            airbag_time_ms: l.values.airbag_time_ms,
+            source: PlanSource::Adaptive,
+        }
+    }
+
+    /// The same plan without airbag deployment (low-speed no-fire).
+    pub fn without_airbag(mut self) -> Self {
+        self.airbag_stage = AirbagStage::NoFire;
+        self.airbag_level_kn = 0.0;
+        self
+    }
+
+    /// True if the airbag is to be fired.
+    pub fn airbag_fires(&self) -> bool {
+        self.airbag_stage != AirbagStage::NoFire
+    }
+}
