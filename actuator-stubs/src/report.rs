@@ -3,6 +3,7 @@
 
 use crate::commands::Action;
 use crate::outcome::Judged;
+use heck::ToSnakeCase;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -123,37 +124,25 @@ impl Report {
     }
 }
 
-/// EcuStatus fault flags in bit order (DBC `FaultVehicleInput` … `FaultConfig`).
-pub const ECU_FAULT_NAMES: [&str; 8] = [
-    "vehicle_input",
-    "occupant_input",
-    "object_input",
-    "accel_sensor",
-    "e2e",
-    "lut",
-    "overrun",
-    "config",
-];
-
-/// The names of the fault flags set in `bits` (see [`ECU_FAULT_NAMES`]).
-pub fn ecu_fault_names(bits: u8) -> Vec<String> {
-    ECU_FAULT_NAMES
+/// The EcuStatus fault flags, in DBC order: every `EcuStatus` signal named `Fault…`, as
+/// (index in `EcuStatus::SIGNALS`, report name = the rest of the name in snake case).
+pub fn ecu_fault_signals() -> impl Iterator<Item = (usize, String)> {
+    bus::EcuStatus::SIGNALS
         .iter()
         .enumerate()
-        .filter(|(i, _)| bits & (1 << i) != 0)
-        .map(|(_, n)| (*n).to_owned())
+        .filter_map(|(i, s)| s.name.strip_prefix("Fault").map(|n| (i, n.to_snake_case())))
+}
+
+/// The names of the fault flags set in `bits` (bit k = the k-th of [`ecu_fault_signals`]).
+pub fn ecu_fault_names(bits: u8) -> Vec<String> {
+    ecu_fault_signals()
+        .enumerate()
+        .filter(|(k, _)| bits & (1 << k) != 0)
+        .map(|(_, (_, n))| n)
         .collect()
 }
 
-/// DBC EcuMode names.
+/// DBC EcuMode names (the DBC's value table; "Unknown" outside it).
 pub fn ecu_mode_name(mode: u8) -> &'static str {
-    match mode {
-        0 => "Init",
-        1 => "Normal",
-        2 => "ReferenceFallback",
-        3 => "CrashDetected",
-        4 => "Deployed",
-        5 => "Fault",
-        _ => "Unknown",
-    }
+    bus::value_name(bus::EcuStatus::ECU_MODE_VALUES, i64::from(mode)).unwrap_or("Unknown")
 }

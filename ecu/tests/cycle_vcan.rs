@@ -7,6 +7,7 @@
 //! On a host without SocketCAN the visible test re-runs the `#[ignore]`d worker inside a
 //! user-mode Linux guest through `vcan-setup.sh --run`; with neither it FAILS (never skipped).
 
+#[path = "../../restraint/tests/cycle_support/mod.rs"]
 mod cycle_support;
 #[path = "../../bus/tests/support/vcan_rerun.rs"]
 mod vcan_rerun;

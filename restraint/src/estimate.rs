@@ -16,7 +16,7 @@ use physics::{
     MassClass,
 };
 
-use crate::config::{ms_to_ns, CycleConfig, ConfigError};
+use crate::config::{ms_to_ns, ConfigError, CycleConfig};
 use crate::cycle::CycleCounters;
 use crate::inputs::InputMonitor;
 use crate::plan::RestraintPlan;

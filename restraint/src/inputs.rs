@@ -10,8 +10,8 @@ use bus::codec::{OccupantClassificationBeltBuckle, OccupantClassificationOccupan
 use bus::{E2eChecker, Messages, RawFrame, RejectReason, CAN_EFF_FLAG};
 use heapless::Deque;
 
-use crate::confirm::{ConfirmParams, CrashDetector, G_MPS2};
 use crate::config::{ms_to_ns, CycleConfig, MAX_E2E_BURST};
+use crate::confirm::{ConfirmParams, CrashDetector, G_MPS2};
 use crate::cycle::CycleCounters;
 use crate::signals::{CrashAccelSample, Degraded, ObjectState};
 

@@ -184,6 +184,9 @@ mod tests {
         assert_eq!(ids, [0x30, 0x31]);
         assert_eq!(io.sent_since(before).count(), 2);
         io.can_on = false;
-        assert_eq!(io.send_can(&RawFrame::new(1, &[])), Err(IoError::CanDisabled));
+        assert_eq!(
+            io.send_can(&RawFrame::new(1, &[])),
+            Err(IoError::CanDisabled)
+        );
     }
 }

@@ -81,7 +81,10 @@ fn the_core_depends_on_no_std_only_crate() {
         .filter(|(n, _, _)| STD_ONLY.contains(&n.as_str()))
         .map(|(n, _, _)| n.as_str())
         .collect();
-    assert!(bad.is_empty(), "std-only crates in the core's tree: {bad:?}");
+    assert!(
+        bad.is_empty(),
+        "std-only crates in the core's tree: {bad:?}"
+    );
 }
 
 #[test]
