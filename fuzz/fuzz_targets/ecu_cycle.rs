@@ -252,7 +252,7 @@ impl Harness {
     }
 
     fn check_sent(&mut self) {
-        for f in self.io.can_tx.iter() {
+        for f in self.io.can_tx.oldest_ordered() {
             let msg = match bus::decode(f.id, f.payload()) {
                 Ok(m) => m,
                 // No SecOC sender is set, so every frame carries E2E and must decode.

@@ -79,8 +79,9 @@ pub trait CycleIo {
     fn drain_can(&mut self, f: &mut dyn FnMut(&RawFrame)) -> usize;
     /// Queues one CAN frame for sending.
     fn send_can(&mut self, frame: &RawFrame) -> Result<(), IoError>;
-    /// Publishes one diagnostics record: `fill` writes it in place (pre-initialised to
-    /// [`EcuDiagnostics::ZERO`]).
+    /// Publishes one diagnostics record: `fill` writes it in place, into whatever the buffer
+    /// held before ([`crate::RestraintCycle`] writes every field, so an I/O need not clear
+    /// the buffer for it).
     fn publish_diagnostics(
         &mut self,
         fill: &mut dyn FnMut(&mut EcuDiagnostics),

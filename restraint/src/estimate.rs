@@ -228,6 +228,7 @@ impl<'a> Estimator<'a> {
     /// Situation from the newest object sample; runs the prediction and the LUT lookup when
     /// contact is within the exit horizon. Returns the plan when one was looked up.
     /// Called only when a new sample (or a changed occupant) arrived.
+    #[inline(always)]
     pub(crate) fn update(
         &mut self,
         now: u64,
@@ -267,6 +268,7 @@ impl<'a> Estimator<'a> {
         Some(self.lookup(&sit, inputs, counters))
     }
 
+    #[inline(always)]
     fn predict(&mut self, sit: &Situation, counters: &mut CycleCounters) {
         counters.predictions = counters.predictions.saturating_add(1);
         let class = physics::class_for_mass_kg(sit.opponent_mass_kg)

@@ -365,22 +365,35 @@ pub(crate) fn publish_diagnostics(
         rec.last_accel_sequence = last_acc;
         rec.object_samples_rx = objects_rx;
         rec.accel_batches_rx = accel_rx;
-        if let Some(s) = summary {
-            rec.predicted_delta_v_mps = s.vehicle.delta_v_mps as f32;
-            rec.predicted_a_max_mps2 = s.vehicle.a_max_mps2 as f32;
-            rec.predicted_a_mean_mps2 = s.vehicle.a_mean_mps2 as f32;
-            rec.predicted_contact_time_s = s.contact_duration_s as f32;
-            let mut n = 0u32;
-            for (dst, src) in rec
-                .pulse_accel_mps2
-                .iter_mut()
-                .zip(pulse.iter().step_by(stride))
-            {
-                *dst = *src as f32;
-                n += 1;
+        // Every field is written (the I/O need not clear the record first).
+        match summary {
+            Some(s) => {
+                rec.predicted_delta_v_mps = s.vehicle.delta_v_mps as f32;
+                rec.predicted_a_max_mps2 = s.vehicle.a_max_mps2 as f32;
+                rec.predicted_a_mean_mps2 = s.vehicle.a_mean_mps2 as f32;
+                rec.predicted_contact_time_s = s.contact_duration_s as f32;
+                let mut n = 0usize;
+                // Every `stride`-th sample: the first of each chunk (cheaper than `step_by`).
+                for (dst, chunk) in rec.pulse_accel_mps2.iter_mut().zip(pulse.chunks(stride)) {
+                    *dst = chunk.first().map_or(0.0, |v| *v as f32);
+                    n += 1;
+                }
+                for dst in rec.pulse_accel_mps2.iter_mut().skip(n) {
+                    *dst = 0.0;
+                }
+                rec.pulse_points = n as u32;
+                rec.pulse_dt_s = (step_s * stride as f64) as f32;
             }
-            rec.pulse_points = n;
-            rec.pulse_dt_s = (step_s * stride as f64) as f32;
+            None => {
+                let z = &EcuDiagnostics::ZERO;
+                rec.predicted_delta_v_mps = z.predicted_delta_v_mps;
+                rec.predicted_a_max_mps2 = z.predicted_a_max_mps2;
+                rec.predicted_a_mean_mps2 = z.predicted_a_mean_mps2;
+                rec.predicted_contact_time_s = z.predicted_contact_time_s;
+                rec.pulse_accel_mps2 = z.pulse_accel_mps2;
+                rec.pulse_points = z.pulse_points;
+                rec.pulse_dt_s = z.pulse_dt_s;
+            }
         }
         rec.time_to_contact_s = ttc_s;
         rec.belt_force_limit_n = plan.belt_limiter_kn * 1000.0;

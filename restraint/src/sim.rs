@@ -7,7 +7,7 @@
 //! running total, so a caller reads what one cycle sent with [`SimIo::sent_since`].
 
 use bus::RawFrame;
-use heapless::Deque;
+use heapless::{Deque, HistoryBuf};
 
 use crate::contract::{CycleIo, IoError};
 use crate::signals::{CrashAccelSample, EcuDiagnostics, ObjectState};
@@ -33,8 +33,8 @@ pub struct SimIo {
     pub accel: Deque<CrashAccelSample, SIM_QUEUE>,
     /// CAN frames delivered on the next drain.
     pub can_rx: Deque<RawFrame, SIM_QUEUE>,
-    /// The newest frames sent, oldest first.
-    pub can_tx: Deque<RawFrame, SIM_QUEUE>,
+    /// The newest frames sent (a ring that overwrites its oldest entry).
+    pub can_tx: HistoryBuf<RawFrame, SIM_QUEUE>,
     /// Frames sent since creation.
     pub can_tx_total: u64,
     /// The newest diagnostics record.
@@ -60,7 +60,7 @@ impl SimIo {
             objects: Deque::new(),
             accel: Deque::new(),
             can_rx: Deque::new(),
-            can_tx: Deque::new(),
+            can_tx: HistoryBuf::new(),
             can_tx_total: 0,
             diagnostics: EcuDiagnostics::ZERO,
             diagnostics_published: 0,
@@ -88,8 +88,8 @@ impl SimIo {
     /// a cycle), as far as they are still kept.
     pub fn sent_since(&self, total: u64) -> impl Iterator<Item = &RawFrame> {
         let n = usize::try_from(self.can_tx_total.saturating_sub(total)).unwrap_or(usize::MAX);
-        let kept = self.can_tx.storage_len();
-        self.can_tx.iter().skip(kept.saturating_sub(n))
+        let kept = self.can_tx.len();
+        self.can_tx.oldest_ordered().skip(kept.saturating_sub(n))
     }
 }
 
@@ -129,8 +129,7 @@ impl CycleIo for SimIo {
         if !self.can_on {
             return Err(IoError::CanDisabled);
         }
-        let mut overwritten = 0;
-        push_dropping_oldest(&mut self.can_tx, *frame, &mut overwritten);
+        self.can_tx.write(*frame);
         self.can_tx_total = self.can_tx_total.saturating_add(1);
         Ok(())
     }
@@ -139,7 +138,6 @@ impl CycleIo for SimIo {
         &mut self,
         fill: &mut dyn FnMut(&mut EcuDiagnostics),
     ) -> Result<(), IoError> {
-        self.diagnostics = EcuDiagnostics::ZERO;
         fill(&mut self.diagnostics);
         self.diagnostics_published = self.diagnostics_published.saturating_add(1);
         Ok(())

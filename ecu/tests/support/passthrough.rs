@@ -87,6 +87,7 @@ impl Activity for PassthroughActivity {
         reasons.set(Degraded::CAN_DISABLED, !io.can_enabled());
         let (objects_rx, accel_rx) = (self.objects_rx, self.accel_batches_rx);
         let published = io.publish_diagnostics(&mut |d| {
+            *d = restraint::EcuDiagnostics::ZERO; // writes only some fields
             d.timestamp_ns = info.now_ns;
             d.cycle_count = info.cycle + 1;
             d.overrun_count = info.overruns;
