@@ -71,7 +71,7 @@ pub enum Decoded {
         /// ECU mode raw value (DBC `EcuMode`, named by `bus::EcuStatus::ECU_MODE_VALUES`).
         mode: u8,
         /// The frame's fault flags (why the ECU degraded): bit k = the k-th `Fault…` signal of
-        /// the DBC ([`crate::report::ecu_fault_signals`]).
+        /// the DBC ([`crate::status::ecu_fault_signals`]).
         faults: u8,
     },
     /// Any other accepted frame (authenticators, foreign frames).
@@ -113,7 +113,7 @@ pub fn decode(msg: &Messages) -> Decoded {
             let n = bus::signal_values(msg, &mut values).unwrap_or(0);
             Decoded::Status {
                 mode: u8::from(m.ecu_mode()),
-                faults: crate::report::ecu_fault_signals()
+                faults: crate::status::ecu_fault_signals()
                     .enumerate()
                     .filter(|(_, (i, _))| *i < n && values.get(*i).is_some_and(|v| *v != 0.0))
                     .fold(0, |bits, (k, _)| bits | (1 << k)),
@@ -415,7 +415,7 @@ mod tests {
         };
         assert_eq!(mode, 2);
         assert_eq!(
-            crate::report::ecu_fault_names(faults),
+            crate::status::ecu_fault_names(faults),
             ["object_input", "overrun"]
         );
         let mut m = Modules::default();

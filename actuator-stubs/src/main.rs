@@ -7,10 +7,9 @@
 use actuator_stubs::commands::{CommandRecord, Modules};
 use actuator_stubs::outcome::{self, judge, no_worse, reference_as_fired};
 use actuator_stubs::plot;
-use actuator_stubs::report::{
-    ecu_fault_names, ecu_mode_name, Outcome, Report, TimedAction, TrueCrash,
-};
+use actuator_stubs::report::{Outcome, Report, TimedAction, TrueCrash};
 use actuator_stubs::rx::Receiver;
+use actuator_stubs::status::{ecu_fault_names, ecu_mode_name};
 use anyhow::{Context, Result};
 use bus::secoc::SecOcConfig;
 use bus::socket::BusSocket;

@@ -3,7 +3,6 @@
 
 use crate::commands::Action;
 use crate::outcome::Judged;
-use heck::ToSnakeCase;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -95,7 +94,7 @@ pub struct Report {
     /// ECU mode changes from EcuStatus: (ms rel. contact or since start, mode name).
     pub ecu_modes: Vec<(f64, String)>,
     /// ECU fault-flag changes from EcuStatus (why it degraded): (ms rel. contact or since
-    /// start, flags set, named as in [`ECU_FAULT_NAMES`]; empty = no fault).
+    /// start, flags set, named as in [`crate::status::ecu_fault_names`]; empty = no fault).
     #[serde(default)]
     pub ecu_faults: Vec<(f64, Vec<String>)>,
     /// ECU mode changes from its iceoryx2 diagnostics: (ms rel. contact or since start, mode).
@@ -122,27 +121,4 @@ impl Report {
     pub fn action(&self, what: &str) -> Option<&TimedAction> {
         self.actions.iter().find(|a| a.action.what == what)
     }
-}
-
-/// The EcuStatus fault flags, in DBC order: every `EcuStatus` signal named `Fault…`, as
-/// (index in `EcuStatus::SIGNALS`, report name = the rest of the name in snake case).
-pub fn ecu_fault_signals() -> impl Iterator<Item = (usize, String)> {
-    bus::EcuStatus::SIGNALS
-        .iter()
-        .enumerate()
-        .filter_map(|(i, s)| s.name.strip_prefix("Fault").map(|n| (i, n.to_snake_case())))
-}
-
-/// The names of the fault flags set in `bits` (bit k = the k-th of [`ecu_fault_signals`]).
-pub fn ecu_fault_names(bits: u8) -> Vec<String> {
-    ecu_fault_signals()
-        .enumerate()
-        .filter(|(k, _)| bits & (1 << k) != 0)
-        .map(|(_, (_, n))| n)
-        .collect()
-}
-
-/// DBC EcuMode names (the DBC's value table; "Unknown" outside it).
-pub fn ecu_mode_name(mode: u8) -> &'static str {
-    bus::value_name(bus::EcuStatus::ECU_MODE_VALUES, i64::from(mode)).unwrap_or("Unknown")
 }

@@ -17,7 +17,7 @@ use physics::{
 };
 
 use crate::config::{ms_to_ns, ConfigError, CycleConfig};
-use crate::cycle::CycleCounters;
+use crate::counters::CycleCounters;
 use crate::inputs::InputMonitor;
 use crate::plan::RestraintPlan;
 

@@ -12,7 +12,7 @@ use heapless::Deque;
 
 use crate::config::{ms_to_ns, CycleConfig, MAX_E2E_BURST};
 use crate::confirm::{ConfirmParams, CrashDetector, G_MPS2};
-use crate::cycle::CycleCounters;
+use crate::counters::CycleCounters;
 use crate::signals::{CrashAccelSample, Degraded, ObjectState};
 
 /// How long an invalid accelerometer sample keeps `ACCEL_INVALID` set, ms.

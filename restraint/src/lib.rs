@@ -33,6 +33,7 @@
 pub mod config;
 pub mod confirm;
 pub mod contract;
+pub mod counters;
 mod cycle;
 pub mod decision;
 pub mod estimate;
@@ -45,7 +46,8 @@ pub mod sim;
 pub use config::{ConfigError, CycleConfig, MAX_E2E_BURST};
 pub use confirm::{ConfirmParams, CrashDetector, G_MPS2};
 pub use contract::{Activity, CycleInfo, CycleIo, IoError, StartupError};
-pub use cycle::{CycleCounters, RestraintCycle, StartupNotes};
+pub use counters::CycleCounters;
+pub use cycle::{RestraintCycle, StartupNotes};
 pub use decision::{Phase, Pretensioner};
 pub use estimate::{
     equivalent_barrier_speed_kph, time_to_contact, Contact, Lut, LutMismatch, Situation,

@@ -16,7 +16,7 @@ use bus::{AirbagStageCmd, BeltLimiterCmd, E2eProtector, EcuStatus, RawFrame};
 use diagram::AirbagStage;
 
 use crate::contract::{CycleInfo, CycleIo};
-use crate::cycle::CycleCounters;
+use crate::counters::CycleCounters;
 use crate::decision::{Decision, Phase, Pretensioner};
 use crate::estimate::Estimator;
 use crate::inputs::InputMonitor;
