@@ -9,7 +9,8 @@
 //!   id), one `E2eMessage` impl per protected message (position of its CRC byte and alive counter
 //!   taken from the DBC), and receive-side range checks on raw values.
 //!
-//! Nothing in `src/` restates a bit position, an id, a cycle time or a data id.
+//! Nothing in `src/` restates a bit position, an id, a cycle time, a data id or a value name:
+//! each message also gets its `RAW_ID` and, per value-table signal, `<SIGNAL>_VALUES`.
 
 use std::collections::BTreeMap;
 use std::env;
@@ -275,6 +276,24 @@ fn generate_meta(dbc: &Dbc) -> String {
             )
             .unwrap();
         }
+        let mut value_tables = String::new();
+        for sig in &msg.signals {
+            if let Some(vals) = dbc.value_descriptions_for_signal(msg.id, &sig.name) {
+                let rows: Vec<String> = vals
+                    .iter()
+                    .map(|v| format!("({}, {:?})", v.id, v.description))
+                    .collect();
+                writeln!(
+                    value_tables,
+                    "    /// `{}` value table (`VAL_`): raw value → DBC name (generated).
+    pub const {}_VALUES: &'static [(i64, &'static str)] = &[{}];",
+                    sig.name,
+                    sig.name.to_snake_case().to_uppercase(),
+                    rows.join(", ")
+                )
+                .unwrap();
+            }
+        }
         let nsig = msg.signals.len();
         let e2e_note = if e2e.is_some() {
             "\n    /// `Crc` and `AliveCounter` are left 0: [`E2eProtector::protect`](crate::E2eProtector::protect) sets them."
@@ -284,6 +303,8 @@ fn generate_meta(dbc: &Dbc) -> String {
         writeln!(
             o,
             "impl {ty} {{
+    /// Linux `can_id` of this message (11-bit id, no flags; generated from the DBC).
+    pub const RAW_ID: u32 = {id:#05x};
     /// Builds the frame from physical values (generated from the DBC): scaled values are
     /// rounded to the nearest step (not truncated), NaN/inf and values outside the DBC range are
     /// rejected with the signal's name.{e2e_note}
@@ -295,7 +316,7 @@ fn generate_meta(dbc: &Dbc) -> String {
     /// The signals of this message, in DBC order (generated).
     pub const SIGNALS: &'static [SignalInfo] = &[
 {sig_rows}    ];
-}}
+{value_tables}}}
 ",
             params.join(", "),
             size = msg.size,

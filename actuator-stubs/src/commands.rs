@@ -68,12 +68,10 @@ pub enum Decoded {
     },
     /// `EcuStatus`.
     Status {
-        /// ECU mode raw value (DBC EcuMode: 0 Init, 1 Normal, 2 ReferenceFallback,
-        /// 3 CrashDetected, 4 Deployed, 5 Fault).
+        /// ECU mode raw value (DBC `EcuMode`, named by `bus::EcuStatus::ECU_MODE_VALUES`).
         mode: u8,
-        /// The frame's fault flags (why the ECU degraded), bit i = [`ECU_FAULT_NAMES`]`[i]`.
-        ///
-        /// [`ECU_FAULT_NAMES`]: crate::report::ECU_FAULT_NAMES
+        /// The frame's fault flags (why the ECU degraded): bit k = the k-th `Fault…` signal of
+        /// the DBC ([`crate::status::ecu_fault_signals`]).
         faults: u8,
     },
     /// Any other accepted frame (authenticators, foreign frames).
@@ -110,22 +108,17 @@ pub fn decode(msg: &Messages) -> Decoded {
             force_level_kn: round3(f64::from(m.force_level())),
             fire_time_ms: round3(f64::from(m.fire_time())),
         },
-        Messages::EcuStatus(m) => Decoded::Status {
-            mode: u8::from(m.ecu_mode()),
-            faults: [
-                m.fault_vehicle_input(),
-                m.fault_occupant_input(),
-                m.fault_object_input(),
-                m.fault_accel_sensor(),
-                m.fault_e2e(),
-                m.fault_lut(),
-                m.fault_overrun(),
-                m.fault_config(),
-            ]
-            .iter()
-            .enumerate()
-            .fold(0, |bits, (i, on)| bits | (u8::from(*on) << i)),
-        },
+        Messages::EcuStatus(m) => {
+            let mut values = [0.0f64; 16];
+            let n = bus::signal_values(msg, &mut values).unwrap_or(0);
+            Decoded::Status {
+                mode: u8::from(m.ecu_mode()),
+                faults: crate::status::ecu_fault_signals()
+                    .enumerate()
+                    .filter(|(_, (i, _))| *i < n && values.get(*i).is_some_and(|v| *v != 0.0))
+                    .fold(0, |bits, (k, _)| bits | (1 << k)),
+            }
+        }
         _ => Decoded::Other,
     }
 }
@@ -422,7 +415,7 @@ mod tests {
         };
         assert_eq!(mode, 2);
         assert_eq!(
-            crate::report::ecu_fault_names(faults),
+            crate::status::ecu_fault_names(faults),
             ["object_input", "overrun"]
         );
         let mut m = Modules::default();

@@ -7,6 +7,7 @@
 //! * [`rx`] — per-frame E2E check and SecOC pairing: the modules act only on authenticated
 //!   commands.
 //! * [`report`] — the `report.json` schema (also read by the `hil-bench` orchestrator).
+//! * [`status`] — the `EcuStatus` vocabulary (fault flags, mode names) from the DBC.
 //! * [`plot`] — occupant deceleration and excursion over time, adaptive vs reference (PNG).
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -16,3 +17,4 @@ pub mod outcome;
 pub mod plot;
 pub mod report;
 pub mod rx;
+pub mod status;

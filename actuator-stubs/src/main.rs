@@ -7,17 +7,17 @@
 use actuator_stubs::commands::{CommandRecord, Modules};
 use actuator_stubs::outcome::{self, judge, no_worse, reference_as_fired};
 use actuator_stubs::plot;
-use actuator_stubs::report::{
-    ecu_fault_names, ecu_mode_name, Outcome, Report, TimedAction, TrueCrash,
-};
+use actuator_stubs::report::{Outcome, Report, TimedAction, TrueCrash};
 use actuator_stubs::rx::Receiver;
+use actuator_stubs::status::{ecu_fault_names, ecu_mode_name};
 use anyhow::{Context, Result};
 use bus::secoc::SecOcConfig;
 use bus::socket::BusSocket;
 use clap::Parser;
+use host::monotonic_ns;
 use ipc::{BenchTruth, BenchTruthSubscriber, ServiceNames};
 use physics::OccupantInput;
-use sensor_feeds::{monotonic_ns, Scenario, Truth};
+use sensor_feeds::{Scenario, Truth};
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::PathBuf;
@@ -86,7 +86,13 @@ fn load_keys(cli: &Cli) -> Result<bus::secoc::SecOcKeys> {
 const RX_QUEUE_BYTES: usize = 8 << 20;
 
 /// Ids the modules listen to (kernel filter): airbag cmd + auth, belt cmd + auth, ECU status.
-const RX_IDS: [u32; 5] = [0x030, 0x031, 0x040, 0x041, 0x110];
+const RX_IDS: [u32; 5] = [
+    bus::AirbagStageCmd::RAW_ID,
+    bus::AirbagStageAuth::RAW_ID,
+    bus::BeltLimiterCmd::RAW_ID,
+    bus::BeltLimiterAuth::RAW_ID,
+    bus::EcuStatus::RAW_ID,
+];
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
@@ -101,10 +107,7 @@ fn main() -> std::process::ExitCode {
 
 /// Offset CLOCK_REALTIME − CLOCK_MONOTONIC [ns], to map kernel (realtime) receive stamps.
 fn realtime_minus_monotonic_ns() -> i128 {
-    let rt = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_nanos() as i128);
-    rt - monotonic_ns() as i128
+    i128::from(host::realtime_ns()) - i128::from(monotonic_ns())
 }
 
 fn run(cli: &Cli) -> Result<()> {
@@ -116,7 +119,7 @@ fn run(cli: &Cli) -> Result<()> {
     .map_err(|e| anyhow::anyhow!("reference restraint: {e}"))?;
     let keys = load_keys(cli)?;
     std::fs::create_dir_all(&cli.out).with_context(|| format!("creating {}", cli.out.display()))?;
-    let stop = ipc::install_stop_signals().context("installing signal handler")?;
+    let stop = host::install_stop_signals().context("installing signal handler")?;
     let mut sock = BusSocket::open(&cli.can, &RX_IDS).with_context(|| {
         format!(
             "CAN interface {} (bring it up with ./vcan-setup.sh)",
@@ -199,8 +202,8 @@ fn run(cli: &Cli) -> Result<()> {
             *frames.entry(name.clone()).or_default() += 1;
             // The synchronized time at arrival, on the same arrival instant as rx_ns (a stubs
             // process that was descheduled must not see a genuine authenticator as stale).
-            let sync_rx_us = actuator_stubs::rx::sync_now_us()
-                .saturating_sub(read_mono.saturating_sub(rx_ns) / 1_000);
+            let sync_rx_us =
+                host::sync_time_us().saturating_sub(read_mono.saturating_sub(rx_ns) / 1_000);
             let v = receiver.on_frame(&f, rx_ns, sync_rx_us);
             if let Some(d) = &v.act {
                 modules.apply(rx_ns, d);

@@ -94,7 +94,7 @@ pub struct Report {
     /// ECU mode changes from EcuStatus: (ms rel. contact or since start, mode name).
     pub ecu_modes: Vec<(f64, String)>,
     /// ECU fault-flag changes from EcuStatus (why it degraded): (ms rel. contact or since
-    /// start, flags set, named as in [`ECU_FAULT_NAMES`]; empty = no fault).
+    /// start, flags set, named as in [`crate::status::ecu_fault_names`]; empty = no fault).
     #[serde(default)]
     pub ecu_faults: Vec<(f64, Vec<String>)>,
     /// ECU mode changes from its iceoryx2 diagnostics: (ms rel. contact or since start, mode).
@@ -120,40 +120,5 @@ impl Report {
     /// [`crate::commands::Modules::action`] is during the run.
     pub fn action(&self, what: &str) -> Option<&TimedAction> {
         self.actions.iter().find(|a| a.action.what == what)
-    }
-}
-
-/// EcuStatus fault flags in bit order (DBC `FaultVehicleInput` … `FaultConfig`).
-pub const ECU_FAULT_NAMES: [&str; 8] = [
-    "vehicle_input",
-    "occupant_input",
-    "object_input",
-    "accel_sensor",
-    "e2e",
-    "lut",
-    "overrun",
-    "config",
-];
-
-/// The names of the fault flags set in `bits` (see [`ECU_FAULT_NAMES`]).
-pub fn ecu_fault_names(bits: u8) -> Vec<String> {
-    ECU_FAULT_NAMES
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| bits & (1 << i) != 0)
-        .map(|(_, n)| (*n).to_owned())
-        .collect()
-}
-
-/// DBC EcuMode names.
-pub fn ecu_mode_name(mode: u8) -> &'static str {
-    match mode {
-        0 => "Init",
-        1 => "Normal",
-        2 => "ReferenceFallback",
-        3 => "CrashDetected",
-        4 => "Deployed",
-        5 => "Fault",
-        _ => "Unknown",
     }
 }

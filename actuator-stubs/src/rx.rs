@@ -15,7 +15,7 @@
 //! * anything else (`EcuStatus`, foreign frames): E2E only, as before.
 //!
 //! Two clocks: the pairing timeout runs on the receive time (CLOCK_MONOTONIC), the SecOC
-//! freshness check on the synchronized time ([`sync_now_us`], CLOCK_REALTIME — the ECU stamps
+//! freshness check on the synchronized time ([`host::sync_time_us`], CLOCK_REALTIME — the ECU stamps
 //! its authenticators with the same clock), so a genuine pair recorded in an earlier session
 //! and replayed later is stale.
 
@@ -174,13 +174,4 @@ impl Receiver {
             .filter(|(_, n)| *n > 0)
             .collect()
     }
-}
-
-/// The synchronized time of the bench, µs: CLOCK_REALTIME since the UNIX epoch, the clock the
-/// ECU stamps its SecOC authenticators with (one machine, one clock; a vehicle would use its
-/// StbM/gPTP time). 0 if the clock is before 1970 (then nothing is fresh).
-pub fn sync_now_us() -> u64 {
-    std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| u64::try_from(d.as_micros()).unwrap_or(u64::MAX))
 }

@@ -1,4 +1,4 @@
-//! The ECU restraint cycle (`ecu::cycle::RestraintCycle::step`) on three paths, set up by
+//! The ECU restraint cycle (`restraint::RestraintCycle::step`) on three paths, set up by
 //! `cycle_benches::ecu_cycle` (shared with the `icount_cycle` instruction-count binary):
 //!
 //! * `decision_only` — PRE-CRASH, no new input (inputs refreshed in untimed cycles): state
@@ -11,8 +11,8 @@
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use cycle_benches::ecu_cycle::{self, DecisionOnly, WorstCasePreCrash};
-use ecu::cycle::Phase;
-use ecu::runtime::Activity;
+use restraint::Activity;
+use restraint::Phase;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 

@@ -1,6 +1,6 @@
 //! Physics: one collision prediction (150 ms of crash, symmetric Table 5 case with the
 //! combined curve) at the offline 0.1 ms step (LUT building) and at the ECU's per-cycle step
-//! (`ecu::cycle::CycleConfig::default().prediction_step_ms`, 0.5 ms — what runs inside the
+//! (`restraint::CycleConfig::default().prediction_step_ms`, 0.5 ms — what runs inside the
 //! cycle), and one occupant simulation on that pulse (LUT building, thousands per cell).
 //!
 //! The closed-form solution (`physics::exact`) of the same cases: the summary alone (what the
@@ -27,7 +27,7 @@ fn bench_physics(c: &mut Criterion) {
         b.iter(|| simulate_collision(black_box(&input), &mut buf).expect("valid"))
     });
     let ecu_input = CollisionInput {
-        step_s: ecu::cycle::CycleConfig::default().prediction_step_ms * 1e-3,
+        step_s: restraint::CycleConfig::default().prediction_step_ms * 1e-3,
         ..input
     };
     c.bench_function("collision_prediction_150ms_ecu_step", |b| {

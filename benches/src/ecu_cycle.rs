@@ -1,4 +1,4 @@
-//! The real ECU cycle (`ecu::cycle::RestraintCycle::step`) on its measured paths, shared by
+//! The real ECU cycle (`restraint::RestraintCycle::step`) on its measured paths, shared by
 //! the `cycle` criterion bench and the `icount_cycle` callgrind binary so both time the same
 //! code on the same inputs:
 //!
@@ -13,8 +13,8 @@
 //! * [`crash_confirmation_setup`] — the state one cycle before the accelerometer batch that
 //!   confirms the crash.
 //!
-//! Everything run per cycle is allocation-free (the [`BenchIo`] com layer holds at most one
-//! input of each kind); set-up may allocate.
+//! Everything run per cycle is allocation-free (the com layer is the core's fixed-capacity
+//! [`SimIo`], the same test double the cycle tests use); set-up may allocate.
 
 use crate::workload::bench_table;
 use anyhow::Context;
@@ -22,10 +22,11 @@ use bus::codec::{
     EgoVehicleStateBrakeState, OccupantClassificationBeltBuckle,
     OccupantClassificationOccupantClass,
 };
-use ecu::cycle::{CycleConfig, Phase, RestraintCycle};
-use ecu::runtime::{Activity, CanFrame, CycleInfo, CycleIo, IoError};
-use ipc::{CrashAccelSample, EcuDiagnostics, ObjectState, VALID};
-use physics::reference::ReferenceSettings;
+use bus::RawFrame;
+use restraint::{
+    Activity, CrashAccelSample, CycleConfig, CycleInfo, ObjectState, Phase, ReferenceSettings,
+    RestraintCycle, SimIo, VALID,
+};
 
 /// One cycle period, ns.
 pub const MS: u64 = 1_000_000;
@@ -41,59 +42,6 @@ const REFERENCE: ReferenceSettings = ReferenceSettings {
 /// Cycles between CAN input refreshes (the 10 ms ego frame would arrive every 10th cycle;
 /// refreshing every 8th keeps the inputs from going stale without making every cycle decode).
 const CAN_EVERY: u64 = 8;
-
-/// Allocation-free com layer with one optional input of each kind per cycle.
-#[derive(Debug, Clone)]
-pub struct BenchIo {
-    /// Object sample handed to the next cycle.
-    pub object: Option<ObjectState>,
-    /// Accelerometer batch handed to the next cycle.
-    pub accel: Option<CrashAccelSample>,
-    /// CAN frame handed to the next cycle.
-    pub can: Option<CanFrame>,
-    /// Last diagnostics record written.
-    pub diag: EcuDiagnostics,
-    /// Frames sent so far.
-    pub tx: u64,
-}
-
-impl Default for BenchIo {
-    fn default() -> Self {
-        Self {
-            object: None,
-            accel: None,
-            can: None,
-            diag: EcuDiagnostics::ZERO,
-            tx: 0,
-        }
-    }
-}
-
-impl CycleIo for BenchIo {
-    fn drain_objects(&mut self, f: &mut dyn FnMut(&ObjectState)) -> usize {
-        self.object.take().map(|o| f(&o)).map_or(0, |()| 1)
-    }
-    fn drain_accel(&mut self, f: &mut dyn FnMut(&CrashAccelSample)) -> usize {
-        self.accel.take().map(|a| f(&a)).map_or(0, |()| 1)
-    }
-    fn drain_can(&mut self, f: &mut dyn FnMut(&CanFrame)) -> usize {
-        self.can.take().map(|c| f(&c)).map_or(0, |()| 1)
-    }
-    fn send_can(&mut self, _frame: &CanFrame) -> Result<(), IoError> {
-        self.tx += 1;
-        Ok(())
-    }
-    fn publish_diagnostics(
-        &mut self,
-        fill: &mut dyn FnMut(&mut EcuDiagnostics),
-    ) -> Result<(), IoError> {
-        fill(&mut self.diag);
-        Ok(())
-    }
-    fn can_enabled(&self) -> bool {
-        true
-    }
-}
 
 /// Object 6.25 m ahead closing at 25 m/s in even and 25.5 m/s in odd cycles (~250 ms to
 /// contact): steady PRE-CRASH, inside the prediction horizon, so every new sample runs the
@@ -145,13 +93,7 @@ pub fn info(now_ns: u64) -> CycleInfo {
 ///
 /// # Errors
 /// A value outside its DBC range (a bench bug).
-pub fn can_inputs(tx: &mut bus::E2eProtector) -> anyhow::Result<[CanFrame; 2]> {
-    let to = |r: bus::RawFrame| CanFrame {
-        id: r.id,
-        extended: false,
-        len: r.len,
-        data: r.data,
-    };
+pub fn can_inputs(tx: &mut bus::E2eProtector) -> anyhow::Result<[RawFrame; 2]> {
     let ego = bus::EgoVehicleState::encode(EgoVehicleStateBrakeState::Released, 15.0, 0.0)
         .map_err(|e| anyhow::anyhow!("ego frame: {e:?}"))?;
     let occ = bus::OccupantClassification::encode(
@@ -163,7 +105,19 @@ pub fn can_inputs(tx: &mut bus::E2eProtector) -> anyhow::Result<[CanFrame; 2]> {
         150,
     )
     .map_err(|e| anyhow::anyhow!("occupant frame: {e:?}"))?;
-    Ok([to(tx.seal(ego)), to(tx.seal(occ))])
+    Ok([tx.seal(ego), tx.seal(occ)])
+}
+
+/// The bench table, leaked to `'static` (set-up only: the cycle borrows its table as the
+/// shell's does, and a bench process builds a handful).
+fn bench_lut() -> restraint::Lut<'static> {
+    let d: &'static diagram::Diagram = Box::leak(Box::new(bench_table()));
+    restraint::Lut {
+        view: d.view(),
+        id: d.lut_id(),
+        ego_mass_kg: d.header().ego.mass_kg,
+        ego_class: d.header().ego.class,
+    }
 }
 
 /// A cycle (default config, bench table) driven 50 cycles into steady PRE-CRASH.
@@ -172,15 +126,15 @@ pub fn can_inputs(tx: &mut bus::E2eProtector) -> anyhow::Result<[CanFrame; 2]> {
 /// Cycle construction failed or it is not in PRE-CRASH afterwards.
 pub fn precrash(
     now_ns: &mut u64,
-    io: &mut BenchIo,
+    io: &mut SimIo,
     tx: &mut bus::E2eProtector,
-) -> anyhow::Result<RestraintCycle> {
-    let (mut ecu, _) = RestraintCycle::new(CycleConfig::default(), Some(bench_table()), &REFERENCE)
+) -> anyhow::Result<RestraintCycle<'static>> {
+    let (mut ecu, _) = RestraintCycle::new(CycleConfig::default(), Some(bench_lut()), &REFERENCE)
         .map_err(|e| anyhow::anyhow!("RestraintCycle::new: {e}"))?;
     for k in 0..50u64 {
         let [e, o] = can_inputs(tx)?;
-        io.can = Some(if k.is_multiple_of(2) { e } else { o });
-        io.object = Some(object(*now_ns));
+        io.push_can(if k.is_multiple_of(2) { e } else { o });
+        io.push_object(object(*now_ns));
         ecu.step(&info(*now_ns), io);
         *now_ns += MS;
     }
@@ -195,7 +149,7 @@ pub fn precrash(
 /// Pre-sealed CAN inputs replayed with valid alive counters (4 bits: 16 frames per message),
 /// so the measured cycles do no encoding of their own inputs.
 struct CanReplay {
-    frames: [[CanFrame; 2]; 16],
+    frames: [[RawFrame; 2]; 16],
     next: usize,
 }
 
@@ -210,7 +164,7 @@ impl CanReplay {
     }
 
     /// Alternates ego and occupant frames, each with its next alive counter.
-    fn next(&mut self) -> Option<CanFrame> {
+    fn next(&mut self) -> Option<RawFrame> {
         let [e, o] = self.frames.get(self.next / 2)?;
         let ego = self.next.is_multiple_of(2);
         self.next = (self.next + 1) % 32;
@@ -220,8 +174,8 @@ impl CanReplay {
 
 /// The worst-case pre-crash cycle: a new object sample every cycle (see the module docs).
 pub struct WorstCasePreCrash {
-    ecu: RestraintCycle,
-    io: BenchIo,
+    ecu: RestraintCycle<'static>,
+    io: SimIo,
     can: CanReplay,
     now_ns: u64,
     k: u64,
@@ -232,7 +186,7 @@ pub struct WorstCasePreCrash {
 }
 
 /// Input frames rejected so far (all reasons).
-fn rejected(ecu: &RestraintCycle) -> u64 {
+fn rejected(ecu: &RestraintCycle<'_>) -> u64 {
     ecu.e2e_stats().rejected.iter().sum()
 }
 
@@ -243,7 +197,7 @@ impl WorstCasePreCrash {
     /// See [`precrash`].
     pub fn new() -> anyhow::Result<Self> {
         let mut now_ns = 1_000 * MS;
-        let mut io = BenchIo::default();
+        let mut io = SimIo::new();
         let mut tx = bus::E2eProtector::new();
         let ecu = precrash(&mut now_ns, &mut io, &mut tx)?;
         let can = CanReplay::new(&mut tx)?;
@@ -252,7 +206,7 @@ impl WorstCasePreCrash {
             predictions_before: c.predictions,
             lookups_before: c.lut_lookups,
             rejected_before: rejected(&ecu),
-            sent_before: io.tx,
+            sent_before: io.can_tx_total,
             ecu,
             io,
             can,
@@ -264,9 +218,11 @@ impl WorstCasePreCrash {
     /// One measured cycle: new object sample (+ a CAN input every 8th cycle), then `step`.
     pub fn step(&mut self) {
         self.k += 1;
-        self.io.object = Some(object(self.now_ns));
+        self.io.push_object(object(self.now_ns));
         if self.k.is_multiple_of(CAN_EVERY) {
-            self.io.can = self.can.next();
+            if let Some(f) = self.can.next() {
+                self.io.push_can(f);
+            }
         }
         self.ecu
             .step(std::hint::black_box(&info(self.now_ns)), &mut self.io);
@@ -295,7 +251,7 @@ impl WorstCasePreCrash {
             "{looked_up} LUT lookups in {} cycles",
             self.k
         );
-        let sent = self.io.tx - self.sent_before;
+        let sent = self.io.can_tx_total - self.sent_before;
         anyhow::ensure!(
             sent >= 2 * self.k,
             "{sent} command frames in {} cycles (airbag + belt expected every cycle)",
@@ -308,14 +264,14 @@ impl WorstCasePreCrash {
 
     /// Commands sent so far (keeps the output observable).
     pub fn frames_sent(&self) -> u64 {
-        self.io.tx
+        self.io.can_tx_total
     }
 }
 
 /// The common pre-crash cycle without new inputs (see the module docs).
 pub struct DecisionOnly {
-    ecu: RestraintCycle,
-    io: BenchIo,
+    ecu: RestraintCycle<'static>,
+    io: SimIo,
     can: CanReplay,
     now_ns: u64,
     k: u64,
@@ -328,7 +284,7 @@ impl DecisionOnly {
     /// See [`precrash`].
     pub fn new() -> anyhow::Result<Self> {
         let mut now_ns = 1_000 * MS;
-        let mut io = BenchIo::default();
+        let mut io = SimIo::new();
         let mut tx = bus::E2eProtector::new();
         let ecu = precrash(&mut now_ns, &mut io, &mut tx)?;
         let can = CanReplay::new(&mut tx)?;
@@ -346,8 +302,10 @@ impl DecisionOnly {
     pub fn refresh_if_due(&mut self) {
         self.k += 1;
         if self.k.is_multiple_of(CAN_EVERY) {
-            self.io.object = Some(object(self.now_ns));
-            self.io.can = self.can.next();
+            self.io.push_object(object(self.now_ns));
+            if let Some(f) = self.can.next() {
+                self.io.push_can(f);
+            }
             self.ecu.step(&info(self.now_ns), &mut self.io);
             self.now_ns += MS;
         }
@@ -376,17 +334,17 @@ impl DecisionOnly {
 ///
 /// # Errors
 /// See [`precrash`].
-pub fn crash_confirmation_setup() -> anyhow::Result<(RestraintCycle, BenchIo, u64)> {
+pub fn crash_confirmation_setup() -> anyhow::Result<(RestraintCycle<'static>, SimIo, u64)> {
     let mut now_ns = 1_000 * MS;
-    let mut io = BenchIo::default();
+    let mut io = SimIo::new();
     let mut tx = bus::E2eProtector::new();
     let mut ecu = precrash(&mut now_ns, &mut io, &mut tx).context("crash confirmation")?;
     for _ in 0..2 {
-        io.accel = Some(accel(now_ns));
+        io.push_accel(accel(now_ns));
         ecu.step(&info(now_ns), &mut io);
         now_ns += MS;
     }
-    io.accel = Some(accel(now_ns));
+    io.push_accel(accel(now_ns));
     Ok((ecu, io, now_ns))
 }
 

@@ -6,7 +6,7 @@
 //!
 //! * [`workload`] — the measured work: one cycle's input frames, its command frames, the bench
 //!   characteristic diagram.
-//! * [`ecu_cycle`] — the real ECU cycle (`ecu::cycle::RestraintCycle`) on its worst-case and
+//! * [`ecu_cycle`] — the real ECU cycle (`restraint::RestraintCycle`) on its worst-case and
 //!   common paths, set up once for the `cycle` bench and the `icount_cycle` binary.
 //! * [`budgets`] — `benches/budgets.toml`, the one file of budgets.
 //! * [`gate`] — reading criterion's `estimates.json` and comparing with the budgets.

@@ -155,6 +155,12 @@ pub(crate) fn raw_from_f64(
     Some(r.clamp(raw_min, raw_max))
 }
 
+/// The DBC name of `raw` in a generated value table (`<Message>::<SIGNAL>_VALUES`).
+#[must_use]
+pub fn value_name(table: &[(i64, &'static str)], raw: i64) -> Option<&'static str> {
+    table.iter().find(|(v, _)| *v == raw).map(|(_, n)| *n)
+}
+
 /// Looks a frame id up in the generated table.
 #[must_use]
 pub fn message_info(id: u32) -> Option<&'static MessageInfo> {

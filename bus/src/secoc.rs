@@ -157,8 +157,8 @@ impl SecOcStream {
     #[must_use]
     pub const fn command_id(self) -> u32 {
         match self {
-            Self::AirbagStage => 0x030,
-            Self::BeltLimiter => 0x040,
+            Self::AirbagStage => AirbagStageCmd::RAW_ID,
+            Self::BeltLimiter => BeltLimiterCmd::RAW_ID,
         }
     }
 
@@ -166,8 +166,8 @@ impl SecOcStream {
     #[must_use]
     pub const fn auth_id(self) -> u32 {
         match self {
-            Self::AirbagStage => 0x031,
-            Self::BeltLimiter => 0x041,
+            Self::AirbagStage => AirbagStageAuth::RAW_ID,
+            Self::BeltLimiter => BeltLimiterAuth::RAW_ID,
         }
     }
 
@@ -184,8 +184,8 @@ impl SecOcStream {
     #[must_use]
     pub const fn name(self) -> &'static str {
         match self {
-            Self::AirbagStage => "AirbagStageCmd",
-            Self::BeltLimiter => "BeltLimiterCmd",
+            Self::AirbagStage => <AirbagStageCmd as E2eMessage>::NAME,
+            Self::BeltLimiter => <BeltLimiterCmd as E2eMessage>::NAME,
         }
     }
 

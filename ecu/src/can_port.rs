@@ -1,7 +1,7 @@
 //! The SocketCAN port of the ECU: [`CanPort`] over [`bus::socket::BusSocket`].
 //!
 //! Opened non-blocking with a kernel filter that passes only the ECU's input frames
-//! ([`crate::cycle::input_can_ids`]: EgoVehicleState, OccupantClassification), so the cycle
+//! ([`restraint::input_can_ids`]: EgoVehicleState, OccupantClassification), so the cycle
 //! never spends time on other traffic and a flooded bus costs the kernel, not the cycle.
 //! Nothing here allocates after [`SocketCanPort::open`].
 
@@ -10,7 +10,7 @@ use std::io;
 use bus::socket::BusSocket;
 use bus::RawFrame;
 
-use crate::runtime::{CanFrame, CanPort, IoError};
+use crate::runtime::{CanPort, IoError};
 
 /// A non-blocking, kernel-filtered SocketCAN port.
 #[derive(Debug)]
@@ -30,7 +30,7 @@ impl SocketCanPort {
 
     /// Opens `iface` with the ECU's input filter.
     pub fn open_ecu(iface: &str) -> io::Result<Self> {
-        Self::open(iface, &crate::cycle::input_can_ids())
+        Self::open(iface, &restraint::input_can_ids())
     }
 
     /// Socket counters (frames, error frames) and receive errors.
@@ -40,17 +40,9 @@ impl SocketCanPort {
 }
 
 impl CanPort for SocketCanPort {
-    fn try_recv(&mut self) -> Option<CanFrame> {
+    fn try_recv(&mut self) -> Option<RawFrame> {
         match self.sock.recv() {
-            Ok(Some(rx)) => {
-                let f = rx.frame;
-                Some(CanFrame {
-                    id: f.id & !bus::CAN_EFF_FLAG,
-                    extended: f.id & bus::CAN_EFF_FLAG != 0,
-                    len: f.len,
-                    data: f.data,
-                })
-            }
+            Ok(Some(rx)) => Some(rx.frame),
             Ok(None) => None,
             Err(_) => {
                 self.rx_errors = self.rx_errors.saturating_add(1);
@@ -59,14 +51,8 @@ impl CanPort for SocketCanPort {
         }
     }
 
-    fn try_send(&mut self, frame: &CanFrame) -> Result<(), IoError> {
-        let id = if frame.extended {
-            frame.id | bus::CAN_EFF_FLAG
-        } else {
-            frame.id
-        };
-        let raw = RawFrame::new(id, frame.payload());
-        match self.sock.send(&raw) {
+    fn try_send(&mut self, frame: &RawFrame) -> Result<(), IoError> {
+        match self.sock.send(frame) {
             Ok(()) => Ok(()),
             Err(e) if e.kind() == io::ErrorKind::WouldBlock => Err(IoError::CanWouldBlock),
             Err(_) => Err(IoError::CanIo),

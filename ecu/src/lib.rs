@@ -1,18 +1,37 @@
-//! The fixed-rate restraint ECU.
+//! The restraint ECU's process shell.
 //!
-//! Two halves, kept apart on purpose:
+//! The restraint logic is the `no_std` core [`restraint`] (its own crate, so the compiler keeps
+//! it free of the operating system). This crate is everything around it:
 //!
-//! * [`runtime`] — the real-time *shell*: absolute-deadline loop on CLOCK_MONOTONIC,
-//!   RT settings (SCHED_FIFO, mlockall, pinning, PM-QoS), preallocated timing
-//!   histograms, the timing report, configuration, the iceoryx2 com layer and the
-//!   `monitor` command. It knows nothing about restraints.
-//! * [`cycle`] — the pure cycle logic (prediction, LUT interpolation, decision state
-//!   machine): [`cycle::RestraintCycle`] implements [`runtime::Activity`] and talks to the
-//!   world only through [`runtime::CycleIo`], so it runs unchanged under the real clock and
-//!   under [`runtime::SimClock`] with [`runtime::SimIo`] in tests.
+//! * [`runtime`] — absolute-deadline loop on CLOCK_MONOTONIC, RT settings (SCHED_FIFO,
+//!   mlockall, pinning, PM-QoS), preallocated timing histograms, the timing report,
+//!   configuration, the iceoryx2 com layer and the `monitor` command. It knows nothing about
+//!   restraints: it runs any [`restraint::Activity`] through [`restraint::CycleIo`].
 //! * [`can_port`] — the SocketCAN [`runtime::CanPort`] over `bus::socket::BusSocket`.
+//! * [`lut_input`], [`reference_input`] — what the shell loaded, handed to the core as a
+//!   borrowed view and plain numbers.
 
 pub mod runtime;
 
 pub mod can_port;
-pub mod cycle;
+
+/// The loaded characteristic diagram as the core takes it: the borrowed view plus the header
+/// facts it checks (ego vehicle) and reports (LUT id).
+pub fn lut_input(d: &diagram::Diagram) -> restraint::Lut<'_> {
+    restraint::Lut {
+        view: d.view(),
+        id: d.lut_id(),
+        ego_mass_kg: d.header().ego.mass_kg,
+        ego_class: d.header().ego.class,
+    }
+}
+
+/// The reference-restraint file's settings as the core takes them.
+pub fn reference_input(r: &physics::reference::ReferenceSettings) -> restraint::ReferenceSettings {
+    restraint::ReferenceSettings {
+        belt_limiter_kn: r.belt_limiter_kn,
+        airbag_level_kn: r.airbag_level_kn,
+        pretensioner_time_ms: r.pretensioner_time_ms,
+        airbag_time_ms: r.airbag_time_ms,
+    }
+}

@@ -2,9 +2,9 @@
 
 use clap::Parser;
 use ecu::can_port::SocketCanPort;
-use ecu::cycle::RestraintCycle;
 use ecu::runtime::{app, monitor, CanPort, Cli, Command, EcuConfig};
 use physics::reference::ReferenceRestraint;
+use restraint::RestraintCycle;
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
@@ -58,7 +58,9 @@ fn load_secoc(cfg: &EcuConfig) -> Option<bus::secoc::SecOcTx> {
         }
         Err(e) => {
             eprintln!(
-                "ecu: error: SecOC keys unusable: {e} — commands are sent WITHOUT                  authenticators (authenticated actuators will ignore them), EcuStatus.FaultConfig                  set (pass --secoc-keys FILE)"
+                "ecu: error: SecOC keys unusable: {e} — commands are sent WITHOUT \
+                 authenticators (authenticated actuators will ignore them), EcuStatus.FaultConfig \
+                 set (pass --secoc-keys FILE)"
             );
             None
         }
@@ -77,13 +79,17 @@ fn load_reference(cfg: &EcuConfig) -> anyhow::Result<ReferenceRestraint> {
 
 fn run(cli: &Cli) -> anyhow::Result<()> {
     let cfg = EcuConfig::resolve(&cli.run)?;
-    let stop = ipc::install_stop_signals()?;
+    let stop = host::install_stop_signals()?;
     let lut = load_lut(&cfg);
     let reference = load_reference(&cfg)?;
-    let (mut activity, notes) = RestraintCycle::new(cfg.cycle.clone(), lut, &reference.restraint)
-        .map_err(anyhow::Error::msg)?;
-    for w in &notes.warnings {
-        eprintln!("ecu: warning: {w}");
+    let (mut activity, notes) = RestraintCycle::new(
+        cfg.cycle.decision.clone(),
+        lut.as_ref().map(ecu::lut_input),
+        &ecu::reference_input(&reference.restraint),
+    )
+    .map_err(|e| anyhow::anyhow!("{e}"))?;
+    if let Some(m) = notes.lut_rejected {
+        eprintln!("ecu: warning: {m}");
     }
     activity.set_secoc(load_secoc(&cfg));
     // SocketCAN with the kernel input filter when CAN is on and the interface exists; the

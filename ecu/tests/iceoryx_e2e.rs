@@ -6,11 +6,14 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use ecu::runtime::{app, EcuConfig, PassthroughActivity};
+mod support;
+
+use ecu::runtime::{app, EcuConfig};
 use ipc::{
-    degraded, AccelPublisher, CrashAccelSample, DiagnosticsSubscriber, EcuDiagnostics, EcuMode,
+    AccelPublisher, CrashAccelSample, Degraded, DiagnosticsSubscriber, EcuDiagnostics, EcuMode,
     ObjectPublisher, ObjectState, ServiceNames, VALID,
 };
+use support::passthrough::PassthroughActivity;
 
 /// Generous bound for "the ECU eventually reacts"; only a functional failure hits it.
 const PATIENCE: Duration = Duration::from_secs(30);
@@ -62,7 +65,7 @@ fn feed_to_ecu_to_diagnostics_subscriber() {
     // The ECU is up (its subscribers exist) once it publishes.
     let first = wait_for(&mut diag, "first diagnostics", |d| d.cycle_count > 0);
     assert_eq!(first.mode, EcuMode::Monitoring as u8);
-    assert_ne!(first.degraded_reasons & degraded::CAN_DISABLED, 0);
+    assert_ne!(first.degraded_reasons & Degraded::CAN_DISABLED.bits(), 0);
 
     for seq in 1..=50u64 {
         objects
@@ -95,7 +98,7 @@ fn feed_to_ecu_to_diagnostics_subscriber() {
     assert!(d.accel_batches_rx >= 1 && d.accel_batches_rx <= 20, "{d:?}");
     // Fresh object state → not stale.
     let fresh = wait_for(&mut diag, "object not stale", |d| {
-        d.degraded_reasons & degraded::OBJECT_STALE == 0
+        d.degraded_reasons & Degraded::OBJECT_STALE.bits() == 0
     });
     assert_eq!(fresh.last_object_sequence, 50);
 

@@ -6,6 +6,7 @@
 //! loop really receives every cycle and its diagnostics really reach a subscriber (via
 //! the companion publisher thread, see `runtime::com`).
 
+#[path = "../../restraint/tests/alloc_counter/mod.rs"]
 mod alloc_counter;
 
 use alloc_counter::{allocations_here, set_counting};
@@ -13,14 +14,17 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
+mod support;
+
 use ecu::runtime::{
     run_activity, Activity, CycleInfo, CycleIo, IceoryxIo, LoopConfig, LoopStats, MonotonicClock,
-    PassthroughActivity,
 };
 use ipc::{
     AccelPublisher, CrashAccelSample, DiagnosticsSubscriber, ObjectPublisher, ObjectState,
     ServiceNames, VALID,
 };
+use restraint::StartupError;
+use support::passthrough::PassthroughActivity;
 
 const WARMUP_CYCLES: u64 = 1_000;
 const MEASURED_CYCLES: u64 = 10_000;
@@ -39,7 +43,7 @@ impl Activity for Counted {
     fn name(&self) -> &'static str {
         "counted"
     }
-    fn startup(&mut self, now_ns: u64, io: &mut dyn CycleIo) -> anyhow::Result<()> {
+    fn startup(&mut self, now_ns: u64, io: &mut dyn CycleIo) -> Result<(), StartupError> {
         self.inner.startup(now_ns, io)
     }
     fn step(&mut self, info: &CycleInfo, io: &mut dyn CycleIo) {

@@ -1,4 +1,4 @@
-//! The whole ECU decision cycle (`ecu::cycle::RestraintCycle` as an `Activity`) driven through
+//! The whole ECU decision cycle (`restraint::RestraintCycle` as an `Activity`) driven through
 //! `SimIo` with arbitrary inputs, cycle after cycle — on BOTH decision paths:
 //!
 //! * the adaptive LUT path (input flag bit 0 = 1): the real table `data/default.lut` (9×12×7×6
@@ -53,8 +53,7 @@ use bus::codec::{
 };
 use bus::{E2eProtector, EgoVehicleState, Messages, OccupantClassification, RawFrame};
 use diagram::Diagram;
-use ecu::cycle::{CycleConfig, Phase, RestraintCycle, G_MPS2};
-use ecu::runtime::{Activity, CanFrame, CycleInfo, SimIo};
+use restraint::{Activity, CycleConfig, CycleInfo, Phase, RestraintCycle, SimIo, G_MPS2};
 use libfuzzer_sys::fuzz_target;
 use physics::reference::ReferenceSettings;
 
@@ -139,13 +138,6 @@ struct CanGen {
     next_occupant_ns: u64,
 }
 
-fn to_can(r: RawFrame) -> CanFrame {
-    CanFrame {
-        id: r.id,
-        extended: false,
-        len: r.len,
-        data: r.data,
-    }
 }
 
 /// What the accelerometer input made possible so far (the independent fire oracle).
@@ -158,7 +150,7 @@ struct AccelFed {
 }
 
 impl AccelFed {
-    fn note(&mut self, cfg: &CycleConfig, a: &ipc::CrashAccelSample) {
+    fn note(&mut self, cfg: &CycleConfig, a: &restraint::CrashAccelSample) {
         if a.sample_period_ns == 0 || a.sample_period_ns > MAX_SAMPLE_PERIOD_NS {
             return; // the detector drops the whole batch
         }
@@ -186,7 +178,7 @@ impl AccelFed {
 }
 
 struct Harness {
-    cycle: RestraintCycle,
+    cycle: RestraintCycle<'static>,
     io: SimIo,
     info: CycleInfo,
     now_ns: u64,
@@ -208,7 +200,7 @@ impl Harness {
                 t.next_ns = now.saturating_add(OBJECT_PERIOD_NS);
                 t.sequence += 1;
                 let to_contact_s = (t.contact_ns as f64 - now as f64) * 1.0e-9;
-                let o = ipc::ObjectState {
+                let o = restraint::ObjectState {
                     timestamp_ns: now,
                     sequence: t.sequence,
                     object_id: 7,
@@ -219,10 +211,10 @@ impl Harness {
                     opponent_mass_kg: t.opp_kg,
                     opponent_mass_sigma_kg: t.sigma_kg,
                     confidence: t.confidence,
-                    valid: ipc::VALID,
+                    valid: restraint::VALID,
                     ..Default::default()
                 };
-                self.io.objects.push_back(o);
+                self.io.push_object(o);
             }
         }
         if let Some(g) = self.can_gen.as_mut() {
@@ -233,7 +225,7 @@ impl Harness {
                     g.ego_speed_mps,
                     0.0,
                 ) {
-                    self.io.can_rx.push_back(to_can(self.tx.seal(m)));
+                    self.io.push_can(self.tx.seal(m));
                 }
             }
             if now >= g.next_occupant_ns {
@@ -241,7 +233,7 @@ impl Harness {
                 if let Ok(m) =
                     OccupantClassification::encode(g.buckle, g.class, 90, g.occ_kg, g.chest_mm, 150)
                 {
-                    self.io.can_rx.push_back(to_can(self.tx.seal(m)));
+                    self.io.push_can(self.tx.seal(m));
                 }
             }
         }
@@ -257,12 +249,10 @@ impl Harness {
         self.info.slot += 1;
         self.cycles += 1;
         self.check_sent();
-        // Diagnostics records are not checked; dropping them keeps the per-cycle cost flat.
-        self.io.diagnostics.clear();
     }
 
     fn check_sent(&mut self) {
-        for f in &self.io.can_tx {
+        for f in self.io.can_tx.oldest_ordered() {
             let msg = match bus::decode(f.id, f.payload()) {
                 Ok(m) => m,
                 // No SecOC sender is set, so every frame carries E2E and must decode.
@@ -311,9 +301,9 @@ impl Harness {
         self.io.can_tx.clear();
     }
 
-    fn push_accel(&mut self, a: ipc::CrashAccelSample) {
+    fn push_accel(&mut self, a: restraint::CrashAccelSample) {
         self.fed.note(self.cycle.config(), &a);
-        self.io.accel.push_back(a);
+        self.io.push_accel(a);
     }
 }
 
@@ -342,15 +332,16 @@ fuzz_target!(|data: &[u8]| {
     };
     let fx = fixture();
     let with_lut = flags & 1 != 0;
-    let lut = with_lut.then(|| fx.lut.clone());
-    let Ok((mut cycle, notes)) = RestraintCycle::new(CycleConfig::default(), lut, &fx.reference)
+    let lut = with_lut.then(|| ecu::lut_input(&fx.lut));
+    let reference = ecu::reference_input(&fx.reference);
+    let Ok((mut cycle, notes)) = RestraintCycle::new(CycleConfig::default(), lut, &reference)
     else {
         panic!("default cycle config must build");
     };
     assert!(
-        !with_lut || notes.warnings.is_empty(),
+        !with_lut || notes.lut_rejected.is_none(),
         "data/default.lut rejected by the default cycle config: {:?}",
-        notes.warnings
+        notes.lut_rejected
     );
     let now_ns: u64 = 1_000_000_000;
     if cycle.startup(now_ns, &mut SimIo::new()).is_err() {
@@ -382,7 +373,7 @@ fuzz_target!(|data: &[u8]| {
         match kind % 8 {
             0 => {
                 // Fields are read in declaration order (the documented layout).
-                let o = ipc::ObjectState {
+                let o = restraint::ObjectState {
                     timestamp_ns: now_ns.saturating_sub(u64::from(r.u8().unwrap_or(0)) * 100_000),
                     sequence: u64::from(r.u8().unwrap_or(0)),
                     distance_m: r.f32().unwrap_or(10.0),
@@ -394,10 +385,10 @@ fuzz_target!(|data: &[u8]| {
                     valid: r.u8().unwrap_or(1) & 1,
                     ..Default::default()
                 };
-                h.io.objects.push_back(o);
+                h.io.push_object(o);
             }
             1 => {
-                let mut a = ipc::CrashAccelSample::EMPTY;
+                let mut a = restraint::CrashAccelSample::EMPTY;
                 a.first_timestamp_ns =
                     now_ns.saturating_sub(u64::from(r.u8().unwrap_or(0)) * 100_000);
                 a.sequence = u64::from(r.u8().unwrap_or(0));
@@ -417,9 +408,10 @@ fuzz_target!(|data: &[u8]| {
                 for d in &mut data {
                     *d = r.u8().unwrap_or(0);
                 }
-                h.io.can_rx.push_back(CanFrame {
-                    id: u32::from(u16::from_le_bytes([id_lo, id_hi]) & 0x7FF),
-                    extended: id_hi & 0x80 != 0,
+                let id = u32::from(u16::from_le_bytes([id_lo, id_hi]) & 0x7FF);
+                let extended = id_hi & 0x80 != 0;
+                h.io.push_can(RawFrame {
+                    id: if extended { id | bus::CAN_EFF_FLAG } else { id },
                     len,
                     data,
                 });
@@ -473,7 +465,7 @@ fuzz_target!(|data: &[u8]| {
                     .min(now_ns);
                 h.accel_next_ns = first.saturating_add(span_ns);
                 h.accel_sequence += 1;
-                let mut a = ipc::CrashAccelSample::EMPTY;
+                let mut a = restraint::CrashAccelSample::EMPTY;
                 a.first_timestamp_ns = first;
                 a.sequence = h.accel_sequence;
                 a.sample_period_ns = period_ns;

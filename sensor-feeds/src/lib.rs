@@ -14,25 +14,7 @@ pub use scenario::{Scenario, ScenarioError};
 pub use sensors::SensorModelSim;
 pub use truth::{Truth, WorldState};
 
-/// CLOCK_MONOTONIC now [ns] (the bench's one clock, shared by every process).
-pub fn monotonic_ns() -> u64 {
-    match nix::time::clock_gettime(nix::time::ClockId::CLOCK_MONOTONIC) {
-        Ok(ts) => (ts.tv_sec() as u64).saturating_mul(1_000_000_000) + ts.tv_nsec() as u64,
-        Err(_) => 0,
-    }
-}
-
+/// The bench's clock, from the one clock module of the bench processes (`host`).
+pub use host::monotonic_ns;
 /// Sleeps until CLOCK_MONOTONIC reaches `deadline_ns` (absolute: no drift accumulates).
-pub fn sleep_until_ns(deadline_ns: u64) {
-    use nix::sys::time::TimeSpec;
-    use nix::time::{clock_nanosleep, ClockId, ClockNanosleepFlags};
-    let ts = TimeSpec::new(
-        (deadline_ns / 1_000_000_000) as i64,
-        (deadline_ns % 1_000_000_000) as i64,
-    );
-    while let Err(nix::errno::Errno::EINTR) = clock_nanosleep(
-        ClockId::CLOCK_MONOTONIC,
-        ClockNanosleepFlags::TIMER_ABSTIME,
-        &ts,
-    ) {}
-}
+pub use host::sleep_through_signals_until_ns as sleep_until_ns;

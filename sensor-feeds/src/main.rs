@@ -95,7 +95,7 @@ fn run(cli: &Cli) -> Result<()> {
     let mut model = SensorModelSim::new(truth);
     let sensor = scenario.sensor.clone();
 
-    let stop = ipc::install_stop_signals().context("installing signal handler")?;
+    let stop = host::install_stop_signals().context("installing signal handler")?;
 
     let names = ServiceNames::with_prefix(&cli.service_prefix);
     let node_name = format!("sensor-feeds-{}", std::process::id());

@@ -6,13 +6,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use ipc::ServiceNames;
 
-use super::activity::Activity;
-use super::clock::MonotonicClock;
 use super::com::{CanPort, IceoryxIo};
 use super::config::EcuConfig;
 use super::report::{CanStatus, IpcStatus, TimingReport};
 use super::rt;
 use super::run::{run_activity, LoopConfig, LoopStats};
+use host::MonotonicClock;
+use restraint::Activity;
 
 /// Decides whether the CAN side runs. `Err` when CAN is requested but the interface is
 /// missing (the operator must bring up vcan0 or pass `--no-can`: never silently off).
@@ -41,9 +41,7 @@ pub fn can_decision(cfg: &EcuConfig, can_port_available: bool) -> anyhow::Result
         CanStatus {
             enabled: false,
             interface,
-            reason: "interface present but no SocketCAN port is wired into this build yet \
-                     (bus crate integration point)"
-                .into(),
+            reason: "interface present but no CAN port was handed to the shell".into(),
         }
     })
 }
@@ -130,7 +128,7 @@ pub fn run_ecu(
 
     io.shutdown(); // sends the final diagnostics record
     let mut counters = Vec::new();
-    activity.report_counters(&mut counters);
+    activity.report_counters(&mut |name, v| counters.push((name, v)));
     let (o, a, d) = (
         io.object_counters(),
         io.accel_counters(),

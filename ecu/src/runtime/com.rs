@@ -22,16 +22,16 @@ use ipc::{
 };
 use triple_buffer::triple_buffer;
 
-use super::activity::{CanFrame, CycleIo, IoError};
+use bus::RawFrame;
+use restraint::{CycleIo, IoError};
 
-/// A non-blocking CAN port. **INTEGRATION POINT** for the `bus` crate's SocketCAN I/O
-/// (kernel filters, non-blocking socket): implement this and pass it to
-/// [`IceoryxIo::new`].
+/// A non-blocking CAN port, implemented by [`crate::can_port::SocketCanPort`] over the bus
+/// crate's SocketCAN socket (kernel filter, non-blocking) and passed to [`IceoryxIo::new`].
 pub trait CanPort {
     /// Next received frame, or `None` when the socket has nothing queued (never blocks).
-    fn try_recv(&mut self) -> Option<CanFrame>;
+    fn try_recv(&mut self) -> Option<RawFrame>;
     /// Sends without blocking.
-    fn try_send(&mut self, frame: &CanFrame) -> Result<(), IoError>;
+    fn try_send(&mut self, frame: &RawFrame) -> Result<(), IoError>;
 }
 
 /// Upper bound of CAN frames drained per cycle, so a flooded bus cannot starve the cycle.
@@ -222,7 +222,7 @@ impl CycleIo for IceoryxIo {
         self.accel.drain(f)
     }
 
-    fn drain_can(&mut self, f: &mut dyn FnMut(&CanFrame)) -> usize {
+    fn drain_can(&mut self, f: &mut dyn FnMut(&RawFrame)) -> usize {
         let Some(can) = self.can.as_mut() else {
             return 0;
         };
@@ -239,7 +239,7 @@ impl CycleIo for IceoryxIo {
         n
     }
 
-    fn send_can(&mut self, frame: &CanFrame) -> Result<(), IoError> {
+    fn send_can(&mut self, frame: &RawFrame) -> Result<(), IoError> {
         let result = match self.can.as_mut() {
             Some(can) => can.try_send(frame),
             None => Err(IoError::CanDisabled),

@@ -26,8 +26,143 @@ pub struct EcuConfig {
     pub ipc: IpcConfig,
     /// CAN settings.
     pub can: CanConfig,
-    /// Restraint decision thresholds, LUT and reference-restraint files (`crate::cycle`).
-    pub cycle: crate::cycle::CycleConfig,
+    /// Restraint decision thresholds and the files the shell loads for the cycle.
+    pub cycle: CycleSection,
+}
+
+/// `[cycle]`: the files the shell loads for the restraint core, and the core's decision
+/// thresholds ([`restraint::CycleConfig`], same table: every key documented there). Read by
+/// [`cycle_section`]: the file keys are taken out, everything else goes to the core's struct,
+/// which rejects unknown keys and reports wrong types at their line as any other table.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CycleSection {
+    /// Characteristic diagram (LUT) file (`--lut`). Missing/corrupt → DEGRADED mode with the
+    /// reference restraint; the ECU still starts.
+    pub lut: PathBuf,
+    /// Reference-restraint file (`--reference`). Missing/corrupt → the copy built into the
+    /// binary (same file at build time), with a warning.
+    pub reference: PathBuf,
+    /// SecOC key file (`--secoc-keys`, format in `bus::secoc::SecOcKeys`). Missing/corrupt →
+    /// the ECU still starts and still sends its (E2E-protected) commands, but without
+    /// authenticator frames, and reports `FaultConfig` in `EcuStatus`: an unauthenticated
+    /// command that authenticated actuators ignore is still better than refusing to protect,
+    /// and the fault bit tells the bench why the actuators are not acting.
+    pub secoc_keys: PathBuf,
+    /// The decision thresholds (same table; unknown keys are rejected by the core's struct).
+    #[serde(flatten)]
+    pub decision: restraint::CycleConfig,
+}
+
+mod cycle_section {
+    //! Deserialises `[cycle]` without `#[serde(flatten)]` (which would lose toml's line
+    //! numbers and switch off `deny_unknown_fields`): a map access that hands the three file
+    //! keys to the shell and every other key, with its span, to the core's derived impl.
+
+    use std::path::PathBuf;
+
+    use serde::de::value::MapAccessDeserializer;
+    use serde::de::{DeserializeSeed, Deserializer, IntoDeserializer, MapAccess, Visitor};
+    use serde::Deserialize;
+
+    use super::CycleSection;
+
+    /// A key of `[cycle]`: one of the core's fields, or a file key (with the unused seed).
+    enum Key<F, K> {
+        Field(F),
+        File(usize, K),
+    }
+
+    const FILE_KEYS: [&str; 3] = ["lut", "reference", "secoc_keys"];
+
+    struct KeySeed<K>(K);
+
+    impl<'de, K: DeserializeSeed<'de>> DeserializeSeed<'de> for KeySeed<K> {
+        type Value = Key<K::Value, K>;
+        fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
+            let key = String::deserialize(d)?;
+            match FILE_KEYS.iter().position(|k| *k == key) {
+                Some(i) => Ok(Key::File(i, self.0)),
+                // Inside toml's key deserialisation: an unknown key gets the key's span.
+                None => self.0.deserialize(key.into_deserializer()).map(Key::Field),
+            }
+        }
+    }
+
+    struct Split<'f, A> {
+        inner: A,
+        files: &'f mut [Option<PathBuf>; 3],
+    }
+
+    impl<'de, A: MapAccess<'de>> MapAccess<'de> for Split<'_, A> {
+        type Error = A::Error;
+        fn next_key_seed<K: DeserializeSeed<'de>>(
+            &mut self,
+            seed: K,
+        ) -> Result<Option<K::Value>, A::Error> {
+            let mut seed = seed;
+            loop {
+                match self.inner.next_key_seed(KeySeed(seed))? {
+                    None => return Ok(None),
+                    Some(Key::Field(f)) => return Ok(Some(f)),
+                    Some(Key::File(i, s)) => {
+                        let path: PathBuf = self.inner.next_value()?;
+                        if let Some(slot) = self.files.get_mut(i) {
+                            *slot = Some(path);
+                        }
+                        seed = s;
+                    }
+                }
+            }
+        }
+        fn next_value_seed<V: DeserializeSeed<'de>>(
+            &mut self,
+            seed: V,
+        ) -> Result<V::Value, A::Error> {
+            self.inner.next_value_seed(seed)
+        }
+    }
+
+    struct SectionVisitor;
+
+    impl<'de> Visitor<'de> for SectionVisitor {
+        type Value = CycleSection;
+        fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            f.write_str("the [cycle] table")
+        }
+        fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<CycleSection, A::Error> {
+            let mut files = [None, None, None];
+            let decision =
+                restraint::CycleConfig::deserialize(MapAccessDeserializer::new(Split {
+                    inner: map,
+                    files: &mut files,
+                }))?;
+            let [lut, reference, secoc_keys] = files;
+            let d = CycleSection::default();
+            Ok(CycleSection {
+                lut: lut.unwrap_or(d.lut),
+                reference: reference.unwrap_or(d.reference),
+                secoc_keys: secoc_keys.unwrap_or(d.secoc_keys),
+                decision,
+            })
+        }
+    }
+
+    impl<'de> Deserialize<'de> for CycleSection {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            d.deserialize_map(SectionVisitor)
+        }
+    }
+}
+
+impl Default for CycleSection {
+    fn default() -> Self {
+        Self {
+            lut: PathBuf::from("data/default.lut"),
+            reference: PathBuf::from("data/reference-restraint.toml"),
+            secoc_keys: PathBuf::from("data/secoc-keys.example.toml"),
+            decision: restraint::CycleConfig::default(),
+        }
+    }
 }
 
 /// Real-time settings; each is optional and degrades with a message when not permitted.
@@ -75,7 +210,7 @@ impl Default for EcuConfig {
             rt: RtConfig::default(),
             ipc: IpcConfig::default(),
             can: CanConfig::default(),
-            cycle: crate::cycle::CycleConfig::default(),
+            cycle: CycleSection::default(),
         }
     }
 }
@@ -211,8 +346,8 @@ impl EcuConfig {
                 ),
             ));
         }
-        if let Err(m) = self.cycle.validate() {
-            return Err(invalid("cycle", m));
+        if let Err(e) = self.cycle.decision.validate() {
+            return Err(invalid("cycle", e.to_string()));
         }
         if self.ipc.node_name.is_empty() {
             return Err(invalid("ipc.node_name", "must not be empty".into()));
@@ -497,6 +632,26 @@ mod tests {
             .to_string();
         assert!(e.starts_with("ecu.toml:4:"), "{e}");
         assert!(e.contains("mlock_all"), "{e}");
+    }
+
+    #[test]
+    fn cycle_table_holds_the_shell_files_and_the_core_thresholds() {
+        let text = "[cycle]\nlut = \"a.lut\"\nconfirm_decel_g = 5.0\nsecoc_keys = \"k.toml\"\n";
+        let cfg = EcuConfig::from_toml_str(text, &p()).unwrap();
+        assert_eq!(cfg.cycle.lut, PathBuf::from("a.lut"));
+        assert_eq!(cfg.cycle.secoc_keys, PathBuf::from("k.toml"));
+        assert_eq!(cfg.cycle.reference, CycleSection::default().reference);
+        assert_eq!(cfg.cycle.decision.confirm_decel_g, 5.0);
+        // Unknown keys and wrong types inside [cycle] name their line and column.
+        let e = EcuConfig::from_toml_str("[cycle]\nlut = \"a\"\nconfirm_decel_gg = 4\n", &p())
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("ecu.toml:3:1:"), "{e}");
+        assert!(e.contains("confirm_decel_gg"), "{e}");
+        let e = EcuConfig::from_toml_str("[cycle]\nconfirm_decel_g = \"x\"\n", &p())
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("ecu.toml:2:19:"), "{e}");
     }
 
     #[test]

@@ -3,26 +3,26 @@
 use std::io::Write;
 use std::time::Duration;
 
-use ipc::{degraded, DiagnosticsSubscriber, EcuDiagnostics, EcuMode, ServiceNames};
+use ipc::{Degraded, DiagnosticsSubscriber, EcuDiagnostics, EcuMode, ServiceNames};
 
 use super::config::{EcuConfig, MonitorArgs};
 
 /// Names of the set bits of a degraded-reason word.
 pub fn degraded_names(bits: u32) -> String {
-    const NAMES: [(u32, &str); 9] = [
-        (degraded::OBJECT_STALE, "object-stale"),
-        (degraded::OBJECT_INVALID, "object-invalid"),
-        (degraded::ACCEL_STALE, "accel-stale"),
-        (degraded::ACCEL_INVALID, "accel-invalid"),
-        (degraded::CAN_STALE, "can-stale"),
-        (degraded::E2E_FAILURE, "e2e"),
-        (degraded::LUT_INVALID, "lut-invalid"),
-        (degraded::CAN_DISABLED, "can-off"),
-        (degraded::IPC_ERROR, "ipc-error"),
+    const NAMES: [(Degraded, &str); 9] = [
+        (Degraded::OBJECT_STALE, "object-stale"),
+        (Degraded::OBJECT_INVALID, "object-invalid"),
+        (Degraded::ACCEL_STALE, "accel-stale"),
+        (Degraded::ACCEL_INVALID, "accel-invalid"),
+        (Degraded::CAN_STALE, "can-stale"),
+        (Degraded::E2E_FAILURE, "e2e"),
+        (Degraded::LUT_INVALID, "lut-invalid"),
+        (Degraded::CAN_DISABLED, "can-off"),
+        (Degraded::IPC_ERROR, "ipc-error"),
     ];
     let v: Vec<&str> = NAMES
         .iter()
-        .filter(|(b, _)| bits & b != 0)
+        .filter(|(b, _)| bits & b.bits() != 0)
         .map(|(_, n)| *n)
         .collect();
     if v.is_empty() {
@@ -115,7 +115,7 @@ mod tests {
     fn degraded_bits_are_named() {
         assert_eq!(degraded_names(0), "-");
         assert_eq!(
-            degraded_names(degraded::OBJECT_STALE | degraded::CAN_DISABLED),
+            degraded_names((Degraded::OBJECT_STALE | Degraded::CAN_DISABLED).bits()),
             "object-stale,can-off"
         );
     }

@@ -2,10 +2,10 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use super::activity::{Activity, CycleInfo, CycleIo};
-use super::clock::{Clock, SleepOutcome};
 use super::deadline::DeadlineGrid;
 use super::histogram::LatencyHistogram;
+use host::{Clock, SleepOutcome};
+use restraint::{Activity, CycleInfo, CycleIo};
 
 /// Loop parameters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -62,7 +62,9 @@ where
     else {
         anyhow::bail!("cycle period must be > 0 ns");
     };
-    activity.startup(clock.now_ns(), io)?;
+    activity
+        .startup(clock.now_ns(), io)
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
 
     let mut slot = 0u64;
     let mut deadline_ns = grid.deadline_ns(0);
@@ -116,9 +118,9 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::super::clock::SimClock;
-    use super::super::sim::SimIo;
     use super::*;
+    use host::SimClock;
+    use restraint::{SimIo, StartupError};
 
     /// Models execution cost on the simulated clock and records what it saw.
     struct Scripted {
@@ -133,7 +135,7 @@ mod tests {
         fn name(&self) -> &'static str {
             "scripted"
         }
-        fn startup(&mut self, _now_ns: u64, _io: &mut dyn CycleIo) -> anyhow::Result<()> {
+        fn startup(&mut self, _now_ns: u64, _io: &mut dyn CycleIo) -> Result<(), StartupError> {
             self.started = true;
             Ok(())
         }

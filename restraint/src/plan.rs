@@ -2,6 +2,20 @@
 
 use diagram::{AirbagStage, AirbagThresholds, Lookup};
 
+/// The conventional reference restraint as numbers (the shell reads them from
+/// `data/reference-restraint.toml`; levels kN, times ms relative to first contact).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReferenceSettings {
+    /// Belt load-limiter level, kN.
+    pub belt_limiter_kn: f64,
+    /// Airbag + column force level, kN.
+    pub airbag_level_kn: f64,
+    /// Pretensioner trigger time after contact, ms.
+    pub pretensioner_time_ms: f64,
+    /// Airbag trigger time after contact, ms.
+    pub airbag_time_ms: f64,
+}
+
 /// Where the settings of a plan came from (sent as `CmdSource` on CAN).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PlanSource {
@@ -54,11 +68,8 @@ impl RestraintPlan {
         }
     }
 
-    /// From the reference-restraint file.
-    pub fn from_reference_file(
-        r: &physics::reference::ReferenceSettings,
-        thresholds: &AirbagThresholds,
-    ) -> Self {
+    /// From the reference-restraint settings.
+    pub fn from_reference_settings(r: &ReferenceSettings, thresholds: &AirbagThresholds) -> Self {
         Self::reference(
             r.belt_limiter_kn as f32,
             r.airbag_level_kn as f32,

@@ -2,8 +2,8 @@
 //!
 //! Every number the decision logic uses lives here, with its default and the reason for it.
 //! Times are in ms in the file (engineers think in ms); the cycle converts them to ns once.
-
-use std::path::PathBuf;
+//! Files (LUT, reference restraint, SecOC keys) are the shell's business: the core gets their
+//! contents, never a path.
 
 use serde::{Deserialize, Serialize};
 
@@ -11,19 +11,6 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct CycleConfig {
-    /// Characteristic diagram (LUT) file (`--lut`). Missing/corrupt → DEGRADED mode with the
-    /// reference restraint; the ECU still starts.
-    pub lut: PathBuf,
-    /// Reference-restraint file (`--reference`). Missing/corrupt → the copy built into the
-    /// binary (same file at build time), with a warning.
-    pub reference: PathBuf,
-    /// SecOC key file (`--secoc-keys`, format in `bus::secoc::SecOcKeys`). Missing/corrupt →
-    /// the ECU still starts and still sends its (E2E-protected) commands, but without
-    /// authenticator frames, and reports `FaultConfig` in `EcuStatus`: an unauthenticated
-    /// command that authenticated actuators ignore is still better than refusing to protect,
-    /// and the fault bit tells the bench why the actuators are not acting.
-    pub secoc_keys: PathBuf,
-
     /// Ego vehicle mass, kg (*default* 1785 kg: the paper's Ford Taurus). The LUT header must
     /// agree (±1 %), otherwise the LUT is rejected: its cells were optimised for another car.
     pub ego_mass_kg: f64,
@@ -103,9 +90,6 @@ pub struct CycleConfig {
 impl Default for CycleConfig {
     fn default() -> Self {
         Self {
-            lut: PathBuf::from("data/default.lut"),
-            reference: PathBuf::from("data/reference-restraint.toml"),
-            secoc_keys: PathBuf::from("data/secoc-keys.example.toml"),
             ego_mass_kg: 1785.0,
             ego_class: 4,
             prediction_step_ms: 0.5,
@@ -136,12 +120,12 @@ pub const MAX_E2E_BURST: usize = 16;
 
 impl CycleConfig {
     /// Range checks; the error names the key.
-    pub fn validate(&self) -> Result<(), String> {
-        fn range(key: &str, v: f64, lo: f64, hi: f64) -> Result<(), String> {
-            if v.is_finite() && (lo..=hi).contains(&v) {
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        fn range(key: &'static str, value: f64, lo: f64, hi: f64) -> Result<(), ConfigError> {
+            if value.is_finite() && (lo..=hi).contains(&value) {
                 Ok(())
             } else {
-                Err(format!("cycle.{key} = {v} is outside {lo}..={hi}"))
+                Err(ConfigError { key, value, lo, hi })
             }
         }
         range("ego_mass_kg", self.ego_mass_kg, 500.0, 5000.0)?;
@@ -204,6 +188,26 @@ impl CycleConfig {
     }
 }
 
+/// A decision setting outside its range (the shell adds where it came from).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ConfigError {
+    /// Key inside `[cycle]`.
+    pub key: &'static str,
+    /// The value given.
+    pub value: f64,
+    /// Smallest allowed value.
+    pub lo: f64,
+    /// Largest allowed value.
+    pub hi: f64,
+}
+
+impl core::fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let Self { key, value, lo, hi } = self;
+        write!(f, "cycle.{key} = {value} is outside {lo}..={hi}")
+    }
+}
+
 /// ms (config) → ns (cycle), saturating, NaN → 0.
 pub(crate) fn ms_to_ns(ms: f64) -> u64 {
     // `as` from float saturates and maps NaN to 0: never panics.
@@ -221,11 +225,12 @@ mod tests {
             conservative_mass_k: f64::NAN,
             ..CycleConfig::default()
         };
-        assert!(c.validate().unwrap_err().contains("conservative_mass_k"));
+        assert_eq!(c.validate().unwrap_err().key, "conservative_mass_k");
         let c = CycleConfig {
             e2e_burst_count: 17,
             ..CycleConfig::default()
         };
-        assert!(c.validate().unwrap_err().contains("e2e_burst_count"));
+        let e = c.validate().unwrap_err();
+        assert_eq!((e.key, e.value, e.hi), ("e2e_burst_count", 17.0, 16.0));
     }
 }

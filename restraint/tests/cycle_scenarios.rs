@@ -12,8 +12,7 @@ use bus::codec::{
     BeltLimiterCmdCmdSource, BeltLimiterCmdPretensionerCmd, EcuStatusEcuMode,
 };
 use cycle_support::*;
-use ecu::cycle::{Phase, Pretensioner};
-use ipc::{degraded, EcuMode, ObjectState};
+use restraint::{Degraded, EcuMode, ObjectState, Phase, Pretensioner};
 
 const G: f32 = 9.806_65;
 
@@ -41,7 +40,7 @@ fn run_scenario(
             } else {
                 let mut o = ObjectState::INVALID;
                 o.timestamp_ns = b.now;
-                b.io.objects.push_back(o);
+                b.io.push_object(o);
             }
         }
         if let Some(c) = crash_at {
@@ -139,7 +138,7 @@ fn precrash_preset_pretensioner_at_planned_time_then_airbag_at_planned_time_and_
         rx.check(f.id, f.payload()).expect("E2E-valid stream");
     }
     // Diagnostics carry the predicted pulse.
-    let d = b.io.diagnostics.last().unwrap();
+    let d = b.diagnostics.last().unwrap();
     assert!(d.pulse_points > 10 && d.predicted_delta_v_mps > 5.0);
     assert!(d.pulse_accel_mps2.iter().any(|&a| a < -100.0));
 }
@@ -153,7 +152,7 @@ fn avoided_collision_releases_pretensioner_and_never_fires_the_airbag() {
     // ... then the opponent turns away: receding object.
     let mut o = cycle_support::object(b.now, -2.0, 1500.0, 100.0);
     o.distance_m = 3.0;
-    b.io.objects.push_back(o);
+    b.io.push_object(o);
     let t_avoid = b.now;
     b.step();
     assert_eq!(b.ecu.phase(), Phase::Monitoring);
@@ -202,8 +201,8 @@ fn stale_object_data_degrades_after_the_timeout_and_the_reference_fires() {
     // Last object received at T0 + 290 ms; stale when older than 100 ms.
     assert_eq!(b.mode_at(T0 + 390 * MS), EcuMode::Monitoring as u8);
     assert_eq!(b.first_mode(EcuMode::Degraded), Some(T0 + 391 * MS));
-    let d = &b.io.diagnostics[400];
-    assert_ne!(d.degraded_reasons & degraded::OBJECT_STALE, 0);
+    let d = &b.diagnostics[400];
+    assert_ne!(d.degraded_reasons & Degraded::OBJECT_STALE.bits(), 0);
     // Reference: pretensioner and airbag 10 ms after the measured contact, reference levels.
     let bag = b
         .airbag_frames()
@@ -296,14 +295,14 @@ fn e2e_failure_burst_degrades_for_the_hold_time() {
             150,
         )
         .unwrap();
-        let mut f = to_can(tx.seal(m));
+        let mut f = tx.seal(m);
         f.data[5] ^= 0x10; // payload bit flip → CRC mismatch
         f
     };
     // Two rejections 150 ms apart: no burst.
     run_scenario(&mut b, T0 + 200 * MS, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
     for _ in 0..2 {
-        b.io.can_rx.push_back(corrupt(&mut bad_tx));
+        b.io.push_can(corrupt(&mut bad_tx));
         let end = b.now + 150 * MS;
         run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
     }
@@ -311,7 +310,7 @@ fn e2e_failure_burst_degrades_for_the_hold_time() {
     // Three within 100 ms: burst at the third.
     let mut t3 = 0;
     for _ in 0..3 {
-        b.io.can_rx.push_back(corrupt(&mut bad_tx));
+        b.io.push_can(corrupt(&mut bad_tx));
         t3 = b.now;
         let end = b.now + 10 * MS;
         run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
@@ -320,7 +319,7 @@ fn e2e_failure_burst_degrades_for_the_hold_time() {
     assert_eq!(b.first_mode(EcuMode::Degraded), Some(t3));
     let i = b.step_times.iter().position(|&t| t == t3).unwrap();
     assert_ne!(
-        b.io.diagnostics[i].degraded_reasons & degraded::E2E_FAILURE,
+        b.diagnostics[i].degraded_reasons & Degraded::E2E_FAILURE.bits(),
         0
     );
     // Held 500 ms after the last rejection, then back to monitoring.
@@ -349,7 +348,7 @@ fn missing_lut_runs_degraded_from_the_start_and_fires_the_reference() {
     );
     assert_eq!(b.mode_at(T0), EcuMode::Degraded as u8);
     assert_ne!(
-        b.io.diagnostics[0].degraded_reasons & degraded::LUT_INVALID,
+        b.diagnostics[0].degraded_reasons & Degraded::LUT_INVALID.bits(),
         0
     );
     assert_eq!(b.first_mode(EcuMode::PreCrash), None);
@@ -393,12 +392,12 @@ fn nan_object_fields_degrade_until_a_valid_sample_arrives() {
     run_scenario(&mut b, T0 + 200 * MS, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
     let mut o = cycle_support::object(b.now, f32::NAN, 1500.0, 100.0);
     o.distance_m = f32::INFINITY;
-    b.io.objects.push_back(o);
+    b.io.push_object(o);
     let t_bad = b.now;
     b.step();
     assert_eq!(b.mode_at(t_bad), EcuMode::Degraded as u8);
     assert_ne!(
-        b.io.diagnostics.last().unwrap().degraded_reasons & degraded::OBJECT_INVALID,
+        b.diagnostics.last().unwrap().degraded_reasons & Degraded::OBJECT_INVALID.bits(),
         0
     );
     let end = b.now + 30 * MS;
@@ -425,7 +424,7 @@ fn restarted_sender_is_accepted_after_its_timeout_but_a_counter_jump_is_not() {
     idle(&mut b, 150); // > 100 ms vehicle timeout
     let stale_at = b.now - MS;
     assert_ne!(
-        b.io.diagnostics.last().unwrap().degraded_reasons & degraded::CAN_STALE,
+        b.diagnostics.last().unwrap().degraded_reasons & Degraded::CAN_STALE.bits(),
         0
     );
     // The restarted gateway: a fresh protector, counter 0.
@@ -433,12 +432,12 @@ fn restarted_sender_is_accepted_after_its_timeout_but_a_counter_jump_is_not() {
     let m =
         bus::EgoVehicleState::encode(bus::codec::EgoVehicleStateBrakeState::Released, 15.0, 0.0)
             .unwrap();
-    b.io.can_rx.push_back(to_can(restarted.seal(m)));
+    b.io.push_can(restarted.seal(m));
     let resumed = b.now;
     idle(&mut b, 1);
-    let d = *b.io.diagnostics.last().unwrap();
+    let d = *b.diagnostics.last().unwrap();
     assert_eq!(
-        d.degraded_reasons & degraded::CAN_STALE,
+        d.degraded_reasons & Degraded::CAN_STALE.bits(),
         0,
         "vehicle fresh on the first frame after the restart (stale since {stale_at})"
     );
@@ -453,7 +452,7 @@ fn restarted_sender_is_accepted_after_its_timeout_but_a_counter_jump_is_not() {
     for _ in 0..5 {
         let _ = restarted.seal(m); // counters 1..=5 never sent
     }
-    b.io.can_rx.push_back(to_can(restarted.seal(m)));
+    b.io.push_can(restarted.seal(m));
     idle(&mut b, 1);
     assert_eq!(
         b.ecu
@@ -476,14 +475,16 @@ fn stuck_no_track_records_degrade_like_stale_samples() {
     stuck.timestamp_ns = b.now;
     let frozen_at = b.now;
     for _ in 0..30 {
-        b.io.objects.push_back(stuck); // the same record every 10 ms
+        b.io.push_object(stuck); // the same record every 10 ms
         b.run_ms(10);
     }
     let first_degraded = b
         .step_times
         .iter()
-        .zip(&b.io.diagnostics)
-        .find(|(t, d)| **t >= frozen_at && d.degraded_reasons & degraded::OBJECT_INVALID != 0)
+        .zip(&b.diagnostics)
+        .find(|(t, d)| {
+            **t >= frozen_at && d.degraded_reasons & Degraded::OBJECT_INVALID.bits() != 0
+        })
         .map(|(t, _)| *t)
         .expect("degraded while the record is stuck");
     let after_ms = (first_degraded - frozen_at) / MS;
@@ -495,7 +496,7 @@ fn stuck_no_track_records_degrade_like_stale_samples() {
     let end = b.now + 20 * MS;
     run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
     assert_eq!(
-        b.io.diagnostics.last().unwrap().degraded_reasons & degraded::OBJECT_INVALID,
+        b.diagnostics.last().unwrap().degraded_reasons & Degraded::OBJECT_INVALID.bits(),
         0
     );
 }

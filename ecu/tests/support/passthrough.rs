@@ -1,12 +1,9 @@
-//! A trivial built-in activity: drains the inputs and publishes diagnostics every cycle.
-//!
-//! It makes the shell testable end to end before the real cycle logic lands, and it is
-//! the reference for how an activity uses [`CycleIo`]. It takes no restraint decisions
-//! (mode stays `Monitoring`).
+//! A trivial test activity of the shell's tests: drains the inputs and publishes diagnostics
+//! every cycle, takes no restraint decisions (mode stays `Monitoring`). It lets the shell's
+//! loop, iceoryx2 I/O and allocation tests run without the restraint logic in the way.
+#![allow(dead_code)]
 
-use ipc::{degraded, EcuMode};
-
-use super::activity::{Activity, CycleInfo, CycleIo};
+use restraint::{Activity, CycleInfo, CycleIo, Degraded, EcuMode, StartupError};
 
 /// Object state older than this (by receipt time) counts as stale.
 const OBJECT_STALE_AFTER_NS: u64 = 100_000_000;
@@ -48,7 +45,7 @@ impl Activity for PassthroughActivity {
         "passthrough"
     }
 
-    fn startup(&mut self, _now_ns: u64, _io: &mut dyn CycleIo) -> anyhow::Result<()> {
+    fn startup(&mut self, _now_ns: u64, _io: &mut dyn CycleIo) -> Result<(), StartupError> {
         Ok(())
     }
 
@@ -85,15 +82,12 @@ impl Activity for PassthroughActivity {
             .is_none_or(|t| info.now_ns.saturating_sub(t) > OBJECT_STALE_AFTER_NS);
         self.object_stale_cycles += u64::from(object_stale);
 
-        let mut reasons = 0u32;
-        if object_stale {
-            reasons |= degraded::OBJECT_STALE;
-        }
-        if !io.can_enabled() {
-            reasons |= degraded::CAN_DISABLED;
-        }
+        let mut reasons = Degraded::empty();
+        reasons.set(Degraded::OBJECT_STALE, object_stale);
+        reasons.set(Degraded::CAN_DISABLED, !io.can_enabled());
         let (objects_rx, accel_rx) = (self.objects_rx, self.accel_batches_rx);
         let published = io.publish_diagnostics(&mut |d| {
+            *d = restraint::EcuDiagnostics::ZERO; // writes only some fields
             d.timestamp_ns = info.now_ns;
             d.cycle_count = info.cycle + 1;
             d.overrun_count = info.overruns;
@@ -104,7 +98,7 @@ impl Activity for PassthroughActivity {
             d.object_samples_rx = objects_rx;
             d.accel_batches_rx = accel_rx;
             d.mode = EcuMode::Monitoring as u8;
-            d.degraded_reasons = reasons;
+            d.degraded_reasons = reasons.bits();
         });
         if published.is_err() {
             self.diagnostics_failures += 1;
@@ -113,8 +107,8 @@ impl Activity for PassthroughActivity {
 
     fn shutdown(&mut self, _now_ns: u64, _io: &mut dyn CycleIo) {}
 
-    fn report_counters(&self, out: &mut Vec<(&'static str, u64)>) {
-        out.extend([
+    fn report_counters(&self, out: &mut dyn FnMut(&'static str, u64)) {
+        for (name, v) in [
             ("objects_rx", self.objects_rx),
             ("accel_batches_rx", self.accel_batches_rx),
             ("accel_samples_rx", self.accel_samples_rx),
@@ -122,52 +116,49 @@ impl Activity for PassthroughActivity {
             ("object_stale_cycles", self.object_stale_cycles),
             ("non_finite_inputs", self.non_finite_inputs),
             ("diagnostics_publish_failures", self.diagnostics_failures),
-        ]);
+        ] {
+            out(name, v);
+        }
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::super::sim::SimIo;
-    use super::*;
-    use ipc::{CrashAccelSample, ObjectState};
+/// The shell's own check of its test activity (runs with every test binary that uses it).
+#[test]
+fn passthrough_drains_counts_and_flags_staleness() {
+    use restraint::{CrashAccelSample, ObjectState, SimIo};
+    let mut io = SimIo::new();
+    io.can_on = false;
+    let mut a = PassthroughActivity::new();
+    let mut o = ObjectState::INVALID;
+    o.sequence = 7;
+    o.distance_m = f32::NAN;
+    io.push_object(o);
+    let mut acc = CrashAccelSample::EMPTY;
+    acc.sequence = 3;
+    acc.count = 99; // corrupt: clamped to capacity
+    io.push_accel(acc);
+    let mut info = CycleInfo {
+        now_ns: 1_000_000,
+        ..CycleInfo::default()
+    };
+    a.step(&info, &mut io);
+    let d0 = io.diagnostics;
+    info.cycle = 1;
+    info.now_ns += 200_000_000; // 200 ms later, nothing new → stale
+    a.step(&info, &mut io);
 
-    #[test]
-    fn drains_counts_and_flags_staleness() {
-        let mut io = SimIo::new();
-        io.can_on = false;
-        let mut a = PassthroughActivity::new();
-        let mut o = ObjectState::INVALID;
-        o.sequence = 7;
-        o.distance_m = f32::NAN;
-        io.objects.push_back(o);
-        let mut acc = CrashAccelSample::EMPTY;
-        acc.sequence = 3;
-        acc.count = 99; // corrupt: clamped to capacity
-        io.accel.push_back(acc);
-        let mut info = CycleInfo {
-            now_ns: 1_000_000,
-            ..CycleInfo::default()
-        };
-        a.step(&info, &mut io);
-        info.cycle = 1;
-        info.now_ns += 200_000_000; // 200 ms later, nothing new → stale
-        a.step(&info, &mut io);
-
-        assert_eq!(io.diagnostics.len(), 2);
-        let d0 = io.diagnostics[0];
-        assert_eq!((d0.last_object_sequence, d0.last_accel_sequence), (7, 3));
-        assert_eq!(d0.degraded_reasons, degraded::CAN_DISABLED);
-        let d1 = io.diagnostics[1];
-        assert_eq!(d1.cycle_count, 2);
-        assert_eq!(
-            d1.degraded_reasons,
-            degraded::CAN_DISABLED | degraded::OBJECT_STALE
-        );
-        let mut c = Vec::new();
-        a.report_counters(&mut c);
-        assert!(c.contains(&("accel_samples_rx", 8)));
-        assert!(c.contains(&("non_finite_inputs", 1)));
-        assert!(c.contains(&("object_stale_cycles", 1)));
-    }
+    assert_eq!(io.diagnostics_published, 2);
+    assert_eq!((d0.last_object_sequence, d0.last_accel_sequence), (7, 3));
+    assert_eq!(d0.degraded_reasons, Degraded::CAN_DISABLED.bits());
+    let d1 = io.diagnostics;
+    assert_eq!(d1.cycle_count, 2);
+    assert_eq!(
+        d1.degraded(),
+        Degraded::CAN_DISABLED | Degraded::OBJECT_STALE
+    );
+    let mut c = Vec::new();
+    a.report_counters(&mut |n, v| c.push((n, v)));
+    assert!(c.contains(&("accel_samples_rx", 8)));
+    assert!(c.contains(&("non_finite_inputs", 1)));
+    assert!(c.contains(&("object_stale_cycles", 1)));
 }

@@ -6,10 +6,10 @@
 
 mod cycle_support;
 
+use bus::RawFrame;
 use cycle_support::{Bench, MS};
-use ecu::runtime::{Activity, CanFrame, CycleInfo};
-use ipc::{CrashAccelSample, ObjectState};
 use proptest::prelude::*;
+use restraint::{Activity, CrashAccelSample, CycleInfo, ObjectState};
 
 fn any_f32() -> impl Strategy<Value = f32> {
     prop_oneof![
@@ -28,7 +28,7 @@ fn any_f32() -> impl Strategy<Value = f32> {
 enum Event {
     Object(ObjectState, bool),
     Accel(CrashAccelSample, bool),
-    Raw(CanFrame),
+    Raw(RawFrame),
     Vehicle(f32),
     Occupant(f32, u16),
     Time(u64, bool),
@@ -96,9 +96,12 @@ fn event() -> impl Strategy<Value = Event> {
         object().prop_map(|(o, n)| Event::Object(o, n)),
         accel().prop_map(|(a, n)| Event::Accel(a, n)),
         (any::<u32>(), any::<bool>(), any::<u8>(), any::<[u8; 8]>()).prop_map(
-            |(id, ext, len, data)| Event::Raw(CanFrame {
-                id: if ext { id } else { id & 0x7FF },
-                extended: ext,
+            |(id, ext, len, data)| Event::Raw(RawFrame {
+                id: if ext {
+                    id | bus::CAN_EFF_FLAG
+                } else {
+                    id & 0x7FF
+                },
                 len,
                 data
             })
@@ -121,37 +124,37 @@ proptest! {
             match e {
                 Event::Object(mut o, ts_now) => {
                     if ts_now { o.timestamp_ns = now; }
-                    b.io.objects.push_back(o);
+                    b.io.push_object(o);
                 }
                 Event::Accel(mut a, ts_now) => {
                     if ts_now { a.first_timestamp_ns = now; }
-                    b.io.accel.push_back(a);
+                    b.io.push_accel(a);
                 }
-                Event::Raw(f) => b.io.can_rx.push_back(f),
+                Event::Raw(f) => b.io.push_can(f),
                 Event::Vehicle(v) => {
                     let f = b.vehicle_frame(v);
-                    b.io.can_rx.push_back(f);
+                    b.io.push_can(f);
                 }
                 Event::Occupant(m, d) => {
                     b.occupant_mass_kg = m;
                     b.chest_mm = d;
                     let f = b.occupant_frame();
-                    b.io.can_rx.push_back(f);
+                    b.io.push_can(f);
                 }
                 Event::Time(t, small) => {
                     now = if small { now.wrapping_add(t % (50 * MS)) } else { t };
                 }
             }
             let info = CycleInfo { cycle: i as u64, now_ns: now, period_ns: MS, ..CycleInfo::default() };
-            let before = b.io.can_tx.len();
+            let before = b.io.can_tx_total;
             b.ecu.step(&info, &mut b.io);
-            for f in &b.io.can_tx[before..] {
+            for f in b.io.sent_since(before) {
                 prop_assert!(bus::decode(f.id, f.payload()).is_ok(), "malformed output {f:?}");
             }
             now = now.wrapping_add(MS);
         }
         let mut c = Vec::new();
-        b.ecu.report_counters(&mut c);
+        b.ecu.report_counters(&mut |n, v| c.push((n, v)));
         prop_assert!(c.iter().any(|(n, _)| *n == "encode_errors"));
         prop_assert_eq!(b.ecu.counters().encode_errors, 0);
     }

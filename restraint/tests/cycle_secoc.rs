@@ -22,7 +22,7 @@ fn session(keys: &SecOcKeys, start_ns: u64, ms: u64) -> Vec<(u64, RawFrame)> {
     b.run_ms(ms);
     b.sent
         .iter()
-        .map(|(t, f)| (*t, RawFrame::new(f.id, &f.data[..usize::from(f.len)])))
+        .map(|(t, f)| (*t, RawFrame::new(f.id, f.payload())))
         .collect()
 }
 

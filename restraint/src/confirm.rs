@@ -1,66 +1,7 @@
-//! Situation estimate (time to contact, closing speed at contact, equivalent barrier speed)
-//! and the compartment-accelerometer crash confirmation. Pure, allocation-free, NaN-safe.
+//! Crash confirmation from the compartment accelerometer. Pure, allocation-free, NaN-safe.
 
 /// Standard gravity, m/s² (same constant as the physics crate).
 pub const G_MPS2: f64 = physics::defaults::STANDARD_GRAVITY_MPS2;
-
-/// Predicted contact of a constant-relative-acceleration approach.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Contact {
-    /// Time from the measurement to first contact, s (≥ 0).
-    pub ttc_s: f64,
-    /// Closing speed at contact, m/s (≥ 0).
-    pub closing_speed_mps: f64,
-}
-
-/// Time to contact from distance `d` (m), closing speed `v` (m/s, positive approaching) and
-/// relative acceleration `a` (m/s², rate of change of the closing speed): the smallest
-/// t ≥ 0 with d − v t − ½ a t² = 0, i.e. t = 2d / (v + √(v² + 2ad)) (the cancellation-free
-/// form of the quadratic root; exact for a = 0: t = d/v). `None` when the object stops
-/// closing before it reaches us (v² + 2ad < 0), recedes, or any input is not finite.
-/// d ≤ 0 means contact now at the current closing speed.
-pub fn time_to_contact(d_m: f64, v_mps: f64, a_mps2: f64) -> Option<Contact> {
-    if !(d_m.is_finite() && v_mps.is_finite() && a_mps2.is_finite()) {
-        return None;
-    }
-    if d_m <= 0.0 {
-        return (v_mps > 0.0).then_some(Contact {
-            ttc_s: 0.0,
-            closing_speed_mps: v_mps,
-        });
-    }
-    let disc = v_mps * v_mps + 2.0 * a_mps2 * d_m;
-    if !(disc >= 0.0) {
-        return None;
-    }
-    let v_contact = disc.sqrt();
-    // Receding (v ≤ 0) with positive acceleration still reaches us on the "+" root only if
-    // v + √disc > 0; the v < 0 branch is the object turning around and coming back, which a
-    // tracker would report as a new approach: treat as no contact now.
-    if v_mps <= 0.0 {
-        return None;
-    }
-    let denom = v_mps + v_contact;
-    if !(denom > 0.0) {
-        return None;
-    }
-    let t = 2.0 * d_m / denom;
-    (t.is_finite() && t >= 0.0).then_some(Contact {
-        ttc_s: t,
-        closing_speed_mps: v_contact,
-    })
-}
-
-/// Ego equivalent barrier speed, km/h: the ego's speed change to the common velocity,
-/// v_close · m_opp / (m_ego + m_opp) (v/2 for equal masses, v for a rigid barrier).
-pub fn equivalent_barrier_speed_kph(closing_mps: f64, ego_kg: f64, opp_kg: f64) -> f64 {
-    let share = if opp_kg.is_infinite() {
-        1.0
-    } else {
-        opp_kg / (ego_kg + opp_kg)
-    };
-    closing_mps * share * 3.6
-}
 
 /// Crash-confirmation settings in the detector's units.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -179,33 +120,6 @@ impl CrashDetector {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn ttc_constant_speed_is_distance_over_speed() {
-        let c = time_to_contact(10.0, 20.0, 0.0).unwrap();
-        assert!((c.ttc_s - 0.5).abs() < 1e-12);
-        assert_eq!(c.closing_speed_mps, 20.0);
-    }
-
-    #[test]
-    fn ttc_braking_matches_kinematics() {
-        // d = 10 m, v = 20 m/s, closing speed falls at 8 m/s² (a = −8):
-        // 10 = 20 t − 4 t² → t = (20 − √(400 − 160)) / 8 = 0.563508…; v_c = √(400 − 160).
-        let c = time_to_contact(10.0, 20.0, -8.0).unwrap();
-        let t = (20.0 - 240f64.sqrt()) / 8.0;
-        assert!((c.ttc_s - t).abs() < 1e-12, "{c:?}");
-        assert!((c.closing_speed_mps - 240f64.sqrt()).abs() < 1e-12);
-        // Stops before contact: v² < 2|a|d.
-        assert!(time_to_contact(10.0, 5.0, -8.0).is_none());
-        assert!(time_to_contact(10.0, -1.0, 0.0).is_none());
-        assert!(time_to_contact(f64::NAN, 1.0, 0.0).is_none());
-    }
-
-    #[test]
-    fn ebs_is_half_for_equal_masses_and_full_for_a_barrier() {
-        assert!((equivalent_barrier_speed_kph(30.0, 1500.0, 1500.0) - 54.0).abs() < 1e-9);
-        assert!((equivalent_barrier_speed_kph(15.0, 1500.0, f64::INFINITY) - 54.0).abs() < 1e-9);
-    }
 
     fn params() -> ConfirmParams {
         ConfirmParams {

@@ -1,4 +1,5 @@
-//! Clocks: the real CLOCK_MONOTONIC one and a simulated one for deterministic tests.
+//! Clocks: the real CLOCK_MONOTONIC one and a simulated one for deterministic tests, and the
+//! synchronized time of SecOC freshness. Every bench process reads time through here.
 
 use std::cell::Cell;
 use std::rc::Rc;
@@ -13,8 +14,8 @@ pub trait Clock {
     /// Sleeps until the absolute time `deadline_ns` (or returns early when a signal
     /// interrupts the sleep; the loop re-checks its stop flag and sleeps again).
     fn sleep_until_ns(&mut self, deadline_ns: u64) -> SleepOutcome;
-    /// Current synchronized global time, µs (SecOC freshness; see
-    /// [`super::CycleInfo::sync_time_us`]). Allocation-free.
+    /// Current synchronized global time, µs (SecOC freshness: the ECU stamps its
+    /// authenticators with it, the actuators check them against it). Allocation-free.
     fn sync_time_us(&self) -> u64;
 }
 
@@ -34,41 +35,72 @@ pub enum SleepOutcome {
 #[derive(Debug, Default, Clone, Copy)]
 pub struct MonotonicClock;
 
+/// CLOCK_MONOTONIC now, ns: the bench's one time base for timestamps and deadlines, shared
+/// by every process on the machine. CLOCK_MONOTONIC with a valid pointer cannot fail
+/// (EINVAL/EFAULT only); 0 if it ever did.
+pub fn monotonic_ns() -> u64 {
+    match clock_gettime(ClockId::CLOCK_MONOTONIC) {
+        Ok(ts) => timespec_to_ns(&ts),
+        Err(_) => 0,
+    }
+}
+
+/// CLOCK_REALTIME now, ns since the UNIX epoch (0 before 1970). Kernel receive timestamps of
+/// SocketCAN frames are on this clock.
+pub fn realtime_ns() -> u64 {
+    match clock_gettime(ClockId::CLOCK_REALTIME) {
+        Ok(ts) => timespec_to_ns(&ts),
+        Err(_) => 0,
+    }
+}
+
+/// The synchronized time of the bench, µs: CLOCK_REALTIME since the UNIX epoch (every process
+/// on the machine reads the same clock; a vehicle would use StbM/gPTP time). The ECU stamps
+/// its SecOC authenticators with it, the actuators judge freshness against it. 0 if the clock
+/// is before 1970 (then nothing is fresh). `clock_gettime` goes through the vDSO: no system
+/// call, no allocation.
+pub fn sync_time_us() -> u64 {
+    realtime_ns() / 1_000
+}
+
+/// Sleeps until CLOCK_MONOTONIC reaches `deadline_ns` (absolute: no drift accumulates), or a
+/// signal interrupts the sleep.
+pub fn sleep_until_ns(deadline_ns: u64) -> SleepOutcome {
+    let secs = deadline_ns / 1_000_000_000;
+    let nanos = deadline_ns % 1_000_000_000;
+    let ts = TimeSpec::new(
+        i64::try_from(secs).unwrap_or(i64::MAX),
+        // < 1e9 always fits.
+        nanos as _,
+    );
+    match clock_nanosleep(
+        ClockId::CLOCK_MONOTONIC,
+        ClockNanosleepFlags::TIMER_ABSTIME,
+        &ts,
+    ) {
+        Ok(_) => SleepOutcome::Reached,
+        Err(_) => SleepOutcome::Interrupted,
+    }
+}
+
+/// Sleeps until CLOCK_MONOTONIC reaches `deadline_ns`, through any signal (for loops that do
+/// not poll a stop flag between sleeps).
+pub fn sleep_through_signals_until_ns(deadline_ns: u64) {
+    while sleep_until_ns(deadline_ns) == SleepOutcome::Interrupted && monotonic_ns() < deadline_ns {
+    }
+}
+
 impl Clock for MonotonicClock {
     fn now_ns(&self) -> u64 {
-        // CLOCK_MONOTONIC with a valid pointer cannot fail (EINVAL/EFAULT only).
-        match clock_gettime(ClockId::CLOCK_MONOTONIC) {
-            Ok(ts) => timespec_to_ns(&ts),
-            Err(_) => 0,
-        }
+        monotonic_ns()
     }
 
     fn sleep_until_ns(&mut self, deadline_ns: u64) -> SleepOutcome {
-        let secs = deadline_ns / 1_000_000_000;
-        let nanos = deadline_ns % 1_000_000_000;
-        let ts = TimeSpec::new(
-            i64::try_from(secs).unwrap_or(i64::MAX),
-            // < 1e9 always fits.
-            nanos as _,
-        );
-        match clock_nanosleep(
-            ClockId::CLOCK_MONOTONIC,
-            ClockNanosleepFlags::TIMER_ABSTIME,
-            &ts,
-        ) {
-            Ok(_) => SleepOutcome::Reached,
-            Err(_) => SleepOutcome::Interrupted,
-        }
+        sleep_until_ns(deadline_ns)
     }
 
-    /// CLOCK_REALTIME in µs since the UNIX epoch: the bench's synchronized time base (every
-    /// process on the machine reads the same clock; a vehicle would use StbM/gPTP time).
-    /// `clock_gettime` goes through the vDSO: no system call, no allocation.
     fn sync_time_us(&self) -> u64 {
-        match clock_gettime(ClockId::CLOCK_REALTIME) {
-            Ok(ts) => timespec_to_ns(&ts) / 1_000,
-            Err(_) => 0,
-        }
+        sync_time_us()
     }
 }
 

@@ -7,12 +7,13 @@ use bus::codec::{
     EgoVehicleStateBrakeState, OccupantClassificationBeltBuckle,
     OccupantClassificationOccupantClass,
 };
+use bus::RawFrame;
 use bus::{E2eProtector, EgoVehicleState, OccupantClassification};
 use diagram::{AirbagThresholds, Axes, BuildInfo, Cell, Diagram, EgoVehicle, Header};
-use ecu::cycle::{CycleConfig, RestraintCycle};
-use ecu::runtime::{Activity, CanFrame, CycleInfo, SimClock, SimIo};
-use ipc::{CrashAccelSample, ObjectState, VALID};
-use physics::reference::ReferenceSettings;
+use restraint::{
+    Activity, CrashAccelSample, CycleConfig, CycleInfo, EcuDiagnostics, EcuMode, Lut, ObjectState,
+    ReferenceSettings, RestraintCycle, SimIo, VALID,
+};
 
 pub const MS: u64 = 1_000_000;
 
@@ -72,9 +73,19 @@ pub const REFERENCE: ReferenceSettings = ReferenceSettings {
     airbag_time_ms: 10.0,
 };
 
+/// The core's view of an owned test table (the shell's `ecu::lut_input` does the same).
+pub fn lut_of(d: &Diagram) -> Lut<'_> {
+    Lut {
+        view: d.view(),
+        id: d.lut_id(),
+        ego_mass_kg: d.header().ego.mass_kg,
+        ego_class: d.header().ego.class,
+    }
+}
+
 /// Simulated bench at 1 kHz with scripted CAN inputs.
 pub struct Bench {
-    pub ecu: RestraintCycle,
+    pub ecu: RestraintCycle<'static>,
     pub io: SimIo,
     pub now: u64,
     pub cycle: u64,
@@ -84,18 +95,26 @@ pub struct Bench {
     pub occupant_mass_kg: f32,
     pub chest_mm: u16,
     pub buckle: OccupantClassificationBeltBuckle,
-    /// (cycle index, now) of every step, aligned with `io.diagnostics`.
+    /// (cycle index, now) of every step, aligned with `diagnostics`.
     pub step_times: Vec<u64>,
+    /// The diagnostics record of every step.
+    pub diagnostics: Vec<EcuDiagnostics>,
     /// (send time, frame) of every frame sent.
-    pub sent: Vec<(u64, CanFrame)>,
+    pub sent: Vec<(u64, RawFrame)>,
+    /// Deadline of the next step (`None`: the step's `now`, an on-time cycle).
+    pub deadline: Option<u64>,
 }
 
 pub const T0: u64 = 10_000 * MS;
 
+/// Synchronized time at simulated time 0, µs (the shell's `host::SimClock::SYNC_EPOCH_US`:
+/// 2025-06-15 15:06:40 UTC, a plausible wall-clock value).
+pub const SYNC_EPOCH_US: u64 = 1_750_000_000_000_000;
+
 /// The synchronized time (µs) the bench hands the cycle at monotonic `now_ns`, as the
 /// simulated clock defines it.
 pub fn sync_time_us(now_ns: u64) -> u64 {
-    SimClock::SYNC_EPOCH_US + now_ns / 1_000
+    SYNC_EPOCH_US + now_ns / 1_000
 }
 
 impl Bench {
@@ -103,8 +122,11 @@ impl Bench {
         Self::with_config(CycleConfig::default(), lut)
     }
 
+    /// `lut` is leaked to `'static`: a bench lives for one test, and the cycle borrows its
+    /// table as the shell's does.
     pub fn with_config(cfg: CycleConfig, lut: Option<Diagram>) -> Self {
-        let (ecu, _) = RestraintCycle::new(cfg, lut, &REFERENCE).expect("valid config");
+        let lut: Option<&'static Diagram> = lut.map(|d| &*Box::leak(Box::new(d)));
+        let (ecu, _) = RestraintCycle::new(cfg, lut.map(lut_of), &REFERENCE).expect("valid config");
         Self {
             ecu,
             io: SimIo::new(),
@@ -117,17 +139,19 @@ impl Bench {
             chest_mm: 300,
             buckle: OccupantClassificationBeltBuckle::Buckled,
             step_times: Vec::new(),
+            diagnostics: Vec::new(),
             sent: Vec::new(),
+            deadline: None,
         }
     }
 
-    pub fn vehicle_frame(&mut self, speed_mps: f32) -> CanFrame {
+    pub fn vehicle_frame(&mut self, speed_mps: f32) -> RawFrame {
         let m =
             EgoVehicleState::encode(EgoVehicleStateBrakeState::Released, speed_mps, 0.0).unwrap();
-        to_can(self.tx.seal(m))
+        self.tx.seal(m)
     }
 
-    pub fn occupant_frame(&mut self) -> CanFrame {
+    pub fn occupant_frame(&mut self) -> RawFrame {
         let m = OccupantClassification::encode(
             self.buckle,
             OccupantClassificationOccupantClass::MidAdult,
@@ -137,7 +161,7 @@ impl Bench {
             150,
         )
         .unwrap();
-        to_can(self.tx.seal(m))
+        self.tx.seal(m)
     }
 
     /// One 1 ms cycle; CAN inputs at their DBC rates (10 ms / 100 ms).
@@ -145,26 +169,27 @@ impl Bench {
         let ms = (self.now - T0) / MS;
         if self.send_vehicle && ms.is_multiple_of(10) {
             let f = self.vehicle_frame(15.0);
-            self.io.can_rx.push_back(f);
+            self.io.push_can(f);
         }
         if self.send_occupant && ms.is_multiple_of(100) {
             let f = self.occupant_frame();
-            self.io.can_rx.push_back(f);
+            self.io.push_can(f);
         }
         let info = CycleInfo {
             cycle: self.cycle,
             slot: self.cycle,
             period_ns: MS,
-            deadline_ns: self.now,
+            deadline_ns: self.deadline.take().unwrap_or(self.now),
             now_ns: self.now,
             sync_time_us: sync_time_us(self.now),
             ..CycleInfo::default()
         };
-        let before = self.io.can_tx.len();
+        let before = self.io.can_tx_total;
         self.ecu.step(&info, &mut self.io);
-        for f in &self.io.can_tx[before..] {
+        for f in self.io.sent_since(before) {
             self.sent.push((self.now, *f));
         }
+        self.diagnostics.push(self.io.diagnostics);
         self.step_times.push(self.now);
         self.now += MS;
         self.cycle += 1;
@@ -189,7 +214,7 @@ impl Bench {
         let ttc_s = (contact_ns as f64 - self.now as f64) * 1e-9;
         let mut o = object(self.now, closing_mps, opp_kg, sigma_kg);
         o.distance_m = (ttc_s * f64::from(closing_mps)) as f32;
-        self.io.objects.push_back(o);
+        self.io.push_object(o);
     }
 
     /// Pushes one 1-sample accelerometer batch measured at `t_ns`.
@@ -200,7 +225,7 @@ impl Bench {
         a.count = 1;
         a.accel_mps2[0] = accel_mps2;
         a.sequence = t_ns / MS;
-        self.io.accel.push_back(a);
+        self.io.push_accel(a);
     }
 
     pub fn decoded(&self) -> Vec<(u64, bus::Messages)> {
@@ -252,13 +277,12 @@ impl Bench {
             .iter()
             .position(|&x| x == t)
             .expect("step at t");
-        self.io.diagnostics[i].mode
+        self.diagnostics[i].mode
     }
 
     /// First step time at which the diagnostics mode equals `mode`.
-    pub fn first_mode(&self, mode: ipc::EcuMode) -> Option<u64> {
-        self.io
-            .diagnostics
+    pub fn first_mode(&self, mode: EcuMode) -> Option<u64> {
+        self.diagnostics
             .iter()
             .zip(&self.step_times)
             .find(|(d, _)| d.mode == mode as u8)
@@ -279,15 +303,6 @@ pub fn object(now: u64, closing_mps: f32, opp_kg: f32, sigma_kg: f32) -> ObjectS
         object_id: 7,
         valid: VALID,
         _reserved: [0; 3],
-    }
-}
-
-pub fn to_can(r: bus::RawFrame) -> CanFrame {
-    CanFrame {
-        id: r.id,
-        extended: false,
-        len: r.len,
-        data: r.data,
     }
 }
 

@@ -4,7 +4,7 @@
 //! confirmation, airbag fire and POST-CRASH with 8-sample accelerometer batches every cycle.
 //! SecOC is on (the example key file): every command frame is followed by its AES-CMAC
 //! authenticator, computed inside the counted cycles.
-//! The com layer of this test is itself allocation-free (preallocated buffers).
+//! The com layer of this test ([`SimIo`]) is itself allocation-free (fixed-capacity queues).
 
 mod alloc_counter;
 
@@ -12,76 +12,23 @@ use alloc_counter::{allocations_here, set_counting};
 mod cycle_support;
 
 use cycle_support::{MS, REFERENCE, T0};
-use ecu::cycle::{CycleConfig, Phase, RestraintCycle};
-use ecu::runtime::{Activity, CanFrame, CycleInfo, CycleIo, IoError};
-use ipc::{CrashAccelSample, EcuDiagnostics, ObjectState};
-
-/// Allocation-free com layer: fixed inputs per cycle, outputs counted.
-struct FixedIo {
-    object: Option<ObjectState>,
-    accel: Option<CrashAccelSample>,
-    can: [CanFrame; 2],
-    can_n: usize,
-    tx: u64,
-    auth_tx: u64,
-    last_tx: CanFrame,
-    diag: EcuDiagnostics,
-}
-
-impl CycleIo for FixedIo {
-    fn drain_objects(&mut self, f: &mut dyn FnMut(&ObjectState)) -> usize {
-        self.object.take().map(|o| f(&o)).map_or(0, |_| 1)
-    }
-    fn drain_accel(&mut self, f: &mut dyn FnMut(&CrashAccelSample)) -> usize {
-        self.accel.take().map(|a| f(&a)).map_or(0, |_| 1)
-    }
-    fn drain_can(&mut self, f: &mut dyn FnMut(&CanFrame)) -> usize {
-        let n = self.can_n;
-        for c in self.can.iter().take(n) {
-            f(c);
-        }
-        self.can_n = 0;
-        n
-    }
-    fn send_can(&mut self, frame: &CanFrame) -> Result<(), IoError> {
-        self.tx += 1;
-        if bus::secoc::SecOcStream::for_auth_id(frame.id).is_some() {
-            self.auth_tx += 1;
-        }
-        self.last_tx = *frame;
-        Ok(())
-    }
-    fn publish_diagnostics(
-        &mut self,
-        fill: &mut dyn FnMut(&mut EcuDiagnostics),
-    ) -> Result<(), IoError> {
-        self.diag = EcuDiagnostics::ZERO;
-        fill(&mut self.diag);
-        Ok(())
-    }
-    fn can_enabled(&self) -> bool {
-        true
-    }
-}
+use restraint::{Activity, CrashAccelSample, CycleConfig, CycleInfo, Phase, RestraintCycle, SimIo};
 
 #[test]
 fn no_allocation_in_precrash_and_crash_cycles() {
     let lut = cycle_support::test_lut();
-    let (mut ecu, _) = RestraintCycle::new(CycleConfig::default(), Some(lut), &REFERENCE).unwrap();
+    let (mut ecu, _) = RestraintCycle::new(
+        CycleConfig::default(),
+        Some(cycle_support::lut_of(&lut)),
+        &REFERENCE,
+    )
+    .unwrap();
     let keys =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/secoc-keys.example.toml");
     ecu.set_secoc(Some(bus::secoc::SecOcKeys::load(&keys).unwrap().tx()));
     let mut bench = cycle_support::Bench::new(None); // only for its sealed CAN frames
-    let mut io = FixedIo {
-        object: None,
-        accel: None,
-        can: [CanFrame::default(); 2],
-        can_n: 0,
-        tx: 0,
-        auth_tx: 0,
-        last_tx: CanFrame::default(),
-        diag: EcuDiagnostics::ZERO,
-    };
+    let mut io = SimIo::new();
+    let mut auth_tx = 0u64;
     let mut now = T0;
     let mut allocations = 0u64;
     let mut precrash_cycles = 0u64;
@@ -96,7 +43,7 @@ fn no_allocation_in_precrash_and_crash_cycles() {
         if ms < crash_from && ms.is_multiple_of(10) {
             let mut o = cycle_support::object(now, 25.0, 1500.0, 100.0);
             o.distance_m = 6.25; // 250 ms at 25 m/s
-            io.object = Some(o);
+            io.push_object(o);
         }
         if ms >= crash_from {
             let mut a = CrashAccelSample::EMPTY;
@@ -104,20 +51,13 @@ fn no_allocation_in_precrash_and_crash_cycles() {
             a.sample_period_ns = 125_000;
             a.count = 8;
             a.accel_mps2 = [-150.0; 8];
-            io.accel = Some(a);
+            io.push_accel(a);
         }
-        io.can_n = 0;
         if ms.is_multiple_of(10) {
-            io.can[0] = bench.vehicle_frame(25.0);
-            io.can_n = 1;
+            io.push_can(bench.vehicle_frame(25.0));
         }
         if ms.is_multiple_of(100) {
-            io.can[1] = bench.occupant_frame();
-            io.can_n = 2;
-            if !ms.is_multiple_of(10) {
-                io.can[0] = io.can[1];
-                io.can_n = 1;
-            }
+            io.push_can(bench.occupant_frame());
         }
         let info = CycleInfo {
             cycle: k,
@@ -134,9 +74,14 @@ fn no_allocation_in_precrash_and_crash_cycles() {
         let count = k >= 1_000;
         set_counting(count);
         let before = allocations_here();
+        let sent_before = io.can_tx_total;
         ecu.step(&info, &mut io);
         allocations += allocations_here() - before;
         set_counting(false);
+        auth_tx += io
+            .sent_since(sent_before)
+            .filter(|f| bus::secoc::SecOcStream::for_auth_id(f.id).is_some())
+            .count() as u64;
         if count {
             match ecu.phase() {
                 Phase::PreCrash => precrash_cycles += 1,
@@ -155,7 +100,7 @@ fn no_allocation_in_precrash_and_crash_cycles() {
     assert!(ecu.airbag_fired());
     // The worst-case path really ran: a prediction per new object sample.
     assert_eq!(ecu.counters().predictions - predictions_before, 1_000);
-    assert!(io.tx > 2_000);
+    assert!(io.can_tx_total > 2_000);
     // Commands go out every 10 ms on two streams, each with its authenticator.
-    assert!(io.auth_tx > 2_000, "authenticators sent: {}", io.auth_tx);
+    assert!(auth_tx > 2_000, "authenticators sent: {auth_tx}");
 }

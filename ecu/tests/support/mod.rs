@@ -1,0 +1,2 @@
+//! Test support of the shell's tests.
+pub mod passthrough;

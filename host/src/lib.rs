@@ -1,0 +1,16 @@
+//! What the bench processes (ECU, sensor feeds, actuator stubs) take from the Linux host, in
+//! one place so that every process reads time the same way:
+//!
+//! * [`clock`] — CLOCK_MONOTONIC (the bench's one time base for timestamps and deadlines,
+//!   shared by every process on the machine), the synchronized time of SecOC freshness
+//!   (CLOCK_REALTIME µs), absolute sleeps, and the simulated clock of deterministic tests;
+//! * [`stop`] — the SIGTERM/SIGINT stop flag.
+
+pub mod clock;
+pub mod stop;
+
+pub use clock::{
+    monotonic_ns, realtime_ns, sleep_through_signals_until_ns, sleep_until_ns, sync_time_us, Clock,
+    MonotonicClock, SimClock, SleepOutcome,
+};
+pub use stop::install_stop_signals;

@@ -1,0 +1,41 @@
+//! The cycle's counters for the timing report. Each job counts into the same record; it has
+//! a module of its own so that the jobs depend on it, not on the cycle that composes them.
+
+/// Counters for the timing report.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct CycleCounters {
+    /// Object states received.
+    pub objects_rx: u64,
+    /// Object states rejected as invalid (NaN, out of range, implausible).
+    pub objects_invalid: u64,
+    /// Cycles with stale object data.
+    pub object_stale_cycles: u64,
+    /// Accelerometer batches received.
+    pub accel_batches_rx: u64,
+    /// Accelerometer samples received.
+    pub accel_samples_rx: u64,
+    /// CAN frames received.
+    pub can_frames_rx: u64,
+    /// Collision predictions computed.
+    pub predictions: u64,
+    /// Predictions that failed (input outside the physics model).
+    pub prediction_errors: u64,
+    /// LUT lookups.
+    pub lut_lookups: u64,
+    /// Lookups outside the table (reference used).
+    pub lut_out_of_range: u64,
+    /// Lookups whose optimum still bottoms out (reported, not hidden).
+    pub lut_bottoming_out: u64,
+    /// Cycles spent degraded.
+    pub degraded_cycles: u64,
+    /// CAN frames sent.
+    pub can_tx: u64,
+    /// CAN send failures.
+    pub can_tx_errors: u64,
+    /// Commands sent together with their SecOC authenticator (both frames taken by the socket).
+    pub secoc_commands_tx: u64,
+    /// Command encode failures (value outside the DBC after clamping: should stay 0).
+    pub encode_errors: u64,
+    /// Diagnostics publish failures.
+    pub diagnostics_failures: u64,
+}

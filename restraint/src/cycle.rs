@@ -1,0 +1,241 @@
+//! The restraint cycle: inputs + now → commands. Composes the four jobs, each in its own
+//! module with its own state — [`InputMonitor`], [`Estimator`], [`Decision`], [`Outputs`] —
+//! and implements the [`Activity`] contract the shell runs.
+//!
+//! All state is built in [`RestraintCycle::new`]; `step` does not allocate, lock, block or
+//! panic (property-tested and counted in `tests/cycle_*.rs`).
+
+use bus::secoc::SecOcTx;
+use bus::RejectReason;
+use physics::CollisionSummary;
+
+use crate::config::{ConfigError, CycleConfig};
+use crate::contract::{Activity, CycleInfo, CycleIo, StartupError};
+use crate::counters::CycleCounters;
+use crate::decision::{Decision, DecisionInputs, Phase, Pretensioner};
+use crate::estimate::{check_lut, Estimator, Lut, LutMismatch, Situation};
+use crate::inputs::InputMonitor;
+use crate::outputs::{publish_diagnostics, Outputs};
+use crate::plan::{ReferenceSettings, RestraintPlan};
+use crate::signals::Degraded;
+
+/// What [`RestraintCycle::new`] found (for start-up messages).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StartupNotes {
+    /// The LUT given was optimised for another car: rejected, the ECU runs DEGRADED.
+    pub lut_rejected: Option<LutMismatch>,
+}
+
+/// The restraint decision activity. `'lut` is the life of the characteristic diagram it
+/// borrows (the shell keeps the loaded table alive as long as the cycle).
+pub struct RestraintCycle<'lut> {
+    cfg: CycleConfig,
+    inputs: InputMonitor,
+    estimate: Estimator<'lut>,
+    decision: Decision,
+    outputs: Outputs,
+    reasons: Degraded,
+    counters: CycleCounters,
+}
+
+/// Report-counter names of the E2E rejections, in [`RejectReason::ALL`] order.
+const E2E_COUNTER_NAMES: [&str; RejectReason::COUNT] = [
+    "can_rejected_unknown_id",
+    "can_rejected_wrong_dlc",
+    "can_rejected_crc_mismatch",
+    "can_rejected_counter_repeated",
+    "can_rejected_counter_skipped",
+    "can_rejected_out_of_range",
+];
+
+impl<'lut> RestraintCycle<'lut> {
+    /// Builds the activity: validates `cfg`, precomputes the collision model and checks that
+    /// `lut` belongs to the configured ego vehicle. `lut = None` (or a mismatching table) →
+    /// permanent `LUT_INVALID`: the ECU runs DEGRADED on the `reference` restraint.
+    pub fn new(
+        cfg: CycleConfig,
+        lut: Option<Lut<'lut>>,
+        reference: &ReferenceSettings,
+    ) -> Result<(Self, StartupNotes), ConfigError> {
+        cfg.validate()?;
+        let (lut, lut_rejected) = check_lut(&cfg, lut);
+        let thresholds = Estimator::thresholds(lut.as_ref());
+        let reference = RestraintPlan::from_reference_settings(reference, &thresholds);
+        let lut_id = lut.map_or(0, |l| l.id);
+        let estimate = Estimator::new(&cfg, lut, reference)?;
+        let s = Self {
+            inputs: InputMonitor::new(&cfg),
+            estimate,
+            decision: Decision::new(&cfg, reference),
+            outputs: Outputs::new(lut_id),
+            reasons: Degraded::empty(),
+            counters: CycleCounters::default(),
+            cfg,
+        };
+        Ok((s, StartupNotes { lut_rejected }))
+    }
+
+    /// Sets the SecOC sender (call once before the first `step`). `Some`: every
+    /// `BeltLimiterCmd` / `AirbagStageCmd` frame is followed by its authenticator frame.
+    /// `None`: the key file was unusable — commands go out without authenticators (the
+    /// actuators ignore them) and `EcuStatus.FaultConfig` is set, so the failure is visible on
+    /// the bus instead of the ECU refusing to start. A cycle never given a sender (tests,
+    /// benches) sends no authenticators and reports no fault.
+    pub fn set_secoc(&mut self, tx: Option<SecOcTx>) {
+        self.outputs.set_secoc(tx);
+    }
+
+    /// Whether authenticator frames are sent.
+    pub fn secoc_enabled(&self) -> bool {
+        self.outputs.secoc_enabled()
+    }
+    /// Current phase.
+    pub fn phase(&self) -> Phase {
+        self.decision.phase()
+    }
+    /// Current degraded reasons.
+    pub fn degraded_reasons(&self) -> Degraded {
+        self.reasons
+    }
+    /// The preset plan (adaptive or reference).
+    pub fn plan(&self) -> RestraintPlan {
+        self.decision.plan()
+    }
+    /// The plan latched at crash confirmation.
+    pub fn crash_plan(&self) -> RestraintPlan {
+        self.decision.crash_plan()
+    }
+    /// The reference restraint plan.
+    pub fn reference_plan(&self) -> RestraintPlan {
+        self.decision.reference_plan()
+    }
+    /// Pretensioner state.
+    pub fn pretensioner(&self) -> Pretensioner {
+        self.decision.pretensioner()
+    }
+    /// Whether the airbag fire command has been sent.
+    pub fn airbag_fired(&self) -> bool {
+        self.decision.airbag_fired()
+    }
+    /// Newest situation estimate.
+    pub fn situation(&self) -> Option<Situation> {
+        self.estimate.situation
+    }
+    /// Newest collision prediction.
+    pub fn prediction(&self) -> Option<CollisionSummary> {
+        self.estimate.summary
+    }
+    /// Counters.
+    pub fn counters(&self) -> CycleCounters {
+        self.counters
+    }
+    /// E2E receive statistics (rejections by [`RejectReason`]).
+    pub fn e2e_stats(&self) -> bus::RxStats {
+        *self.inputs.e2e_stats()
+    }
+    /// LUT id sent in the heartbeat (0 = no LUT).
+    pub fn lut_id(&self) -> u16 {
+        self.outputs.lut_id()
+    }
+    /// The configuration in use.
+    pub fn config(&self) -> &CycleConfig {
+        &self.cfg
+    }
+}
+
+impl Activity for RestraintCycle<'_> {
+    fn name(&self) -> &'static str {
+        "restraint-cycle"
+    }
+
+    fn startup(&mut self, _now_ns: u64, _io: &mut dyn CycleIo) -> Result<(), StartupError> {
+        Ok(())
+    }
+
+    fn step(&mut self, info: &CycleInfo, io: &mut dyn CycleIo) {
+        let now = info.now_ns;
+        let c = &mut self.counters;
+        let inputs = &mut self.inputs;
+        inputs.begin_cycle();
+        io.drain_can(&mut |f| inputs.on_can(f, now, c));
+        io.drain_objects(&mut |o| inputs.on_object(o, now, c));
+        io.drain_accel(&mut |a| inputs.on_accel(a, now, c));
+        let lut_present = self.estimate.lut().is_some();
+        self.reasons = self.inputs.reasons(now, io.can_enabled(), lut_present);
+        let c = &mut self.counters;
+        if self.reasons.contains(Degraded::OBJECT_STALE) {
+            c.object_stale_cycles = c.object_stale_cycles.saturating_add(1);
+        }
+        let degraded = self.reasons.intersects(Degraded::DEGRADING);
+        if degraded {
+            c.degraded_cycles = c.degraded_cycles.saturating_add(1);
+        }
+        // Recompute the prediction only when its inputs changed materially.
+        if self.inputs.new_object
+            || (self.inputs.occupant_changed && self.estimate.situation.is_some())
+        {
+            if let Some(plan) = self.estimate.update(now, &self.inputs, c) {
+                self.decision.plan = plan;
+            }
+        }
+        if self.reasons.contains(Degraded::OBJECT_STALE) {
+            self.estimate.situation = None; // a stale track predicts nothing
+        }
+        let x = DecisionInputs {
+            degraded,
+            situation: self.estimate.situation,
+            new_object: self.inputs.new_object,
+            object_present: self.inputs.object_present,
+            detector: &self.inputs.detector,
+        };
+        self.decision.step(now, &x);
+        let c = &mut self.counters;
+        self.outputs
+            .write(info, io, &self.decision, &self.inputs, self.reasons, c);
+        publish_diagnostics(
+            info,
+            io,
+            &self.decision,
+            &self.estimate,
+            &self.inputs,
+            self.reasons,
+            c,
+        );
+    }
+
+    fn shutdown(&mut self, _now_ns: u64, _io: &mut dyn CycleIo) {}
+
+    fn report_counters(&self, out: &mut dyn FnMut(&'static str, u64)) {
+        let c = &self.counters;
+        let d = &self.inputs.detector;
+        let e2e = self.inputs.e2e_stats();
+        for (name, v) in [
+            ("objects_rx", c.objects_rx),
+            ("objects_invalid", c.objects_invalid),
+            ("object_stale_cycles", c.object_stale_cycles),
+            ("accel_batches_rx", c.accel_batches_rx),
+            ("accel_samples_rx", c.accel_samples_rx),
+            ("accel_invalid_samples", d.invalid_samples),
+            ("accel_invalid_batches", d.invalid_batches),
+            ("can_frames_rx", c.can_frames_rx),
+            ("can_accepted", e2e.accepted),
+            ("can_lost_frames", e2e.lost_frames),
+            ("predictions", c.predictions),
+            ("prediction_errors", c.prediction_errors),
+            ("lut_lookups", c.lut_lookups),
+            ("lut_out_of_range", c.lut_out_of_range),
+            ("lut_bottoming_out", c.lut_bottoming_out),
+            ("degraded_cycles", c.degraded_cycles),
+            ("can_tx", c.can_tx),
+            ("can_tx_errors", c.can_tx_errors),
+            ("secoc_commands_tx", c.secoc_commands_tx),
+            ("encode_errors", c.encode_errors),
+            ("diagnostics_publish_failures", c.diagnostics_failures),
+        ] {
+            out(name, v);
+        }
+        for (name, reason) in E2E_COUNTER_NAMES.iter().zip(RejectReason::ALL) {
+            out(name, e2e.rejected_for(reason));
+        }
+    }
+}

@@ -1,0 +1,370 @@
+//! The estimate: what the newest object sample says about the coming collision, and what the
+//! restraint should do about it.
+//!
+//! Time to contact, closing speed at contact, conservative opponent mass and equivalent barrier
+//! speed ([`Situation`]); the two-mass collision prediction ([`physics::simulate_collision`])
+//! into a preallocated pulse buffer; the characteristic-diagram query ([`Lut`]). Everything is
+//! built in [`Estimator::new`]; [`Estimator::update`] allocates nothing.
+//!
+//! This is where a track filter belongs (the estimation work: a nalgebra Kalman filter over
+//! the object samples, smoothing distance, closing speed and acceleration before
+//! [`time_to_contact`]); the decision only consumes [`Situation`].
+
+use diagram::{AirbagThresholds, DiagramView, Query};
+use physics::{
+    simulate_collision, CollisionInput, CollisionSummary, CombinedSpring, DefaultPulseBuffer,
+    MassClass,
+};
+
+use crate::config::{ms_to_ns, ConfigError, CycleConfig};
+use crate::counters::CycleCounters;
+use crate::inputs::InputMonitor;
+use crate::plan::RestraintPlan;
+
+/// Predicted contact of a constant-relative-acceleration approach.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Contact {
+    /// Time from the measurement to first contact, s (≥ 0).
+    pub ttc_s: f64,
+    /// Closing speed at contact, m/s (≥ 0).
+    pub closing_speed_mps: f64,
+}
+
+/// Time to contact from distance `d` (m), closing speed `v` (m/s, positive approaching) and
+/// relative acceleration `a` (m/s², rate of change of the closing speed): the smallest
+/// t ≥ 0 with d − v t − ½ a t² = 0, i.e. t = 2d / (v + √(v² + 2ad)) (the cancellation-free
+/// form of the quadratic root; exact for a = 0: t = d/v). `None` when the object stops
+/// closing before it reaches us (v² + 2ad < 0), recedes, or any input is not finite.
+/// d ≤ 0 means contact now at the current closing speed.
+pub fn time_to_contact(d_m: f64, v_mps: f64, a_mps2: f64) -> Option<Contact> {
+    if !(d_m.is_finite() && v_mps.is_finite() && a_mps2.is_finite()) {
+        return None;
+    }
+    if d_m <= 0.0 {
+        return (v_mps > 0.0).then_some(Contact {
+            ttc_s: 0.0,
+            closing_speed_mps: v_mps,
+        });
+    }
+    let disc = v_mps * v_mps + 2.0 * a_mps2 * d_m;
+    if !(disc >= 0.0) {
+        return None;
+    }
+    let v_contact = libm::sqrt(disc);
+    // Receding (v ≤ 0) with positive acceleration still reaches us on the "+" root only if
+    // v + √disc > 0; the v < 0 branch is the object turning around and coming back, which a
+    // tracker would report as a new approach: treat as no contact now.
+    if v_mps <= 0.0 {
+        return None;
+    }
+    let denom = v_mps + v_contact;
+    if !(denom > 0.0) {
+        return None;
+    }
+    let t = 2.0 * d_m / denom;
+    (t.is_finite() && t >= 0.0).then_some(Contact {
+        ttc_s: t,
+        closing_speed_mps: v_contact,
+    })
+}
+
+/// Ego equivalent barrier speed, km/h: the ego's speed change to the common velocity,
+/// v_close · m_opp / (m_ego + m_opp) (v/2 for equal masses, v for a rigid barrier).
+pub fn equivalent_barrier_speed_kph(closing_mps: f64, ego_kg: f64, opp_kg: f64) -> f64 {
+    let share = if opp_kg.is_infinite() {
+        1.0
+    } else {
+        opp_kg / (ego_kg + opp_kg)
+    };
+    closing_mps * share * 3.6
+}
+
+/// The characteristic diagram as the core needs it: the borrowed, validated view plus the
+/// header facts the shell read from the file.
+#[derive(Debug, Clone, Copy)]
+pub struct Lut<'a> {
+    /// Allocation-free interpolation.
+    pub view: DiagramView<'a>,
+    /// Id sent in the heartbeat (`EcuStatus.LutId`).
+    pub id: u16,
+    /// Ego vehicle mass the table was optimised for, kg.
+    pub ego_mass_kg: f32,
+    /// Ego stiffness class the table was optimised for.
+    pub ego_class: u8,
+}
+
+/// A LUT optimised for another car than the configured one (rejected at start-up).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LutMismatch {
+    /// The table's ego mass, kg.
+    pub table_mass_kg: f32,
+    /// The table's ego class.
+    pub table_class: u8,
+    /// The configured ego mass, kg.
+    pub config_mass_kg: f64,
+    /// The configured ego class.
+    pub config_class: u8,
+}
+
+impl core::fmt::Display for LutMismatch {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "LUT is for ego {} kg class {}, ECU configured for {} kg class {}: \
+             LUT rejected, DEGRADED (reference restraint)",
+            self.table_mass_kg, self.table_class, self.config_mass_kg, self.config_class
+        )
+    }
+}
+
+/// `lut` if it was optimised for the configured ego vehicle (class equal, mass within 1 %):
+/// its cells are optimal for that car only. A mismatch drops it and says why.
+pub fn check_lut<'a>(
+    cfg: &CycleConfig,
+    lut: Option<Lut<'a>>,
+) -> (Option<Lut<'a>>, Option<LutMismatch>) {
+    match lut {
+        Some(l) => {
+            let rel = (f64::from(l.ego_mass_kg) - cfg.ego_mass_kg).abs() / cfg.ego_mass_kg;
+            if l.ego_class != cfg.ego_class || rel > 0.01 {
+                let m = LutMismatch {
+                    table_mass_kg: l.ego_mass_kg,
+                    table_class: l.ego_class,
+                    config_mass_kg: cfg.ego_mass_kg,
+                    config_class: cfg.ego_class,
+                };
+                (None, Some(m))
+            } else {
+                (Some(l), None)
+            }
+        }
+        None => (None, None),
+    }
+}
+
+/// The estimated situation from the newest object sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Situation {
+    /// Predicted first contact, CLOCK_MONOTONIC ns.
+    pub contact_ns: u64,
+    /// Closing speed at contact, m/s.
+    pub closing_speed_mps: f64,
+    /// Conservative opponent mass m + k·σ, kg.
+    pub opponent_mass_kg: f64,
+    /// Ego equivalent barrier speed, km/h.
+    pub ebs_kph: f64,
+    /// Below the no-fire threshold.
+    pub low_speed: bool,
+}
+
+/// State of the estimate: situation, prediction (springs, pulse buffer) and the LUT.
+pub struct Estimator<'a> {
+    ego_mass_kg: f64,
+    conservative_mass_k: f64,
+    no_fire_ebs_kph: f64,
+    prediction_step_ms: f64,
+    exit_horizon_ns: u64,
+    springs: [Option<CombinedSpring>; 6],
+    pulse: DefaultPulseBuffer,
+    lut: Option<Lut<'a>>,
+    reference: RestraintPlan,
+    /// Newest situation estimate.
+    pub(crate) situation: Option<Situation>,
+    /// Newest collision prediction.
+    pub(crate) summary: Option<CollisionSummary>,
+}
+
+impl<'a> Estimator<'a> {
+    /// Precomputes the six combined springs (ego class × opponent class) and the pulse
+    /// buffer; `lut` has passed [`check_lut`].
+    pub fn new(
+        cfg: &CycleConfig,
+        lut: Option<Lut<'a>>,
+        reference: RestraintPlan,
+    ) -> Result<Self, ConfigError> {
+        let class_error = ConfigError {
+            key: "ego_class",
+            value: f64::from(cfg.ego_class),
+            lo: 1.0,
+            hi: 6.0,
+        };
+        let ego_class = MassClass::new(cfg.ego_class).map_err(|_| class_error)?;
+        let mut springs = [None; 6];
+        for (i, s) in springs.iter_mut().enumerate() {
+            let opp = MassClass::new(i as u8 + 1).map_err(|_| class_error)?;
+            *s = CombinedSpring::series(ego_class.curve(), Some(opp.curve())).ok();
+        }
+        let horizon_ns = ms_to_ns(cfg.preset_horizon_ms);
+        Ok(Self {
+            ego_mass_kg: cfg.ego_mass_kg,
+            conservative_mass_k: cfg.conservative_mass_k,
+            no_fire_ebs_kph: cfg.no_fire_ebs_kph,
+            prediction_step_ms: cfg.prediction_step_ms,
+            exit_horizon_ns: horizon_ns.saturating_add(ms_to_ns(cfg.preset_exit_hysteresis_ms)),
+            springs,
+            pulse: DefaultPulseBuffer::new(),
+            lut,
+            reference,
+            situation: None,
+            summary: None,
+        })
+    }
+
+    /// The airbag thresholds of the LUT in use (the defaults without one).
+    pub fn thresholds(lut: Option<&Lut<'_>>) -> AirbagThresholds {
+        lut.map_or(AirbagThresholds::DEFAULT, |l| l.view.thresholds())
+    }
+
+    /// The LUT in use (`None`: missing or rejected).
+    pub fn lut(&self) -> Option<&Lut<'a>> {
+        self.lut.as_ref()
+    }
+
+    /// The predicted pulse of the newest prediction (ego acceleration, m/s²) and its step, s.
+    pub(crate) fn pulse(&self) -> (&[f64], f64) {
+        (self.pulse.ego_accel_mps2(), self.pulse.step_s())
+    }
+
+    /// Situation from the newest object sample; runs the prediction and the LUT lookup when
+    /// contact is within the exit horizon. Returns the plan when one was looked up.
+    /// Called only when a new sample (or a changed occupant) arrived.
+    #[inline(always)]
+    pub(crate) fn update(
+        &mut self,
+        now: u64,
+        inputs: &InputMonitor,
+        counters: &mut CycleCounters,
+    ) -> Option<RestraintPlan> {
+        self.situation = None;
+        if !inputs.object_present || inputs.object_invalid {
+            return None;
+        }
+        let o = inputs.object;
+        let c = time_to_contact(
+            f64::from(o.distance_m),
+            f64::from(o.closing_speed_mps),
+            f64::from(o.relative_accel_mps2),
+        )?;
+        let meas_ns = o.timestamp_ns.min(now);
+        let contact_ns = meas_ns.saturating_add((c.ttc_s * 1.0e9) as u64);
+        let m = f64::from(o.opponent_mass_kg);
+        let sigma = f64::from(o.opponent_mass_sigma_kg);
+        let opp_kg = m + self.conservative_mass_k * sigma;
+        let ebs_kph = equivalent_barrier_speed_kph(c.closing_speed_mps, self.ego_mass_kg, opp_kg);
+        let sit = Situation {
+            contact_ns,
+            closing_speed_mps: c.closing_speed_mps,
+            opponent_mass_kg: opp_kg,
+            ebs_kph,
+            low_speed: !(ebs_kph >= self.no_fire_ebs_kph),
+        };
+        self.situation = Some(sit);
+        // Predict only what can become relevant before the next sample: contact within the
+        // exit horizon (bounds the work to objects that matter).
+        if contact_ns.saturating_sub(now) > self.exit_horizon_ns || sit.low_speed {
+            return None;
+        }
+        self.predict(&sit, counters);
+        Some(self.lookup(&sit, inputs, counters))
+    }
+
+    #[inline(always)]
+    fn predict(&mut self, sit: &Situation, counters: &mut CycleCounters) {
+        counters.predictions = counters.predictions.saturating_add(1);
+        let class = physics::class_for_mass_kg(sit.opponent_mass_kg)
+            .map(MassClass::number)
+            .unwrap_or(6);
+        let spring = self
+            .springs
+            .get(usize::from(class.saturating_sub(1)))
+            .and_then(Option::as_ref);
+        let Some(spring) = spring else {
+            self.summary = None;
+            counters.prediction_errors = counters.prediction_errors.saturating_add(1);
+            return;
+        };
+        let input = CollisionInput {
+            step_s: self.prediction_step_ms * 1e-3,
+            ..CollisionInput::with_defaults(
+                spring,
+                self.ego_mass_kg,
+                sit.opponent_mass_kg,
+                sit.closing_speed_mps,
+            )
+        };
+        match simulate_collision(&input, &mut self.pulse) {
+            Ok(s) => self.summary = Some(s),
+            Err(_) => {
+                self.summary = None;
+                counters.prediction_errors = counters.prediction_errors.saturating_add(1);
+            }
+        }
+    }
+
+    /// LUT plan for the situation; the reference plan when the LUT is missing, the occupant
+    /// is outside what the table covers (unbelted, not an adult, no data), or any query
+    /// axis is out of the table's range or NaN (the diagram's rule: a flagged lookup is
+    /// degraded input).
+    fn lookup(
+        &self,
+        sit: &Situation,
+        inputs: &InputMonitor,
+        counters: &mut CycleCounters,
+    ) -> RestraintPlan {
+        let Some(lut) = self.lut.as_ref() else {
+            return self.reference;
+        };
+        let occ = inputs.occupant;
+        if !(occ.buckled && occ.adult) {
+            return self.reference;
+        }
+        let q = Query {
+            closing_speed_kph: (sit.closing_speed_mps * 3.6) as f32,
+            opponent_mass_kg: sit.opponent_mass_kg as f32,
+            occupant_mass_kg: occ.mass_kg,
+            seat_distance_mm: occ.chest_to_wheel_mm,
+        };
+        let l = lut.view.lookup(&q);
+        counters.lut_lookups = counters.lut_lookups.saturating_add(1);
+        if l.bottoming_out {
+            counters.lut_bottoming_out = counters.lut_bottoming_out.saturating_add(1);
+        }
+        if l.out_of_range.any() {
+            counters.lut_out_of_range = counters.lut_out_of_range.saturating_add(1);
+            return self.reference;
+        }
+        RestraintPlan::from_lookup(&l)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ttc_constant_speed_is_distance_over_speed() {
+        let c = time_to_contact(10.0, 20.0, 0.0).unwrap();
+        assert!((c.ttc_s - 0.5).abs() < 1e-12);
+        assert_eq!(c.closing_speed_mps, 20.0);
+    }
+
+    #[test]
+    fn ttc_braking_matches_kinematics() {
+        // d = 10 m, v = 20 m/s, closing speed falls at 8 m/s² (a = −8):
+        // 10 = 20 t − 4 t² → t = (20 − √(400 − 160)) / 8 = 0.563508…; v_c = √(400 − 160).
+        let c = time_to_contact(10.0, 20.0, -8.0).unwrap();
+        let t = (20.0 - 240f64.sqrt()) / 8.0;
+        assert!((c.ttc_s - t).abs() < 1e-12, "{c:?}");
+        assert!((c.closing_speed_mps - 240f64.sqrt()).abs() < 1e-12);
+        // Stops before contact: v² < 2|a|d.
+        assert!(time_to_contact(10.0, 5.0, -8.0).is_none());
+        assert!(time_to_contact(10.0, -1.0, 0.0).is_none());
+        assert!(time_to_contact(f64::NAN, 1.0, 0.0).is_none());
+    }
+
+    #[test]
+    fn ebs_is_half_for_equal_masses_and_full_for_a_barrier() {
+        assert!((equivalent_barrier_speed_kph(30.0, 1500.0, 1500.0) - 54.0).abs() < 1e-9);
+        assert!((equivalent_barrier_speed_kph(15.0, 1500.0, f64::INFINITY) - 54.0).abs() < 1e-9);
+    }
+}

@@ -1,0 +1,335 @@
+//! Input monitoring: what the ECU believes about its inputs and how fresh that belief is.
+//!
+//! CAN frames go through the bus crate's [`E2eChecker`] (a stream that timed out is
+//! resynchronised on its next frame); rejections feed the E2E burst window; object states are
+//! checked for range, age and plausibility against the ego speed; accelerometer batches feed
+//! the [`CrashDetector`]. [`InputMonitor::reasons`] turns all of it into the degraded reasons of
+//! the cycle. Allocation-free: the burst window is a fixed-capacity `heapless` queue.
+
+use bus::codec::{OccupantClassificationBeltBuckle, OccupantClassificationOccupantClass};
+use bus::{E2eChecker, Messages, RawFrame, RejectReason, CAN_EFF_FLAG};
+use heapless::Deque;
+
+use crate::config::{ms_to_ns, CycleConfig, MAX_E2E_BURST};
+use crate::confirm::{ConfirmParams, CrashDetector, G_MPS2};
+use crate::counters::CycleCounters;
+use crate::signals::{CrashAccelSample, Degraded, ObjectState};
+
+/// How long an invalid accelerometer sample keeps `ACCEL_INVALID` set, ms.
+const ACCEL_INVALID_HOLD_MS: f64 = 500.0;
+/// Closing speed above ego speed + this is implausible (opponent > 250 km/h), m/s.
+const MAX_OPPONENT_SPEED_MPS: f32 = 70.0;
+
+/// CAN ids the ECU consumes (kernel filter of the SocketCAN port), from the generated codec.
+pub fn input_can_ids() -> [u32; 2] {
+    [
+        bus::EgoVehicleState::RAW_ID,
+        bus::OccupantClassification::RAW_ID,
+    ]
+}
+
+/// Occupant as last reported on CAN.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Occupant {
+    /// Mass, kg.
+    pub mass_kg: f32,
+    /// Chest to wheel / airbag module, mm.
+    pub chest_to_wheel_mm: f32,
+    /// Belt buckled (the LUT is optimised for belted occupants; unbelted → reference).
+    pub buckled: bool,
+    /// An adult occupant the LUT covers (not empty, not a child seat).
+    pub adult: bool,
+}
+
+/// The E2E failure burst: `count` rejections within `window_ns` set `E2E_FAILURE`, held until
+/// `hold_ns` after the last rejection.
+#[derive(Debug, Clone)]
+struct E2eBurst {
+    /// Times of the newest rejections, oldest first.
+    recent_ns: Deque<u64, MAX_E2E_BURST>,
+    count: usize,
+    window_ns: u64,
+    hold_ns: u64,
+    active_until_ns: Option<u64>,
+}
+
+impl E2eBurst {
+    fn note_rejection(&mut self, now: u64) {
+        if self.recent_ns.is_full() {
+            self.recent_ns.pop_front();
+        }
+        // Cannot fail: a slot was freed above.
+        let _ = self.recent_ns.push_back(now);
+        let len = self.recent_ns.storage_len();
+        if len >= self.count {
+            // The count-th newest rejection.
+            let oldest = self.recent_ns.get(len - self.count).copied().unwrap_or(0);
+            if now.saturating_sub(oldest) <= self.window_ns {
+                self.active_until_ns = Some(now.saturating_add(self.hold_ns));
+            }
+        }
+        if let Some(until) = self.active_until_ns {
+            // A rejection while the burst is held extends the hold.
+            if now <= until {
+                self.active_until_ns = Some(now.saturating_add(self.hold_ns));
+            }
+        }
+    }
+
+    fn active(&self, now: u64) -> bool {
+        self.active_until_ns.is_some_and(|t| now <= t)
+    }
+}
+
+/// State of the input monitoring.
+#[derive(Debug, Clone)]
+pub struct InputMonitor {
+    pub(crate) confirm: ConfirmParams,
+    object_timeout_ns: u64,
+    vehicle_timeout_ns: u64,
+    occupant_timeout_ns: u64,
+    accel_hold_ns: u64,
+    min_confidence: f64,
+
+    checker: E2eChecker,
+    burst: E2eBurst,
+
+    /// Newest accepted object sample.
+    pub(crate) object: ObjectState,
+    /// The newest sample tracks an object (valid, confident).
+    pub(crate) object_present: bool,
+    /// The newest sample was implausible (until the next good one).
+    pub(crate) object_invalid: bool,
+    object_rx_ns: Option<u64>,
+    /// A new object sample arrived this cycle.
+    pub(crate) new_object: bool,
+    ego_speed_mps: f32,
+    vehicle_rx_ns: Option<u64>,
+    /// Occupant as last reported.
+    pub(crate) occupant: Occupant,
+    occupant_rx_ns: Option<u64>,
+    /// The occupant report changed this cycle.
+    pub(crate) occupant_changed: bool,
+    accel_invalid_until_ns: Option<u64>,
+    /// Sequence of the newest accelerometer batch.
+    pub(crate) last_accel_sequence: u64,
+    /// Crash confirmation from the accelerometer.
+    pub(crate) detector: CrashDetector,
+}
+
+impl InputMonitor {
+    /// Monitoring with the timeouts of a validated `cfg`.
+    pub fn new(cfg: &CycleConfig) -> Self {
+        Self {
+            confirm: ConfirmParams {
+                wake_mps2: cfg.confirm_wake_g * G_MPS2,
+                decel_mps2: cfg.confirm_decel_g * G_MPS2,
+                samples: cfg.confirm_samples,
+                delta_v_mps: cfg.confirm_delta_v_mps,
+                reset_gap_ns: ms_to_ns(cfg.confirm_reset_gap_ms),
+            },
+            object_timeout_ns: ms_to_ns(cfg.object_timeout_ms),
+            vehicle_timeout_ns: ms_to_ns(cfg.vehicle_timeout_ms),
+            occupant_timeout_ns: ms_to_ns(cfg.occupant_timeout_ms),
+            accel_hold_ns: ms_to_ns(ACCEL_INVALID_HOLD_MS),
+            min_confidence: cfg.min_confidence,
+            checker: E2eChecker::with_max_lost(cfg.e2e_max_lost),
+            burst: E2eBurst {
+                recent_ns: Deque::new(),
+                count: (cfg.e2e_burst_count as usize).clamp(1, MAX_E2E_BURST),
+                window_ns: ms_to_ns(cfg.e2e_burst_window_ms),
+                hold_ns: ms_to_ns(cfg.e2e_hold_ms),
+                active_until_ns: None,
+            },
+            object: ObjectState::INVALID,
+            object_present: false,
+            object_invalid: false,
+            object_rx_ns: None,
+            new_object: false,
+            ego_speed_mps: 0.0,
+            vehicle_rx_ns: None,
+            occupant: Occupant {
+                mass_kg: f32::NAN,
+                chest_to_wheel_mm: f32::NAN,
+                buckled: false,
+                adult: false,
+            },
+            occupant_rx_ns: None,
+            occupant_changed: false,
+            accel_invalid_until_ns: None,
+            last_accel_sequence: 0,
+            detector: CrashDetector::default(),
+        }
+    }
+
+    /// Starts a cycle: nothing new yet.
+    pub(crate) fn begin_cycle(&mut self) {
+        self.new_object = false;
+        self.occupant_changed = false;
+    }
+
+    /// E2E receive statistics.
+    pub fn e2e_stats(&self) -> &bus::RxStats {
+        self.checker.stats()
+    }
+
+    fn stale(rx: Option<u64>, now: u64, limit: u64) -> bool {
+        rx.is_none_or(|t| now.saturating_sub(t) > limit)
+    }
+
+    /// The ego vehicle frame is missing or older than its timeout.
+    pub(crate) fn vehicle_stale(&self, now: u64) -> bool {
+        Self::stale(self.vehicle_rx_ns, now, self.vehicle_timeout_ns)
+    }
+
+    /// The occupant frame is missing or older than its timeout.
+    pub(crate) fn occupant_stale(&self, now: u64) -> bool {
+        Self::stale(self.occupant_rx_ns, now, self.occupant_timeout_ns)
+    }
+
+    /// One received CAN frame.
+    pub(crate) fn on_can(&mut self, f: &RawFrame, now: u64, counters: &mut CycleCounters) {
+        counters.can_frames_rx = counters.can_frames_rx.saturating_add(1);
+        if f.id & CAN_EFF_FLAG != 0 {
+            return; // never ours; the kernel filter drops them on a real bus
+        }
+        // A stream that timed out starts a new counter sequence (e.g. its sender restarted):
+        // resynchronise on its first frame instead of rejecting it.
+        let resync = match f.id {
+            bus::EgoVehicleState::RAW_ID => self.vehicle_stale(now),
+            bus::OccupantClassification::RAW_ID => self.occupant_stale(now),
+            _ => false,
+        };
+        let checked = if resync {
+            self.checker.check_resync(f.id, f.payload())
+        } else {
+            self.checker.check(f.id, f.payload())
+        };
+        match checked {
+            Ok(Messages::EgoVehicleState(m)) => {
+                self.ego_speed_mps = m.ego_speed();
+                self.vehicle_rx_ns = Some(now);
+            }
+            Ok(Messages::OccupantClassification(m)) => {
+                let occ = Occupant {
+                    mass_kg: m.occupant_mass(),
+                    chest_to_wheel_mm: f32::from(m.chest_to_wheel()),
+                    buckled: m.belt_buckle() == OccupantClassificationBeltBuckle::Buckled,
+                    adult: matches!(
+                        m.occupant_class(),
+                        OccupantClassificationOccupantClass::SmallAdult
+                            | OccupantClassificationOccupantClass::MidAdult
+                            | OccupantClassificationOccupantClass::LargeAdult
+                    ),
+                };
+                self.occupant_changed |= occ != self.occupant;
+                self.occupant = occ;
+                self.occupant_rx_ns = Some(now);
+            }
+            Ok(_) => {}
+            Err(e) if e.reason() == RejectReason::UnknownId => {}
+            Err(_) => self.burst.note_rejection(now),
+        }
+    }
+
+    fn object_plausible(&self, o: &ObjectState, now: u64) -> bool {
+        let f = [
+            o.distance_m,
+            o.closing_speed_mps,
+            o.relative_accel_mps2,
+            o.opponent_mass_kg,
+            o.opponent_mass_sigma_kg,
+            o.confidence,
+        ];
+        if !f.iter().all(|v| v.is_finite()) {
+            return false;
+        }
+        let ranges_ok = (-5.0..=300.0).contains(&o.distance_m)
+            && (-100.0..=100.0).contains(&o.closing_speed_mps)
+            && (-300.0..=300.0).contains(&o.relative_accel_mps2)
+            && (100.0..=60_000.0).contains(&o.opponent_mass_kg)
+            && (0.0..=10_000.0).contains(&o.opponent_mass_sigma_kg)
+            && (0.0..=1.0).contains(&o.confidence);
+        // The measurement must be recent on our clock (same CLOCK_MONOTONIC on the bench).
+        let age_ok = now.abs_diff(o.timestamp_ns) <= self.object_timeout_ns;
+        let vehicle_fresh = !self.vehicle_stale(now);
+        let speed_ok =
+            !vehicle_fresh || o.closing_speed_mps <= self.ego_speed_mps + MAX_OPPONENT_SPEED_MPS;
+        ranges_ok && age_ok && speed_ok
+    }
+
+    /// One received object state.
+    pub(crate) fn on_object(&mut self, o: &ObjectState, now: u64, counters: &mut CycleCounters) {
+        counters.objects_rx = counters.objects_rx.saturating_add(1);
+        if !o.is_valid() {
+            // A "no track" record is information too, and can be as old as any other: a
+            // stuck sensor repeating its last "nothing ahead" must go stale like any sample.
+            if now.abs_diff(o.timestamp_ns) > self.object_timeout_ns {
+                counters.objects_invalid = counters.objects_invalid.saturating_add(1);
+                self.object_invalid = true;
+                return;
+            }
+            // A fresh "no track" sample: the sensor is alive, nothing ahead.
+            self.object_present = false;
+            self.object_invalid = false;
+            self.object_rx_ns = Some(now);
+            self.object = *o;
+            self.new_object = true;
+            return;
+        }
+        if self.object_plausible(o, now) {
+            self.object = *o;
+            self.object_present = f64::from(o.confidence) >= self.min_confidence;
+            self.object_invalid = false;
+            self.object_rx_ns = Some(now);
+            self.new_object = true;
+        } else {
+            counters.objects_invalid = counters.objects_invalid.saturating_add(1);
+            self.object_invalid = true;
+        }
+    }
+
+    /// One received accelerometer batch.
+    pub(crate) fn on_accel(
+        &mut self,
+        a: &CrashAccelSample,
+        now: u64,
+        counters: &mut CycleCounters,
+    ) {
+        counters.accel_batches_rx = counters.accel_batches_rx.saturating_add(1);
+        let s = a.samples();
+        counters.accel_samples_rx = counters.accel_samples_rx.saturating_add(s.len() as u64);
+        self.last_accel_sequence = a.sequence;
+        if self
+            .detector
+            .feed(&self.confirm, a.first_timestamp_ns, a.sample_period_ns, s)
+        {
+            self.accel_invalid_until_ns = Some(now.saturating_add(self.accel_hold_ns));
+        }
+    }
+
+    /// The degraded reasons at `now` (`lut_present`: a usable LUT was loaded).
+    pub(crate) fn reasons(&self, now: u64, can_on: bool, lut_present: bool) -> Degraded {
+        let mut r = Degraded::empty();
+        r.set(
+            Degraded::OBJECT_STALE,
+            Self::stale(self.object_rx_ns, now, self.object_timeout_ns),
+        );
+        r.set(Degraded::OBJECT_INVALID, self.object_invalid);
+        r.set(
+            Degraded::ACCEL_INVALID,
+            self.accel_invalid_until_ns.is_some_and(|t| now <= t),
+        );
+        if can_on {
+            r.set(
+                Degraded::CAN_STALE,
+                self.vehicle_stale(now) || self.occupant_stale(now),
+            );
+        } else {
+            r |= Degraded::CAN_DISABLED;
+        }
+        r.set(Degraded::E2E_FAILURE, self.burst.active(now));
+        r.set(Degraded::LUT_INVALID, !lut_present);
+        r
+    }
+}

@@ -1,0 +1,61 @@
+//! The restraint ECU's logic, as a `no_std` core with no allocator.
+//!
+//! Per cycle: drain inputs (CAN through the bus crate's E2E checker, object states,
+//! accelerometer batches) → estimate (time to contact, closing speed at contact, conservative
+//! opponent mass, occupant) → collision prediction (`physics`, only when a new object sample
+//! arrived) → characteristic-diagram query (`diagram::DiagramView`) → decision state machine →
+//! E2E-protected, SecOC-authenticated CAN commands (on change and cyclically) → diagnostics
+//! record. One module per job, each with its own state:
+//!
+//! | module | job |
+//! |---|---|
+//! | [`inputs`] | input monitoring: E2E, freshness, plausibility, degraded reasons |
+//! | [`confirm`] | crash confirmation from the compartment accelerometer |
+//! | [`estimate`] | situation, collision prediction, LUT query (the place for a track filter) |
+//! | [`decision`] | the state machine: preset, arm, fire, release, fall back |
+//! | [`outputs`] | command, status and diagnostics encoding, clock-timed cyclic sends |
+//! | [`contract`] | the activity contract a shell runs the cycle through |
+//! | [`signals`] | the non-CAN inputs and outputs (object, accelerometer, diagnostics) |
+//! | [`sim`] | the in-memory I/O of tests, benches and fuzz targets |
+//!
+//! **The rule this crate enforces**: no `std`, no `alloc`, no operating system. It gets a
+//! [`diagram::DiagramView`], the reference restraint as numbers, SecOC keys as bytes and time as
+//! an argument; files, clocks, sockets and shared memory are the shell's (`ecu`). The compiler
+//! checks the crate itself (`#![no_std]`, and no `extern crate alloc`);
+//! `tests/dependency_tree.rs` fails when its normal dependency tree gains a std-only crate.
+
+#![no_std]
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+// `!(x >= y)` is deliberate: it is true for NaN, which is how NaN inputs fail safe.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod config;
+pub mod confirm;
+pub mod contract;
+pub mod counters;
+mod cycle;
+pub mod decision;
+pub mod estimate;
+pub mod inputs;
+pub mod outputs;
+pub mod plan;
+pub mod signals;
+pub mod sim;
+
+pub use config::{ConfigError, CycleConfig, MAX_E2E_BURST};
+pub use confirm::{ConfirmParams, CrashDetector, G_MPS2};
+pub use contract::{Activity, CycleInfo, CycleIo, IoError, StartupError};
+pub use counters::CycleCounters;
+pub use cycle::{RestraintCycle, StartupNotes};
+pub use decision::{Phase, Pretensioner};
+pub use estimate::{
+    equivalent_barrier_speed_kph, time_to_contact, Contact, Lut, LutMismatch, Situation,
+};
+pub use inputs::{input_can_ids, Occupant};
+pub use plan::{PlanSource, ReferenceSettings, RestraintPlan};
+pub use signals::{
+    CrashAccelSample, Degraded, EcuDiagnostics, EcuMode, ObjectState, ACCEL_BATCH_CAPACITY,
+    PULSE_POINTS, VALID,
+};
+pub use sim::SimIo;

@@ -1,0 +1,337 @@
+//! What the cycle reads and writes besides CAN: the opponent object, the crash accelerometer
+//! and the diagnostics record, plus the mode and degraded-reason vocabulary they use.
+//!
+//! Plain `#[repr(C)]`, `Copy`, pointer-free records: the shell carries them over iceoryx2
+//! shared memory (the `ipc` crate wraps each in its transport type), a microcontroller port
+//! would fill them from its drivers. Flags are `u8`, not `bool`: a producer in another process
+//! could write any byte, and a `bool` other than 0/1 is undefined behaviour in Rust.
+
+/// `valid` flag value meaning "the producer vouches for this object".
+pub const VALID: u8 = 1;
+
+/// Opponent object / pre-crash state from the environment sensors (one tracked object).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObjectState {
+    /// CLOCK_MONOTONIC time of the measurement (not of publication), ns.
+    pub timestamp_ns: u64,
+    /// Publisher sequence counter; gaps reveal dropped samples.
+    pub sequence: u64,
+    /// Longitudinal distance to the object, m (positive ahead).
+    pub distance_m: f32,
+    /// Closing speed, m/s (positive = approaching).
+    pub closing_speed_mps: f32,
+    /// Relative acceleration (rate of change of closing speed), m/s².
+    pub relative_accel_mps2: f32,
+    /// Estimated opponent mass, kg.
+    pub opponent_mass_kg: f32,
+    /// One-sigma uncertainty of the opponent mass, kg.
+    pub opponent_mass_sigma_kg: f32,
+    /// Track confidence 0..1.
+    pub confidence: f32,
+    /// Tracker object id.
+    pub object_id: u32,
+    /// [`VALID`] (1) if the track is valid; anything else is invalid.
+    pub valid: u8,
+    /// Explicit padding so the layout has no implicit holes.
+    pub _reserved: [u8; 3],
+}
+
+impl ObjectState {
+    /// An invalid, all-zero state (used as the "nothing received" value).
+    pub const INVALID: Self = Self {
+        timestamp_ns: 0,
+        sequence: 0,
+        distance_m: 0.0,
+        closing_speed_mps: 0.0,
+        relative_accel_mps2: 0.0,
+        opponent_mass_kg: 0.0,
+        opponent_mass_sigma_kg: 0.0,
+        confidence: 0.0,
+        object_id: 0,
+        valid: 0,
+        _reserved: [0; 3],
+    };
+
+    /// True if the producer flagged the track valid (does not check the values).
+    pub fn is_valid(&self) -> bool {
+        self.valid == VALID
+    }
+}
+
+impl Default for ObjectState {
+    fn default() -> Self {
+        Self::INVALID
+    }
+}
+
+/// Maximum samples in one [`CrashAccelSample`] batch.
+pub const ACCEL_BATCH_CAPACITY: usize = 8;
+
+/// A small batch of compartment accelerometer samples (longitudinal, vehicle frame).
+///
+/// Batching keeps the sample rate (e.g. 4–8 kHz) decoupled from the message rate.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CrashAccelSample {
+    /// CLOCK_MONOTONIC time of `accel_mps2[0]`, ns.
+    pub first_timestamp_ns: u64,
+    /// Publisher sequence counter.
+    pub sequence: u64,
+    /// Time between consecutive samples, ns.
+    pub sample_period_ns: u32,
+    /// Number of valid entries in `accel_mps2` (values above capacity are clamped by readers).
+    pub count: u32,
+    /// Longitudinal acceleration, m/s² (negative = deceleration).
+    pub accel_mps2: [f32; ACCEL_BATCH_CAPACITY],
+}
+
+impl CrashAccelSample {
+    /// An empty batch.
+    pub const EMPTY: Self = Self {
+        first_timestamp_ns: 0,
+        sequence: 0,
+        sample_period_ns: 0,
+        count: 0,
+        accel_mps2: [0.0; ACCEL_BATCH_CAPACITY],
+    };
+
+    /// The valid samples; a corrupt `count` is clamped, so this never panics.
+    pub fn samples(&self) -> &[f32] {
+        let n = (self.count as usize).min(ACCEL_BATCH_CAPACITY);
+        self.accel_mps2.get(..n).unwrap_or(&[])
+    }
+}
+
+impl Default for CrashAccelSample {
+    fn default() -> Self {
+        Self::EMPTY
+    }
+}
+
+/// Points of the predicted pulse carried in [`EcuDiagnostics`].
+pub const PULSE_POINTS: usize = 64;
+
+/// ECU operating mode as carried in diagnostics (`EcuDiagnostics::mode`).
+#[repr(u8)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EcuMode {
+    /// Runtime up, cycle logic not yet running.
+    Startup = 0,
+    /// Normal monitoring.
+    Monitoring = 1,
+    /// Collision predicted, settings preset.
+    PreCrash = 2,
+    /// Crash confirmed by the accelerometer.
+    Crash = 3,
+    /// After the crash.
+    PostCrash = 4,
+    /// Inputs degraded: conventional reference restraint.
+    Degraded = 5,
+}
+
+impl EcuMode {
+    /// Decodes a raw mode byte; unknown values map to `None`.
+    pub fn from_u8(v: u8) -> Option<Self> {
+        Some(match v {
+            0 => Self::Startup,
+            1 => Self::Monitoring,
+            2 => Self::PreCrash,
+            3 => Self::Crash,
+            4 => Self::PostCrash,
+            5 => Self::Degraded,
+            _ => return None,
+        })
+    }
+
+    /// Short display name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Startup => "startup",
+            Self::Monitoring => "monitoring",
+            Self::PreCrash => "pre-crash",
+            Self::Crash => "crash",
+            Self::PostCrash => "post-crash",
+            Self::Degraded => "degraded",
+        }
+    }
+}
+
+bitflags::bitflags! {
+    /// Why the inputs are not trusted (`EcuDiagnostics::degraded_reasons` carries the bits).
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+    pub struct Degraded: u32 {
+        /// Object state missing or older than the staleness limit.
+        const OBJECT_STALE = 1 << 0;
+        /// Object state present but invalid / out of range / NaN.
+        const OBJECT_INVALID = 1 << 1;
+        /// Accelerometer samples missing or stale.
+        const ACCEL_STALE = 1 << 2;
+        /// Accelerometer samples invalid.
+        const ACCEL_INVALID = 1 << 3;
+        /// CAN inputs stale (vehicle speed, occupant).
+        const CAN_STALE = 1 << 4;
+        /// E2E check failed on a CAN input.
+        const E2E_FAILURE = 1 << 5;
+        /// Characteristic diagram (LUT) missing or invalid.
+        const LUT_INVALID = 1 << 6;
+        /// CAN side switched off (`--no-can`) or unavailable.
+        const CAN_DISABLED = 1 << 7;
+        /// IPC receive errors this cycle.
+        const IPC_ERROR = 1 << 8;
+    }
+}
+
+impl Degraded {
+    /// Reasons that switch the decision to the reference restraint. `CAN_DISABLED` is among
+    /// them: without CAN there is no occupant information for the LUT.
+    pub const DEGRADING: Self = Self::OBJECT_STALE
+        .union(Self::OBJECT_INVALID)
+        .union(Self::ACCEL_INVALID)
+        .union(Self::CAN_STALE)
+        .union(Self::E2E_FAILURE)
+        .union(Self::LUT_INVALID)
+        .union(Self::CAN_DISABLED);
+}
+
+/// ECU diagnostics, published every cycle (predicted pulse, chosen settings, mode, timing).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EcuDiagnostics {
+    /// CLOCK_MONOTONIC time of the cycle that produced this record, ns.
+    pub timestamp_ns: u64,
+    /// Cycles run since start.
+    pub cycle_count: u64,
+    /// Cycles that ended after the next deadline (skipped slots are not re-run).
+    pub overrun_count: u64,
+    /// Execution time of the previous cycle, ns.
+    pub last_exec_ns: u64,
+    /// Wake-up latency of this cycle (actual wake − deadline), ns.
+    pub wake_latency_ns: u64,
+    /// Sequence of the newest object state seen (0 = none).
+    pub last_object_sequence: u64,
+    /// Sequence of the newest accelerometer batch seen (0 = none).
+    pub last_accel_sequence: u64,
+    /// Object states received since start.
+    pub object_samples_rx: u64,
+    /// Accelerometer batches received since start.
+    pub accel_batches_rx: u64,
+    /// Predicted velocity change of the ego vehicle, m/s.
+    pub predicted_delta_v_mps: f32,
+    /// Predicted peak deceleration magnitude, m/s².
+    pub predicted_a_max_mps2: f32,
+    /// Predicted mean deceleration magnitude, m/s².
+    pub predicted_a_mean_mps2: f32,
+    /// Predicted contact duration, s.
+    pub predicted_contact_time_s: f32,
+    /// Predicted time to contact, s (negative/NaN when none).
+    pub time_to_contact_s: f32,
+    /// Time between consecutive `pulse_accel_mps2` points, s.
+    pub pulse_dt_s: f32,
+    /// Predicted pulse, ego acceleration m/s², from contact on.
+    pub pulse_accel_mps2: [f32; PULSE_POINTS],
+    /// Number of valid pulse points.
+    pub pulse_points: u32,
+    /// Chosen belt load-limiter level, N.
+    pub belt_force_limit_n: f32,
+    /// Chosen pretensioner fire time relative to predicted contact, s.
+    pub pretensioner_time_s: f32,
+    /// Chosen airbag fire time relative to contact, s.
+    pub airbag_time_s: f32,
+    /// Chosen airbag stage/level (0 = no fire).
+    pub airbag_stage: u8,
+    /// [`EcuMode`] as a byte.
+    pub mode: u8,
+    /// 1 if the pretensioner is commanded/fired.
+    pub pretensioner_fired: u8,
+    /// 1 if the airbag is commanded/fired.
+    pub airbag_fired: u8,
+    /// Bits of [`Degraded`].
+    pub degraded_reasons: u32,
+}
+
+impl EcuDiagnostics {
+    /// All-zero record in [`EcuMode::Startup`].
+    pub const ZERO: Self = Self {
+        timestamp_ns: 0,
+        cycle_count: 0,
+        overrun_count: 0,
+        last_exec_ns: 0,
+        wake_latency_ns: 0,
+        last_object_sequence: 0,
+        last_accel_sequence: 0,
+        object_samples_rx: 0,
+        accel_batches_rx: 0,
+        predicted_delta_v_mps: 0.0,
+        predicted_a_max_mps2: 0.0,
+        predicted_a_mean_mps2: 0.0,
+        predicted_contact_time_s: 0.0,
+        time_to_contact_s: f32::NAN,
+        pulse_dt_s: 0.0,
+        pulse_accel_mps2: [0.0; PULSE_POINTS],
+        pulse_points: 0,
+        belt_force_limit_n: 0.0,
+        pretensioner_time_s: 0.0,
+        airbag_time_s: 0.0,
+        airbag_stage: 0,
+        mode: EcuMode::Startup as u8,
+        pretensioner_fired: 0,
+        airbag_fired: 0,
+        degraded_reasons: 0,
+    };
+
+    /// The degraded reasons as a set (unknown bits dropped).
+    pub fn degraded(&self) -> Degraded {
+        Degraded::from_bits_truncate(self.degraded_reasons)
+    }
+}
+
+impl Default for EcuDiagnostics {
+    fn default() -> Self {
+        Self::ZERO
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn payloads_are_fixed_size_and_padding_free_where_it_matters() {
+        // Sizes computed by hand from the field lists (repr(C), natural alignment).
+        assert_eq!(
+            core::mem::size_of::<ObjectState>(),
+            8 + 8 + 6 * 4 + 4 + 1 + 3
+        );
+        assert_eq!(
+            core::mem::size_of::<CrashAccelSample>(),
+            8 + 8 + 4 + 4 + 8 * 4
+        );
+    }
+
+    #[test]
+    fn corrupt_accel_count_is_clamped() {
+        let mut s = CrashAccelSample::EMPTY;
+        s.count = u32::MAX;
+        assert_eq!(s.samples().len(), ACCEL_BATCH_CAPACITY);
+        s.count = 3;
+        assert_eq!(s.samples().len(), 3);
+    }
+
+    #[test]
+    fn mode_roundtrip() {
+        for m in 0..=5u8 {
+            assert_eq!(EcuMode::from_u8(m).map(|x| x as u8), Some(m));
+        }
+        assert_eq!(EcuMode::from_u8(6), None);
+    }
+
+    #[test]
+    fn degraded_bits_are_the_published_ones() {
+        // The diagnostics record's bit positions are an interface (monitors, stubs, tests).
+        assert_eq!(Degraded::OBJECT_STALE.bits(), 1);
+        assert_eq!(Degraded::CAN_DISABLED.bits(), 0x80);
+        assert_eq!(Degraded::IPC_ERROR.bits(), 0x100);
+        assert_eq!(Degraded::DEGRADING.bits(), 0b1111_1011);
+    }
+}

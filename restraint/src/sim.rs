@@ -1,0 +1,190 @@
+//! The one in-memory [`CycleIo`] of the project: tests, benches and fuzz targets script
+//! inputs into it and read what the cycle sent. Fixed capacity (`heapless`), so it allocates
+//! nothing and can sit inside an allocation-counting test or an instruction-count bench.
+//!
+//! Queues behave like the shell's iceoryx2 ports with safe overflow: a full queue drops its
+//! oldest entry (counted in `dropped`). Sent frames are kept as the newest [`SIM_QUEUE`] with a
+//! running total, so a caller reads what one cycle sent with [`SimIo::sent_since`].
+
+use bus::RawFrame;
+use heapless::{Deque, HistoryBuf};
+
+use crate::contract::{CycleIo, IoError};
+use crate::signals::{CrashAccelSample, EcuDiagnostics, ObjectState};
+
+/// Capacity of every queue of [`SimIo`].
+pub const SIM_QUEUE: usize = 64;
+
+fn push_dropping_oldest<T, const N: usize>(q: &mut Deque<T, N>, item: T, dropped: &mut u64) {
+    if q.is_full() {
+        q.pop_front();
+        *dropped = dropped.saturating_add(1);
+    }
+    // Cannot fail: a slot was freed above.
+    let _ = q.push_back(item);
+}
+
+/// Scripted inputs and captured outputs.
+#[derive(Debug, Clone)]
+pub struct SimIo {
+    /// Object states delivered on the next drain.
+    pub objects: Deque<ObjectState, SIM_QUEUE>,
+    /// Accelerometer batches delivered on the next drain.
+    pub accel: Deque<CrashAccelSample, SIM_QUEUE>,
+    /// CAN frames delivered on the next drain.
+    pub can_rx: Deque<RawFrame, SIM_QUEUE>,
+    /// The newest frames sent (a ring that overwrites its oldest entry).
+    pub can_tx: HistoryBuf<RawFrame, SIM_QUEUE>,
+    /// Frames sent since creation.
+    pub can_tx_total: u64,
+    /// The newest diagnostics record.
+    pub diagnostics: EcuDiagnostics,
+    /// Diagnostics records published since creation.
+    pub diagnostics_published: u64,
+    /// Inputs dropped because their queue was full.
+    pub dropped: u64,
+    /// When false, CAN sends fail with [`IoError::CanDisabled`] and nothing is received.
+    pub can_on: bool,
+}
+
+impl Default for SimIo {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl SimIo {
+    /// Empty queues, CAN on.
+    pub const fn new() -> Self {
+        Self {
+            objects: Deque::new(),
+            accel: Deque::new(),
+            can_rx: Deque::new(),
+            can_tx: HistoryBuf::new(),
+            can_tx_total: 0,
+            diagnostics: EcuDiagnostics::ZERO,
+            diagnostics_published: 0,
+            dropped: 0,
+            can_on: true,
+        }
+    }
+
+    /// Queues an object state for the next cycle.
+    pub fn push_object(&mut self, o: ObjectState) {
+        push_dropping_oldest(&mut self.objects, o, &mut self.dropped);
+    }
+
+    /// Queues an accelerometer batch for the next cycle.
+    pub fn push_accel(&mut self, a: CrashAccelSample) {
+        push_dropping_oldest(&mut self.accel, a, &mut self.dropped);
+    }
+
+    /// Queues a received CAN frame for the next cycle.
+    pub fn push_can(&mut self, f: RawFrame) {
+        push_dropping_oldest(&mut self.can_rx, f, &mut self.dropped);
+    }
+
+    /// The frames sent after the `total`-th (a value of [`SimIo::can_tx_total`] read before
+    /// a cycle), as far as they are still kept.
+    pub fn sent_since(&self, total: u64) -> impl Iterator<Item = &RawFrame> {
+        let n = usize::try_from(self.can_tx_total.saturating_sub(total)).unwrap_or(usize::MAX);
+        let kept = self.can_tx.len();
+        self.can_tx.oldest_ordered().skip(kept.saturating_sub(n))
+    }
+}
+
+impl CycleIo for SimIo {
+    fn drain_objects(&mut self, f: &mut dyn FnMut(&ObjectState)) -> usize {
+        let mut n = 0;
+        while let Some(o) = self.objects.pop_front() {
+            f(&o);
+            n += 1;
+        }
+        n
+    }
+
+    fn drain_accel(&mut self, f: &mut dyn FnMut(&CrashAccelSample)) -> usize {
+        let mut n = 0;
+        while let Some(a) = self.accel.pop_front() {
+            f(&a);
+            n += 1;
+        }
+        n
+    }
+
+    fn drain_can(&mut self, f: &mut dyn FnMut(&RawFrame)) -> usize {
+        if !self.can_on {
+            self.can_rx.clear();
+            return 0;
+        }
+        let mut n = 0;
+        while let Some(c) = self.can_rx.pop_front() {
+            f(&c);
+            n += 1;
+        }
+        n
+    }
+
+    fn send_can(&mut self, frame: &RawFrame) -> Result<(), IoError> {
+        if !self.can_on {
+            return Err(IoError::CanDisabled);
+        }
+        self.can_tx.write(*frame);
+        self.can_tx_total = self.can_tx_total.saturating_add(1);
+        Ok(())
+    }
+
+    fn publish_diagnostics(
+        &mut self,
+        fill: &mut dyn FnMut(&mut EcuDiagnostics),
+    ) -> Result<(), IoError> {
+        fill(&mut self.diagnostics);
+        self.diagnostics_published = self.diagnostics_published.saturating_add(1);
+        Ok(())
+    }
+
+    fn can_enabled(&self) -> bool {
+        self.can_on
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn full_queues_drop_the_oldest_and_sent_since_reads_one_cycle() {
+        let mut io = SimIo::new();
+        for i in 0..(SIM_QUEUE as u64 + 3) {
+            let mut o = ObjectState::INVALID;
+            o.sequence = i;
+            io.push_object(o);
+        }
+        assert_eq!(io.dropped, 3);
+        let mut first = None;
+        assert_eq!(
+            io.drain_objects(&mut |o| {
+                first.get_or_insert(o.sequence);
+            }),
+            SIM_QUEUE
+        );
+        assert_eq!(first, Some(3));
+        for id in 0..70u32 {
+            io.send_can(&RawFrame::new(id, &[])).unwrap();
+        }
+        let before = io.can_tx_total;
+        io.send_can(&RawFrame::new(0x30, &[1])).unwrap();
+        io.send_can(&RawFrame::new(0x31, &[2])).unwrap();
+        let ids: [u32; 2] = {
+            let mut it = io.sent_since(before).map(|f| f.id);
+            [it.next().unwrap(), it.next().unwrap()]
+        };
+        assert_eq!(ids, [0x30, 0x31]);
+        assert_eq!(io.sent_since(before).count(), 2);
+        io.can_on = false;
+        assert_eq!(
+            io.send_can(&RawFrame::new(1, &[])),
+            Err(IoError::CanDisabled)
+        );
+    }
+}
