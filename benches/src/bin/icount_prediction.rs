@@ -23,7 +23,7 @@ fn main() {
     let n = icount::iterations_from_args();
     let mode = std::env::args().nth(2).unwrap_or_else(|| "exact".into());
     let w = PredictionWorkload::new();
-    let ecu_step_s = ecu::cycle::CycleConfig::default().prediction_step_ms * 1e-3;
+    let ecu_step_s = restraint::CycleConfig::default().prediction_step_ms * 1e-3;
     let diag_step_s = defaults::PULSE_DURATION_S / ipc::PULSE_POINTS as f64;
     let mut buf = Box::new(DefaultPulseBuffer::new());
     let mut points = [0.0f32; ipc::PULSE_POINTS];
