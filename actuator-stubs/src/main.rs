@@ -5,9 +5,9 @@
 //! outcome of what was commanded: DIR/report.json + DIR/outcome.png.
 
 use actuator_stubs::commands::{CommandRecord, Modules};
-use actuator_stubs::outcome::{self, judge, no_worse, reference_as_fired};
+use actuator_stubs::outcome;
 use actuator_stubs::plot;
-use actuator_stubs::report::{Outcome, Report, TimedAction, TrueCrash};
+use actuator_stubs::report::{Report, TimedAction};
 use actuator_stubs::rx::Receiver;
 use actuator_stubs::status::{ecu_fault_names, ecu_mode_name};
 use anyhow::{Context, Result};
@@ -16,7 +16,6 @@ use bus::socket::BusSocket;
 use clap::Parser;
 use host::monotonic_ns;
 use ipc::{BenchTruth, BenchTruthSubscriber, ServiceNames};
-use physics::OccupantInput;
 use sensor_feeds::{Scenario, Truth};
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -372,34 +371,13 @@ fn build_report(
         return Ok(report);
     }
     let t = Truth::new(scenario).map_err(|e| anyhow::anyhow!(e))?;
-    let Some(crash) = t.collision else {
+    let Some(judged) =
+        outcome::evaluate(scenario, &t, modules, contact_ns, reference).map_err(|e| anyhow::anyhow!(e))?
+    else {
         anyhow::bail!("bench truth reports a contact but the scenario's true physics has none");
     };
-    report.true_crash = Some(TrueCrash {
-        closing_speed_kph: t.closing_speed_at_contact_mps() * 3.6,
-        delta_v_kph: crash.vehicle.delta_v_mps * 3.6,
-        a_max_g: physics::mps2_to_g(crash.vehicle.a_max_mps2),
-        a_mean_g: physics::mps2_to_g(crash.vehicle.a_mean_mps2),
-        crush_mm: crash.vehicle.crush_m * 1e3,
-    });
+    report.true_crash = Some(judged.true_crash);
     let pulse = t.pulse.ego_pulse();
-    let occ = OccupantInput {
-        mass_kg: scenario.occupant.mass_kg,
-        chest_to_wheel_m: scenario.occupant.chest_to_wheel_mm * 1e-3,
-        belted: scenario.occupant.belted,
-    };
-    let ref_set = reference.settings();
-    let commanded = outcome::commanded(modules, contact_ns);
-    let (adaptive, out_a) =
-        judge(&pulse, &occ, &commanded.settings(&ref_set)).map_err(|e| anyhow::anyhow!(e))?;
-    let (refj, _) = judge(
-        &pulse,
-        &occ,
-        &reference_as_fired(&ref_set, crash.vehicle.delta_v_mps),
-    )
-    .map_err(|e| anyhow::anyhow!(e))?;
-    let sum_a = adaptive.a_max_g + adaptive.a_mean_g;
-    let sum_r = refj.a_max_g + refj.a_mean_g;
     let png = cli.out.join("outcome.png");
     let pulse_g: Vec<f64> = pulse
         .accel_mps2
@@ -409,41 +387,14 @@ fn build_report(
     match plot::draw(
         &png,
         &scenario.name,
-        &adaptive,
-        &refj,
+        &judged.outcome.adaptive,
+        &judged.outcome.reference,
         &pulse_g,
         pulse.step_s * 1e3,
     ) {
         Ok(()) => report.plot = Some("outcome.png".into()),
         Err(e) => eprintln!("actuator-stubs: warning: {e}"),
     }
-    // The same levels at the ECU's PLANNED times (relative to its predicted contact ≈ the true
-    // one): separates the plan's quality from command timing.
-    let planned = outcome::Commanded {
-        pretensioner_s: commanded.pretensioner_s.and(
-            modules
-                .action("pretensioner_fire")
-                .map(|a| a.planned_ms * 1e-3),
-        ),
-        load_limiter_kn: commanded.load_limiter_kn,
-        airbag: modules
-            .action("airbag_fire")
-            .map(|a| (a.planned_ms * 1e-3, a.level_kn)),
-    };
-    let adaptive_planned = judge(&pulse, &occ, &planned.settings(&ref_set))
-        .ok()
-        .map(|j| j.0);
-    report.outcome = Some(Outcome {
-        adaptive_planned,
-        adaptive_no_worse: no_worse(&adaptive, &refj),
-        change_pct: if sum_r > 0.0 {
-            (sum_a / sum_r - 1.0) * 100.0
-        } else {
-            0.0
-        },
-        ideal_g: physics::mps2_to_g(out_a.ideal_decel_mps2),
-        adaptive,
-        reference: refj,
-    });
+    report.outcome = Some(judged.outcome);
     Ok(report)
 }

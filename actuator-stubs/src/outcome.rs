@@ -162,6 +162,88 @@ pub fn reference_as_fired(
     }
 }
 
+/// What [`evaluate`] found: the true crash and the occupant outcome comparison.
+#[derive(Clone, Debug)]
+pub struct Evaluated {
+    /// The true crash.
+    pub true_crash: crate::report::TrueCrash,
+    /// Adaptive (as commanded and as planned) vs reference vs ideal.
+    pub outcome: crate::report::Outcome,
+}
+
+/// Judges what `modules` did against the scenario's TRUE crash (`truth`, contact at
+/// `contact_ns` on the modules' clock): the restraint as commanded (receive times), the same
+/// levels at the ECU's planned times, and the reference restraint as a conventional ECU fires
+/// it. `Ok(None)` when the true physics has no collision.
+///
+/// # Errors
+/// An occupant simulation failed (invalid settings).
+pub fn evaluate(
+    scenario: &sensor_feeds::Scenario,
+    truth: &sensor_feeds::Truth,
+    modules: &crate::commands::Modules,
+    contact_ns: u64,
+    reference: &physics::reference::ReferenceRestraint,
+) -> Result<Option<Evaluated>, String> {
+    let Some(crash) = truth.collision else {
+        return Ok(None);
+    };
+    let true_crash = crate::report::TrueCrash {
+        closing_speed_kph: truth.closing_speed_at_contact_mps() * 3.6,
+        delta_v_kph: crash.vehicle.delta_v_mps * 3.6,
+        a_max_g: physics::mps2_to_g(crash.vehicle.a_max_mps2),
+        a_mean_g: physics::mps2_to_g(crash.vehicle.a_mean_mps2),
+        crush_mm: crash.vehicle.crush_m * 1e3,
+    };
+    let pulse = truth.pulse.ego_pulse();
+    let occ = OccupantInput {
+        mass_kg: scenario.occupant.mass_kg,
+        chest_to_wheel_m: scenario.occupant.chest_to_wheel_mm * 1e-3,
+        belted: scenario.occupant.belted,
+    };
+    let ref_set = reference.settings();
+    let commanded = commanded(modules, contact_ns);
+    let (adaptive, out_a) = judge(&pulse, &occ, &commanded.settings(&ref_set))?;
+    let (refj, _) = judge(
+        &pulse,
+        &occ,
+        &reference_as_fired(&ref_set, crash.vehicle.delta_v_mps),
+    )?;
+    let sum_a = adaptive.a_max_g + adaptive.a_mean_g;
+    let sum_r = refj.a_max_g + refj.a_mean_g;
+    // The same levels at the ECU's PLANNED times (relative to its predicted contact ≈ the true
+    // one): separates the plan's quality from command timing.
+    let planned = Commanded {
+        pretensioner_s: commanded.pretensioner_s.and(
+            modules
+                .action("pretensioner_fire")
+                .map(|a| a.planned_ms * 1e-3),
+        ),
+        load_limiter_kn: commanded.load_limiter_kn,
+        airbag: modules
+            .action("airbag_fire")
+            .map(|a| (a.planned_ms * 1e-3, a.level_kn)),
+    };
+    let adaptive_planned = judge(&pulse, &occ, &planned.settings(&ref_set))
+        .ok()
+        .map(|j| j.0);
+    Ok(Some(Evaluated {
+        true_crash,
+        outcome: crate::report::Outcome {
+            adaptive_planned,
+            adaptive_no_worse: no_worse(&adaptive, &refj),
+            change_pct: if sum_r > 0.0 {
+                (sum_a / sum_r - 1.0) * 100.0
+            } else {
+                0.0
+            },
+            ideal_g: physics::mps2_to_g(out_a.ideal_decel_mps2),
+            adaptive,
+            reference: refj,
+        },
+    }))
+}
+
 /// True when the adaptive outcome is no worse than the reference: no bottoming-out the
 /// reference avoided, and a_max + a_mean within [`NO_WORSE_TOLERANCE`].
 pub fn no_worse(adaptive: &Judged, reference: &Judged) -> bool {

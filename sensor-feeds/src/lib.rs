@@ -6,10 +6,12 @@
 #![warn(missing_docs)]
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod player;
 pub mod scenario;
 pub mod sensors;
 pub mod truth;
 
+pub use player::{PlayCounts, Player, TickOutput};
 pub use scenario::{Scenario, ScenarioError};
 pub use sensors::SensorModelSim;
 pub use truth::{Truth, WorldState};

@@ -8,12 +8,9 @@
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use ipc::{
-    AccelPublisher, BenchTruth, BenchTruthPublisher, CrashAccelSample, ObjectPublisher,
-    ServiceNames,
-};
-use sensor_feeds::scenario::DropoutTarget;
-use sensor_feeds::{monotonic_ns, sleep_until_ns, Scenario, SensorModelSim, Truth};
+use ipc::{AccelPublisher, BenchTruth, BenchTruthPublisher, ObjectPublisher, ServiceNames};
+use sensor_feeds::player::TICK_NS;
+use sensor_feeds::{monotonic_ns, sleep_until_ns, Player, Scenario, TickOutput, Truth};
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 
@@ -48,7 +45,6 @@ struct Cli {
     epoch_ns: Option<u64>,
 }
 
-const TICK_NS: u64 = 1_000_000;
 const TRUTH_PERIOD_TICKS: u64 = 10;
 
 fn main() -> std::process::ExitCode {
@@ -92,8 +88,7 @@ fn run(cli: &Cli) -> Result<()> {
         return Ok(());
     }
     let contact_s = truth.contact_s;
-    let mut model = SensorModelSim::new(truth);
-    let sensor = scenario.sensor.clone();
+    let closing_at_contact_mps = truth.closing_speed_at_contact_mps();
 
     let stop = host::install_stop_signals().context("installing signal handler")?;
 
@@ -115,7 +110,6 @@ fn run(cli: &Cli) -> Result<()> {
             })?,
         )
     };
-    let mut protector = bus::E2eProtector::new();
 
     let scale = 1.0 / cli.speedup;
     let to_ns = |t_s: f64| (t_s * 1e9 * scale).round() as u64;
@@ -143,26 +137,15 @@ fn run(cli: &Cli) -> Result<()> {
         let _ = writeln!(out, "epoch_ns {start_ns}");
         let _ = out.flush();
     }
-    let t0_s = first_tick as f64 * 1e-3;
     if first_tick > 0 {
-        eprintln!("sensor-feeds: resuming at t = {t0_s:.3} s (epoch {start_ns} ns)");
+        eprintln!(
+            "sensor-feeds: resuming at t = {:.3} s (epoch {start_ns} ns)",
+            first_tick as f64 * 1e-3
+        );
     }
-    let obj_period_s = sensor.object_period_ms * 1e-3;
-    let veh_period_s = sensor.vehicle_period_ms * 1e-3;
-    let occ_period_s = sensor.occupant_period_ms * 1e-3;
-    let accel_dt_s = 1.0 / sensor.accel_rate_hz;
-    // First instant of each feed at or after t0 (all 0 on a fresh start).
-    let first_at = |period_s: f64| (t0_s / period_s - 1e-9).ceil().max(0.0) * period_s;
-    let (mut next_obj, mut next_veh, mut next_occ, mut next_accel_k) = (
-        first_at(obj_period_s),
-        first_at(veh_period_s),
-        first_at(occ_period_s),
-        (t0_s / accel_dt_s - 1e-9).ceil().max(0.0) as u64,
-    );
-    // The last object sample published: what a stuck sensor keeps repeating.
-    let mut last_object: Option<ipc::ObjectState> = None;
+    let mut player = Player::new(truth, start_ns, scale, first_tick);
+    let mut out = TickOutput::default();
     let mut counts = Counts::default();
-    let mut accel_seq = 0u64;
     let mut truth_rec = BenchTruth::EMPTY;
     truth_rec.set_scenario_name(&scenario.name);
     truth_rec.start_ns = start_ns;
@@ -177,96 +160,22 @@ fn run(cli: &Cli) -> Result<()> {
         }
         let t = tick as f64 * 1e-3;
         sleep_until_ns(start_ns + to_ns(t));
-        // Object list.
-        while next_obj <= t + 1e-9 {
-            let tp = next_obj;
-            next_obj += obj_period_s;
-            if sensor.dropped(DropoutTarget::Object, tp) {
-                counts.objects_dropped += 1;
-                continue;
-            }
-            let sample = match last_object.filter(|_| sensor.frozen(tp)) {
-                Some(stuck) => {
-                    counts.objects_frozen += 1;
-                    Some(stuck)
-                }
-                None => match (model.object(tp), model.measurement_time_s(tp)) {
-                    (Some(mut o), Some(tm)) => {
-                        o.timestamp_ns = start_ns + to_ns(tm);
-                        Some(o)
-                    }
-                    _ => None,
-                },
-            };
-            if let Some(o) = sample {
-                last_object = Some(o);
-                match objects.publish(o) {
-                    Ok(()) => counts.objects += 1,
-                    Err(_) => counts.ipc_errors += 1,
-                }
+        player
+            .tick(tick, &mut out)
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        for o in &out.objects {
+            if objects.publish(*o).is_err() {
+                counts.ipc_errors += 1;
             }
         }
-        // Accelerometer: every sample whose instant has passed, in batches of ≤ 8.
-        if !sensor.dropped(DropoutTarget::Accel, t) {
-            let mut batch = CrashAccelSample::EMPTY;
-            while (next_accel_k as f64) * accel_dt_s <= t + 1e-9 {
-                let ts = next_accel_k as f64 * accel_dt_s;
-                if batch.count == 0 {
-                    batch.first_timestamp_ns = start_ns + to_ns(ts);
-                    batch.sample_period_ns = to_ns(accel_dt_s) as u32;
-                }
-                batch.accel_mps2[batch.count as usize] = model.accel_mps2(ts) as f32;
-                batch.count += 1;
-                next_accel_k += 1;
-                if batch.count as usize == ipc::ACCEL_BATCH_CAPACITY {
-                    accel_seq += 1;
-                    batch.sequence = accel_seq;
-                    counts.accel_samples += u64::from(batch.count);
-                    if accel.publish(batch).is_err() {
-                        counts.ipc_errors += 1;
-                    }
-                    batch = CrashAccelSample::EMPTY;
-                }
+        for b in &out.accel {
+            if accel.publish(*b).is_err() {
+                counts.ipc_errors += 1;
             }
-            if batch.count > 0 {
-                accel_seq += 1;
-                batch.sequence = accel_seq;
-                counts.accel_samples += u64::from(batch.count);
-                if accel.publish(batch).is_err() {
-                    counts.ipc_errors += 1;
-                }
-            }
-        } else {
-            // Samples in a dropout are lost, not delivered late.
-            next_accel_k = ((t / accel_dt_s).floor() as u64) + 1;
         }
-        // CAN.
         if let Some(sock) = can.as_mut() {
-            while next_veh <= t + 1e-9 {
-                let tp = next_veh;
-                next_veh += veh_period_s;
-                if sensor.dropped(DropoutTarget::Vehicle, tp) {
-                    continue;
-                }
-                let frame =
-                    protector.seal(model.ego_frame(tp).map_err(|e| anyhow::anyhow!("{e:?}"))?);
-                match sock.send(&frame) {
-                    Ok(()) => counts.can_frames += 1,
-                    Err(_) => counts.can_errors += 1,
-                }
-            }
-            while next_occ <= t + 1e-9 {
-                let tp = next_occ;
-                next_occ += occ_period_s;
-                if sensor.dropped(DropoutTarget::Occupant, tp) {
-                    continue;
-                }
-                let frame = protector.seal(
-                    model
-                        .occupant_frame()
-                        .map_err(|e| anyhow::anyhow!("{e:?}"))?,
-                );
-                match sock.send(&frame) {
+            for f in &out.can {
+                match sock.send(f) {
                     Ok(()) => counts.can_frames += 1,
                     Err(_) => counts.can_errors += 1,
                 }
@@ -278,8 +187,7 @@ fn run(cli: &Cli) -> Result<()> {
             contact_announced = true;
             announce = true;
             truth_rec.contact_ns = start_ns + to_ns(tc);
-            truth_rec.closing_speed_at_contact_mps =
-                model.truth().closing_speed_at_contact_mps() as f32;
+            truth_rec.closing_speed_at_contact_mps = closing_at_contact_mps as f32;
         }
         if announce || tick % TRUTH_PERIOD_TICKS == 0 {
             truth_rec.sequence += 1;
@@ -299,21 +207,19 @@ fn run(cli: &Cli) -> Result<()> {
         }
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
+    let p = player.counts();
     eprintln!(
-        "sensor-feeds: done: {} objects ({} dropped, {} stale repeats), {} accel samples, {} CAN frames, {} CAN errors, {} IPC errors",
-        counts.objects, counts.objects_dropped, counts.objects_frozen, counts.accel_samples, counts.can_frames, counts.can_errors, counts.ipc_errors
+        "sensor-feeds: done: {} objects ({} dropped, {} stale repeats), {} accel samples ({} faulty), {} CAN frames, {} CAN errors, {} IPC errors",
+        p.objects, p.objects_dropped, p.objects_frozen, p.accel_samples, p.accel_faulty, counts.can_frames, counts.can_errors, counts.ipc_errors
     );
     // Keep the publishers alive a moment so subscribers can read the last samples.
     std::thread::sleep(std::time::Duration::from_millis(50));
     Ok(())
 }
 
+/// What the transports did with the player's output.
 #[derive(Default)]
 struct Counts {
-    objects: u64,
-    objects_dropped: u64,
-    objects_frozen: u64,
-    accel_samples: u64,
     can_frames: u64,
     can_errors: u64,
     ipc_errors: u64,

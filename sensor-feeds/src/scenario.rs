@@ -166,6 +166,28 @@ pub struct Freeze {
     pub end_s: f64,
 }
 
+/// What a faulty crash accelerometer reports inside an [`AccelFault`] window.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum AccelFaultKind {
+    /// Stuck at its last genuine reading (the batches keep coming, the value never changes).
+    Stuck,
+    /// Pinned at full scale in the deceleration direction (`accel_full_scale_g`).
+    Saturated,
+}
+
+/// A time window in which the crash accelerometer is faulty but keeps publishing.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AccelFault {
+    /// Window start [s after scenario start].
+    pub start_s: f64,
+    /// Window end [s after scenario start] (exclusive).
+    pub end_s: f64,
+    /// What it reports meanwhile.
+    pub kind: AccelFaultKind,
+}
+
 /// Sensor model; every field has a documented default.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
@@ -184,6 +206,8 @@ pub struct SensorModel {
     pub mass_bias_kg: f64,
     /// Per-sample Gaussian noise of the mass estimate [kg, 1σ].
     pub mass_noise_kg: f64,
+    /// Systematic error of the reported closing speed [m/s] (a miscalibrated radar).
+    pub speed_bias_mps: f64,
     /// Uncertainty the sensor reports with its estimate [kg, 1σ] (~300 kg payload range).
     pub mass_sigma_kg: f64,
     /// Reported mass instead of true mass + bias [kg] (a barrier has no finite mass; what a
@@ -199,10 +223,15 @@ pub struct SensorModel {
     pub accel_rate_hz: f64,
     /// Gaussian accelerometer noise [m/s², 1σ].
     pub accel_noise_mps2: f64,
+    /// Measuring range of the crash accelerometer [g]: readings are clipped to ±this, and a
+    /// saturated sensor reads −this.
+    pub accel_full_scale_g: f64,
     /// Feed dropouts.
     pub dropouts: Vec<Dropout>,
     /// Stuck object-list windows (stale data: the last sample repeated).
     pub freezes: Vec<Freeze>,
+    /// Faulty-accelerometer windows (stuck, saturated).
+    pub accel_faults: Vec<AccelFault>,
 }
 
 impl Default for SensorModel {
@@ -215,6 +244,7 @@ impl Default for SensorModel {
             speed_noise_mps: 0.1,
             mass_bias_kg: 0.0,
             mass_noise_kg: 0.0,
+            speed_bias_mps: 0.0,
             mass_sigma_kg: 300.0,
             mass_estimate_kg: None,
             confidence: 0.95,
@@ -222,8 +252,10 @@ impl Default for SensorModel {
             occupant_period_ms: 100.0,
             accel_rate_hz: 4000.0,
             accel_noise_mps2: 0.5,
+            accel_full_scale_g: 200.0,
             dropouts: Vec::new(),
             freezes: Vec::new(),
+            accel_faults: Vec::new(),
         }
     }
 }
@@ -236,6 +268,14 @@ impl SensorModel {
                 && t_s >= d.start_s
                 && t_s < d.end_s
         })
+    }
+
+    /// The accelerometer fault at scenario time `t_s`, if any (the first window that holds).
+    pub fn accel_fault(&self, t_s: f64) -> Option<AccelFaultKind> {
+        self.accel_faults
+            .iter()
+            .find(|f| t_s >= f.start_s && t_s < f.end_s)
+            .map(|f| f.kind)
     }
 
     /// True if the object list is stuck at scenario time `t_s`.
@@ -288,6 +328,9 @@ pub struct Expect {
     /// The ECU falls back to the conventional reference restraint (commands with
     /// `CmdSource = Reference`).
     pub reference_fallback: Option<bool>,
+    /// The ECU reports the crash accelerometer faulty (`EcuStatus.FaultAccelSensor`) before the
+    /// true contact.
+    pub accel_fault_before_contact: Option<bool>,
 }
 
 /// A scenario-file error: where and what.
@@ -571,6 +614,7 @@ impl Scenario {
         )?;
         range("sensor.mass_bias_kg", s.mass_bias_kg, -3000.0, 3000.0, "kg")?;
         range("sensor.mass_noise_kg", s.mass_noise_kg, 0.0, 3000.0, "kg")?;
+        range("sensor.speed_bias_mps", s.speed_bias_mps, -30.0, 30.0, "m/s")?;
         range("sensor.mass_sigma_kg", s.mass_sigma_kg, 0.0, 3000.0, "kg")?;
         if let Some(m) = s.mass_estimate_kg {
             range("sensor.mass_estimate_kg", m, 100.0, 100000.0, "kg")?;
@@ -611,6 +655,13 @@ impl Scenario {
             50.0,
             "m/s²",
         )?;
+        range(
+            "sensor.accel_full_scale_g",
+            s.accel_full_scale_g,
+            10.0,
+            1000.0,
+            "g",
+        )?;
         let windows = s
             .dropouts
             .iter()
@@ -621,6 +672,12 @@ impl Scenario {
                     .iter()
                     .enumerate()
                     .map(|(i, d)| (format!("sensor.freezes[{i}]"), d.start_s, d.end_s)),
+            )
+            .chain(
+                s.accel_faults
+                    .iter()
+                    .enumerate()
+                    .map(|(i, d)| (format!("sensor.accel_faults[{i}]"), d.start_s, d.end_s)),
             );
         for (f, start_s, end_s) in windows {
             if !(start_s.is_finite() && end_s.is_finite() && start_s >= 0.0 && end_s > start_s) {
@@ -794,6 +851,25 @@ mass_kg = 75
         assert_eq!(e.field.as_deref(), Some("sensor.freezes[0]"), "{e}");
         let unknown = text.replace("end_s = 0.9", "end_s = 0.9, target = \"object\"");
         assert!(Scenario::parse("x.toml", &unknown).is_err());
+    }
+
+    #[test]
+    fn accel_fault_windows_and_speed_bias() {
+        let text = format!(
+            "{OK}\n[sensor]\nspeed_bias_mps = -2.5\naccel_faults = [{{ start_s = 0.5, end_s = 0.7, kind = \"stuck\" }}, {{ start_s = 1.0, end_s = 1.1, kind = \"saturated\" }}]\n"
+        );
+        let s = Scenario::parse("x.toml", &text).expect("valid");
+        assert_eq!(s.sensor.speed_bias_mps, -2.5);
+        assert_eq!(s.sensor.accel_fault(0.49), None);
+        assert_eq!(s.sensor.accel_fault(0.5), Some(AccelFaultKind::Stuck));
+        assert_eq!(s.sensor.accel_fault(1.05), Some(AccelFaultKind::Saturated));
+        assert_eq!(s.sensor.accel_fault(1.1), None);
+        assert_eq!(s.sensor.accel_full_scale_g, 200.0);
+        let bad = text.replace("end_s = 0.7", "end_s = 0.4");
+        let e = Scenario::parse("x.toml", &bad).unwrap_err();
+        assert_eq!(e.field.as_deref(), Some("sensor.accel_faults[0]"), "{e}");
+        let bad = text.replace("\"stuck\"", "\"sticky\"");
+        assert!(Scenario::parse("x.toml", &bad).is_err());
     }
 
     #[test]

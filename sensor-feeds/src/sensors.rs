@@ -69,8 +69,9 @@ impl SensorModelSim {
         let mass = s.mass_estimate_kg.unwrap_or(true_mass + s.mass_bias_kg)
             + s.mass_noise_kg * gauss(&mut self.rng);
         o.distance_m = (w.distance_m + s.distance_noise_m * gauss(&mut self.rng)).max(0.0) as f32;
-        o.closing_speed_mps =
-            (w.closing_speed_mps + s.speed_noise_mps * gauss(&mut self.rng)) as f32;
+        o.closing_speed_mps = (w.closing_speed_mps
+            + s.speed_bias_mps
+            + s.speed_noise_mps * gauss(&mut self.rng)) as f32;
         o.relative_accel_mps2 = w.relative_accel_mps2 as f32;
         o.opponent_mass_kg = mass.max(1.0) as f32;
         o.opponent_mass_sigma_kg = s.mass_sigma_kg as f32;
@@ -86,10 +87,13 @@ impl SensorModelSim {
     }
 
     /// Compartment accelerometer reading at `t_s` [m/s²]: braking deceleration before contact,
-    /// the TRUE crash pulse after it, plus sensor noise.
+    /// the TRUE crash pulse after it, plus sensor noise, clipped to the measuring range.
     pub fn accel_mps2(&mut self, t_s: f64) -> f64 {
         let w = self.truth.state(t_s);
-        w.ego_accel_mps2 + self.scenario().sensor.accel_noise_mps2 * gauss(&mut self.rng)
+        let s = &self.truth.scenario().sensor;
+        let full_scale = s.accel_full_scale_g * physics::defaults::STANDARD_GRAVITY_MPS2;
+        let noise = s.accel_noise_mps2 * gauss(&mut self.rng);
+        (w.ego_accel_mps2 + noise).clamp(-full_scale, full_scale)
     }
 
     /// The `EgoVehicleState` frame content at `t_s` (E2E bytes are filled by the protector).

@@ -69,7 +69,12 @@ fn paper_cases_meet_at_their_published_speeds() {
             "{name}: {e:.2} + {o:.2} km/h"
         );
     }
-    for (name, kph) in [("fmvss208-56-belted", 56.0), ("fmvss208-48-unbelted", 48.0)] {
+    for (name, kph) in [
+        ("fmvss208-56-belted", 56.0),
+        ("fmvss208-48-unbelted", 48.0),
+        ("barrier-16-objects-dead", 16.0),
+        ("barrier-35-objects-dead", 35.0),
+    ] {
         let (e, o) = impact_kph(name);
         assert!((e - kph).abs() < 0.05 && o == 0.0, "{name}: {e:.2} km/h");
     }

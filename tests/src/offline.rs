@@ -1,0 +1,223 @@
+//! The bench without processes, bus or clock: a scenario's sensor feeds
+//! ([`sensor_feeds::Player`], the model the real feeds play) drive the restraint core
+//! ([`restraint::RestraintCycle`] through [`restraint::SimIo`]) on a simulated 1 kHz grid,
+//! every frame the core sends is applied to the actuator stubs' module state machines
+//! ([`actuator_stubs::commands::Modules`]) at the cycle's time, and the stubs' judge
+//! ([`actuator_stubs::outcome::evaluate`]) rates what was commanded against the TRUE crash —
+//! the same judge as the real bench.
+//!
+//! Deterministic and fast (a library scenario in ≈ 50 ms), so outcome tables over the scenario
+//! library and its variations can be made before and after a change of the decision logic,
+//! on a busy machine, without the emulated timing of the QEMU route. What it leaves out: CAN
+//! transfer and scheduling latency (a command acts at the end of the cycle that sent it), SecOC
+//! (commands are applied unauthenticated), the processes' start-up. The ECU cycles run half a
+//! period after the feeds' ticks (`ecu_phase_ns`), as two unsynchronised 1 kHz loops would.
+
+use actuator_stubs::commands::{decode, Modules};
+use actuator_stubs::outcome::{evaluate, Evaluated};
+use actuator_stubs::status::{ecu_fault_names, ecu_mode_name};
+use anyhow::{anyhow, Result};
+use restraint::{Activity, CycleConfig, CycleInfo, RestraintCycle, SimIo};
+use sensor_feeds::{Player, Scenario, TickOutput, Truth};
+
+/// Scenario time 0 on the simulated clock [ns] (any value clear of 0).
+const START_NS: u64 = 1_000_000_000;
+const MS: u64 = 1_000_000;
+
+/// What the offline bench runs the ECU core with.
+pub struct OfflineConfig {
+    /// Characteristic diagram (`None`: the ECU runs DEGRADED on the reference restraint).
+    pub lut: Option<diagram::Diagram>,
+    /// Reference restraint.
+    pub reference: physics::reference::ReferenceRestraint,
+    /// Decision settings.
+    pub cycle: CycleConfig,
+    /// Offset of the ECU's cycle grid after the feeds' tick grid [ns] (0..1 ms).
+    pub ecu_phase_ns: u64,
+}
+
+impl OfflineConfig {
+    /// The shipped table (`data/default.lut` under `repo`), the built-in reference restraint and
+    /// the default decision settings.
+    ///
+    /// # Errors
+    /// The table or the built-in reference restraint does not load.
+    pub fn shipped(repo: &std::path::Path) -> Result<Self> {
+        let lut = diagram::Diagram::load(repo.join("data/default.lut"))
+            .map_err(|e| anyhow!("data/default.lut: {e}"))?;
+        Ok(Self {
+            lut: Some(lut),
+            reference: physics::reference::ReferenceRestraint::builtin()
+                .map_err(|e| anyhow!("reference restraint: {e}"))?,
+            cycle: CycleConfig::default(),
+            ecu_phase_ns: MS / 2,
+        })
+    }
+}
+
+/// One offline run: what the modules did and how it came out.
+#[derive(Debug)]
+pub struct OfflineRun {
+    /// Scenario name.
+    pub name: String,
+    /// True contact [s after start] (`None`: no contact).
+    pub contact_s: Option<f64>,
+    /// The module state machines after the run (actions, limiter levels, EcuStatus history).
+    pub modules: Modules,
+    /// Occupant outcome (contact only).
+    pub evaluated: Option<Evaluated>,
+    /// First cycle in the diagnostics mode "crash" or "post-crash" (the crash confirmed) [ms rel.
+    /// contact, or since start].
+    pub crash_mode_ms: Option<f64>,
+    /// Every EcuStatus mode change: (ms rel. contact or since start, mode name).
+    pub modes: Vec<(f64, String)>,
+    /// Every EcuStatus fault-flag change: (ms, flag names).
+    pub faults: Vec<(f64, Vec<String>)>,
+}
+
+impl OfflineRun {
+    /// Scenario time [ns] → ms relative to the true contact (or since start without contact).
+    fn rel_ms(contact_s: Option<f64>, t_ns: u64) -> f64 {
+        let t_s = (t_ns - START_NS) as f64 * 1e-9;
+        (t_s - contact_s.unwrap_or(0.0)) * 1e3
+    }
+
+    /// The first module action `what` (`airbag_fire`, `pretensioner_fire`, …): (ms rel. contact,
+    /// planned ms, level kN, source).
+    pub fn action(&self, what: &str) -> Option<(f64, f64, f64, &str)> {
+        self.modules.action(what).map(|a| {
+            (
+                Self::rel_ms(self.contact_s, a.t_ns),
+                a.planned_ms,
+                a.level_kn,
+                a.source.as_str(),
+            )
+        })
+    }
+
+    /// First instant a fault flag named `flag` was set [ms rel. contact].
+    pub fn fault_first_ms(&self, flag: &str) -> Option<f64> {
+        self.faults
+            .iter()
+            .find(|(_, f)| f.iter().any(|n| n == flag))
+            .map(|(t, _)| *t)
+    }
+}
+
+/// Runs `scenario` through the core with `cfg`.
+///
+/// # Errors
+/// The cycle configuration is invalid, the scenario has no consistent truth, or the judge
+/// failed.
+pub fn run(scenario: &Scenario, cfg: &OfflineConfig) -> Result<OfflineRun> {
+    let truth = Truth::new(scenario).map_err(|e| anyhow!("{}: {e}", scenario.name))?;
+    let contact_s = truth.contact_s;
+    let lut = cfg.lut.as_ref().map(ecu::lut_input);
+    let reference = ecu::reference_input(&cfg.reference.restraint);
+    let (mut ecu, _) = RestraintCycle::new(cfg.cycle.clone(), lut, &reference)
+        .map_err(|e| anyhow!("cycle config: {e}"))?;
+    let mut io = SimIo::new();
+    let mut player = Player::new(truth, START_NS, 1.0, 0);
+    let mut out = TickOutput::default();
+    let mut modules = Modules::default();
+    let mut crash_mode_ns = None;
+    let ticks = (scenario.duration_s * 1e3).round() as u64;
+    for tick in 0..=ticks {
+        player
+            .tick(tick, &mut out)
+            .map_err(|e| anyhow!("{}: feeds: {e:?}", scenario.name))?;
+        out.objects.iter().for_each(|o| io.push_object(*o));
+        out.accel.iter().for_each(|a| io.push_accel(*a));
+        out.can.iter().for_each(|f| io.push_can(*f));
+        let now = START_NS + tick * MS + cfg.ecu_phase_ns;
+        let info = CycleInfo {
+            cycle: tick,
+            slot: tick,
+            period_ns: MS,
+            deadline_ns: now,
+            now_ns: now,
+            sync_time_us: now / 1_000,
+            ..CycleInfo::default()
+        };
+        let before = io.can_tx_total;
+        ecu.step(&info, &mut io);
+        for f in io.sent_since(before) {
+            if let Ok(m) = bus::decode(f.id, f.payload()) {
+                modules.apply(now, &decode(&m));
+            }
+        }
+        let m = io.diagnostics.mode;
+        let crashed = m == restraint::EcuMode::Crash as u8 || m == restraint::EcuMode::PostCrash as u8;
+        if crash_mode_ns.is_none() && crashed {
+            crash_mode_ns = Some(now);
+        }
+    }
+    let truth = Truth::new(scenario).map_err(|e| anyhow!("{}: {e}", scenario.name))?;
+    let contact_ns = contact_s.map_or(u64::MAX, |tc| START_NS + (tc * 1e9).round() as u64);
+    let evaluated = match contact_s {
+        Some(_) => evaluate(scenario, &truth, &modules, contact_ns, &cfg.reference)
+            .map_err(|e| anyhow!("{}: judge: {e}", scenario.name))?,
+        None => None,
+    };
+    let rel = |t: u64| OfflineRun::rel_ms(contact_s, t);
+    Ok(OfflineRun {
+        name: scenario.name.clone(),
+        contact_s,
+        crash_mode_ms: crash_mode_ns.map(rel),
+        modes: modules
+            .ecu_modes
+            .iter()
+            .map(|(t, m)| (rel(*t), ecu_mode_name(*m).to_owned()))
+            .collect(),
+        faults: modules
+            .ecu_faults
+            .iter()
+            .map(|(t, f)| (rel(*t), ecu_fault_names(*f)))
+            .collect(),
+        evaluated,
+        modules,
+    })
+}
+
+/// Header of [`table_row`].
+pub const TABLE_HEADER: &str = "scenario                      confirm  airbag ms (plan)  src   adaptive a_max/a_mean/exc   reference a_max/a_mean/exc   change  verdict";
+
+/// One line of the outcome table.
+pub fn table_row(r: &OfflineRun) -> String {
+    let bang = |b: bool| if b { "!" } else { " " };
+    let confirm = r
+        .crash_mode_ms
+        .filter(|_| r.contact_s.is_some())
+        .map_or("    —".to_owned(), |t| format!("{t:+5.1}"));
+    let bag = r
+        .action("airbag_fire")
+        .map_or("no fire          ".to_owned(), |(t, p, _, _)| {
+            format!("{t:+5.1} ({p:+5.1})     ")
+        });
+    let src = r
+        .action("airbag_fire")
+        .or_else(|| r.action("pretensioner_fire"))
+        .map_or("—", |a| if a.3 == "adaptive" { "adpt" } else { "ref" });
+    let Some(e) = &r.evaluated else {
+        return format!("{:<28} {confirm}  {bag} {src:<4}  no contact", r.name);
+    };
+    let (a, f) = (&e.outcome.adaptive, &e.outcome.reference);
+    format!(
+        "{:<28} {confirm}  {bag} {src:<4}  {:5.1} g/{:5.1} g/{:4.0} mm{}   {:5.1} g/{:5.1} g/{:4.0} mm{}   {:+6.1} %  {}",
+        r.name,
+        a.a_max_g,
+        a.a_mean_g,
+        a.excursion_mm,
+        bang(a.bottomed_out),
+        f.a_max_g,
+        f.a_mean_g,
+        f.excursion_mm,
+        bang(f.bottomed_out),
+        e.outcome.change_pct,
+        if e.outcome.adaptive_no_worse {
+            "no worse"
+        } else {
+            "WORSE"
+        }
+    )
+}
