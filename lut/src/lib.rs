@@ -17,6 +17,7 @@
 #![warn(missing_docs)]
 
 pub mod distributed;
+pub mod fallback_study;
 pub mod optimise;
 pub mod progress;
 pub mod reference;

@@ -12,6 +12,7 @@ mod cmd_table;
 mod heatmap;
 mod plot;
 mod study;
+mod study_fallback;
 mod study_occ;
 
 use clap::{Parser, Subcommand};

@@ -239,7 +239,7 @@ fn unit(rng: &mut Xoshiro256PlusPlus) -> f64 {
 }
 
 /// Standard normal (Box–Muller; the first of the pair).
-fn normal(rng: &mut Xoshiro256PlusPlus) -> f64 {
+pub fn normal(rng: &mut Xoshiro256PlusPlus) -> f64 {
     let u1 = 1.0 - unit(rng); // (0, 1]: ln is finite
     let u2 = unit(rng);
     (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()

@@ -22,6 +22,10 @@ pub enum StudyCommand {
     /// Monte-Carlo: the pre-crash estimate's errors (payload, speed, distance) → spread of the
     /// occupant's outcome in one cell; locally or as a Slurm job array (--slurm N).
     Robustness(crate::cmd_robustness::RobustnessArgs),
+    /// The ECU's accelerometer-only airbag algorithm over a sweep of barrier and car-to-car
+    /// crashes: no-fire and must-fire lines, fire times against the occupant's deadline;
+    /// `--derive` calibrates its boundary.
+    Fallback(crate::study_fallback::FallbackArgs),
 }
 
 #[derive(Args, Debug)]
@@ -40,6 +44,7 @@ pub fn run(cmd: &StudyCommand) -> Result<()> {
         StudyCommand::OpponentMass(args) => crate::study_occ::opponent_mass(args),
         StudyCommand::Reduction(args) => crate::study_occ::reduction(args),
         StudyCommand::Robustness(args) => crate::cmd_robustness::run(args),
+        StudyCommand::Fallback(args) => crate::study_fallback::run(args),
     }
 }
 

@@ -1,4 +1,9 @@
-//! Crash confirmation from the compartment accelerometer. Pure, allocation-free, NaN-safe.
+//! Generic crash confirmation from the compartment accelerometer (the path that needs no
+//! prediction), and the onset tracking the crash detectors share. Pure, allocation-free,
+//! NaN-safe; fed with the plausible samples of [`crate::accel::AccelMonitor`].
+
+use crate::accel::AccelSample;
+use crate::config::{ms_to_ns, CycleConfig};
 
 /// Standard gravity, m/s² (same constant as the physics crate).
 pub const G_MPS2: f64 = physics::defaults::STANDARD_GRAVITY_MPS2;
@@ -18,8 +23,93 @@ pub struct ConfirmParams {
     pub reset_gap_ns: u64,
 }
 
-/// Longest sample period the integrator accepts, ns (10 ms: slower than any crash sensor).
-const MAX_SAMPLE_PERIOD_NS: u32 = 10_000_000;
+impl ConfirmParams {
+    /// The generic confirmation's thresholds of a validated `cfg` (`confirm_*`).
+    pub fn from_config(cfg: &CycleConfig) -> Self {
+        Self {
+            wake_mps2: cfg.confirm_wake_g * G_MPS2,
+            decel_mps2: cfg.confirm_decel_g * G_MPS2,
+            samples: cfg.confirm_samples,
+            delta_v_mps: cfg.confirm_delta_v_mps,
+            reset_gap_ns: ms_to_ns(cfg.confirm_reset_gap_ms),
+        }
+    }
+}
+
+/// An event in the accelerometer signal: awake from the first sample at or above the wake
+/// threshold (its time is the measured onset), over after `reset_gap_ns` below it. Δv is
+/// integrated from the interval that ends at the wake-up sample on.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Onset {
+    awake: bool,
+    onset_ns: u64,
+    last_wake_ns: u64,
+    delta_v_mps: f64,
+    /// The previous sample's deceleration (trapezoidal integration).
+    prev_decel_mps2: f64,
+}
+
+/// What one sample did to an [`Onset`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OnsetStep {
+    /// Below the wake threshold with no event in progress (or the event just ended).
+    Quiet,
+    /// This sample woke the tracker (first sample of an event).
+    Woke,
+    /// Inside an event (Δv updated).
+    Awake,
+    /// The quiet gap passed: the event is over, the tracker reset.
+    Reset,
+}
+
+impl Onset {
+    /// Feeds one sample. Δv is integrated with the trapezoidal rule from the sample before
+    /// the wake-up (so that it does not depend on where the sample grid falls: 1 kHz and 8 kHz
+    /// sensors measure the same Δv of the same crash).
+    pub fn push(&mut self, p: &ConfirmParams, s: &AccelSample) -> OnsetStep {
+        let decel = s.decel_mps2;
+        let prev = core::mem::replace(&mut self.prev_decel_mps2, decel);
+        let step = if decel >= p.wake_mps2 {
+            let woke = !self.awake;
+            if woke {
+                *self = Self {
+                    awake: true,
+                    onset_ns: s.t_ns,
+                    prev_decel_mps2: decel,
+                    ..Self::default()
+                };
+            }
+            self.last_wake_ns = s.t_ns;
+            if woke {
+                OnsetStep::Woke
+            } else {
+                OnsetStep::Awake
+            }
+        } else if self.awake && s.t_ns.saturating_sub(self.last_wake_ns) > p.reset_gap_ns {
+            *self = Self {
+                prev_decel_mps2: decel,
+                ..Self::default()
+            };
+            return OnsetStep::Reset;
+        } else if self.awake {
+            OnsetStep::Awake
+        } else {
+            return OnsetStep::Quiet;
+        };
+        self.delta_v_mps += 0.5 * (prev + decel) * s.dt_s;
+        step
+    }
+
+    /// Onset time of the event in progress.
+    pub fn onset_ns(&self) -> Option<u64> {
+        self.awake.then_some(self.onset_ns)
+    }
+
+    /// Δv integrated since the onset, m/s (0 when quiet).
+    pub fn delta_v_mps(&self) -> f64 {
+        self.delta_v_mps
+    }
+}
 
 /// Crash confirmation from the compartment accelerometer: deceleration over a threshold for
 /// N consecutive samples AND Δv integrated since wake-up over a threshold. Both are needed: the
@@ -27,93 +117,51 @@ const MAX_SAMPLE_PERIOD_NS: u32 = 10_000_000;
 /// carry no velocity change.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct CrashDetector {
-    awake: bool,
-    onset_ns: u64,
-    last_wake_ns: u64,
+    onset: Onset,
     run: u32,
-    delta_v_mps: f64,
-    confirmed_at_ns: Option<u64>,
-    /// Non-finite samples skipped so far.
-    pub invalid_samples: u64,
-    /// Batches with an unusable sample period.
-    pub invalid_batches: u64,
+    confirmed: Option<(u64, u64)>,
 }
 
 impl CrashDetector {
-    /// Feeds one batch (`first_ns`, `period_ns`, samples in m/s², negative = deceleration).
-    /// Returns true if this batch contained invalid data.
-    pub fn feed(
-        &mut self,
-        p: &ConfirmParams,
-        first_ns: u64,
-        period_ns: u32,
-        samples: &[f32],
-    ) -> bool {
-        if period_ns == 0 || period_ns > MAX_SAMPLE_PERIOD_NS {
-            self.invalid_batches = self.invalid_batches.saturating_add(1);
-            return true;
+    /// Feeds one plausible sample (nothing changes once confirmed: latched).
+    pub fn push(&mut self, p: &ConfirmParams, s: &AccelSample) {
+        if self.confirmed.is_some() {
+            return;
         }
-        let dt_s = f64::from(period_ns) * 1.0e-9;
-        let mut invalid = false;
-        let mut t = first_ns;
-        for &a in samples {
-            let now = t;
-            t = t.saturating_add(u64::from(period_ns));
-            if !a.is_finite() {
-                self.invalid_samples = self.invalid_samples.saturating_add(1);
-                invalid = true;
-                continue;
+        match self.onset.push(p, s) {
+            OnsetStep::Quiet | OnsetStep::Reset => {
+                self.run = 0;
+                return;
             }
-            if self.confirmed_at_ns.is_some() {
-                continue; // latched
-            }
-            let decel = -f64::from(a);
-            if decel >= p.wake_mps2 {
-                if !self.awake {
-                    self.awake = true;
-                    self.onset_ns = now;
-                    self.delta_v_mps = 0.0;
-                    self.run = 0;
-                }
-                self.last_wake_ns = now;
-            } else if self.awake && now.saturating_sub(self.last_wake_ns) > p.reset_gap_ns {
-                *self = Self {
-                    invalid_samples: self.invalid_samples,
-                    invalid_batches: self.invalid_batches,
-                    ..Self::default()
-                };
-                continue;
-            }
-            if !self.awake {
-                continue;
-            }
-            self.delta_v_mps += decel * dt_s;
-            self.run = if decel >= p.decel_mps2 {
-                self.run.saturating_add(1)
-            } else {
-                0
-            };
-            if self.run >= p.samples && self.delta_v_mps >= p.delta_v_mps {
-                self.confirmed_at_ns = Some(now);
+            OnsetStep::Woke => self.run = 0,
+            OnsetStep::Awake => {}
+        }
+        self.run = if s.decel_mps2 >= p.decel_mps2 {
+            self.run.saturating_add(1)
+        } else {
+            0
+        };
+        if self.run >= p.samples && self.onset.delta_v_mps() >= p.delta_v_mps {
+            if let Some(onset) = self.onset.onset_ns() {
+                self.confirmed = Some((s.t_ns, onset));
             }
         }
-        invalid
     }
 
     /// Time of confirmation, if confirmed (latched).
     pub fn confirmed_at_ns(&self) -> Option<u64> {
-        self.confirmed_at_ns
+        self.confirmed.map(|c| c.0)
     }
 
-    /// Measured contact instant (first sample over the wake threshold of the confirmed event,
-    /// or of the event in progress).
+    /// Measured contact instant: the wake-up sample of the confirmed event, or of the event in
+    /// progress.
     pub fn onset_ns(&self) -> Option<u64> {
-        self.awake.then_some(self.onset_ns)
+        self.confirmed.map(|c| c.1).or(self.onset.onset_ns())
     }
 
     /// Δv integrated since wake-up, m/s.
     pub fn delta_v_mps(&self) -> f64 {
-        self.delta_v_mps
+        self.onset.delta_v_mps()
     }
 }
 
@@ -131,12 +179,23 @@ mod tests {
         }
     }
 
+    fn feed(d: &mut CrashDetector, first_ns: u64, decel_mps2: &[f64]) {
+        for (k, &a) in decel_mps2.iter().enumerate() {
+            let s = AccelSample {
+                t_ns: first_ns + k as u64 * 1_000_000,
+                dt_s: 1e-3,
+                decel_mps2: a,
+            };
+            d.push(&params(), &s);
+        }
+    }
+
     #[test]
     fn confirms_a_constant_10g_pulse_when_delta_v_reaches_threshold() {
-        // 10 g at 1 kHz: Δv after n samples = n · 98.0665 · 1e-3 → ≥ 0.5 at n = 6.
+        // 10 g at 1 kHz from a quiet 0 g: Δv after n samples (trapezoidal, the first interval
+        // rising from 0) = (n − ½) · 98.0665 · 1e-3 → ≥ 0.5 at n = 6.
         let mut d = CrashDetector::default();
-        let s = [-10.0 * G_MPS2 as f32; 8];
-        d.feed(&params(), 1_000_000, 1_000_000, &s);
+        feed(&mut d, 1_000_000, &[10.0 * G_MPS2; 8]);
         assert_eq!(d.onset_ns(), Some(1_000_000));
         assert_eq!(d.confirmed_at_ns(), Some(1_000_000 + 5 * 1_000_000));
     }
@@ -145,24 +204,31 @@ mod tests {
     fn a_short_spike_or_a_braking_manoeuvre_never_confirms() {
         let mut d = CrashDetector::default();
         // 30 g for 2 samples then nothing: persistence fails.
-        d.feed(
-            &params(),
-            0,
-            1_000_000,
-            &[-300.0, -300.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-        );
+        feed(&mut d, 0, &[300.0, 300.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
         // 1.2 g braking for a long time: below the wake threshold.
-        for k in 0..100u64 {
-            d.feed(
-                &params(),
-                20_000_000 + k * 8_000_000,
-                1_000_000,
-                &[-11.8; 8],
-            );
-        }
+        feed(&mut d, 20_000_000, &[11.8; 800]);
         assert_eq!(d.confirmed_at_ns(), None);
-        // NaN samples are skipped and counted.
-        assert!(d.feed(&params(), 0, 1_000_000, &[f32::NAN]));
-        assert_eq!(d.invalid_samples, 1);
+        assert_eq!(d.onset_ns(), None, "the spike's event reset after 10 ms quiet");
+    }
+
+    #[test]
+    fn the_onset_resets_after_the_quiet_gap_and_integrates_from_the_wake_sample() {
+        let p = params();
+        let mut o = Onset::default();
+        let s = |t_ms: u64, g: f64| AccelSample {
+            t_ns: t_ms * 1_000_000,
+            dt_s: 1e-3,
+            decel_mps2: g * G_MPS2,
+        };
+        assert_eq!(o.push(&p, &s(0, 1.0)), OnsetStep::Quiet);
+        assert_eq!(o.push(&p, &s(1, 2.0)), OnsetStep::Woke);
+        assert_eq!(o.push(&p, &s(2, 1.0)), OnsetStep::Awake);
+        // Trapezoids (1 + 2)/2 and (2 + 1)/2 g over 1 ms each.
+        assert!((o.delta_v_mps() - 3.0 * G_MPS2 * 1e-3).abs() < 1e-12);
+        assert_eq!(o.onset_ns(), Some(1_000_000));
+        // 10 ms after the last wake sample: still awake; 11 ms: reset.
+        assert_eq!(o.push(&p, &s(11, 0.0)), OnsetStep::Awake);
+        assert_eq!(o.push(&p, &s(12, 0.0)), OnsetStep::Reset);
+        assert_eq!((o.onset_ns(), o.delta_v_mps()), (None, 0.0));
     }
 }

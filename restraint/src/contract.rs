@@ -53,6 +53,16 @@ pub enum IoError {
     Ipc,
 }
 
+/// Receive errors of the shell's input ports since start (iceoryx2 `receive()` failures);
+/// the core turns new ones into `IPC_ERROR` and the fault bit of the input concerned.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ReceiveErrors {
+    /// On the object-state port.
+    pub objects: u64,
+    /// On the crash-accelerometer port.
+    pub accel: u64,
+}
+
 /// Why an activity refused to start.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StartupError {
@@ -88,6 +98,10 @@ pub trait CycleIo {
     ) -> Result<(), IoError>;
     /// Whether the CAN side is active.
     fn can_enabled(&self) -> bool;
+    /// Receive errors of the input ports since start (none by default).
+    fn receive_errors(&self) -> ReceiveErrors {
+        ReceiveErrors::default()
+    }
 }
 
 /// The cycle logic as seen by a shell.

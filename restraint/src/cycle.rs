@@ -12,6 +12,7 @@ use physics::CollisionSummary;
 use crate::config::{ConfigError, CycleConfig};
 use crate::contract::{Activity, CycleInfo, CycleIo, StartupError};
 use crate::counters::CycleCounters;
+use crate::crash::{plan_for, CrashMonitor, FreezeContext};
 use crate::decision::{Decision, DecisionInputs, Phase, Pretensioner};
 use crate::estimate::{check_lut, Estimator, Lut, LutMismatch, Situation};
 use crate::inputs::InputMonitor;
@@ -33,6 +34,7 @@ pub struct RestraintCycle<'lut> {
     inputs: InputMonitor,
     estimate: Estimator<'lut>,
     decision: Decision,
+    crash: CrashMonitor,
     outputs: Outputs,
     reasons: Degraded,
     counters: CycleCounters,
@@ -67,6 +69,7 @@ impl<'lut> RestraintCycle<'lut> {
             inputs: InputMonitor::new(&cfg),
             estimate,
             decision: Decision::new(&cfg, reference),
+            crash: CrashMonitor::new(&cfg),
             outputs: Outputs::new(lut_id),
             reasons: Degraded::empty(),
             counters: CycleCounters::default(),
@@ -112,6 +115,14 @@ impl<'lut> RestraintCycle<'lut> {
     /// Pretensioner state.
     pub fn pretensioner(&self) -> Pretensioner {
         self.decision.pretensioner()
+    }
+    /// The crash detectors' evidence (confirmation, matcher, accelerometer-only algorithm).
+    pub fn crash(&self) -> &CrashMonitor {
+        &self.crash
+    }
+    /// How the crash was confirmed (`None` before a crash).
+    pub fn crash_kind(&self) -> Option<crate::crash::ConfirmKind> {
+        self.decision.crash_kind()
     }
     /// Whether the airbag fire command has been sent.
     pub fn airbag_fired(&self) -> bool {
@@ -159,20 +170,34 @@ impl Activity for RestraintCycle<'_> {
         inputs.begin_cycle();
         io.drain_can(&mut |f| inputs.on_can(f, now, c));
         io.drain_objects(&mut |o| inputs.on_object(o, now, c));
-        io.drain_accel(&mut |a| inputs.on_accel(a, now, c));
+        // Plausible samples go to the crash detectors; a wake-up in PRE-CRASH freezes the
+        // prediction of the previous cycle's situation.
+        let freeze = FreezeContext {
+            situation: self.estimate.situation,
+            armed: self.decision.phase() == Phase::PreCrash,
+            estimator: &self.estimate,
+        };
+        let crash = &mut self.crash;
+        io.drain_accel(&mut |a| inputs.on_accel(a, now, c, &mut |s| crash.on_sample(s, &freeze)));
+        inputs.on_receive_errors(io.receive_errors(), now);
         let lut_present = self.estimate.lut().is_some();
         self.reasons = self.inputs.reasons(now, io.can_enabled(), lut_present);
         let c = &mut self.counters;
         if self.reasons.contains(Degraded::OBJECT_STALE) {
             c.object_stale_cycles = c.object_stale_cycles.saturating_add(1);
         }
+        if self.reasons.contains(Degraded::ACCEL_STALE) {
+            self.inputs.accel.note_stale_cycle();
+        }
         let degraded = self.reasons.intersects(Degraded::DEGRADING);
         if degraded {
             c.degraded_cycles = c.degraded_cycles.saturating_add(1);
         }
-        // Recompute the prediction only when its inputs changed materially.
-        if self.inputs.new_object
-            || (self.inputs.occupant_changed && self.estimate.situation.is_some())
+        // Recompute the prediction only when its inputs changed materially — and not once the
+        // accelerometer shows a crash in progress (the object list then predicts nothing new).
+        if (self.inputs.new_object
+            || (self.inputs.occupant_changed && self.estimate.situation.is_some()))
+            && !self.crash.awake()
         {
             if let Some(plan) = self.estimate.update(now, &self.inputs, c) {
                 self.decision.plan = plan;
@@ -181,14 +206,32 @@ impl Activity for RestraintCycle<'_> {
         if self.reasons.contains(Degraded::OBJECT_STALE) {
             self.estimate.situation = None; // a stale track predicts nothing
         }
-        let x = DecisionInputs {
+        let accel_faulty = self
+            .reasons
+            .intersects(Degraded::ACCEL_STALE | Degraded::ACCEL_INVALID);
+        self.crash.end_cycle(
+            now,
+            accel_faulty,
+            self.estimate.situation.as_ref(),
+            &self.inputs,
+        );
+        let (cfg, est, inputs) = (&self.cfg, &self.estimate, &self.inputs);
+        let situation = est.situation;
+        let c = &mut self.counters;
+        let mut replan = |closing_mps: f64| {
+            let sit = situation?;
+            plan_for(cfg, est, &sit, closing_mps, inputs, c)
+        };
+        let mut x = DecisionInputs {
             degraded,
-            situation: self.estimate.situation,
+            situation,
             new_object: self.inputs.new_object,
             object_present: self.inputs.object_present,
-            detector: &self.inputs.detector,
+            confirmation: self.crash.confirmation(),
+            fallback: self.crash.fallback(),
+            replan: &mut replan,
         };
-        self.decision.step(now, &x);
+        self.decision.step(now, &mut x);
         let c = &mut self.counters;
         self.outputs
             .write(info, io, &self.decision, &self.inputs, self.reasons, c);
@@ -207,7 +250,7 @@ impl Activity for RestraintCycle<'_> {
 
     fn report_counters(&self, out: &mut dyn FnMut(&'static str, u64)) {
         let c = &self.counters;
-        let d = &self.inputs.detector;
+        let a = self.inputs.accel.faults;
         let e2e = self.inputs.e2e_stats();
         for (name, v) in [
             ("objects_rx", c.objects_rx),
@@ -215,8 +258,11 @@ impl Activity for RestraintCycle<'_> {
             ("object_stale_cycles", c.object_stale_cycles),
             ("accel_batches_rx", c.accel_batches_rx),
             ("accel_samples_rx", c.accel_samples_rx),
-            ("accel_invalid_samples", d.invalid_samples),
-            ("accel_invalid_batches", d.invalid_batches),
+            ("accel_bad_time_batches", a.bad_time_batches),
+            ("accel_out_of_range_samples", a.out_of_range_samples),
+            ("accel_saturated_samples", a.saturated_samples),
+            ("accel_stuck_events", a.stuck_events),
+            ("accel_stale_cycles", a.stale_cycles),
             ("can_frames_rx", c.can_frames_rx),
             ("can_accepted", e2e.accepted),
             ("can_lost_frames", e2e.lost_frames),

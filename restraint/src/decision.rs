@@ -5,19 +5,30 @@
 //!     ▲   ▲                                                  pretensioner at contact + t_pt)
 //!     │   └──────── avoided (lost / receding / contact + margin passed): release, disarm
 //!     │
-//!  Degraded (stale/invalid inputs, E2E burst, no LUT): reference restraint
+//!  Degraded (stale/invalid inputs, E2E burst, no LUT, faulty accelerometer): reference
 //!
-//! any of the three ──accelerometer confirms──▶ Crash: airbag at max(confirm, contact + t_ab)
-//!                                                        ──all fired──▶ PostCrash (latched)
+//! any of the three ──crash confirmed (crash::Confirmation)──▶ Crash ──all done──▶ PostCrash
 //! ```
 //!
+//! **The crash plan** — every path to Fire (README "Decision table"):
+//!
+//! | confirmed by | when | plan | airbag |
+//! |---|---|---|---|
+//! | the pulse matching the prediction (or departing within the re-estimation range) | PRE-CRASH, not degraded, re-estimated at or above the no-fire line | the table at the re-estimated closing speed and the robust mass (`crash::plan_for`; the reference restraint where the table does not cover the situation) | at max(confirm, onset + t_ab) if the plan fires |
+//! | the vehicle-dynamics deceleration on CAN (backup) | crash accelerometer faulty, a crash predicted above the no-fire line | reference restraint | at max(confirm, predicted contact + t_ab,ref) |
+//! | the generic thresholds (any other case: no prediction, degraded, pulse refuted or re-estimated below the no-fire line) | — | reference belt | only when the accelerometer-only algorithm decides must-fire: at max(decision, onset + t_ab,ref) |
+//!
+//! Only the matched path uses the table: it confirms 1.5–3.5 ms after contact, so a plan is
+//! executed within a cycle of its time, which is what the table's fire-delay tolerance assumes.
+//!
 //! Inputs are the estimate ([`Situation`], the looked-up plan), the input monitor's object
-//! facts and crash confirmation, and whether the inputs are degraded; outputs are the phase,
-//! the active plan and the pretensioner/airbag commands ([`Decision`]'s accessors).
+//! facts, the crash detectors' evidence and whether the inputs are degraded; outputs are the
+//! phase, the active plan and the pretensioner/airbag commands ([`Decision`]'s accessors).
 
 use crate::config::{ms_to_ns, CycleConfig};
-use crate::confirm::CrashDetector;
+use crate::crash::{ConfirmKind, Confirmation};
 use crate::estimate::Situation;
+use crate::fallback::{FallbackDecision, WINDOW_MS};
 use crate::plan::RestraintPlan;
 use crate::signals::EcuMode;
 
@@ -61,7 +72,6 @@ pub enum Pretensioner {
 }
 
 /// What the state machine reads from the estimate and the input monitor in one cycle.
-#[derive(Debug, Clone, Copy)]
 pub(crate) struct DecisionInputs<'d> {
     /// Any degrading reason is set.
     pub degraded: bool,
@@ -71,8 +81,22 @@ pub(crate) struct DecisionInputs<'d> {
     pub new_object: bool,
     /// The newest object sample tracks an object.
     pub object_present: bool,
-    /// Crash confirmation.
-    pub detector: &'d CrashDetector,
+    /// The crash confirmation (latched), if any.
+    pub confirmation: Option<Confirmation>,
+    /// The accelerometer-only algorithm's decision on the current event.
+    pub fallback: FallbackDecision,
+    /// The table's plan for an adaptive crash at a closing speed (m/s): `None` when that
+    /// severity is below the no-fire line (`crash::plan_for`).
+    pub replan: &'d mut dyn FnMut(f64) -> Option<RestraintPlan>,
+}
+
+/// How the airbag of the crash plan is decided.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum AirbagGate {
+    /// Decided at the confirmation (scheduled or not fired).
+    Decided,
+    /// Waiting for the accelerometer-only algorithm (reference airbag, conventional path).
+    Fallback,
 }
 
 /// State of the decision.
@@ -92,6 +116,9 @@ pub struct Decision {
     airbag_fired: bool,
     armed: bool,
     contact_ns: Option<u64>,
+    gate: AirbagGate,
+    /// How the crash was confirmed (latched with the crash plan).
+    crash_kind: Option<ConfirmKind>,
 }
 
 fn time_ms_to_ns(t_ms: f32) -> i64 {
@@ -120,7 +147,14 @@ impl Decision {
             airbag_fired: false,
             armed: false,
             contact_ns: None,
+            gate: AirbagGate::Decided,
+            crash_kind: None,
         }
+    }
+
+    /// How the crash was confirmed (`None` before a crash).
+    pub fn crash_kind(&self) -> Option<ConfirmKind> {
+        self.crash_kind
     }
 
     /// Current phase.
@@ -168,43 +202,66 @@ impl Decision {
         self.pretensioner_at_ns = None;
     }
 
-    fn enter_crash(&mut self, confirm_ns: u64, x: &DecisionInputs<'_>) {
-        // Measured contact (accelerometer wake-up) is a better contact estimate than the
-        // pre-crash TTC; fall back to the prediction, then to the confirmation instant.
-        let contact = x
-            .detector
-            .onset_ns()
-            .or(self.contact_ns)
-            .unwrap_or(confirm_ns);
-        let fresh_low_speed = x.situation.is_some_and(|s| {
-            s.low_speed && s.contact_ns.abs_diff(contact) <= self.avoided_margin_ns
-        });
-        let plan = if self.phase == Phase::PreCrash && !x.degraded {
-            self.plan
-        } else if fresh_low_speed && !x.degraded {
-            // Low-speed no-fire: belt per reference, no airbag.
-            self.reference.without_airbag()
-        } else {
-            self.reference
-        };
+    /// The crash plan and its airbag gate for confirmation `c` (table in the module docs).
+    fn crash_plan_for(&self, c: &Confirmation, x: &mut DecisionInputs<'_>) -> (RestraintPlan, AirbagGate) {
+        let predicted = self.phase == Phase::PreCrash && !x.degraded;
+        if let (ConfirmKind::Matched(e), true) = (c.kind, predicted) {
+            if let Some(plan) = (x.replan)(e.closing_mps) {
+                return (plan, AirbagGate::Decided);
+            }
+        }
+        if c.kind == ConfirmKind::Backup {
+            return (self.reference, AirbagGate::Decided);
+        }
+        (self.reference, AirbagGate::Fallback)
+    }
+
+    fn enter_crash(&mut self, c: Confirmation, x: &mut DecisionInputs<'_>) {
+        let (plan, gate) = self.crash_plan_for(&c, x);
+        let (confirm_ns, contact) = (c.at_ns, c.contact_ns);
         self.crash_plan = plan;
+        self.crash_kind = Some(c.kind);
+        self.gate = gate;
         self.contact_ns = Some(contact);
         self.armed = true;
         if self.pretensioner != Pretensioner::Fired {
             self.pretensioner_at_ns = Some(at(contact, plan.pretensioner_time_ms).max(confirm_ns));
         }
-        self.airbag_fire_at_ns = plan
-            .airbag_fires()
+        self.airbag_fire_at_ns = (gate == AirbagGate::Decided && plan.airbag_fires())
             .then(|| at(contact, plan.airbag_time_ms).max(confirm_ns));
         self.phase = Phase::Crash;
     }
 
+    /// The conventional path: the reference airbag when the accelerometer-only algorithm says
+    /// must-fire; no airbag when it says no-fire or its window has passed.
+    fn gate_airbag(&mut self, now: u64, fallback: FallbackDecision) {
+        if self.gate != AirbagGate::Fallback {
+            return;
+        }
+        let contact = self.contact_ns.unwrap_or(now);
+        let window_over = now > at(contact, (WINDOW_MS + 1.0) as f32);
+        match fallback {
+            FallbackDecision::Fire(t) if self.crash_plan.airbag_fires() => {
+                self.airbag_fire_at_ns = Some(at(contact, self.crash_plan.airbag_time_ms).max(t));
+                self.gate = AirbagGate::Decided;
+            }
+            FallbackDecision::Pending if !window_over => {}
+            _ => {
+                self.crash_plan = self.crash_plan.without_airbag();
+                self.gate = AirbagGate::Decided;
+            }
+        }
+    }
+
     /// One step of the state machine at `now`, then the scheduled fires that are due.
-    pub(crate) fn step(&mut self, now: u64, x: &DecisionInputs<'_>) {
-        if let (Some(confirm), Phase::Monitoring | Phase::PreCrash | Phase::Degraded) =
-            (x.detector.confirmed_at_ns(), self.phase)
+    pub(crate) fn step(&mut self, now: u64, x: &mut DecisionInputs<'_>) {
+        if let (Some(c), Phase::Monitoring | Phase::PreCrash | Phase::Degraded) =
+            (x.confirmation, self.phase)
         {
-            self.enter_crash(confirm, x);
+            self.enter_crash(c, x);
+        }
+        if self.phase == Phase::Crash {
+            self.gate_airbag(now, x.fallback);
         }
         match self.phase {
             Phase::Monitoring => {
@@ -286,6 +343,7 @@ impl Decision {
         if self.phase == Phase::Crash
             && self.pretensioner_at_ns.is_none()
             && self.airbag_fire_at_ns.is_none()
+            && self.gate == AirbagGate::Decided
         {
             self.phase = Phase::PostCrash;
         }

@@ -157,6 +157,17 @@ pub struct Situation {
     pub low_speed: bool,
 }
 
+/// The spring of the opponent class of `opp_kg` (by mass; beyond the heaviest class the
+/// heaviest) among the six precomputed ones.
+fn spring_of(springs: &[Option<CombinedSpring>; 6], opp_kg: f64) -> Option<&CombinedSpring> {
+    let class = physics::class_for_mass_kg(opp_kg)
+        .map(MassClass::number)
+        .unwrap_or(6);
+    springs
+        .get(usize::from(class.saturating_sub(1)))
+        .and_then(Option::as_ref)
+}
+
 /// State of the estimate: situation, prediction (springs, pulse buffer) and the LUT.
 pub struct Estimator<'a> {
     ego_mass_kg: f64,
@@ -220,6 +231,18 @@ impl<'a> Estimator<'a> {
         self.lut.as_ref()
     }
 
+    /// The combined crush spring of the ego against an opponent of `opp_kg` (its class by
+    /// mass; beyond the heaviest class the heaviest). `None` only if a class curve failed to
+    /// combine at start-up.
+    pub(crate) fn spring_for(&self, opp_kg: f64) -> Option<&CombinedSpring> {
+        spring_of(&self.springs, opp_kg)
+    }
+
+    /// The configured ego mass, kg.
+    pub(crate) fn ego_mass_kg(&self) -> f64 {
+        self.ego_mass_kg
+    }
+
     /// The predicted pulse of the newest prediction (ego acceleration, m/s²) and its step, s.
     pub(crate) fn pulse(&self) -> (&[f64], f64) {
         (self.pulse.ego_accel_mps2(), self.pulse.step_s())
@@ -271,14 +294,7 @@ impl<'a> Estimator<'a> {
     #[inline(always)]
     fn predict(&mut self, sit: &Situation, counters: &mut CycleCounters) {
         counters.predictions = counters.predictions.saturating_add(1);
-        let class = physics::class_for_mass_kg(sit.opponent_mass_kg)
-            .map(MassClass::number)
-            .unwrap_or(6);
-        let spring = self
-            .springs
-            .get(usize::from(class.saturating_sub(1)))
-            .and_then(Option::as_ref);
-        let Some(spring) = spring else {
+        let Some(spring) = spring_of(&self.springs, sit.opponent_mass_kg) else {
             self.summary = None;
             counters.prediction_errors = counters.prediction_errors.saturating_add(1);
             return;
@@ -305,7 +321,7 @@ impl<'a> Estimator<'a> {
     /// is outside what the table covers (unbelted, not an adult, no data), or any query
     /// axis is out of the table's range or NaN (the diagram's rule: a flagged lookup is
     /// degraded input).
-    fn lookup(
+    pub(crate) fn lookup(
         &self,
         sit: &Situation,
         inputs: &InputMonitor,

@@ -2,21 +2,22 @@
 //!
 //! CAN frames go through the bus crate's [`E2eChecker`] (a stream that timed out is
 //! resynchronised on its next frame); rejections feed the E2E burst window; object states are
-//! checked for range, age and plausibility against the ego speed; accelerometer batches feed
-//! the [`CrashDetector`]. [`InputMonitor::reasons`] turns all of it into the degraded reasons of
-//! the cycle. Allocation-free: the burst window is a fixed-capacity `heapless` queue.
+//! checked for range, age and plausibility against the ego speed; accelerometer batches are
+//! checked by the [`AccelMonitor`] (stale, stuck, saturated, out of range, non-monotonic time),
+//! whose plausible samples go on to the crash detectors; iceoryx2 receive errors reported by
+//! the shell are held for [`INVALID_HOLD_MS`]. [`InputMonitor::reasons`] turns all of it into
+//! the degraded reasons of the cycle. Allocation-free: the burst window is a fixed-capacity
+//! `heapless` queue.
 
 use bus::codec::{OccupantClassificationBeltBuckle, OccupantClassificationOccupantClass};
 use bus::{E2eChecker, Messages, RawFrame, RejectReason, CAN_EFF_FLAG};
 use heapless::Deque;
 
+use crate::accel::{AccelMonitor, AccelSample, INVALID_HOLD_MS};
 use crate::config::{ms_to_ns, CycleConfig, MAX_E2E_BURST};
-use crate::confirm::{ConfirmParams, CrashDetector, G_MPS2};
+use crate::contract::ReceiveErrors;
 use crate::counters::CycleCounters;
 use crate::signals::{CrashAccelSample, Degraded, ObjectState};
-
-/// How long an invalid accelerometer sample keeps `ACCEL_INVALID` set, ms.
-const ACCEL_INVALID_HOLD_MS: f64 = 500.0;
 /// Closing speed above ego speed + this is implausible (opponent > 250 km/h), m/s.
 const MAX_OPPONENT_SPEED_MPS: f32 = 70.0;
 
@@ -84,11 +85,10 @@ impl E2eBurst {
 /// State of the input monitoring.
 #[derive(Debug, Clone)]
 pub struct InputMonitor {
-    pub(crate) confirm: ConfirmParams,
     object_timeout_ns: u64,
     vehicle_timeout_ns: u64,
     occupant_timeout_ns: u64,
-    accel_hold_ns: u64,
+    hold_ns: u64,
     min_confidence: f64,
 
     checker: E2eChecker,
@@ -104,34 +104,32 @@ pub struct InputMonitor {
     /// A new object sample arrived this cycle.
     pub(crate) new_object: bool,
     ego_speed_mps: f32,
+    /// Newest `EgoLongAccel`, m/s² (negative = decelerating).
+    ego_long_accel_mps2: f32,
     vehicle_rx_ns: Option<u64>,
     /// Occupant as last reported.
     pub(crate) occupant: Occupant,
     occupant_rx_ns: Option<u64>,
     /// The occupant report changed this cycle.
     pub(crate) occupant_changed: bool,
-    accel_invalid_until_ns: Option<u64>,
     /// Sequence of the newest accelerometer batch.
     pub(crate) last_accel_sequence: u64,
-    /// Crash confirmation from the accelerometer.
-    pub(crate) detector: CrashDetector,
+    /// Plausibility and freshness of the crash accelerometer.
+    pub(crate) accel: AccelMonitor,
+    /// Receive errors reported by the I/O so far, and until when each port's are held.
+    rx_errors: ReceiveErrors,
+    object_rx_error_until_ns: Option<u64>,
+    accel_rx_error_until_ns: Option<u64>,
 }
 
 impl InputMonitor {
     /// Monitoring with the timeouts of a validated `cfg`.
     pub fn new(cfg: &CycleConfig) -> Self {
         Self {
-            confirm: ConfirmParams {
-                wake_mps2: cfg.confirm_wake_g * G_MPS2,
-                decel_mps2: cfg.confirm_decel_g * G_MPS2,
-                samples: cfg.confirm_samples,
-                delta_v_mps: cfg.confirm_delta_v_mps,
-                reset_gap_ns: ms_to_ns(cfg.confirm_reset_gap_ms),
-            },
             object_timeout_ns: ms_to_ns(cfg.object_timeout_ms),
             vehicle_timeout_ns: ms_to_ns(cfg.vehicle_timeout_ms),
             occupant_timeout_ns: ms_to_ns(cfg.occupant_timeout_ms),
-            accel_hold_ns: ms_to_ns(ACCEL_INVALID_HOLD_MS),
+            hold_ns: ms_to_ns(INVALID_HOLD_MS),
             min_confidence: cfg.min_confidence,
             checker: E2eChecker::with_max_lost(cfg.e2e_max_lost),
             burst: E2eBurst {
@@ -147,6 +145,7 @@ impl InputMonitor {
             object_rx_ns: None,
             new_object: false,
             ego_speed_mps: 0.0,
+            ego_long_accel_mps2: 0.0,
             vehicle_rx_ns: None,
             occupant: Occupant {
                 mass_kg: f32::NAN,
@@ -156,9 +155,11 @@ impl InputMonitor {
             },
             occupant_rx_ns: None,
             occupant_changed: false,
-            accel_invalid_until_ns: None,
             last_accel_sequence: 0,
-            detector: CrashDetector::default(),
+            accel: AccelMonitor::new(cfg),
+            rx_errors: ReceiveErrors::default(),
+            object_rx_error_until_ns: None,
+            accel_rx_error_until_ns: None,
         }
     }
 
@@ -208,6 +209,7 @@ impl InputMonitor {
         match checked {
             Ok(Messages::EgoVehicleState(m)) => {
                 self.ego_speed_mps = m.ego_speed();
+                self.ego_long_accel_mps2 = m.ego_long_accel();
                 self.vehicle_rx_ns = Some(now);
             }
             Ok(Messages::OccupantClassification(m)) => {
@@ -289,23 +291,50 @@ impl InputMonitor {
         }
     }
 
-    /// One received accelerometer batch.
+    /// One received accelerometer batch: checked by the [`AccelMonitor`], its plausible
+    /// samples handed to `sink` in time order.
     pub(crate) fn on_accel(
         &mut self,
         a: &CrashAccelSample,
         now: u64,
         counters: &mut CycleCounters,
+        sink: &mut dyn FnMut(&AccelSample),
     ) {
         counters.accel_batches_rx = counters.accel_batches_rx.saturating_add(1);
         let s = a.samples();
         counters.accel_samples_rx = counters.accel_samples_rx.saturating_add(s.len() as u64);
         self.last_accel_sequence = a.sequence;
-        if self
-            .detector
-            .feed(&self.confirm, a.first_timestamp_ns, a.sample_period_ns, s)
-        {
-            self.accel_invalid_until_ns = Some(now.saturating_add(self.accel_hold_ns));
+        self.accel
+            .feed(now, a.first_timestamp_ns, a.sample_period_ns, s, sink);
+    }
+
+    /// The I/O's receive-error totals at `now`: new errors on a port hold its fault.
+    pub(crate) fn on_receive_errors(&mut self, e: ReceiveErrors, now: u64) {
+        let until = Some(now.saturating_add(self.hold_ns));
+        if e.objects > self.rx_errors.objects {
+            self.object_rx_error_until_ns = until;
         }
+        if e.accel > self.rx_errors.accel {
+            self.accel_rx_error_until_ns = until;
+        }
+        self.rx_errors = e;
+    }
+
+    /// Receive errors on the object port within the hold time.
+    pub(crate) fn object_port_error(&self, now: u64) -> bool {
+        self.object_rx_error_until_ns.is_some_and(|t| now <= t)
+    }
+
+    /// Receive errors on the accelerometer port within the hold time.
+    pub(crate) fn accel_port_error(&self, now: u64) -> bool {
+        self.accel_rx_error_until_ns.is_some_and(|t| now <= t)
+    }
+
+    /// The newest vehicle-dynamics deceleration (m/s², positive = slowing down) and when it was
+    /// received, if the vehicle frame is fresh.
+    pub(crate) fn vehicle_decel(&self, now: u64) -> Option<(f64, u64)> {
+        let rx = self.vehicle_rx_ns.filter(|_| !self.vehicle_stale(now))?;
+        Some((-f64::from(self.ego_long_accel_mps2), rx))
     }
 
     /// The degraded reasons at `now` (`lut_present`: a usable LUT was loaded).
@@ -316,9 +345,11 @@ impl InputMonitor {
             Self::stale(self.object_rx_ns, now, self.object_timeout_ns),
         );
         r.set(Degraded::OBJECT_INVALID, self.object_invalid);
+        r.set(Degraded::ACCEL_INVALID, self.accel.invalid(now));
+        r.set(Degraded::ACCEL_STALE, self.accel.stale(now));
         r.set(
-            Degraded::ACCEL_INVALID,
-            self.accel_invalid_until_ns.is_some_and(|t| now <= t),
+            Degraded::IPC_ERROR,
+            self.object_port_error(now) || self.accel_port_error(now),
         );
         if can_on {
             r.set(

@@ -10,7 +10,11 @@
 //! | module | job |
 //! |---|---|
 //! | [`inputs`] | input monitoring: E2E, freshness, plausibility, degraded reasons |
-//! | [`confirm`] | crash confirmation from the compartment accelerometer |
+//! | [`accel`] | crash-accelerometer plausibility: stale, stuck, saturated, out of range, time |
+//! | [`confirm`] | generic crash confirmation from the compartment accelerometer |
+//! | [`crash_match`] | prediction-matched confirmation and the in-crash severity estimate |
+//! | [`fallback`] | the accelerometer-only airbag algorithm (no usable prediction) |
+//! | [`crash`] | the crash phase's evidence: which path confirmed, the backup, the re-plan |
 //! | [`estimate`] | situation, collision prediction, LUT query (the place for a track filter) |
 //! | [`decision`] | the state machine: preset, arm, fire, release, fall back |
 //! | [`outputs`] | command, status and diagnostics encoding, clock-timed cyclic sends |
@@ -30,13 +34,17 @@
 // `!(x >= y)` is deliberate: it is true for NaN, which is how NaN inputs fail safe.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod accel;
 pub mod config;
 pub mod confirm;
 pub mod contract;
 pub mod counters;
+pub mod crash;
+pub mod crash_match;
 mod cycle;
 pub mod decision;
 pub mod estimate;
+pub mod fallback;
 pub mod inputs;
 pub mod outputs;
 pub mod plan;
@@ -45,7 +53,7 @@ pub mod sim;
 
 pub use config::{ConfigError, CycleConfig, MAX_E2E_BURST};
 pub use confirm::{ConfirmParams, CrashDetector, G_MPS2};
-pub use contract::{Activity, CycleInfo, CycleIo, IoError, StartupError};
+pub use contract::{Activity, CycleInfo, CycleIo, IoError, ReceiveErrors, StartupError};
 pub use counters::CycleCounters;
 pub use cycle::{RestraintCycle, StartupNotes};
 pub use decision::{Phase, Pretensioner};

@@ -295,8 +295,10 @@ impl Outputs {
         let faults = StatusFaults {
             vehicle_input: inputs.vehicle_stale(now),
             occupant_input: inputs.occupant_stale(now),
-            object_input: reasons.intersects(Degraded::OBJECT_STALE | Degraded::OBJECT_INVALID),
-            accel_sensor: reasons.intersects(Degraded::ACCEL_INVALID | Degraded::ACCEL_STALE),
+            object_input: reasons.intersects(Degraded::OBJECT_STALE | Degraded::OBJECT_INVALID)
+                || inputs.object_port_error(now),
+            accel_sensor: reasons.intersects(Degraded::ACCEL_INVALID | Degraded::ACCEL_STALE)
+                || inputs.accel_port_error(now),
             e2e: reasons.contains(Degraded::E2E_FAILURE),
             lut: reasons.contains(Degraded::LUT_INVALID),
             overrun: info.overruns > 0,

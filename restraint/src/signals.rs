@@ -177,17 +177,21 @@ bitflags::bitflags! {
         const LUT_INVALID = 1 << 6;
         /// CAN side switched off (`--no-can`) or unavailable.
         const CAN_DISABLED = 1 << 7;
-        /// IPC receive errors this cycle.
+        /// IPC receive errors (held 500 ms after the last).
         const IPC_ERROR = 1 << 8;
     }
 }
 
 impl Degraded {
     /// Reasons that switch the decision to the reference restraint. `CAN_DISABLED` is among
-    /// them: without CAN there is no occupant information for the LUT.
+    /// them: without CAN there is no occupant information for the LUT; so are the crash
+    /// accelerometer's faults (without it no adaptive plan can be confirmed in time: a
+    /// predicted crash is then confirmed by the backup and gets the reference restraint).
     pub const DEGRADING: Self = Self::OBJECT_STALE
         .union(Self::OBJECT_INVALID)
+        .union(Self::ACCEL_STALE)
         .union(Self::ACCEL_INVALID)
+        .union(Self::IPC_ERROR)
         .union(Self::CAN_STALE)
         .union(Self::E2E_FAILURE)
         .union(Self::LUT_INVALID)
@@ -332,6 +336,6 @@ mod tests {
         assert_eq!(Degraded::OBJECT_STALE.bits(), 1);
         assert_eq!(Degraded::CAN_DISABLED.bits(), 0x80);
         assert_eq!(Degraded::IPC_ERROR.bits(), 0x100);
-        assert_eq!(Degraded::DEGRADING.bits(), 0b1111_1011);
+        assert_eq!(Degraded::DEGRADING.bits(), 0b1_1111_1111);
     }
 }

@@ -9,7 +9,7 @@
 use bus::RawFrame;
 use heapless::{Deque, HistoryBuf};
 
-use crate::contract::{CycleIo, IoError};
+use crate::contract::{CycleIo, IoError, ReceiveErrors};
 use crate::signals::{CrashAccelSample, EcuDiagnostics, ObjectState};
 
 /// Capacity of every queue of [`SimIo`].
@@ -45,6 +45,8 @@ pub struct SimIo {
     pub dropped: u64,
     /// When false, CAN sends fail with [`IoError::CanDisabled`] and nothing is received.
     pub can_on: bool,
+    /// Receive-error totals the I/O reports (tests raise them to inject iceoryx2 errors).
+    pub receive_errors: ReceiveErrors,
 }
 
 impl Default for SimIo {
@@ -66,6 +68,10 @@ impl SimIo {
             diagnostics_published: 0,
             dropped: 0,
             can_on: true,
+            receive_errors: ReceiveErrors {
+                objects: 0,
+                accel: 0,
+            },
         }
     }
 
@@ -145,6 +151,10 @@ impl CycleIo for SimIo {
 
     fn can_enabled(&self) -> bool {
         self.can_on
+    }
+
+    fn receive_errors(&self) -> ReceiveErrors {
+        self.receive_errors
     }
 }
 

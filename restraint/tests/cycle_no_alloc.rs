@@ -1,7 +1,9 @@
 //! The restraint cycle allocates nothing in steady state: a counting global allocator over
 //! ≥ 10 000 cycles in PRE-CRASH (a new object sample every 10 ms → collision prediction + LUT
-//! lookup + state machine + E2E command encode) and ≥ 10 000 cycles through crash
-//! confirmation, airbag fire and POST-CRASH with 8-sample accelerometer batches every cycle.
+//! lookup + state machine + E2E command encode; an 8-sample accelerometer batch every cycle)
+//! and ≥ 10 000 cycles through the prediction-matched crash confirmation (the frozen
+//! closed-form prediction, the ramp fit, the re-plan from the table), airbag fire and
+//! POST-CRASH with the predicted crash pulse in 8-sample batches every cycle.
 //! SecOC is on (the example key file): every command frame is followed by its AES-CMAC
 //! authenticator, computed inside the counted cycles.
 //! The com layer of this test ([`SimIo`]) is itself allocation-free (fixed-capacity queues).
@@ -12,6 +14,8 @@ use alloc_counter::{allocations_here, set_counting};
 mod cycle_support;
 
 use cycle_support::{MS, REFERENCE, T0};
+use physics::{CombinedSpring, ExactCollision, MassClass};
+use restraint::crash::ConfirmKind;
 use restraint::{Activity, CrashAccelSample, CycleConfig, CycleInfo, Phase, RestraintCycle, SimIo};
 
 #[test]
@@ -38,21 +42,43 @@ fn no_allocation_in_precrash_and_crash_cycles() {
     // ahead, new sample every 10 ms). Phase B: contact, 10 000 counted crash cycles.
     let total = 1_000 + 10_000 + 10_010;
     let crash_from = 11_000u64;
+    // The crash the objects predict (25 m/s against the conservative 1600 kg, class 3), from
+    // the contact at `crash_from` on: computed outside the counted cycles.
+    let spring = CombinedSpring::series(
+        MassClass::new(4).unwrap().curve(),
+        Some(MassClass::new(3).unwrap().curve()),
+    )
+    .unwrap();
+    let crash = ExactCollision::solve(&physics::CollisionInput::with_defaults(
+        &spring, 1785.0, 1600.0, 25.0,
+    ))
+    .unwrap();
+    let contact_ns = T0 + crash_from * MS;
     for k in 0..total {
         let ms = k;
         if ms < crash_from && ms.is_multiple_of(10) {
+            // Contact always 250 ms ahead, and in the last 250 ms at `contact_ns`.
             let mut o = cycle_support::object(now, 25.0, 1500.0, 100.0);
-            o.distance_m = 6.25; // 250 ms at 25 m/s
+            o.distance_m = (25.0 * ((contact_ns - now) as f64 * 1e-9).min(0.25)) as f32;
             io.push_object(o);
         }
-        if ms >= crash_from {
-            let mut a = CrashAccelSample::EMPTY;
-            a.first_timestamp_ns = now;
-            a.sample_period_ns = 125_000;
-            a.count = 8;
-            a.accel_mps2 = [-150.0; 8];
-            io.push_accel(a);
+        // 8 samples at 8 kHz ending at `now`: noise-like dither before the contact, the
+        // predicted pulse after it.
+        let mut a = CrashAccelSample::EMPTY;
+        a.first_timestamp_ns = now - 7 * 125_000;
+        a.sample_period_ns = 125_000;
+        a.count = 8;
+        for (i, s) in a.accel_mps2.iter_mut().enumerate() {
+            let t = a.first_timestamp_ns + i as u64 * 125_000;
+            let dither = if (k + i as u64).is_multiple_of(2) { 0.05 } else { -0.05 };
+            let pulse = if t >= contact_ns {
+                crash.state_at((t - contact_ns) as f64 * 1e-9).ego_accel_mps2
+            } else {
+                0.0
+            };
+            *s = (pulse + dither) as f32;
         }
+        io.push_accel(a);
         if ms.is_multiple_of(10) {
             io.push_can(bench.vehicle_frame(25.0));
         }
@@ -98,6 +124,11 @@ fn no_allocation_in_precrash_and_crash_cycles() {
     );
     assert!(crash_cycles >= 10_000, "crash / post-crash: {crash_cycles}");
     assert!(ecu.airbag_fired());
+    assert!(
+        matches!(ecu.crash_kind(), Some(ConfirmKind::Matched(_))),
+        "the matched path ran: {:?}",
+        ecu.crash_kind()
+    );
     // The worst-case path really ran: a prediction per new object sample.
     assert_eq!(ecu.counters().predictions - predictions_before, 1_000);
     assert!(io.can_tx_total > 2_000);

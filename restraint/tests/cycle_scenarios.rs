@@ -2,8 +2,11 @@
 //!
 //! Expected times and values are closed form: the test LUT's cells are linear in closing
 //! speed and opponent mass (multilinear interpolation reproduces them exactly), objects move
-//! at constant speed (TTC = d / v), and the crash pulse is a constant deceleration (Δv after n
-//! samples = n·a·1 ms). Every command is decoded with the bus crate (CRC checked).
+//! at constant speed (TTC = d / v), and the crash pulse is either the onset ramp of the
+//! predicted collision (slope k·v/m_ego, k the series stiffness of the two fronts' first
+//! segments: the prediction-matched path) or a constant deceleration (Δv after n samples =
+//! (n − ½)·a·1 ms, trapezoidal from rest: the generic confirmation and the accelerometer-only
+//! algorithm). Every command is decoded with the bus crate (CRC checked).
 
 mod cycle_support;
 
@@ -12,6 +15,7 @@ use bus::codec::{
     BeltLimiterCmdCmdSource, BeltLimiterCmdPretensionerCmd, EcuStatusEcuMode,
 };
 use cycle_support::*;
+use restraint::crash::ConfirmKind;
 use restraint::{Degraded, EcuMode, ObjectState, Phase, Pretensioner};
 
 const G: f32 = 9.806_65;
@@ -19,9 +23,20 @@ const G: f32 = 9.806_65;
 /// Contact of the standard approach scenario.
 const C: u64 = T0 + 1_000 * MS;
 
+/// Series stiffness of the first loading segments of a class-4 ego (175.6 kN at 40 mm) and a
+/// class-3 opponent (170.1 kN at 40 mm, the test approaches' conservative 1600 kg), N/m.
+const K_SERIES_4_3: f64 = 1.0 / (0.040 / 175.6e3 + 0.040 / 170.1e3);
+
+/// The onset ramp of a crash at `closing_mps` against the class-3 test opponent: deceleration
+/// k·v·t / m_ego, in g, `ms` after contact (capped at 15 g after the first knee).
+fn ramp_g(closing_mps: f64, ms: u64) -> f32 {
+    let slope_g_per_ms = K_SERIES_4_3 * closing_mps / 1785.0 * 1e-3 / f64::from(G);
+    (slope_g_per_ms * ms as f64).min(15.0) as f32
+}
+
 /// Runs until `end`: every 10 ms an object sample (approach towards `contact` from
 /// `approach_from`, a "no track" sample before), stops objects at `objects_until`, and from
-/// `crash_at` on a constant `decel_g` accelerometer sample per ms.
+/// `crash_at` on the accelerometer reads `pulse_g(ms since crash_at)` g of deceleration.
 #[allow(clippy::too_many_arguments)]
 fn run_scenario(
     b: &mut Bench,
@@ -31,7 +46,7 @@ fn run_scenario(
     closing_mps: f32,
     objects_until: u64,
     crash_at: Option<u64>,
-    decel_g: f32,
+    pulse_g: &dyn Fn(u64) -> f32,
 ) {
     while b.now < end {
         if (b.now - T0).is_multiple_of(10 * MS) && b.now < objects_until {
@@ -45,7 +60,7 @@ fn run_scenario(
         }
         if let Some(c) = crash_at {
             if b.now >= c {
-                b.push_accel(b.now, -decel_g * G);
+                b.push_accel(-pulse_g((b.now - c) / MS) * G);
             }
         }
         b.step();
@@ -63,7 +78,7 @@ fn precrash_preset_pretensioner_at_planned_time_then_airbag_at_planned_time_and_
         25.0,
         C,
         Some(C),
-        15.0,
+        &|ms| ramp_g(25.0, ms),
     );
 
     // Oracle: 25 m/s = 90 km/h, conservative mass 1500 + 1·100 = 1600 kg.
@@ -72,16 +87,9 @@ fn precrash_preset_pretensioner_at_planned_time_then_airbag_at_planned_time_and_
     // the newest sample) is below the 300 ms horizon: C − 299 ms.
     assert_eq!(b.first_mode(EcuMode::PreCrash), Some(C - 299 * MS));
     assert_eq!(b.mode_at(C - 300 * MS), EcuMode::Monitoring as u8);
-    let plan = b.ecu.crash_plan();
-    assert!(
-        (f64::from(plan.belt_limiter_kn) - belt_kn(v, m)).abs() < 1e-4,
-        "{plan:?}"
-    );
-    assert!((f64::from(plan.airbag_level_kn) - airbag_kn(v, m)).abs() < 1e-4);
-    assert!((f64::from(plan.pretensioner_time_ms) - pret_ms(v, m)).abs() < 1e-3);
-    assert!((f64::from(plan.airbag_time_ms) - airbag_ms(v, m)).abs() < 1e-3);
 
-    // Pretensioner: first Fire command at contact − 45 ms (1 ms cycle resolution).
+    // Pretensioner: first Fire command at contact − 45 ms (1 ms cycle resolution), with the
+    // pre-crash plan of the conservative mass.
     let belts = b.belt_frames();
     let (t_pt, f) = belts
         .iter()
@@ -92,19 +100,39 @@ fn precrash_preset_pretensioner_at_planned_time_then_airbag_at_planned_time_and_
     assert!((f.pretensioner_fire_time() - (-45.0)).abs() < 0.051);
     assert_eq!(f.cmd_source(), BeltLimiterCmdCmdSource::Adaptive);
 
-    // Confirmation: 15 g → Δv 0.147 m/s per ms: ≥ 0.5 m/s at the 4th sample (C + 3 ms).
+    // Prediction-matched confirmation: the ramp (k·v/m_ego = 30.3 m/s² per ms) wakes the
+    // detectors at C + 1 ms (3.1 g ≥ 1.5 g); at 1 kHz the fit needs 3 samples spanning ≥ 1 ms:
+    // confirmed with the C + 3 ms sample, with the predicted slope (ratio 1) and onset C.
     assert_eq!(b.first_mode(EcuMode::Crash), Some(C + 3 * MS));
-    // Airbag: first Fire at contact + 14 ms with the planned stage and level.
+    let Some(ConfirmKind::Matched(e)) = b.ecu.crash_kind() else {
+        panic!("not prediction-matched: {:?}", b.ecu.crash_kind());
+    };
+    assert!((e.ratio - 1.0).abs() < 0.01 && e.follows, "{e:?}");
+    assert!(e.onset_ns.abs_diff(C) < 20_000, "fitted onset {e:?}");
+    // Re-planned before anything is committed: the table at the re-estimated closing speed and
+    // the robust mass, reported 1500 kg + 1200 kg (`mass_misreport_kg`) = 2700 kg.
+    let (v_re, m_robust) = (e.closing_mps * 3.6, 2700.0);
+    let plan = b.ecu.crash_plan();
+    assert!(
+        (f64::from(plan.belt_limiter_kn) - belt_kn(v_re, m_robust)).abs() < 1e-4,
+        "{plan:?}"
+    );
+    assert!((f64::from(plan.airbag_level_kn) - airbag_kn(v_re, m_robust)).abs() < 1e-4);
+    assert!((f64::from(plan.airbag_time_ms) - airbag_ms(v_re, m_robust)).abs() < 1e-3);
+    // Airbag: first Fire at the first cycle after onset + t_ab (≈ C + 14 ms), with the
+    // re-planned stage and level (5.4 kN: Stage 1, between 1 and 6 kN).
+    let due = e.onset_ns + (airbag_ms(v_re, m_robust) * 1e6) as u64;
+    let fire_cycle = T0 + (due - T0).div_ceil(MS) * MS;
+    assert!((C + 14 * MS..=C + 15 * MS).contains(&fire_cycle));
     let bags = b.airbag_frames();
     let (t_ab, a) = bags
         .iter()
         .find(|(_, f)| f.fire() == AirbagStageCmdFire::Fire)
         .expect("airbag fired");
-    assert_eq!(*t_ab, C + 14 * MS);
+    assert_eq!(*t_ab, fire_cycle);
     assert_eq!(a.arm(), AirbagStageCmdArm::Armed);
-    assert_eq!(a.stage(), AirbagStageCmdStage::Stage1); // 3.2 kN: between 1 and 6 kN
-    assert_eq!(a.force_level(), q(airbag_kn(v, m), 0.05));
-    assert!((a.fire_time() - 14.0).abs() < 0.051);
+    assert_eq!(a.stage(), AirbagStageCmdStage::Stage1);
+    assert_eq!(a.force_level(), q(airbag_kn(v_re, m_robust), 0.05));
     assert_eq!(a.cmd_source(), AirbagStageCmdCmdSource::Adaptive);
     // Never before confirmation, and armed during pre-crash.
     assert!(bags
@@ -115,7 +143,7 @@ fn precrash_preset_pretensioner_at_planned_time_then_airbag_at_planned_time_and_
         .iter()
         .filter(|(t, _)| *t >= C - 299 * MS)
         .all(|(_, f)| f.arm() == AirbagStageCmdArm::Armed));
-    assert_eq!(b.first_mode(EcuMode::PostCrash), Some(C + 14 * MS));
+    assert_eq!(b.first_mode(EcuMode::PostCrash), Some(fire_cycle));
     assert_eq!(b.ecu.phase(), Phase::PostCrash);
 
     // Cyclic + on change: never more than 10 ms between two frames of a command.
@@ -147,7 +175,7 @@ fn precrash_preset_pretensioner_at_planned_time_then_airbag_at_planned_time_and_
 fn avoided_collision_releases_pretensioner_and_never_fires_the_airbag() {
     let mut b = Bench::new(Some(test_lut()));
     // Approach as before until the pretensioner has fired (C − 45 ms) ...
-    run_scenario(&mut b, C - 30 * MS, T0 + 200 * MS, C, 25.0, C, None, 0.0);
+    run_scenario(&mut b, C - 30 * MS, T0 + 200 * MS, C, 25.0, C, None, &|_| 0.0);
     assert_eq!(b.ecu.pretensioner(), Pretensioner::Fired);
     // ... then the opponent turns away: receding object.
     let mut o = cycle_support::object(b.now, -2.0, 1500.0, 100.0);
@@ -156,7 +184,7 @@ fn avoided_collision_releases_pretensioner_and_never_fires_the_airbag() {
     let t_avoid = b.now;
     b.step();
     assert_eq!(b.ecu.phase(), Phase::Monitoring);
-    run_scenario(&mut b, C + 300 * MS, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    run_scenario(&mut b, C + 300 * MS, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
     let belts = b.belt_frames();
     let (t_rel, _) = belts
         .iter()
@@ -174,10 +202,10 @@ fn avoided_collision_releases_pretensioner_and_never_fires_the_airbag() {
 #[test]
 fn lost_object_counts_as_avoided() {
     let mut b = Bench::new(Some(test_lut()));
-    run_scenario(&mut b, C - 20 * MS, T0 + 200 * MS, C, 25.0, C, None, 0.0);
+    run_scenario(&mut b, C - 20 * MS, T0 + 200 * MS, C, 25.0, C, None, &|_| 0.0);
     assert_eq!(b.ecu.phase(), Phase::PreCrash);
     // Tracker reports "no object" (valid = 0) from C − 20 ms on.
-    run_scenario(&mut b, C + 200 * MS, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    run_scenario(&mut b, C + 200 * MS, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
     assert_eq!(b.mode_at(C - 20 * MS), EcuMode::Monitoring as u8);
     assert_eq!(b.ecu.pretensioner(), Pretensioner::Released);
     assert!(!b.ecu.airbag_fired());
@@ -196,7 +224,7 @@ fn stale_object_data_degrades_after_the_timeout_and_the_reference_fires() {
         0.0,
         T0 + 300 * MS,
         Some(crash),
-        15.0,
+        &|_| 15.0,
     );
     // Last object received at T0 + 290 ms; stale when older than 100 ms.
     assert_eq!(b.mode_at(T0 + 390 * MS), EcuMode::Monitoring as u8);
@@ -240,7 +268,7 @@ fn crash_without_pre_crash_detection_fires_the_reference() {
         0.0,
         u64::MAX,
         Some(crash),
-        15.0,
+        &|_| 15.0,
     );
     assert_eq!(b.first_mode(EcuMode::PreCrash), None);
     assert_eq!(b.first_mode(EcuMode::Degraded), None);
@@ -265,7 +293,7 @@ fn sensor_dropout_before_pre_crash_then_crash_fires_the_reference() {
         25.0,
         C - 400 * MS,
         Some(C),
-        15.0,
+        &|_| 15.0,
     );
     assert_eq!(b.first_mode(EcuMode::PreCrash), None);
     assert_eq!(
@@ -300,11 +328,11 @@ fn e2e_failure_burst_degrades_for_the_hold_time() {
         f
     };
     // Two rejections 150 ms apart: no burst.
-    run_scenario(&mut b, T0 + 200 * MS, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    run_scenario(&mut b, T0 + 200 * MS, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
     for _ in 0..2 {
         b.io.push_can(corrupt(&mut bad_tx));
         let end = b.now + 150 * MS;
-        run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+        run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
     }
     assert_eq!(b.first_mode(EcuMode::Degraded), None);
     // Three within 100 ms: burst at the third.
@@ -313,9 +341,9 @@ fn e2e_failure_burst_degrades_for_the_hold_time() {
         b.io.push_can(corrupt(&mut bad_tx));
         t3 = b.now;
         let end = b.now + 10 * MS;
-        run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+        run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
     }
-    run_scenario(&mut b, t3 + 700 * MS, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    run_scenario(&mut b, t3 + 700 * MS, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
     assert_eq!(b.first_mode(EcuMode::Degraded), Some(t3));
     let i = b.step_times.iter().position(|&t| t == t3).unwrap();
     assert_ne!(
@@ -344,7 +372,7 @@ fn missing_lut_runs_degraded_from_the_start_and_fires_the_reference() {
         25.0,
         C,
         Some(C),
-        15.0,
+        &|_| 15.0,
     );
     assert_eq!(b.mode_at(T0), EcuMode::Degraded as u8);
     assert_ne!(
@@ -367,29 +395,38 @@ fn missing_lut_runs_degraded_from_the_start_and_fires_the_reference() {
 fn low_closing_speed_never_fires_the_airbag_but_the_belt_follows_the_reference() {
     let mut b = Bench::new(Some(test_lut()));
     // 4 m/s against 1600 kg (conservative): EBS = 4·1600/3385·3.6 = 6.8 km/h < 20 km/h.
-    // 6 g: Δv 0.0588 m/s per ms → ≥ 0.5 m/s at the 9th sample (C + 8 ms).
-    run_scenario(&mut b, C + 100 * MS, T0 + 200 * MS, C, 4.0, C, Some(C), 6.0);
+    // 4.5 g: Δv = (n − ½)·0.04413 m/s after n samples → ≥ 0.5 m/s at n = 12 (C + 11 ms).
+    // The accelerometer-only algorithm decides the airbag: Δv(τ) = 0.0221 + 0.0441·τ stays
+    // under its boundary (0.25 m/s at 4 ms, then rising 0.11–0.16 m/s per ms) until the
+    // 60 ms window closes.
+    run_scenario(&mut b, C + 100 * MS, T0 + 200 * MS, C, 4.0, C, Some(C), &|_| 4.5);
     assert_eq!(b.first_mode(EcuMode::PreCrash), None);
-    assert_eq!(b.first_mode(EcuMode::Crash), Some(C + 8 * MS));
+    assert_eq!(b.first_mode(EcuMode::Crash), Some(C + 11 * MS));
+    assert!(matches!(
+        b.ecu.crash_kind(),
+        Some(ConfirmKind::Generic { .. })
+    ));
     assert!(b
         .airbag_frames()
         .iter()
         .all(|(_, f)| f.fire() == AirbagStageCmdFire::NoFire));
     let last = b.airbag_frames().last().unwrap().1;
     assert_eq!(last.stage(), AirbagStageCmdStage::NoStage);
+    // The window closed at the first sample more than 60 ms after the onset (C): PostCrash.
+    assert_eq!(b.first_mode(EcuMode::PostCrash), Some(C + 61 * MS));
     let belt = b
         .belt_frames()
         .into_iter()
         .find(|(_, f)| f.pretensioner_cmd() == BeltLimiterCmdPretensionerCmd::Fire)
         .expect("belt fires per reference");
-    assert_eq!(belt.0, C + 10 * MS);
+    assert_eq!(belt.0, C + 11 * MS);
     assert_eq!(belt.1.load_limiter_level(), 8.5);
 }
 
 #[test]
 fn nan_object_fields_degrade_until_a_valid_sample_arrives() {
     let mut b = Bench::new(Some(test_lut()));
-    run_scenario(&mut b, T0 + 200 * MS, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    run_scenario(&mut b, T0 + 200 * MS, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
     let mut o = cycle_support::object(b.now, f32::NAN, 1500.0, 100.0);
     o.distance_m = f32::INFINITY;
     b.io.push_object(o);
@@ -401,7 +438,7 @@ fn nan_object_fields_degrade_until_a_valid_sample_arrives() {
         0
     );
     let end = b.now + 30 * MS;
-    run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
     assert_eq!(b.ecu.phase(), Phase::Monitoring);
 }
 
@@ -416,7 +453,7 @@ fn restarted_sender_is_accepted_after_its_timeout_but_a_counter_jump_is_not() {
     // "No track" object samples keep the object input fresh throughout.
     let idle = |b: &mut Bench, ms: u64| {
         let end = b.now + ms * MS;
-        run_scenario(b, end, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+        run_scenario(b, end, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
     };
     idle(&mut b, 300);
     assert_eq!(b.mode_at(b.now - MS), EcuMode::Monitoring as u8);
@@ -469,7 +506,7 @@ fn restarted_sender_is_accepted_after_its_timeout_but_a_counter_jump_is_not() {
 fn stuck_no_track_records_degrade_like_stale_samples() {
     let mut b = Bench::new(Some(test_lut()));
     let end = b.now + 300 * MS;
-    run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
     assert_eq!(b.mode_at(b.now - MS), EcuMode::Monitoring as u8);
     let mut stuck = ObjectState::INVALID;
     stuck.timestamp_ns = b.now;
@@ -494,7 +531,7 @@ fn stuck_no_track_records_degrade_like_stale_samples() {
     );
     // Fresh again.
     let end = b.now + 20 * MS;
-    run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, 0.0);
+    run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
     assert_eq!(
         b.diagnostics.last().unwrap().degraded_reasons & Degraded::OBJECT_INVALID.bits(),
         0

@@ -73,6 +73,8 @@ pub struct OfflineRun {
     pub modes: Vec<(f64, String)>,
     /// Every EcuStatus fault-flag change: (ms, flag names).
     pub faults: Vec<(f64, Vec<String>)>,
+    /// How the core confirmed the crash (its `ConfirmKind`, as text).
+    pub confirmed_by: Option<String>,
 }
 
 impl OfflineRun {
@@ -152,6 +154,7 @@ pub fn run(scenario: &Scenario, cfg: &OfflineConfig) -> Result<OfflineRun> {
             crash_mode_ns = Some(now);
         }
     }
+    let confirmed_by = ecu.crash_kind().map(|k| format!("{k:?}"));
     let truth = Truth::new(scenario).map_err(|e| anyhow!("{}: {e}", scenario.name))?;
     let contact_ns = contact_s.map_or(u64::MAX, |tc| START_NS + (tc * 1e9).round() as u64);
     let evaluated = match contact_s {
@@ -176,6 +179,7 @@ pub fn run(scenario: &Scenario, cfg: &OfflineConfig) -> Result<OfflineRun> {
             .collect(),
         evaluated,
         modules,
+        confirmed_by,
     })
 }
 

@@ -83,7 +83,10 @@ pub fn lut_of(d: &Diagram) -> Lut<'_> {
     }
 }
 
-/// Simulated bench at 1 kHz with scripted CAN inputs.
+/// Simulated bench at 1 kHz with scripted CAN inputs and a live crash accelerometer: every
+/// step delivers one 1 kHz sample stamped on the 1 ms grid, 0 m/s² (or what [`Bench::push_accel`]
+/// scheduled for that step) with a ±0.05 m/s² alternating dither — a real sensor's reading is
+/// never bit-identical for long, and the ECU flags one that is as stuck.
 pub struct Bench {
     pub ecu: RestraintCycle<'static>,
     pub io: SimIo,
@@ -103,6 +106,10 @@ pub struct Bench {
     pub sent: Vec<(u64, RawFrame)>,
     /// Deadline of the next step (`None`: the step's `now`, an on-time cycle).
     pub deadline: Option<u64>,
+    /// The accelerometer delivers a sample every step (false: silent, a dead sensor).
+    pub accel_live: bool,
+    /// The reading of the next step's sample, m/s² (taken by the step; then 0 again).
+    pending_accel_mps2: Option<f32>,
 }
 
 pub const T0: u64 = 10_000 * MS;
@@ -142,6 +149,8 @@ impl Bench {
             diagnostics: Vec::new(),
             sent: Vec::new(),
             deadline: None,
+            accel_live: true,
+            pending_accel_mps2: None,
         }
     }
 
@@ -174,6 +183,11 @@ impl Bench {
         if self.send_occupant && ms.is_multiple_of(100) {
             let f = self.occupant_frame();
             self.io.push_can(f);
+        }
+        let reading = self.pending_accel_mps2.take().unwrap_or(0.0);
+        if self.accel_live {
+            let dither = if ms.is_multiple_of(2) { 0.05 } else { -0.05 };
+            self.io.push_accel(accel_batch(T0 + ms * MS, reading + dither));
         }
         let info = CycleInfo {
             cycle: self.cycle,
@@ -217,15 +231,9 @@ impl Bench {
         self.io.push_object(o);
     }
 
-    /// Pushes one 1-sample accelerometer batch measured at `t_ns`.
-    pub fn push_accel(&mut self, t_ns: u64, accel_mps2: f32) {
-        let mut a = CrashAccelSample::EMPTY;
-        a.first_timestamp_ns = t_ns;
-        a.sample_period_ns = 1_000_000;
-        a.count = 1;
-        a.accel_mps2[0] = accel_mps2;
-        a.sequence = t_ns / MS;
-        self.io.push_accel(a);
+    /// The accelerometer reads `accel_mps2` (negative = deceleration) in the next step.
+    pub fn push_accel(&mut self, accel_mps2: f32) {
+        self.pending_accel_mps2 = Some(accel_mps2);
     }
 
     pub fn decoded(&self) -> Vec<(u64, bus::Messages)> {
@@ -288,6 +296,17 @@ impl Bench {
             .find(|(d, _)| d.mode == mode as u8)
             .map(|(_, t)| *t)
     }
+}
+
+/// A 1-sample, 1 kHz accelerometer batch measured at `t_ns`.
+pub fn accel_batch(t_ns: u64, accel_mps2: f32) -> CrashAccelSample {
+    let mut a = CrashAccelSample::EMPTY;
+    a.first_timestamp_ns = t_ns;
+    a.sample_period_ns = 1_000_000;
+    a.count = 1;
+    a.accel_mps2[0] = accel_mps2;
+    a.sequence = t_ns / MS;
+    a
 }
 
 pub fn object(now: u64, closing_mps: f32, opp_kg: f32, sigma_kg: f32) -> ObjectState {

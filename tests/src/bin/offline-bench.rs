@@ -53,6 +53,7 @@ fn main() -> Result<()> {
             "scenario": r.name,
             "contact_s": r.contact_s,
             "crash_mode_ms": r.crash_mode_ms,
+            "confirmed_by": r.confirmed_by,
             "modes": r.modes,
             "faults": r.faults,
             "actions": r.modules.actions,

@@ -1,0 +1,69 @@
+//! The ECU's accelerometer-only airbag algorithm against its requirements on crashes of the
+//! model (`lut::fallback_study`): the shipped boundary is exactly what the calibration sweep
+//! derives, it meets every no-fire / must-fire / deadline requirement of that sweep, and of a
+//! second sweep it was not calibrated on (other speeds, opponents, noise seeds and rates).
+
+use lut::fallback_study::{
+    calibrate, must_fire_line, run_sweep, violations, Family, SensorSpec, Sweep,
+};
+use restraint::fallback::DEFAULT_DV_MPS;
+use restraint::CycleConfig;
+
+fn t_ref_ms() -> f64 {
+    physics::reference::ReferenceRestraint::builtin()
+        .expect("built-in reference")
+        .restraint
+        .airbag_time_ms
+}
+
+#[test]
+fn the_shipped_boundary_is_the_calibration_of_the_sweep_and_meets_its_requirements() {
+    let cfg = CycleConfig::default();
+    let rows = run_sweep(&cfg, &Sweep::calibration()).expect("sweep");
+    assert_eq!(
+        calibrate(&rows, cfg.no_fire_ebs_kph, 0.10),
+        DEFAULT_DV_MPS,
+        "the default boundary must be what `lut study fallback --derive` derives"
+    );
+    // The README quotes this line: the belt alone (reference limiter) lets the 75 kg occupant
+    // at 300 mm bottom out from a 28 km/h rigid barrier on.
+    let must = must_fire_line(&rows).expect("a must-fire line");
+    assert_eq!(must, 28.0);
+    let bad = violations(&rows, cfg.no_fire_ebs_kph, must, t_ref_ms());
+    assert!(bad.is_empty(), "{bad:#?}");
+}
+
+#[test]
+fn it_also_holds_on_crashes_it_was_not_calibrated_on() {
+    let cfg = CycleConfig::default();
+    let sweep = Sweep {
+        ebs_from_kph: 6.5,
+        ebs_to_kph: 63.5,
+        step_kph: 1.3,
+        families: std::iter::once(Family::Barrier)
+            .chain([900.0, 1150.0, 1450.0, 2000.0, 2400.0, 2800.0].map(|m| Family::Car {
+                opponent_kg: m,
+            }))
+            .collect(),
+        sensors: vec![
+            SensorSpec::bench(11),
+            SensorSpec::bench(12),
+            SensorSpec {
+                rate_hz: 8000.0,
+                ..SensorSpec::bench(13)
+            },
+            SensorSpec {
+                rate_hz: 2000.0,
+                ..SensorSpec::bench(14)
+            },
+        ],
+    };
+    let rows = run_sweep(&cfg, &sweep).expect("sweep");
+    let bad = violations(&rows, cfg.no_fire_ebs_kph, 28.0, t_ref_ms());
+    assert!(bad.is_empty(), "{bad:#?}");
+    // Slow barriers and bumps (EBS < 20 km/h) never fire, whatever the sensor.
+    assert!(rows
+        .iter()
+        .filter(|r| r.req.ebs_kph < cfg.no_fire_ebs_kph && r.spec.onset_ebs_kph() < 20.0)
+        .all(|r| !r.fires(t_ref_ms())));
+}

@@ -1,0 +1,273 @@
+//! Crash-accelerometer monitoring: is the sensor alive, and is what it says a measurement?
+//!
+//! Every batch is checked before any of its samples reaches a crash detector:
+//!
+//! | check | rule | reaction |
+//! |---|---|---|
+//! | **stale** | no batch received for `accel_timeout_ms` (by receipt time; none yet = stale) | `ACCEL_STALE` while it lasts |
+//! | **time** | sample period 0 or > 10 ms; a batch that starts before the previous one ended (half a period of slack: non-monotonic time); a first sample older than the timeout or more than one cycle in the future | batch dropped, `ACCEL_INVALID` held |
+//! | **out of range** | a non-finite sample, or one beyond the sensor's measuring range (`accel_full_scale_g`) | sample dropped, `ACCEL_INVALID` held |
+//! | **saturated** | a sample at full scale (within 0.1 %: a sensor pinned at its rail) | sample dropped, `ACCEL_INVALID` held |
+//! | **stuck** | bit-identical readings for `accel_stuck_ms` | `ACCEL_INVALID` held |
+//!
+//! `ACCEL_INVALID` is held for [`INVALID_HOLD_MS`] after the last implausible sample, so a
+//! flickering sensor cannot toggle the decision every cycle. Why a stuck sensor is caught by
+//! bit-identity: a live MEMS accelerometer's noise (≥ 1 LSB) changes its reading from sample
+//! to sample; the bench's sensor model has 0.5 m/s² of noise, so identical readings for 20 ms
+//! (80 samples at 4 kHz) do not happen by chance. A sensor with a coarse LSB and little noise
+//! needs a longer `accel_stuck_ms`.
+//!
+//! Plausible samples are handed on one by one, in time order, as [`AccelSample`]s.
+
+use crate::config::{ms_to_ns, CycleConfig};
+use crate::confirm::G_MPS2;
+
+/// How long an implausible accelerometer sample keeps `ACCEL_INVALID` set, ms.
+pub const INVALID_HOLD_MS: f64 = 500.0;
+/// Longest sample period accepted, ns (10 ms: slower than any crash sensor).
+pub const MAX_SAMPLE_PERIOD_NS: u32 = 10_000_000;
+/// A batch's first sample may lie this far in the future of the cycle's clock (one cycle of
+/// jitter between the sensor's and the ECU's time stamps), ns.
+const FUTURE_SLACK_NS: u64 = 1_000_000;
+/// Relative band around full scale that counts as saturated.
+const SATURATION_BAND: f64 = 1.0e-3;
+
+/// One plausible accelerometer sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AccelSample {
+    /// Measurement time, ns (the sensor's clock = the cycle's CLOCK_MONOTONIC).
+    pub t_ns: u64,
+    /// Sample period, s (the integration step of this sample).
+    pub dt_s: f64,
+    /// Longitudinal deceleration, m/s² (positive = the car is slowed down).
+    pub decel_mps2: f64,
+}
+
+/// Counts of what the monitor rejected (timing report).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct AccelFaultCounts {
+    /// Batches dropped: unusable period, non-monotonic or out-of-window time stamps.
+    pub bad_time_batches: u64,
+    /// Samples dropped as non-finite or beyond the measuring range.
+    pub out_of_range_samples: u64,
+    /// Samples dropped as saturated (at full scale).
+    pub saturated_samples: u64,
+    /// Times the sensor was found stuck.
+    pub stuck_events: u64,
+    /// Cycles in which the sensor was stale.
+    pub stale_cycles: u64,
+}
+
+/// State of the accelerometer monitoring.
+#[derive(Debug, Clone)]
+pub struct AccelMonitor {
+    timeout_ns: u64,
+    stuck_ns: u64,
+    full_scale_mps2: f64,
+    hold_ns: u64,
+    /// Receipt time of the newest accepted batch.
+    rx_ns: Option<u64>,
+    /// Time of the newest accepted sample + half a period (where the next batch may start).
+    next_from_ns: Option<u64>,
+    /// Bits of the last reading and since when it has not changed.
+    last_bits: Option<u32>,
+    same_since_ns: u64,
+    stuck: bool,
+    invalid_until_ns: Option<u64>,
+    /// What was rejected so far.
+    pub faults: AccelFaultCounts,
+}
+
+impl AccelMonitor {
+    /// Monitoring with the limits of a validated `cfg`.
+    pub fn new(cfg: &CycleConfig) -> Self {
+        Self {
+            timeout_ns: ms_to_ns(cfg.accel_timeout_ms),
+            stuck_ns: ms_to_ns(cfg.accel_stuck_ms),
+            full_scale_mps2: cfg.accel_full_scale_g * G_MPS2,
+            hold_ns: ms_to_ns(INVALID_HOLD_MS),
+            rx_ns: None,
+            next_from_ns: None,
+            last_bits: None,
+            same_since_ns: 0,
+            stuck: false,
+            invalid_until_ns: None,
+            faults: AccelFaultCounts::default(),
+        }
+    }
+
+    fn implausible(&mut self, now: u64) {
+        self.invalid_until_ns = Some(now.saturating_add(self.hold_ns));
+    }
+
+    /// Checks one batch received at `now` (`first_ns`, `period_ns`, samples in m/s²,
+    /// negative = deceleration) and hands each plausible sample to `sink`, in time order.
+    pub fn feed(
+        &mut self,
+        now: u64,
+        first_ns: u64,
+        period_ns: u32,
+        samples: &[f32],
+        sink: &mut dyn FnMut(&AccelSample),
+    ) {
+        let too_old = now.saturating_sub(first_ns) > self.timeout_ns;
+        let in_future = first_ns > now.saturating_add(FUTURE_SLACK_NS);
+        let backwards = self.next_from_ns.is_some_and(|t| first_ns < t);
+        if period_ns == 0 || period_ns > MAX_SAMPLE_PERIOD_NS || too_old || in_future || backwards
+        {
+            self.faults.bad_time_batches = self.faults.bad_time_batches.saturating_add(1);
+            self.implausible(now);
+            return;
+        }
+        self.rx_ns = Some(now);
+        let dt_s = f64::from(period_ns) * 1.0e-9;
+        let half = u64::from(period_ns / 2);
+        let mut t = first_ns;
+        for &a in samples {
+            let t_ns = t;
+            t = t.saturating_add(u64::from(period_ns));
+            self.next_from_ns = Some(t_ns.saturating_add(half));
+            let v = f64::from(a);
+            let magnitude = v.abs();
+            if !(magnitude <= self.full_scale_mps2 * (1.0 + SATURATION_BAND)) {
+                self.faults.out_of_range_samples = self.faults.out_of_range_samples.saturating_add(1);
+                self.implausible(now);
+                continue;
+            }
+            if magnitude >= self.full_scale_mps2 * (1.0 - SATURATION_BAND) {
+                self.faults.saturated_samples = self.faults.saturated_samples.saturating_add(1);
+                self.implausible(now);
+                continue;
+            }
+            let bits = a.to_bits();
+            if self.last_bits == Some(bits) {
+                if !self.stuck && t_ns.saturating_sub(self.same_since_ns) >= self.stuck_ns {
+                    self.stuck = true;
+                    self.faults.stuck_events = self.faults.stuck_events.saturating_add(1);
+                }
+            } else {
+                self.last_bits = Some(bits);
+                self.same_since_ns = t_ns;
+                self.stuck = false;
+            }
+            if self.stuck {
+                self.implausible(now);
+                continue;
+            }
+            sink(&AccelSample {
+                t_ns,
+                dt_s,
+                decel_mps2: -v,
+            });
+        }
+    }
+
+    /// No batch received within the timeout (none at all = stale).
+    pub fn stale(&self, now: u64) -> bool {
+        self.rx_ns
+            .is_none_or(|t| now.saturating_sub(t) > self.timeout_ns)
+    }
+
+    /// An implausible batch or sample within the hold time (or the sensor is stuck now).
+    pub fn invalid(&self, now: u64) -> bool {
+        self.stuck || self.invalid_until_ns.is_some_and(|t| now <= t)
+    }
+
+    /// Counts one stale cycle (the cycle calls it once per cycle while stale).
+    pub(crate) fn note_stale_cycle(&mut self) {
+        self.faults.stale_cycles = self.faults.stale_cycles.saturating_add(1);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use std::vec::Vec;
+
+    const MS: u64 = 1_000_000;
+
+    fn monitor() -> AccelMonitor {
+        AccelMonitor::new(&CycleConfig::default())
+    }
+
+    /// Feeds one 4-sample 4 kHz batch ending at `now`; returns the samples passed on.
+    fn feed(m: &mut AccelMonitor, now: u64, v: [f32; 4]) -> Vec<AccelSample> {
+        let mut out = Vec::new();
+        m.feed(now, now - 750_000, 250_000, &v, &mut |s| out.push(*s));
+        out
+    }
+
+    #[test]
+    fn a_live_sensor_is_passed_through_in_time_order_and_goes_stale_after_the_timeout() {
+        let mut m = monitor();
+        assert!(m.stale(0), "nothing received yet");
+        let s = feed(&mut m, 10 * MS, [-1.0, -2.0, -3.0, -4.0]);
+        assert_eq!(s.len(), 4);
+        assert_eq!(s[0].t_ns, 10 * MS - 750_000);
+        assert_eq!(s[3].decel_mps2, 4.0);
+        assert_eq!(s[1].dt_s, 250e-6);
+        assert!(!m.stale(10 * MS) && !m.invalid(10 * MS));
+        // Default timeout 20 ms: stale strictly after it.
+        assert!(!m.stale(30 * MS));
+        assert!(m.stale(30 * MS + 1));
+    }
+
+    #[test]
+    fn out_of_range_saturated_and_non_finite_samples_never_reach_a_detector() {
+        let mut m = monitor();
+        let fs = (200.0 * G_MPS2) as f32;
+        let s = feed(&mut m, 10 * MS, [-fs, f32::NAN, -3.0 * fs, -100.0]);
+        assert_eq!(s.len(), 1);
+        assert_eq!(s[0].decel_mps2, 100.0);
+        assert_eq!(m.faults.saturated_samples, 1);
+        assert_eq!(m.faults.out_of_range_samples, 2);
+        assert!(m.invalid(10 * MS));
+        // Held 500 ms after the last implausible sample, then plausible again.
+        assert!(m.invalid(510 * MS));
+        assert!(!m.invalid(510 * MS + 1));
+    }
+
+    #[test]
+    fn batches_going_back_in_time_or_from_the_past_or_future_are_dropped() {
+        let mut m = monitor();
+        assert_eq!(feed(&mut m, 10 * MS, [1.0, 2.0, 3.0, 4.0]).len(), 4);
+        // The same batch again (a replayed or duplicated batch): starts before the last ended.
+        let mut n = 0;
+        m.feed(11 * MS, 10 * MS - 750_000, 250_000, &[5.0; 4], &mut |_| n += 1);
+        assert_eq!(n, 0);
+        assert_eq!(m.faults.bad_time_batches, 1);
+        // Older than the timeout, and 2 ms in the future.
+        m.feed(40 * MS, 15 * MS, 250_000, &[5.0; 4], &mut |_| n += 1);
+        m.feed(40 * MS, 42 * MS, 250_000, &[5.0; 4], &mut |_| n += 1);
+        m.feed(40 * MS, 39 * MS, 0, &[5.0; 4], &mut |_| n += 1);
+        assert_eq!((n, m.faults.bad_time_batches), (0, 4));
+        assert!(m.invalid(40 * MS));
+        // A dropped batch is not a sign of life.
+        assert!(m.stale(40 * MS));
+        // The next genuine batch continues.
+        assert_eq!(feed(&mut m, 41 * MS, [1.5, 2.0, 3.0, 4.0]).len(), 4);
+    }
+
+    #[test]
+    fn identical_readings_for_the_stuck_time_are_a_stuck_sensor() {
+        let mut m = monitor();
+        // 20 ms of one value at 4 kHz: the 81st identical sample is 20 ms after the first.
+        let mut passed = 0;
+        let mut now = 10 * MS;
+        for _ in 0..20 {
+            passed += feed(&mut m, now, [-7.25; 4]).len();
+            now += MS;
+        }
+        assert_eq!(passed, 80);
+        assert!(!m.invalid(now));
+        passed += feed(&mut m, now, [-7.25; 4]).len();
+        assert_eq!(passed, 80, "from 20 ms on the repeated reading is not a measurement");
+        assert!(m.invalid(now));
+        assert_eq!(m.faults.stuck_events, 1);
+        // It moves again: plausible, but held invalid for the hold time.
+        assert_eq!(feed(&mut m, now + MS, [-7.0, -7.5, -7.25, -7.0]).len(), 4);
+        assert!(m.invalid(now + MS));
+        assert!(!m.invalid(now + MS + 501 * MS));
+    }
+}

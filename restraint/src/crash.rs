@@ -1,0 +1,225 @@
+//! The crash phase's evidence: which detector confirmed the crash, when, where the contact
+//! was, how severe it is, and — for the conventional path — whether the airbag must fire.
+//!
+//! Every plausible accelerometer sample goes to three detectors at once:
+//!
+//! * [`PulseMatch`] (`crash_match`): in PRE-CRASH, the onset ramp against the frozen prediction
+//!   → an early confirmation with the re-estimated severity, or a mismatch;
+//! * [`CrashDetector`] (`confirm`): the generic thresholds (4 g × 3 samples and 0.5 m/s);
+//! * [`FallbackAlgorithm`] (`fallback`): the accelerometer-only must-fire / no-fire decision.
+//!
+//! With a faulty crash accelerometer none of them has data; then a crash the object list
+//! predicts is confirmed by the vehicle-dynamics deceleration on CAN (`backup_confirm_g`,
+//! within ± `match_window_ms` of the predicted contact) — two independent sensors agreeing, so
+//! that neither a faulty object list nor a faulty vehicle signal alone can fire.
+//!
+//! The first confirmation latches ([`Confirmation`]); [`plan_for`] re-plans an adaptive crash
+//! from the table at the measured severity and the robust planning mass.
+
+use crate::accel::AccelSample;
+use crate::config::{ms_to_ns, CycleConfig};
+use crate::confirm::{ConfirmParams, CrashDetector, G_MPS2};
+use crate::counters::CycleCounters;
+use crate::crash_match::{MatchParams, MatchState, PredictedPulse, PulseMatch, SeverityEstimate};
+use crate::estimate::{equivalent_barrier_speed_kph, Estimator, Situation};
+use crate::fallback::{FallbackAlgorithm, FallbackDecision};
+use crate::inputs::InputMonitor;
+use crate::plan::RestraintPlan;
+
+/// Which path confirmed the crash.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ConfirmKind {
+    /// The onset matched the prediction (or departed from it within the re-estimation range).
+    Matched(SeverityEstimate),
+    /// The generic thresholds (the accelerometer-only algorithm decides the airbag);
+    /// `prediction_refuted`: the matcher found the pulse does not belong to the predicted
+    /// crash (diagnostics only).
+    Generic {
+        /// The matcher rejected this pulse (timing, severity or shape).
+        prediction_refuted: bool,
+    },
+    /// The vehicle-dynamics deceleration on CAN, with the crash accelerometer faulty.
+    Backup,
+}
+
+/// The latched crash confirmation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Confirmation {
+    /// When it was confirmed (sample or frame time), ns.
+    pub at_ns: u64,
+    /// The contact instant it implies (measured onset; for the backup the predicted contact), ns.
+    pub contact_ns: u64,
+    /// The path.
+    pub kind: ConfirmKind,
+}
+
+/// What the samples' handler needs to freeze a prediction at a wake-up.
+pub(crate) struct FreezeContext<'a, 'lut> {
+    /// The newest situation (from the previous cycle's estimate).
+    pub situation: Option<Situation>,
+    /// A crash is predicted (PRE-CRASH, inputs not degraded).
+    pub armed: bool,
+    /// The estimate (springs, ego mass).
+    pub estimator: &'a Estimator<'lut>,
+}
+
+/// State of the crash-phase detectors.
+#[derive(Debug, Clone)]
+pub struct CrashMonitor {
+    onset_params: ConfirmParams,
+    generic: CrashDetector,
+    matcher: PulseMatch,
+    fallback: FallbackAlgorithm,
+    window_ns: u64,
+    backup_decel_mps2: f64,
+    confirmation: Option<Confirmation>,
+}
+
+impl CrashMonitor {
+    /// The detectors with the thresholds of a validated `cfg`.
+    pub fn new(cfg: &CycleConfig) -> Self {
+        let onset_params = ConfirmParams::from_config(cfg);
+        Self {
+            onset_params,
+            generic: CrashDetector::default(),
+            matcher: PulseMatch::new(MatchParams {
+                onset: onset_params,
+                min_span_ns: ms_to_ns(cfg.match_min_ms),
+                window_ns: ms_to_ns(cfg.match_window_ms),
+                tolerance: cfg.match_tolerance,
+                ratio_min: cfg.match_ratio_min,
+                ratio_max: cfg.match_ratio_max,
+            }),
+            fallback: FallbackAlgorithm::new(cfg.fallback_dv_mps),
+            window_ns: ms_to_ns(cfg.match_window_ms),
+            backup_decel_mps2: cfg.backup_confirm_g * G_MPS2,
+            confirmation: None,
+        }
+    }
+
+    /// One plausible accelerometer sample for all three detectors.
+    pub(crate) fn on_sample(&mut self, s: &AccelSample, ctx: &FreezeContext<'_, '_>) {
+        self.matcher.push(s, &mut || {
+            let sit = ctx.situation.filter(|_| ctx.armed)?;
+            let spring = ctx.estimator.spring_for(sit.opponent_mass_kg)?;
+            PredictedPulse::solve(
+                spring,
+                ctx.estimator.ego_mass_kg(),
+                sit.opponent_mass_kg,
+                sit.closing_speed_mps,
+                sit.contact_ns,
+            )
+        });
+        self.generic.push(&self.onset_params, s);
+        self.fallback.push(&self.onset_params, s);
+        if self.confirmation.is_some() {
+            return;
+        }
+        if let MatchState::Confirmed(e) = self.matcher.state() {
+            self.confirmation = Some(Confirmation {
+                at_ns: e.confirm_ns,
+                contact_ns: e.onset_ns,
+                kind: ConfirmKind::Matched(e),
+            });
+        } else if let (Some(at_ns), Some(onset)) =
+            (self.generic.confirmed_at_ns(), self.generic.onset_ns())
+        {
+            self.confirmation = Some(Confirmation {
+                at_ns,
+                contact_ns: onset,
+                kind: ConfirmKind::Generic {
+                    prediction_refuted: matches!(self.matcher.state(), MatchState::Mismatch(_)),
+                },
+            });
+        }
+    }
+
+    /// Once per cycle after the inputs: the backup confirmation. With the crash accelerometer
+    /// faulty (`accel_faulty`) and a crash predicted at `situation.contact_ns` (above the
+    /// no-fire line), a fresh vehicle frame received within ± the match window of the
+    /// predicted contact whose deceleration reaches `backup_confirm_g` confirms it.
+    pub(crate) fn end_cycle(
+        &mut self,
+        now: u64,
+        accel_faulty: bool,
+        situation: Option<&Situation>,
+        inputs: &InputMonitor,
+    ) {
+        if self.confirmation.is_some() || !accel_faulty {
+            return;
+        }
+        let (Some(sit), Some((decel, rx_ns))) = (situation, inputs.vehicle_decel(now)) else {
+            return;
+        };
+        let in_window = rx_ns.abs_diff(sit.contact_ns) <= self.window_ns;
+        if !sit.low_speed && in_window && decel >= self.backup_decel_mps2 {
+            self.confirmation = Some(Confirmation {
+                at_ns: rx_ns,
+                contact_ns: sit.contact_ns,
+                kind: ConfirmKind::Backup,
+            });
+        }
+    }
+
+    /// The latched confirmation.
+    pub fn confirmation(&self) -> Option<Confirmation> {
+        self.confirmation
+    }
+
+    /// The accelerometer-only algorithm's decision on the current event.
+    pub fn fallback(&self) -> FallbackDecision {
+        self.fallback.decision()
+    }
+
+    /// The prediction-matched confirmation's state.
+    pub fn matcher(&self) -> &PulseMatch {
+        &self.matcher
+    }
+
+    /// An accelerometer event is in progress: the object list no longer predicts anything.
+    pub fn awake(&self) -> bool {
+        self.matcher.awake()
+    }
+
+    /// Δv since the onset of the event the generic detector tracks, m/s.
+    pub fn delta_v_mps(&self) -> f64 {
+        self.generic.delta_v_mps()
+    }
+}
+
+/// The table's plan for an adaptive crash at closing speed `closing_mps`: the situation's
+/// conservative mass raised to the robust planning mass — the reported mass plus
+/// `mass_misreport_kg`, capped at the table's heaviest opponent (a heavier opponent is
+/// outside what the table can plan for; the pre-crash lookup already sent those to the
+/// reference restraint). `None` when the re-estimated severity is below the no-fire line:
+/// the crash then goes the conventional way.
+pub(crate) fn plan_for(
+    cfg: &CycleConfig,
+    estimator: &Estimator<'_>,
+    sit: &Situation,
+    closing_mps: f64,
+    inputs: &InputMonitor,
+    counters: &mut CycleCounters,
+) -> Option<RestraintPlan> {
+    let ebs = equivalent_barrier_speed_kph(closing_mps, cfg.ego_mass_kg, sit.opponent_mass_kg);
+    if !(ebs >= cfg.no_fire_ebs_kph) {
+        return None;
+    }
+    let reported_kg = f64::from(inputs.object.opponent_mass_kg);
+    let heaviest = estimator
+        .lut()
+        .and_then(|l| l.view.axes()[1].last().copied())
+        .map_or(sit.opponent_mass_kg, f64::from);
+    let robust = (reported_kg + cfg.mass_misreport_kg).min(heaviest);
+    let mass = if robust > sit.opponent_mass_kg {
+        robust
+    } else {
+        sit.opponent_mass_kg
+    };
+    let planned = Situation {
+        closing_speed_mps: closing_mps,
+        opponent_mass_kg: mass,
+        ..*sit
+    };
+    Some(estimator.lookup(&planned, inputs, counters))
+}

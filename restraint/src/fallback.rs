@@ -1,0 +1,220 @@
+//! The accelerometer-only airbag algorithm: how the ECU discriminates crash severity when it
+//! has no usable prediction (degraded inputs, no object tracked, a tracked object predicted
+//! below the no-fire line, or a pulse that does not match the prediction), as a conventional
+//! airbag ECU does.
+//!
+//! **Velocity-time boundary.** From the onset (first sample ≥ `confirm_wake_g`, the same
+//! [`Onset`] as the generic confirmation) the velocity change Δv(τ) is integrated and compared
+//! sample by sample with a threshold T(τ), piecewise linear through knots every
+//! [`KNOT_SPACING_MS`] from 0 to [`WINDOW_MS`]: the first sample with Δv(τ) ≥ T(τ) is a
+//! must-fire decision; a crash that has not reached the boundary when τ passes [`WINDOW_MS`]
+//! is a no-fire (the decision is closed). Why it discriminates: in the two-mass model the pulse
+//! rises with the closing speed (the onset slope is k·v/m), so at every τ a more severe crash
+//! has more Δv; a bump saturates at its small total Δv, a severe crash crosses the boundary
+//! within a few ms. The boundary is the velocity-time curve of a crash just above the no-fire
+//! line (calibrated by `lut study fallback` on barrier and car-to-car pulses of the model,
+//! README "Accelerometer-only algorithm"), so crashes below the no-fire line stay under it
+//! and crashes above the must-fire line cross it in time.
+//!
+//! It sees what a conventional sensor sees: the opponent's mass does not show in the first
+//! tens of ms (see `crash_match`), so for car-to-car crashes it discriminates by closing
+//! speed and structure; a light opponent's crash ends early and stays under the boundary.
+
+use crate::accel::AccelSample;
+use crate::config::ConfigError;
+use crate::confirm::{ConfirmParams, Onset, OnsetStep};
+
+/// Number of threshold knots (0, 4, … 60 ms).
+pub const KNOTS: usize = 16;
+/// Spacing of the knots, ms.
+pub const KNOT_SPACING_MS: f64 = 4.0;
+/// The decision window after the onset, ms (the last knot).
+pub const WINDOW_MS: f64 = KNOT_SPACING_MS * (KNOTS - 1) as f64;
+
+/// Default boundary, m/s at 0, 4, … 60 ms after the onset: the upper envelope (+10 %) of the
+/// Δv(τ) curves of every no-fire crash of the calibration sweep as this algorithm measures
+/// them, from `lut study fallback --derive` (README "Accelerometer-only algorithm";
+/// `lut/tests/fallback.rs` checks that the sweep still derives exactly these numbers).
+pub const DEFAULT_DV_MPS: [f64; KNOTS] = [
+    0.10, 0.25, 0.70, 1.25, 1.90, 2.55, 3.30, 4.10, 4.90, 5.55, 6.50, 7.05, 7.35, 7.35, 7.35, 7.35,
+];
+
+/// The threshold must be finite, positive at τ = 0 (a decision needs some Δv) and
+/// non-decreasing (Δv only grows during a crash).
+pub fn validate_thresholds(t: &[f64; KNOTS]) -> Result<(), ConfigError> {
+    let bad = |i: usize, lo: f64| ConfigError {
+        key: "fallback_dv_mps",
+        value: t.get(i).copied().unwrap_or(f64::NAN),
+        lo,
+        hi: 50.0,
+    };
+    let mut prev = 0.01;
+    for (i, &v) in t.iter().enumerate() {
+        if !(v.is_finite() && v >= prev && v <= 50.0) {
+            return Err(bad(i, prev));
+        }
+        prev = v;
+    }
+    Ok(())
+}
+
+/// T(τ) for τ in ms (piecewise linear; the last knot's value beyond the window).
+pub fn threshold_mps(t: &[f64; KNOTS], tau_ms: f64) -> f64 {
+    let x = (tau_ms / KNOT_SPACING_MS).max(0.0);
+    let i = x as usize; // saturating cast: NaN → 0, huge → usize::MAX
+    match (t.get(i), t.get(i.saturating_add(1))) {
+        (Some(a), Some(b)) => a + (b - a) * (x - i as f64),
+        (Some(a), None) => *a,
+        _ => t[KNOTS - 1],
+    }
+}
+
+/// The algorithm's decision about the current event.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FallbackDecision {
+    /// No event, or inside the window and under the boundary.
+    Pending,
+    /// Must-fire: the boundary was reached at this sample time, ns.
+    Fire(u64),
+    /// No-fire: the window passed, or the event ended, under the boundary (at this sample
+    /// time, ns). A new event starts pending again.
+    NoFire(u64),
+}
+
+/// State of the accelerometer-only algorithm (one event at a time; a decision latches until
+/// the event is over, a fire latches for good).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FallbackAlgorithm {
+    thresholds: [f64; KNOTS],
+    onset: Onset,
+    decision: FallbackDecision,
+}
+
+impl FallbackAlgorithm {
+    /// The algorithm with a validated boundary.
+    pub fn new(thresholds: [f64; KNOTS]) -> Self {
+        Self {
+            thresholds,
+            onset: Onset::default(),
+            decision: FallbackDecision::Pending,
+        }
+    }
+
+    /// Feeds one plausible sample (`p`: the wake threshold and quiet gap of the onset).
+    pub fn push(&mut self, p: &ConfirmParams, s: &AccelSample) {
+        if matches!(self.decision, FallbackDecision::Fire(_)) {
+            return;
+        }
+        match self.onset.push(p, s) {
+            OnsetStep::Quiet => return,
+            OnsetStep::Reset => {
+                // An event that ended under the boundary was a no-fire.
+                if self.decision == FallbackDecision::Pending {
+                    self.decision = FallbackDecision::NoFire(s.t_ns);
+                }
+                return;
+            }
+            OnsetStep::Woke => self.decision = FallbackDecision::Pending,
+            OnsetStep::Awake => {}
+        }
+        if self.decision != FallbackDecision::Pending {
+            return;
+        }
+        let Some(onset) = self.onset.onset_ns() else {
+            return;
+        };
+        let tau_ms = s.t_ns.saturating_sub(onset) as f64 * 1e-6;
+        if tau_ms > WINDOW_MS {
+            self.decision = FallbackDecision::NoFire(s.t_ns);
+        } else if self.onset.delta_v_mps() >= threshold_mps(&self.thresholds, tau_ms) {
+            self.decision = FallbackDecision::Fire(s.t_ns);
+        }
+    }
+
+    /// The current decision.
+    pub fn decision(&self) -> FallbackDecision {
+        self.decision
+    }
+
+    /// Onset of the event in progress (or of the fired event).
+    pub fn onset_ns(&self) -> Option<u64> {
+        self.onset.onset_ns()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::confirm::G_MPS2;
+
+    fn params() -> ConfirmParams {
+        ConfirmParams {
+            wake_mps2: 1.5 * G_MPS2,
+            decel_mps2: 4.0 * G_MPS2,
+            samples: 3,
+            delta_v_mps: 0.5,
+            reset_gap_ns: 10_000_000,
+        }
+    }
+
+    /// Runs a constant deceleration `g` from t = 0 for `ms` at 1 kHz.
+    fn run(f: &mut FallbackAlgorithm, g: f64, ms: u64) {
+        for k in 0..ms {
+            f.push(
+                &params(),
+                &AccelSample {
+                    t_ns: 1_000_000_000 + k * 1_000_000,
+                    dt_s: 1e-3,
+                    decel_mps2: g * G_MPS2,
+                },
+            );
+        }
+    }
+
+    #[test]
+    fn the_boundary_is_piecewise_linear_through_its_knots() {
+        let t = DEFAULT_DV_MPS;
+        assert_eq!(threshold_mps(&t, 0.0), t[0]);
+        assert!((threshold_mps(&t, 6.0) - 0.5 * (t[1] + t[2])).abs() < 1e-12);
+        assert_eq!(threshold_mps(&t, 40.0), t[10]);
+        assert_eq!(threshold_mps(&t, 60.0), t[15]);
+        assert_eq!(threshold_mps(&t, 1e9), t[15]);
+        assert_eq!(threshold_mps(&t, f64::NAN), t[0]);
+        validate_thresholds(&t).expect("default boundary is valid");
+        let mut bad = t;
+        bad[3] = bad[2] - 0.1;
+        assert_eq!(validate_thresholds(&bad).unwrap_err().key, "fallback_dv_mps");
+        bad = t;
+        bad[0] = 0.0;
+        assert!(validate_thresholds(&bad).is_err());
+    }
+
+    #[test]
+    fn a_constant_pulse_fires_where_its_velocity_line_meets_the_boundary() {
+        // Oracle: Δv after n samples of a = n·a·1 ms (the wake sample counts), τ = (n − 1) ms;
+        // fire at the first n with n·a·1e-3 ≥ T(n − 1). Boundary 0.1 + 0.1·τ/4 m/s (linear).
+        let lin: [f64; KNOTS] = core::array::from_fn(|i| 0.1 + 0.1 * i as f64);
+        // Δv after n samples of a from rest (trapezoidal): (n − ½)·a·1 ms, at τ = n − 1 ms.
+        let mut f = FallbackAlgorithm::new(lin);
+        run(&mut f, 5.0, 80); // a = 49.03 m/s²: (n − ½)·0.04903 ≥ 0.075 + 0.025 n → n ≥ 4.14
+        assert_eq!(f.decision(), FallbackDecision::Fire(1_000_000_000 + 4_000_000));
+        // 2 g: (n − ½)·0.0196 ≥ 0.075 + 0.025 n never holds (slope 0.0196 < 0.025): no fire,
+        // closed at the first sample after the 60 ms window.
+        let mut f = FallbackAlgorithm::new(lin);
+        run(&mut f, 2.0, 80);
+        assert_eq!(
+            f.decision(),
+            FallbackDecision::NoFire(1_000_000_000 + 61_000_000)
+        );
+    }
+
+    #[test]
+    fn braking_never_wakes_it_and_a_new_event_after_the_quiet_gap_is_judged_afresh() {
+        let mut f = FallbackAlgorithm::new(DEFAULT_DV_MPS);
+        run(&mut f, 1.2, 200);
+        assert_eq!((f.decision(), f.onset_ns()), (FallbackDecision::Pending, None));
+        let mut f = FallbackAlgorithm::new([0.1; KNOTS]);
+        run(&mut f, 2.0, 1); // Δv 0.0196 < 0.1: pending
+        assert_eq!(f.decision(), FallbackDecision::Pending);
+    }
+}
