@@ -18,54 +18,8 @@ use cycle_support::*;
 use restraint::crash::ConfirmKind;
 use restraint::{Degraded, EcuMode, ObjectState, Phase, Pretensioner};
 
-const G: f32 = 9.806_65;
-
 /// Contact of the standard approach scenario.
 const C: u64 = T0 + 1_000 * MS;
-
-/// Series stiffness of the first loading segments of a class-4 ego (175.6 kN at 40 mm) and a
-/// class-3 opponent (170.1 kN at 40 mm, the test approaches' conservative 1600 kg), N/m.
-const K_SERIES_4_3: f64 = 1.0 / (0.040 / 175.6e3 + 0.040 / 170.1e3);
-
-/// The onset ramp of a crash at `closing_mps` against the class-3 test opponent: deceleration
-/// k·v·t / m_ego, in g, `ms` after contact (capped at 15 g after the first knee).
-fn ramp_g(closing_mps: f64, ms: u64) -> f32 {
-    let slope_g_per_ms = K_SERIES_4_3 * closing_mps / 1785.0 * 1e-3 / f64::from(G);
-    (slope_g_per_ms * ms as f64).min(15.0) as f32
-}
-
-/// Runs until `end`: every 10 ms an object sample (approach towards `contact` from
-/// `approach_from`, a "no track" sample before), stops objects at `objects_until`, and from
-/// `crash_at` on the accelerometer reads `pulse_g(ms since crash_at)` g of deceleration.
-#[allow(clippy::too_many_arguments)]
-fn run_scenario(
-    b: &mut Bench,
-    end: u64,
-    approach_from: u64,
-    contact: u64,
-    closing_mps: f32,
-    objects_until: u64,
-    crash_at: Option<u64>,
-    pulse_g: &dyn Fn(u64) -> f32,
-) {
-    while b.now < end {
-        if (b.now - T0).is_multiple_of(10 * MS) && b.now < objects_until {
-            if b.now >= approach_from && b.now < contact {
-                b.push_approach(contact, closing_mps, 1500.0, 100.0);
-            } else {
-                let mut o = ObjectState::INVALID;
-                o.timestamp_ns = b.now;
-                b.io.push_object(o);
-            }
-        }
-        if let Some(c) = crash_at {
-            if b.now >= c {
-                b.push_accel(-pulse_g((b.now - c) / MS) * G);
-            }
-        }
-        b.step();
-    }
-}
 
 #[test]
 fn precrash_preset_pretensioner_at_planned_time_then_airbag_at_planned_time_and_level() {

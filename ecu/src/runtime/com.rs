@@ -23,7 +23,7 @@ use ipc::{
 use triple_buffer::triple_buffer;
 
 use bus::RawFrame;
-use restraint::{CycleIo, IoError};
+use restraint::{CycleIo, IoError, ReceiveErrors};
 
 /// A non-blocking CAN port, implemented by [`crate::can_port::SocketCanPort`] over the bus
 /// crate's SocketCAN socket (kernel filter, non-blocking) and passed to [`IceoryxIo::new`].
@@ -265,5 +265,12 @@ impl CycleIo for IceoryxIo {
 
     fn can_enabled(&self) -> bool {
         self.can.is_some()
+    }
+
+    fn receive_errors(&self) -> ReceiveErrors {
+        ReceiveErrors {
+            objects: self.objects.counters().errors,
+            accel: self.accel.counters().errors,
+        }
     }
 }

@@ -613,6 +613,8 @@ mod tests {
         let cfg = EcuConfig::load(&path).unwrap();
         assert_eq!(cfg.period_us, 1_000);
         assert_eq!(cfg.can.interface, "vcan0");
+        // `[cycle]` shows the core's defaults: the example must not drift from them.
+        assert_eq!(cfg.cycle.decision, restraint::CycleConfig::default());
     }
 
     #[test]

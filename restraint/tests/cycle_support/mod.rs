@@ -108,6 +108,10 @@ pub struct Bench {
     pub deadline: Option<u64>,
     /// The accelerometer delivers a sample every step (false: silent, a dead sensor).
     pub accel_live: bool,
+    /// The ±0.05 m/s² dither of a live sensor (false: the bit-identical readings of a stuck one).
+    pub accel_dither: bool,
+    /// `EgoLongAccel` of the vehicle frames, m/s² (the vehicle-dynamics sensor).
+    pub ego_long_accel_mps2: f32,
     /// The reading of the next step's sample, m/s² (taken by the step; then 0 again).
     pending_accel_mps2: Option<f32>,
 }
@@ -150,13 +154,19 @@ impl Bench {
             sent: Vec::new(),
             deadline: None,
             accel_live: true,
+            accel_dither: true,
+            ego_long_accel_mps2: 0.0,
             pending_accel_mps2: None,
         }
     }
 
     pub fn vehicle_frame(&mut self, speed_mps: f32) -> RawFrame {
-        let m =
-            EgoVehicleState::encode(EgoVehicleStateBrakeState::Released, speed_mps, 0.0).unwrap();
+        let m = EgoVehicleState::encode(
+            EgoVehicleStateBrakeState::Released,
+            speed_mps,
+            self.ego_long_accel_mps2,
+        )
+        .unwrap();
         self.tx.seal(m)
     }
 
@@ -186,7 +196,11 @@ impl Bench {
         }
         let reading = self.pending_accel_mps2.take().unwrap_or(0.0);
         if self.accel_live {
-            let dither = if ms.is_multiple_of(2) { 0.05 } else { -0.05 };
+            let dither = match (self.accel_dither, ms.is_multiple_of(2)) {
+                (false, _) => 0.0,
+                (true, true) => 0.05,
+                (true, false) => -0.05,
+            };
             self.io.push_accel(accel_batch(T0 + ms * MS, reading + dither));
         }
         let info = CycleInfo {
@@ -296,6 +310,53 @@ impl Bench {
             .find(|(d, _)| d.mode == mode as u8)
             .map(|(_, t)| *t)
     }
+}
+
+/// Runs until `end`: every 10 ms an object sample (approach towards `contact` from
+/// `approach_from`, a "no track" sample before), stops objects at `objects_until`, and from
+/// `crash_at` on the accelerometer reads `pulse_g(ms since crash_at)` g of deceleration.
+#[allow(clippy::too_many_arguments)]
+pub fn run_scenario(
+    b: &mut Bench,
+    end: u64,
+    approach_from: u64,
+    contact: u64,
+    closing_mps: f32,
+    objects_until: u64,
+    crash_at: Option<u64>,
+    pulse_g: &dyn Fn(u64) -> f32,
+) {
+    while b.now < end {
+        if (b.now - T0).is_multiple_of(10 * MS) && b.now < objects_until {
+            if b.now >= approach_from && b.now < contact {
+                b.push_approach(contact, closing_mps, 1500.0, 100.0);
+            } else {
+                let mut o = ObjectState::INVALID;
+                o.timestamp_ns = b.now;
+                b.io.push_object(o);
+            }
+        }
+        if let Some(c) = crash_at {
+            if b.now >= c {
+                b.push_accel(-pulse_g((b.now - c) / MS) * G);
+            }
+        }
+        b.step();
+    }
+}
+
+/// Standard gravity as the tests type it, m/s².
+pub const G: f32 = 9.806_65;
+
+/// Series stiffness of the first loading segments of a class-4 ego (175.6 kN at 40 mm) and a
+/// class-3 opponent (170.1 kN at 40 mm, the test approaches' conservative 1600 kg), N/m.
+pub const K_SERIES_4_3: f64 = 1.0 / (0.040 / 175.6e3 + 0.040 / 170.1e3);
+
+/// The onset ramp of a crash at `closing_mps` against the class-3 test opponent: deceleration
+/// k·v·t / m_ego, in g, `ms` after contact (capped at 15 g, after the first knee).
+pub fn ramp_g(closing_mps: f64, ms: u64) -> f32 {
+    let slope_g_per_ms = K_SERIES_4_3 * closing_mps / 1785.0 * 1e-3 / f64::from(G);
+    (slope_g_per_ms * ms as f64).min(15.0) as f32
 }
 
 /// A 1-sample, 1 kHz accelerometer batch measured at `t_ns`.

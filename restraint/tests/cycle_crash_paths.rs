@@ -1,0 +1,343 @@
+//! The crash phase's paths under a simulated 1 kHz clock: every path to Fire and the no-fire
+//! cases each is tested against (README "Decision table"), the in-crash severity re-estimate,
+//! and the crash accelerometer's faults — detected, reported on the bus within their limits,
+//! before a crash that follows. Expected values are closed form (linear test LUT, onset ramps
+//! k·v·t / m_ego, constant pulses), as in `cycle_scenarios.rs`.
+
+mod cycle_support;
+
+use bus::codec::{AirbagStageCmdCmdSource, AirbagStageCmdFire, EcuStatusEcuMode};
+use cycle_support::*;
+use restraint::crash::ConfirmKind;
+use restraint::crash_match::{MatchState, Mismatch};
+use restraint::{Degraded, EcuMode, Phase};
+
+/// Contact of the standard approach.
+const C: u64 = T0 + 1_000 * MS;
+
+fn no_airbag_fired(b: &Bench) -> bool {
+    b.airbag_frames()
+        .iter()
+        .all(|(_, f)| f.fire() == AirbagStageCmdFire::NoFire)
+}
+
+fn first_fire(b: &Bench) -> Option<(u64, bus::AirbagStageCmd)> {
+    b.airbag_frames()
+        .into_iter()
+        .find(|(_, f)| f.fire() == AirbagStageCmdFire::Fire)
+}
+
+/// First step time from `from` on at which the diagnostics carry `reason`.
+fn first_reason(b: &Bench, from: u64, reason: Degraded) -> Option<u64> {
+    b.step_times
+        .iter()
+        .zip(&b.diagnostics)
+        .find(|(t, d)| **t >= from && d.degraded_reasons & reason.bits() != 0)
+        .map(|(t, _)| *t)
+}
+
+/// First EcuStatus frame from `from` on with the accelerometer fault bit and the fallback mode.
+fn first_accel_fault_on_bus(b: &Bench, from: u64) -> Option<u64> {
+    b.status_frames()
+        .into_iter()
+        .find(|(t, s)| {
+            *t >= from
+                && s.fault_accel_sensor()
+                && s.ecu_mode() == EcuStatusEcuMode::ReferenceFallback
+        })
+        .map(|(t, _)| t)
+}
+
+/// Quiet running: "no track" objects every 10 ms, live accelerometer.
+fn idle_until(b: &mut Bench, end: u64) {
+    run_scenario(b, end, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
+}
+
+// --- Path 1: the prediction-matched crash -------------------------------------------------
+
+#[test]
+fn a_misestimated_closing_speed_is_re_estimated_from_the_onset_and_re_planned() {
+    // The radar says 20 m/s; the crash has the onset of 28 m/s (ratio 1.4: "departs").
+    let mut b = Bench::new(Some(test_lut()));
+    run_scenario(
+        &mut b,
+        C + 100 * MS,
+        T0 + 200 * MS,
+        C,
+        20.0,
+        C,
+        Some(C),
+        &|ms| ramp_g(28.0, ms),
+    );
+    let Some(ConfirmKind::Matched(e)) = b.ecu.crash_kind() else {
+        panic!("{:?}", b.ecu.crash_kind());
+    };
+    assert!(!e.follows, "{e:?}");
+    assert!((e.closing_mps / 28.0 - 1.0).abs() < 0.02, "{e:?}");
+    assert_eq!(b.first_mode(EcuMode::Crash), Some(C + 3 * MS));
+    // Re-planned at the measured speed (≈ 101 km/h) and the robust mass 1500 + 1200 kg.
+    let plan = b.ecu.crash_plan();
+    let (v, m) = (e.closing_mps * 3.6, 2700.0);
+    assert!((f64::from(plan.belt_limiter_kn) - belt_kn(v, m)).abs() < 1e-4);
+    assert!((f64::from(plan.airbag_time_ms) - airbag_ms(v, m)).abs() < 1e-3);
+    let (t, f) = first_fire(&b).expect("adaptive airbag");
+    assert_eq!(f.cmd_source(), AirbagStageCmdCmdSource::Adaptive);
+    assert_eq!(f.force_level(), q(airbag_kn(v, m), 0.05));
+    // 5 + 0.1·101 = 15.1 ms after the fitted onset (≈ C).
+    assert!((C + 15 * MS..=C + 16 * MS).contains(&t), "{t}");
+}
+
+#[test]
+fn a_pulse_the_prediction_cannot_explain_goes_the_conventional_way() {
+    // Predicted 25 m/s, but the onset is that of 8 m/s (ratio 0.32 < 0.5): not this crash.
+    // Then a 15 g plateau: the generic thresholds confirm and the accelerometer-only
+    // algorithm fires the REFERENCE airbag.
+    let mut b = Bench::new(Some(test_lut()));
+    run_scenario(
+        &mut b,
+        C + 100 * MS,
+        T0 + 200 * MS,
+        C,
+        25.0,
+        C,
+        Some(C),
+        &|ms| if ms < 6 { ramp_g(8.0, ms) } else { 15.0 },
+    );
+    assert_eq!(
+        b.ecu.crash().matcher().state(),
+        MatchState::Mismatch(Mismatch::Severity)
+    );
+    assert!(matches!(
+        b.ecu.crash_kind(),
+        Some(ConfirmKind::Generic {
+            prediction_refuted: true
+        })
+    ));
+    let (t, f) = first_fire(&b).expect("reference airbag");
+    assert_eq!(f.cmd_source(), AirbagStageCmdCmdSource::Reference);
+    assert_eq!(f.force_level(), 12.0);
+    // The reference time, 10 ms after the measured onset: the wake-up sample at C + 2 ms
+    // (1.97 g ≥ 1.5 g).
+    assert_eq!(t, C + 12 * MS);
+}
+
+#[test]
+fn a_pothole_at_the_predicted_contact_of_an_avoided_collision_fires_nothing() {
+    // The opponent swerves away 30 ms before the predicted contact (receding: avoided), and a
+    // pothole hits the car at the predicted contact: 8 g for 2 ms. No ramp, no Δv: nothing
+    // confirms, nothing fires, the pretensioner is released.
+    let mut b = Bench::new(Some(test_lut()));
+    run_scenario(&mut b, C - 30 * MS, T0 + 200 * MS, C, 25.0, C, None, &|_| 0.0);
+    let mut o = object(b.now, -2.0, 1500.0, 100.0);
+    o.distance_m = 3.0;
+    b.io.push_object(o);
+    run_scenario(
+        &mut b,
+        C + 200 * MS,
+        u64::MAX,
+        0,
+        0.0,
+        u64::MAX,
+        Some(C),
+        &|ms| if ms < 2 { 8.0 } else { 0.0 },
+    );
+    assert_eq!(b.first_mode(EcuMode::Crash), None);
+    assert!(no_airbag_fired(&b));
+    assert_eq!(b.ecu.pretensioner(), restraint::Pretensioner::Released);
+}
+
+#[test]
+fn a_pothole_while_the_crash_is_still_predicted_does_not_match_and_does_not_confirm() {
+    // The object still predicts contact at C (a sensor that has not seen the swerve yet): a
+    // 2 ms, 8 g pothole at C is a step, not the predicted ramp — mismatch (shape), and it
+    // carries no Δv for the generic thresholds. Nothing fires.
+    let mut b = Bench::new(Some(test_lut()));
+    run_scenario(
+        &mut b,
+        C + 40 * MS,
+        T0 + 200 * MS,
+        C,
+        25.0,
+        C,
+        Some(C),
+        &|ms| if ms < 2 { 8.0 } else { 0.0 },
+    );
+    assert!(matches!(
+        b.ecu.crash().matcher().state(),
+        MatchState::Mismatch(_) | MatchState::Idle
+    ));
+    assert_eq!(b.first_mode(EcuMode::Crash), None);
+    assert!(no_airbag_fired(&b));
+}
+
+// --- Path 3: the accelerometer-only algorithm ----------------------------------------------
+
+#[test]
+fn without_a_prediction_a_bump_fires_nothing_and_a_severe_crash_fires_the_reference_in_time() {
+    // Monitoring ("no track" objects): a 4.5 g bump (Δv grows 0.044 m/s per ms, under the
+    // boundary), and a 20 g crash (0.196 m/s per ms: over the boundary at τ = 1 ms).
+    let mut b = Bench::new(Some(test_lut()));
+    run_scenario(&mut b, C + 100 * MS, u64::MAX, 0, 0.0, u64::MAX, Some(C), &|ms| {
+        if ms < 40 {
+            4.5
+        } else {
+            0.0
+        }
+    });
+    assert!(b.first_mode(EcuMode::Crash).is_some(), "the bump is a crash for the belt");
+    assert!(no_airbag_fired(&b));
+    let mut b = Bench::new(Some(test_lut()));
+    run_scenario(&mut b, C + 100 * MS, u64::MAX, 0, 0.0, u64::MAX, Some(C), &|_| 20.0);
+    let (t, f) = first_fire(&b).expect("reference airbag");
+    assert_eq!(f.cmd_source(), AirbagStageCmdCmdSource::Reference);
+    assert_eq!(t, C + 10 * MS);
+}
+
+// --- Accelerometer faults ---------------------------------------------------------------
+
+#[test]
+fn a_dead_accelerometer_is_on_the_bus_within_its_timeout_plus_one_status_period() {
+    let mut b = Bench::new(Some(test_lut()));
+    idle_until(&mut b, T0 + 300 * MS);
+    b.accel_live = false;
+    let dead_from = b.now; // last sample at dead_from − 1 ms
+    idle_until(&mut b, T0 + 500 * MS);
+    // Stale strictly after 20 ms without a batch (received at dead_from − 1 ms).
+    assert_eq!(
+        first_reason(&b, dead_from, Degraded::ACCEL_STALE),
+        Some(dead_from + 20 * MS)
+    );
+    assert_eq!(b.mode_at(dead_from + 20 * MS), EcuMode::Degraded as u8);
+    let on_bus = first_accel_fault_on_bus(&b, dead_from).expect("FaultAccelSensor on the bus");
+    assert!(on_bus <= dead_from + 40 * MS, "{} ms", (on_bus - dead_from) / MS);
+    // Back: healthy on the first batch.
+    b.accel_live = true;
+    let back = b.now;
+    idle_until(&mut b, back + 10 * MS);
+    assert_eq!(b.mode_at(back), EcuMode::Monitoring as u8);
+}
+
+#[test]
+fn a_stuck_accelerometer_is_flagged_after_the_stuck_time() {
+    let mut b = Bench::new(Some(test_lut()));
+    idle_until(&mut b, T0 + 300 * MS);
+    b.accel_dither = false; // bit-identical 0.0 from now on
+    let from = b.now;
+    idle_until(&mut b, T0 + 400 * MS);
+    // 20 ms of identical readings: the 21st identical sample (from + 20 ms) is stuck.
+    assert_eq!(
+        first_reason(&b, from, Degraded::ACCEL_INVALID),
+        Some(from + 20 * MS)
+    );
+    assert!(first_accel_fault_on_bus(&b, from).is_some_and(|t| t <= from + 40 * MS));
+    assert_eq!(b.ecu.crash().confirmation(), None);
+}
+
+#[test]
+fn saturated_out_of_range_and_time_travelling_samples_are_implausible_at_once() {
+    for (what, reading) in [
+        ("saturated", -200.0 * G),
+        ("out of range", -1.0e6),
+        ("not a number", f32::NAN),
+    ] {
+        let mut b = Bench::new(Some(test_lut()));
+        idle_until(&mut b, T0 + 100 * MS);
+        let t = b.now;
+        b.push_accel(reading);
+        idle_until(&mut b, T0 + 200 * MS);
+        assert_eq!(
+            first_reason(&b, T0, Degraded::ACCEL_INVALID),
+            Some(t),
+            "{what}"
+        );
+        // Held 500 ms, and never integrated: no crash from a saturated sensor.
+        assert_eq!(b.ecu.crash().confirmation(), None, "{what}");
+        assert!(no_airbag_fired(&b), "{what}");
+    }
+    // A batch older than the last one (non-monotonic time).
+    let mut b = Bench::new(Some(test_lut()));
+    idle_until(&mut b, T0 + 100 * MS);
+    b.io.push_accel(accel_batch(b.now - 50 * MS, 0.3));
+    let t = b.now;
+    idle_until(&mut b, T0 + 150 * MS);
+    assert_eq!(first_reason(&b, T0, Degraded::ACCEL_INVALID), Some(t));
+}
+
+#[test]
+fn ipc_receive_errors_set_their_reason_and_the_fault_bit_of_their_input() {
+    let mut b = Bench::new(Some(test_lut()));
+    idle_until(&mut b, T0 + 100 * MS);
+    b.io.receive_errors.accel += 1;
+    let t = b.now;
+    idle_until(&mut b, T0 + 700 * MS);
+    assert_eq!(first_reason(&b, T0, Degraded::IPC_ERROR), Some(t));
+    assert!(first_accel_fault_on_bus(&b, t).is_some_and(|x| x <= t + 20 * MS));
+    // Held 500 ms after the error, then healthy.
+    assert_eq!(b.mode_at(t + 500 * MS), EcuMode::Degraded as u8);
+    assert_eq!(b.mode_at(t + 501 * MS), EcuMode::Monitoring as u8);
+    b.io.receive_errors.objects += 3;
+    let t = b.now;
+    idle_until(&mut b, t + 30 * MS);
+    assert!(b
+        .status_frames()
+        .iter()
+        .any(|(x, s)| *x >= t && s.fault_object_input() && !s.fault_accel_sensor()));
+}
+
+// --- Path 2: a dead accelerometer at a predicted crash ------------------------------------
+
+/// The approach to C with the accelerometer dead from C − 400 ms; from `decel_at` on the
+/// vehicle frames report `decel_g` of deceleration.
+fn dead_accel_crash(b: &mut Bench, closing_mps: f32, decel_at: u64, decel_g: f32) {
+    while b.now < C + 200 * MS {
+        b.accel_live = b.now < C - 400 * MS;
+        if b.now >= decel_at {
+            b.ego_long_accel_mps2 = -decel_g * G;
+        }
+        let next = b.now + MS;
+        run_scenario(b, next, T0 + 200 * MS, C, closing_mps, C, None, &|_| 0.0);
+    }
+}
+
+#[test]
+fn a_predicted_crash_with_a_dead_accelerometer_is_confirmed_by_the_vehicle_deceleration() {
+    let mut b = Bench::new(Some(test_lut()));
+    dead_accel_crash(&mut b, 25.0, C + 2 * MS, 8.0);
+    // Flagged long before the crash.
+    assert!(first_accel_fault_on_bus(&b, C - 400 * MS).is_some_and(|t| t < C - 350 * MS));
+    assert_eq!(b.first_mode(EcuMode::PreCrash), None, "degraded: no adaptive preset");
+    // The first vehicle frame after the deceleration (every 10 ms: C + 10 ms) confirms.
+    assert_eq!(b.ecu.crash_kind(), Some(ConfirmKind::Backup));
+    let (t, f) = first_fire(&b).expect("reference airbag");
+    assert_eq!(f.cmd_source(), AirbagStageCmdCmdSource::Reference);
+    // At max(confirmation, predicted contact + 10 ms) = C + 10 ms.
+    assert_eq!(t, C + 10 * MS);
+}
+
+#[test]
+fn a_dead_accelerometer_fires_nothing_without_both_a_predicted_crash_and_a_crash_deceleration() {
+    // Predicted crash, but the vehicle never decelerates beyond braking (avoided at the last
+    // moment): no fire.
+    let mut b = Bench::new(Some(test_lut()));
+    dead_accel_crash(&mut b, 25.0, C, 1.0);
+    assert_eq!(b.ecu.crash_kind(), None);
+    assert!(no_airbag_fired(&b));
+    // A crash deceleration 60 ms after the predicted contact (outside the ± 30 ms window).
+    let mut b = Bench::new(Some(test_lut()));
+    dead_accel_crash(&mut b, 25.0, C + 60 * MS, 8.0);
+    assert!(no_airbag_fired(&b));
+    // A predicted bump below the no-fire line (4 m/s): no fire even with the deceleration.
+    let mut b = Bench::new(Some(test_lut()));
+    dead_accel_crash(&mut b, 4.0, C + 2 * MS, 8.0);
+    assert!(no_airbag_fired(&b));
+    // No prediction at all (no object), crash deceleration on CAN: no fire.
+    let mut b = Bench::new(Some(test_lut()));
+    idle_until(&mut b, C - 400 * MS);
+    b.accel_live = false;
+    idle_until(&mut b, C);
+    b.ego_long_accel_mps2 = -8.0 * G;
+    idle_until(&mut b, C + 100 * MS);
+    assert_eq!(b.ecu.crash_kind(), None);
+    assert!(no_airbag_fired(&b));
+    assert_ne!(b.ecu.phase(), Phase::Crash);
+}
