@@ -89,9 +89,10 @@ pub struct CycleConfig {
     /// Highest ratio (*default* 2.5: a rigid barrier instead of a car doubles the slope;
     /// beyond, nothing in the model explains the pulse).
     pub match_ratio_max: f64,
-    /// Robust planning: the crash is planned for an opponent at least this much heavier than
-    /// reported, capped at the table's heaviest mass, kg (*default* 1200 — four times the
-    /// sensing's 300 kg σ, issue 14). Why: an opponent's mass does not show in the ego pulse
+    /// Robust planning: every table lookup (pre-crash preset and in-crash re-plan) is for an
+    /// opponent at least this much heavier than reported, capped at the table's heaviest mass,
+    /// kg (*default* 1200 — four times the sensing's 300 kg σ, issue 14; 0 = the conservative
+    /// mass m + k·σ only). Why: an opponent's mass does not show in the ego pulse
     /// until long after the restraint is committed (the pulses of 1300 and 2400 kg opponents at
     /// 96 km/h agree within 0.1 g for 30 ms), so the plan must already hold the heavier one.
     pub mass_misreport_kg: f64,

@@ -14,7 +14,7 @@
 //! that neither a faulty object list nor a faulty vehicle signal alone can fire.
 //!
 //! The first confirmation latches ([`Confirmation`]); [`plan_for`] re-plans an adaptive crash
-//! from the table at the measured severity and the robust planning mass.
+//! from the table at the measured severity (and, as every lookup, the robust planning mass).
 
 use crate::accel::AccelSample;
 use crate::config::{ms_to_ns, CycleConfig};
@@ -187,12 +187,9 @@ impl CrashMonitor {
     }
 }
 
-/// The table's plan for an adaptive crash at closing speed `closing_mps`: the situation's
-/// conservative mass raised to the robust planning mass — the reported mass plus
-/// `mass_misreport_kg`, capped at the table's heaviest opponent (a heavier opponent is
-/// outside what the table can plan for; the pre-crash lookup already sent those to the
-/// reference restraint). `None` when the re-estimated severity is below the no-fire line:
-/// the crash then goes the conventional way.
+/// The table's plan for an adaptive crash re-estimated at closing speed `closing_mps` (the
+/// lookup raises the mass to the robust planning mass, `Estimator::lookup`). `None` when the
+/// re-estimated severity is below the no-fire line: the crash then goes the conventional way.
 pub(crate) fn plan_for(
     cfg: &CycleConfig,
     estimator: &Estimator<'_>,
@@ -205,20 +202,8 @@ pub(crate) fn plan_for(
     if !(ebs >= cfg.no_fire_ebs_kph) {
         return None;
     }
-    let reported_kg = f64::from(inputs.object.opponent_mass_kg);
-    let heaviest = estimator
-        .lut()
-        .and_then(|l| l.view.axes()[1].last().copied())
-        .map_or(sit.opponent_mass_kg, f64::from);
-    let robust = (reported_kg + cfg.mass_misreport_kg).min(heaviest);
-    let mass = if robust > sit.opponent_mass_kg {
-        robust
-    } else {
-        sit.opponent_mass_kg
-    };
     let planned = Situation {
         closing_speed_mps: closing_mps,
-        opponent_mass_kg: mass,
         ..*sit
     };
     Some(estimator.lookup(&planned, inputs, counters))

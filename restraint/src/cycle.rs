@@ -223,6 +223,7 @@ impl Activity for RestraintCycle<'_> {
             plan_for(cfg, est, &sit, closing_mps, inputs, c)
         };
         let mut x = DecisionInputs {
+            half_period_ns: info.period_ns / 2,
             degraded,
             situation,
             new_object: self.inputs.new_object,

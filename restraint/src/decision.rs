@@ -73,6 +73,8 @@ pub enum Pretensioner {
 
 /// What the state machine reads from the estimate and the input monitor in one cycle.
 pub(crate) struct DecisionInputs<'d> {
+    /// Half the cycle period, ns: a scheduled fire goes out in the cycle nearest its time.
+    pub half_period_ns: u64,
     /// Any degrading reason is set.
     pub degraded: bool,
     /// Newest situation estimate (`None`: no object, no contact, or stale).
@@ -327,15 +329,17 @@ impl Decision {
             }
             Phase::Crash | Phase::PostCrash => {}
         }
-        // Scheduled fires (pre-crash pretensioner, crash fires).
+        // Scheduled fires (pre-crash pretensioner, crash fires), each in the cycle nearest its
+        // time (a crash fire is never scheduled before its confirmation, which is past).
+        let due = |t: u64| now.saturating_add(x.half_period_ns) >= t;
         if let Some(t) = self.pretensioner_at_ns {
-            if now >= t {
+            if due(t) {
                 self.pretensioner = Pretensioner::Fired;
                 self.pretensioner_at_ns = None;
             }
         }
         if let Some(t) = self.airbag_fire_at_ns {
-            if now >= t {
+            if due(t) {
                 self.airbag_fired = true;
                 self.airbag_fire_at_ns = None;
             }

@@ -172,6 +172,7 @@ fn spring_of(springs: &[Option<CombinedSpring>; 6], opp_kg: f64) -> Option<&Comb
 pub struct Estimator<'a> {
     ego_mass_kg: f64,
     conservative_mass_k: f64,
+    mass_misreport_kg: f64,
     no_fire_ebs_kph: f64,
     prediction_step_ms: f64,
     exit_horizon_ns: u64,
@@ -209,6 +210,7 @@ impl<'a> Estimator<'a> {
         Ok(Self {
             ego_mass_kg: cfg.ego_mass_kg,
             conservative_mass_k: cfg.conservative_mass_k,
+            mass_misreport_kg: cfg.mass_misreport_kg,
             no_fire_ebs_kph: cfg.no_fire_ebs_kph,
             prediction_step_ms: cfg.prediction_step_ms,
             exit_horizon_ns: horizon_ns.saturating_add(ms_to_ns(cfg.preset_exit_hysteresis_ms)),
@@ -321,6 +323,13 @@ impl<'a> Estimator<'a> {
     /// is outside what the table covers (unbelted, not an adult, no data), or any query
     /// axis is out of the table's range or NaN (the diagram's rule: a flagged lookup is
     /// degraded input).
+    ///
+    /// **Robust planning mass**: the table is queried at the situation's conservative mass
+    /// raised to the reported mass + `mass_misreport_kg`, capped at the table's heaviest
+    /// opponent. The opponent's mass does not show in the ego pulse before the restraint is
+    /// committed (`crash_match`), so the plan must already hold the heaviest opponent the
+    /// sensing could be wrong about; where even the conservative mass is beyond the table, the
+    /// lookup stays out of range (reference restraint).
     pub(crate) fn lookup(
         &self,
         sit: &Situation,
@@ -334,9 +343,17 @@ impl<'a> Estimator<'a> {
         if !(occ.buckled && occ.adult) {
             return self.reference;
         }
+        let heaviest = lut.view.axes()[1].last().map_or(f64::NAN, |m| f64::from(*m));
+        let robust = (f64::from(inputs.object.opponent_mass_kg) + self.mass_misreport_kg).min(heaviest);
+        // NaN-safe: a NaN robust mass keeps the conservative one.
+        let mass = if robust > sit.opponent_mass_kg {
+            robust
+        } else {
+            sit.opponent_mass_kg
+        };
         let q = Query {
             closing_speed_kph: (sit.closing_speed_mps * 3.6) as f32,
-            opponent_mass_kg: sit.opponent_mass_kg as f32,
+            opponent_mass_kg: mass as f32,
             occupant_mass_kg: occ.mass_kg,
             seat_distance_mm: occ.chest_to_wheel_mm,
         };
@@ -349,7 +366,7 @@ impl<'a> Estimator<'a> {
             counters.lut_out_of_range = counters.lut_out_of_range.saturating_add(1);
             return self.reference;
         }
-        RestraintPlan::from_lookup(&l)
+        RestraintPlan::from_lookup(&l, &lut.view.thresholds())
     }
 }
 

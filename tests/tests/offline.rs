@@ -1,0 +1,189 @@
+//! The scenario library and its variations through the ECU core under a simulated clock
+//! (`e2e_tests::offline`: the real sensor model, the core, the actuator stubs' judge — no
+//! vcan, no processes, deterministic, a few seconds). What the end-to-end bench checks on the
+//! real processes, checked here on every change:
+//!
+//! * every library scenario meets its `[expect]` block and is no worse than the reference
+//!   restraint (the judge's verdict);
+//! * an adaptive airbag fires within 1 ms of its plan whenever the plan is later than the
+//!   confirmation (issue 14);
+//! * the opponent's mass misreported by up to ±1 200 kg, and its closing speed by up to
+//!   ±5 m/s, never makes the outcome worse than the reference restraint, nor bottoms out where
+//!   the reference does not.
+
+use e2e_tests::offline::{run, table_row, OfflineConfig, OfflineRun, TABLE_HEADER};
+use sensor_feeds::Scenario;
+use std::path::PathBuf;
+
+fn root() -> PathBuf {
+    e2e_tests::repo_root()
+}
+
+fn library() -> Vec<Scenario> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("scenarios"))
+        .expect("scenarios/")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    v.sort();
+    v.iter()
+        .map(|p| Scenario::load(p).unwrap_or_else(|e| panic!("{e}")))
+        .collect()
+}
+
+fn scenario(name: &str) -> Scenario {
+    Scenario::load(root().join(format!("scenarios/{name}.toml"))).expect("scenario")
+}
+
+fn cfg() -> OfflineConfig {
+    OfflineConfig::shipped(&root()).expect("shipped table and reference")
+}
+
+/// Problems of one run with its expectations and the judge's verdict.
+fn problems(s: &Scenario, r: &OfflineRun) -> Vec<String> {
+    let mut bad = Vec::new();
+    let e = &s.expect;
+    let mut check = |what: &str, want: Option<bool>, got: bool| {
+        if want.is_some_and(|w| w != got) {
+            bad.push(format!("{}: {what}: expected {want:?}, got {got}", s.name));
+        }
+    };
+    let pre = r.action("pretensioner_fire").is_some_and(|a| a.0 < 0.0)
+        && r.action("pretensioner_release").is_none_or(|rel| rel.0 >= 0.0);
+    check("contact", e.contact, r.contact_s.is_some());
+    check(
+        "airbag fires",
+        e.airbag_fires,
+        r.action("airbag_fire").is_some(),
+    );
+    check("pretensioner before contact", e.pretensioner_before_contact, pre);
+    check(
+        "pretensioner released",
+        e.pretensioner_released,
+        r.action("pretensioner_release").is_some(),
+    );
+    check(
+        "reference fallback",
+        e.reference_fallback,
+        r.modules.first_reference_cmd_ns.is_some(),
+    );
+    check(
+        "accelerometer fault before contact",
+        e.accel_fault_before_contact,
+        r.fault_first_ms("accel_sensor").is_some_and(|t| t < 0.0),
+    );
+    if let Some(ev) = &r.evaluated {
+        if !ev.outcome.adaptive_no_worse {
+            bad.push(format!(
+                "{}: worse than the reference restraint ({:+.1} %)",
+                s.name, ev.outcome.change_pct
+            ));
+        }
+    }
+    if let (Some((t, plan, _, "adaptive")), Some(confirm)) =
+        (r.action("airbag_fire"), r.crash_mode_ms)
+    {
+        if plan >= confirm && (t - plan).abs() > 1.0 {
+            bad.push(format!(
+                "{}: adaptive airbag at {t:+.2} ms, planned {plan:+.2} ms (confirmed {confirm:+.2} ms)",
+                s.name
+            ));
+        }
+    }
+    bad
+}
+
+#[test]
+fn the_library_meets_its_expectations_and_fires_on_plan() {
+    let cfg = cfg();
+    let mut table = format!("{TABLE_HEADER}\n");
+    let mut bad = Vec::new();
+    let lib = library();
+    assert!(lib.len() >= 25, "library: {}", lib.len());
+    for s in &lib {
+        let r = run(s, &cfg).expect("offline run");
+        table.push_str(&table_row(&r));
+        table.push('\n');
+        bad.extend(problems(s, &r));
+    }
+    eprintln!("{table}");
+    assert!(bad.is_empty(), "{bad:#?}\n{table}");
+}
+
+/// `base` with the opponent truly `true_kg` (class by mass) and reported as `reported_kg`.
+fn misreported(base: &Scenario, true_kg: f64, reported_kg: f64) -> Scenario {
+    let mut s = base.clone();
+    s.name = format!("{}-true{true_kg:.0}-rep{reported_kg:.0}", base.name);
+    s.opponent.mass_kg = Some(true_kg);
+    s.opponent.class = None;
+    s.sensor.mass_estimate_kg = Some(reported_kg);
+    s.sensor.mass_bias_kg = 0.0;
+    s.sensor.mass_noise_kg = 0.0;
+    s.expect = Default::default();
+    s
+}
+
+#[test]
+fn a_misreported_opponent_mass_up_to_1200_kg_is_never_worse_than_the_reference() {
+    let cfg = cfg();
+    let mut table = format!("{TABLE_HEADER}\n");
+    let mut bad = Vec::new();
+    let mut runs = 0;
+    for base in [
+        "taurus-48-48-abs",
+        "taurus-52-52-none",
+        "taurus-31-31-abs-eba",
+        "occupant-light-45kg",
+        "occupant-heavy-110kg",
+    ] {
+        let base = scenario(base);
+        for true_kg in [1000.0, 1300.0, 1785.0, 2200.0, 2600.0] {
+            for error_kg in [-1200.0, -600.0, 600.0, 1200.0] {
+                let reported = true_kg + error_kg;
+                if !(800.0..=3000.0).contains(&reported) {
+                    continue;
+                }
+                let s = misreported(&base, true_kg, reported);
+                let r = run(&s, &cfg).expect("offline run");
+                runs += 1;
+                table.push_str(&table_row(&r));
+                table.push('\n');
+                bad.extend(problems(&s, &r));
+            }
+        }
+    }
+    eprintln!("{table}");
+    assert!(runs >= 60, "{runs} runs");
+    assert!(bad.is_empty(), "{bad:#?}\n{table}");
+}
+
+#[test]
+fn a_misreported_closing_speed_up_to_5_mps_is_never_worse_than_the_reference() {
+    let cfg = cfg();
+    let mut table = format!("{TABLE_HEADER}\n");
+    let mut bad = Vec::new();
+    for base in [
+        "taurus-48-48-abs",
+        "taurus-52-52-none",
+        "taurus-31-31-abs-eba",
+        "mass-sweep-1300kg",
+    ] {
+        let base = scenario(base);
+        for bias in [-5.0, -3.0, 3.0, 5.0] {
+            let mut s = base.clone();
+            s.name = format!("{}-speed{bias:+.0}", base.name);
+            s.sensor.speed_bias_mps = bias;
+            s.expect = Default::default();
+            let r = run(&s, &cfg).expect("offline run");
+            table.push_str(&table_row(&r));
+            table.push('\n');
+            bad.extend(problems(&s, &r));
+            // The re-estimate sees through the bias: the plan follows the true closing speed.
+            if let Some(by) = &r.confirmed_by {
+                assert!(by.starts_with("Matched"), "{}: {by}", s.name);
+            }
+        }
+    }
+    eprintln!("{table}");
+    assert!(bad.is_empty(), "{bad:#?}\n{table}");
+}
