@@ -218,15 +218,23 @@ fn run_ms(b: &mut Vec<u8>, mut ms: u32) {
     }
 }
 
-/// ecu_cycle with the generators: a buckled 75 kg mid adult at 300 mm, ego at 15.2 m/s;
-/// an opponent of `opp_b` (800 + 9·b kg, σ 100 kg) closing at `speed_b` (10 + b·20/255 m/s)
-/// with contact 400 ms after the start; then either a 20 g crash pulse at contact (1 kHz,
-/// 3 × 8 samples: the detector confirms after 3 samples, Δv 0.2 m/s each) or, 150 ms before
-/// contact, the track ends (avoided); then 80 ms more.
+/// The live accelerometer (kind 6 with `n ≥ 128`): on with a crash ramp of `0.1·slope_b` g/ms
+/// from now on (0: quiet), or off (a dead sensor).
+fn live_accel(b: &mut Vec<u8>, on: bool, slope_b: u8) {
+    b.extend_from_slice(&[PULSE, slope_b, if on { 0x80 } else { 0xC0 }, 0]);
+}
+
+/// ecu_cycle with the generators: a buckled 75 kg mid adult at 300 mm, ego at 15.2 m/s, a
+/// live accelerometer; an opponent of `opp_b` (800 + 9·b kg, σ 100 kg) closing at `speed_b`
+/// (10 + b·20/255 m/s) with contact 400 ms after the start; then either a 20 g crash pulse at
+/// contact (1 kHz, 3 × 8 samples: a step, not the predicted ramp — the generic thresholds
+/// confirm after 3 samples, Δv 0.2 m/s each) or, 150 ms before contact, the track ends
+/// (avoided); then 80 ms more.
 fn cycle_seed_generated(flags: u8, speed_b: u8, opp_b: u8, crash: bool) -> Vec<u8> {
     let mut b = vec![flags];
     // 15.2 m/s; 74.8 kg; 300 mm; flags: buckle 1 (buckled) | class 3 (mid adult) << 2.
     b.extend_from_slice(&[CAN_GEN, 38, 112, 100, 1 | 3 << 2]);
+    live_accel(&mut b, true, 0);
     b.push(TRACK);
     b.extend_from_slice(&400u16.to_le_bytes());
     b.extend_from_slice(&[speed_b, opp_b, 100, 0]);
@@ -243,6 +251,20 @@ fn cycle_seed_generated(flags: u8, speed_b: u8, opp_b: u8, crash: bool) -> Vec<u
         b.extend_from_slice(&[TRACK, 0, 0, 0, 0, 0, 0]);
         run_ms(&mut b, 300);
     }
+    run_ms(&mut b, 80);
+    b
+}
+
+/// The opponent's approach (as in [`cycle_seed_generated`]) until contact at 400 ms, then
+/// what `at_contact` appends, then 80 ms more.
+fn cycle_seed_approach(flags: u8, speed_b: u8, opp_b: u8, at_contact: impl Fn(&mut Vec<u8>)) -> Vec<u8> {
+    let mut b = vec![flags];
+    b.extend_from_slice(&[CAN_GEN, 38, 112, 100, 1 | 3 << 2]);
+    live_accel(&mut b, true, 0);
+    b.push(TRACK);
+    b.extend_from_slice(&400u16.to_le_bytes());
+    b.extend_from_slice(&[speed_b, opp_b, 100, 0]);
+    at_contact(&mut b);
     run_ms(&mut b, 80);
     b
 }
@@ -291,6 +313,52 @@ fn cycle_seeds(frames: &[RawFrame]) {
         "lut-precrash-avoided",
         &cycle_seed_generated(1, 128, 78, false),
     );
+    // 25.1 m/s into 1502 kg (class 3): at contact the onset ramp of that crash (k·v/m_ego ≈
+    // 3.1 g/ms) — the prediction-matched confirmation, the re-plan, the adaptive airbag.
+    write(
+        "ecu_cycle",
+        "lut-matched-crash",
+        &cycle_seed_approach(1, 192, 78, |b| {
+            run_ms(b, 400);
+            live_accel(b, true, 31);
+            run_ms(b, 20);
+        }),
+    );
+    // The same crash with the accelerometer dead from 300 ms before contact: degraded, the
+    // vehicle-dynamics deceleration on CAN (−8 g) confirms at the predicted contact (backup).
+    write(
+        "ecu_cycle",
+        "lut-dead-accel-backup",
+        &cycle_seed_approach(1, 192, 78, |b| {
+            run_ms(b, 100);
+            live_accel(b, false, 0);
+            run_ms(b, 300);
+            b.extend_from_slice(&[CAN_GEN, 38, 112, 100, 1 | 3 << 2 | 0x40]);
+            run_ms(b, 20);
+        }),
+    );
+    // No object at all and a 4.5 g bump for 24 ms (3 pulse records of 8 samples at 1 ms): the
+    // generic thresholds confirm, the accelerometer-only algorithm stays under its boundary.
+    let mut bump = vec![1];
+    bump.extend_from_slice(&[CAN_GEN, 38, 112, 100, 1 | 3 << 2]);
+    live_accel(&mut bump, true, 0);
+    run_ms(&mut bump, 200);
+    live_accel(&mut bump, false, 0);
+    for _ in 0..3 {
+        bump.extend_from_slice(&[PULSE, 9, 7, 7]);
+        run_ms(&mut bump, 8);
+    }
+    live_accel(&mut bump, true, 0);
+    run_ms(&mut bump, 100);
+    write("ecu_cycle", "lut-bump-no-fire", &bump);
+    // The accelerometer stuck at 0.3 g: the same reading in 8-sample batches for 40 ms.
+    let mut stuck = vec![1];
+    stuck.extend_from_slice(&[CAN_GEN, 38, 112, 100, 1 | 3 << 2]);
+    for _ in 0..40 {
+        stuck.extend_from_slice(&[PULSE, 1, 7, 0]);
+        run_ms(&mut stuck, 1);
+    }
+    write("ecu_cycle", "lut-stuck-accel", &stuck);
 }
 
 fn main() {

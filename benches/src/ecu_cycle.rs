@@ -65,7 +65,7 @@ pub fn object(now_ns: u64) -> ObjectState {
     }
 }
 
-/// 8 samples of −200 m/s² (Δv 0.2 m/s per batch).
+/// 8 samples of −200 m/s² (Δv 0.2 m/s per batch) from `now_ns` on.
 pub fn accel(now_ns: u64) -> CrashAccelSample {
     CrashAccelSample {
         first_timestamp_ns: now_ns,
@@ -73,6 +73,20 @@ pub fn accel(now_ns: u64) -> CrashAccelSample {
         sample_period_ns: 125_000,
         count: 8,
         accel_mps2: [-200.0; 8],
+    }
+}
+
+/// A live crash accelerometer's quiet batch: 8 samples at 8 kHz ending at `now_ns`, ±0.05 m/s²
+/// (the core flags a bit-constant sensor as stuck and a silent one as stale: every measured
+/// cycle drains one batch, as on the bench).
+pub fn quiet_accel(now_ns: u64) -> CrashAccelSample {
+    let first = now_ns.saturating_sub(7 * 125_000);
+    CrashAccelSample {
+        first_timestamp_ns: first,
+        sequence: now_ns / MS,
+        sample_period_ns: 125_000,
+        count: 8,
+        accel_mps2: core::array::from_fn(|i| if i % 2 == 0 { 0.05 } else { -0.05 }),
     }
 }
 
@@ -135,6 +149,7 @@ pub fn precrash(
         let [e, o] = can_inputs(tx)?;
         io.push_can(if k.is_multiple_of(2) { e } else { o });
         io.push_object(object(*now_ns));
+        io.push_accel(quiet_accel(*now_ns));
         ecu.step(&info(*now_ns), io);
         *now_ns += MS;
     }
@@ -219,6 +234,7 @@ impl WorstCasePreCrash {
     pub fn step(&mut self) {
         self.k += 1;
         self.io.push_object(object(self.now_ns));
+        self.io.push_accel(quiet_accel(self.now_ns));
         if self.k.is_multiple_of(CAN_EVERY) {
             if let Some(f) = self.can.next() {
                 self.io.push_can(f);
@@ -303,6 +319,7 @@ impl DecisionOnly {
         self.k += 1;
         if self.k.is_multiple_of(CAN_EVERY) {
             self.io.push_object(object(self.now_ns));
+            self.io.push_accel(quiet_accel(self.now_ns));
             if let Some(f) = self.can.next() {
                 self.io.push_can(f);
             }
@@ -311,8 +328,10 @@ impl DecisionOnly {
         }
     }
 
-    /// One measured cycle without new inputs.
+    /// One measured cycle without new object or CAN inputs (the accelerometer's batch, as
+    /// every cycle).
     pub fn step(&mut self) {
+        self.io.push_accel(quiet_accel(self.now_ns));
         self.ecu
             .step(std::hint::black_box(&info(self.now_ns)), &mut self.io);
         self.now_ns += MS;
@@ -348,6 +367,108 @@ pub fn crash_confirmation_setup() -> anyhow::Result<(RestraintCycle<'static>, Si
     Ok((ecu, io, now_ns))
 }
 
+/// The crash phase of a predicted crash, cycle by cycle (`icount_crash`): a cycle driven into
+/// PRE-CRASH by an approach that predicts contact at `contact_ns` (25 m/s, 1500 ± 150 kg →
+/// conservative 1650 kg, class 3), then from the contact on the accelerometer delivers the
+/// predicted pulse itself (the closed-form collision of that situation) in 8-sample 8 kHz
+/// batches: the first cycles wake the detectors and freeze the prediction (one closed-form
+/// solve), fit the onset ramp, confirm (prediction-matched), re-plan from the table and fire.
+pub struct CrashPhase {
+    ecu: RestraintCycle<'static>,
+    io: SimIo,
+    can: CanReplay,
+    crash: physics::ExactCollision,
+    contact_ns: u64,
+    now_ns: u64,
+}
+
+impl CrashPhase {
+    /// Closing speed of the approach, m/s.
+    const CLOSING_MPS: f32 = 25.0;
+
+    /// Builds the cycle 5 ms before the contact.
+    ///
+    /// # Errors
+    /// Cycle construction failed, or it is not in PRE-CRASH 5 ms before the contact.
+    pub fn new() -> anyhow::Result<Self> {
+        let mut now_ns = 1_000 * MS;
+        let contact_ns = now_ns + 400 * MS;
+        let mut io = SimIo::new();
+        let mut tx = bus::E2eProtector::new();
+        let (mut ecu, _) =
+            RestraintCycle::new(CycleConfig::default(), Some(bench_lut()), &REFERENCE)
+                .map_err(|e| anyhow::anyhow!("RestraintCycle::new: {e}"))?;
+        let mut can = CanReplay::new(&mut tx)?;
+        while now_ns < contact_ns - 5 * MS {
+            if (now_ns / MS).is_multiple_of(10) {
+                let mut o = object(now_ns);
+                o.closing_speed_mps = Self::CLOSING_MPS;
+                o.relative_accel_mps2 = 0.0;
+                o.distance_m = Self::CLOSING_MPS * (contact_ns - now_ns) as f32 * 1e-9;
+                io.push_object(o);
+            }
+            if (now_ns / MS).is_multiple_of(CAN_EVERY) {
+                if let Some(f) = can.next() {
+                    io.push_can(f);
+                }
+            }
+            io.push_accel(quiet_accel(now_ns));
+            ecu.step(&info(now_ns), &mut io);
+            now_ns += MS;
+        }
+        anyhow::ensure!(
+            ecu.phase() == Phase::PreCrash,
+            "set-up did not reach PRE-CRASH: {:?}",
+            ecu.phase()
+        );
+        let ego = physics::MassClass::new(4).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let opp = physics::class_for_mass_kg(1650.0).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let spring = physics::CombinedSpring::series(ego.curve(), Some(opp.curve()))
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let crash = physics::ExactCollision::solve(&physics::CollisionInput::with_defaults(
+            &spring,
+            1785.0,
+            1650.0,
+            f64::from(Self::CLOSING_MPS),
+        ))
+        .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        Ok(Self {
+            ecu,
+            io,
+            can,
+            crash,
+            contact_ns,
+            now_ns,
+        })
+    }
+
+    /// One cycle with the accelerometer batch of the last ms (the pulse from the contact on).
+    pub fn step(&mut self) {
+        let mut a = quiet_accel(self.now_ns);
+        for (i, s) in a.accel_mps2.iter_mut().enumerate() {
+            let t = a.first_timestamp_ns + i as u64 * 125_000;
+            if t >= self.contact_ns {
+                let tau_s = (t - self.contact_ns) as f64 * 1e-9;
+                *s += self.crash.state_at(tau_s).ego_accel_mps2 as f32;
+            }
+        }
+        self.io.push_accel(a);
+        if (self.now_ns / MS).is_multiple_of(CAN_EVERY) {
+            if let Some(f) = self.can.next() {
+                self.io.push_can(f);
+            }
+        }
+        self.ecu
+            .step(std::hint::black_box(&info(self.now_ns)), &mut self.io);
+        self.now_ns += MS;
+    }
+
+    /// The cycle (its phase, how the crash was confirmed, whether the airbag fired).
+    pub fn ecu(&self) -> &RestraintCycle<'static> {
+        &self.ecu
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -366,6 +487,23 @@ mod tests {
             w.step();
         }
         w.verify().unwrap();
+    }
+
+    #[test]
+    fn the_crash_phase_workload_is_confirmed_by_the_prediction_and_fires() {
+        let mut c = CrashPhase::new().unwrap();
+        for _ in 0..20 {
+            c.step();
+        }
+        assert!(
+            matches!(
+                c.ecu().crash_kind(),
+                Some(restraint::crash::ConfirmKind::Matched(_))
+            ),
+            "{:?}",
+            c.ecu().crash_kind()
+        );
+        assert!(c.ecu().airbag_fired());
     }
 
     #[test]

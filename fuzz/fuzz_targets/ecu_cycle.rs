@@ -22,11 +22,17 @@
 //!   `0.25·n` m/s²). While on, every 10 ms of cycle time a valid sample at distance
 //!   `v · (contact − now)` is published — a coherent approach from tens of metres;
 //! * 5 — vehicle / occupant CAN generator: ego speed `0.4·b` m/s, occupant mass `30 + 0.4·b` kg,
-//!   chest to wheel `150 + 1.5·b` mm, flags (bits 0–1 buckle, bits 2–4 class % 5, bit 5 off).
-//!   While on, genuine E2E-sealed `EgoVehicleState` every 10 ms and `OccupantClassification`
-//!   every 100 ms (own `E2eProtector`, so alive counters are consistent);
-//! * 6 — crash pulse: `n % 8 + 1` samples of `−0.5·b·g` at `(1 + p % 20) × 125 µs`, continuing
-//!   the accelerometer time line (what a real crash sensor delivers);
+//!   chest to wheel `150 + 1.5·b` mm, flags (bits 0–1 buckle, bits 2–4 class % 5, bit 5 off,
+//!   bit 6: `EgoLongAccel` −8 g, a crash on the vehicle-dynamics sensor). While on, genuine
+//!   E2E-sealed `EgoVehicleState` every 10 ms and `OccupantClassification` every 100 ms (own
+//!   `E2eProtector`, so alive counters are consistent);
+//! * 6 — accelerometer, `[b, n, p]`: for `n < 128` one crash-pulse batch, `n % 8 + 1` samples of
+//!   `−0.5·b·g` at `(1 + p % 20) × 125 µs`, continuing the accelerometer time line (what a real
+//!   crash sensor delivers); for `n ≥ 128` the live sensor: bit 6 of `n` switches it off (a dead
+//!   sensor), otherwise on: from then on, before every cycle, the samples since the last batch
+//!   at 4 kHz with a ±0.05 m/s² dither (a live MEMS sensor is never bit-constant), plus a crash
+//!   ramp of `0.1·b` g/ms from this record on, capped at 40 g (`b = 0`: quiet) — the onset the
+//!   prediction-matched confirmation looks for;
 //! * 7 — run `b + 1` cycles of 1 ms (long stretches of time from two bytes).
 //!
 //! At most 2 000 cycles per input. Generators emit just before a cycle is run.
@@ -34,12 +40,14 @@
 //! Oracles (every cycle, on the frames it sent): no panic, no hang;
 //! 1. every frame decodes with `bus::decode` (valid DBC frame, correct CRC, signals in range);
 //! 2. an `AirbagStageCmd` with `Fire` is only sent (a) in phase CRASH / POST-CRASH with
-//!    `airbag_fired()` set — the only way the state machine fires is through accelerometer
-//!    confirmation — and (b) only if the accelerometer data fed so far made a confirmation
-//!    POSSIBLE, checked independently of the detector: at least `confirm_samples` finite
-//!    samples with deceleration ≥ `confirm_decel_g` and a summed positive Δv ≥
-//!    `confirm_delta_v_mps` over all batches with a usable period (a necessary condition of
-//!    any confirmation: the detector's run and Δv are counted over a subset of these);
+//!    `airbag_fired()` set — the state machine fires only through a crash confirmation — and
+//!    (b) only if the input fed so far made the path that confirmed POSSIBLE, checked
+//!    independently of the detectors (README "Decision table"): prediction-matched — at least
+//!    three finite samples with deceleration ≥ `confirm_wake_g`; generic thresholds — at
+//!    least `confirm_samples` finite samples ≥ `confirm_decel_g` and an upper bound of the
+//!    integrated Δv ≥ `confirm_delta_v_mps` (each positive sample counts at most half its own
+//!    period plus half the longest usable period, the most a trapezoid can give it); backup —
+//!    a frame decoding as `EgoVehicleState` with `EgoLongAccel` ≤ −`backup_confirm_g`;
 //! 3. a command with source `Adaptive` is only sent with a LUT and after at least one LUT
 //!    lookup (the adaptive settings come from nowhere else).
 #![no_main]
@@ -53,6 +61,7 @@ use bus::codec::{
 };
 use bus::{E2eProtector, EgoVehicleState, Messages, OccupantClassification, RawFrame};
 use diagram::Diagram;
+use restraint::crash::ConfirmKind;
 use restraint::{Activity, CycleConfig, CycleInfo, Phase, RestraintCycle, SimIo, G_MPS2};
 use libfuzzer_sys::fuzz_target;
 use physics::reference::ReferenceSettings;
@@ -130,6 +139,7 @@ struct Track {
 /// Genuine vehicle / occupant CAN sender.
 struct CanGen {
     ego_speed_mps: f32,
+    ego_long_accel_mps2: f32,
     occ_kg: f32,
     chest_mm: u16,
     buckle: OccupantClassificationBeltBuckle,
@@ -140,22 +150,32 @@ struct CanGen {
 
 }
 
-/// What the accelerometer input made possible so far (the independent fire oracle).
+/// What the input made possible so far (the independent fire oracle).
 #[derive(Default)]
 struct AccelFed {
     /// Finite samples at or above the confirmation deceleration.
     over_threshold: u64,
-    /// Σ max(decel, 0)·dt over finite samples of batches with a usable period, m/s.
-    delta_v_mps: f64,
+    /// Finite samples at or above the wake threshold.
+    over_wake: u64,
+    /// Σ max(decel, 0)·own period over finite samples of batches with a usable period, m/s.
+    delta_v_own_mps: f64,
+    /// Σ max(decel, 0) over the same samples, m/s².
+    decel_sum_mps2: f64,
+    /// Longest usable sample period fed, s.
+    max_period_s: f64,
+    /// A vehicle frame with a crash deceleration (≤ −`backup_confirm_g`) was fed.
+    can_crash_decel: bool,
 }
 
 impl AccelFed {
     fn note(&mut self, cfg: &CycleConfig, a: &restraint::CrashAccelSample) {
         if a.sample_period_ns == 0 || a.sample_period_ns > MAX_SAMPLE_PERIOD_NS {
-            return; // the detector drops the whole batch
+            return; // the monitor drops the whole batch
         }
         let dt_s = f64::from(a.sample_period_ns) * 1.0e-9;
+        self.max_period_s = self.max_period_s.max(dt_s);
         let decel_mps2 = cfg.confirm_decel_g * G_MPS2;
+        let wake_mps2 = cfg.confirm_wake_g * G_MPS2;
         for &s in a.samples() {
             if !s.is_finite() {
                 continue;
@@ -164,17 +184,49 @@ impl AccelFed {
             if decel >= decel_mps2 {
                 self.over_threshold += 1;
             }
+            if decel >= wake_mps2 {
+                self.over_wake += 1;
+            }
             if decel > 0.0 {
-                self.delta_v_mps += decel * dt_s;
+                self.delta_v_own_mps += decel * dt_s;
+                self.decel_sum_mps2 += decel;
             }
         }
     }
 
-    fn confirmation_possible(&self, cfg: &CycleConfig) -> bool {
-        // The tolerance only absorbs summation-order rounding (≈ 1e-16 relative).
-        self.over_threshold >= u64::from(cfg.confirm_samples)
-            && self.delta_v_mps >= cfg.confirm_delta_v_mps * (1.0 - 1.0e-9)
+    fn note_can(&mut self, cfg: &CycleConfig, f: &RawFrame) {
+        if let Ok(Messages::EgoVehicleState(m)) = bus::decode(f.id, f.payload()) {
+            if f64::from(m.ego_long_accel()) <= -cfg.backup_confirm_g * G_MPS2 {
+                self.can_crash_decel = true;
+            }
+        }
     }
+
+    /// The most Δv a trapezoidal integration over any subset of the samples can reach, m/s.
+    fn delta_v_bound_mps(&self) -> f64 {
+        0.5 * self.delta_v_own_mps + 0.5 * self.max_period_s * self.decel_sum_mps2
+    }
+
+    /// The input made the confirmation path `kind` possible (module docs, oracle 2b).
+    fn confirmation_possible(&self, cfg: &CycleConfig, kind: Option<ConfirmKind>) -> bool {
+        // The tolerance only absorbs summation-order rounding (≈ 1e-16 relative).
+        let generic = self.over_threshold >= u64::from(cfg.confirm_samples)
+            && self.delta_v_bound_mps() >= cfg.confirm_delta_v_mps * (1.0 - 1.0e-9);
+        match kind {
+            Some(ConfirmKind::Matched(_)) => self.over_wake >= 3,
+            Some(ConfirmKind::Generic { .. }) => generic,
+            Some(ConfirmKind::Backup) => self.can_crash_decel,
+            None => false,
+        }
+    }
+}
+
+/// The live accelerometer generator (kind 6, `n ≥ 128`).
+struct LiveAccel {
+    /// Start of the crash ramp, ns.
+    ramp_from_ns: u64,
+    /// Ramp slope, m/s² per ms (0: quiet).
+    slope_mps2_per_ms: f64,
 }
 
 struct Harness {
@@ -189,11 +241,41 @@ struct Harness {
     tx: E2eProtector,
     accel_next_ns: u64,
     accel_sequence: u64,
+    live_accel: Option<LiveAccel>,
     fed: AccelFed,
 }
 
 impl Harness {
+    /// The live sensor's samples since the last batch, at 4 kHz (≤ 8 per batch).
+    fn emit_live_accel(&mut self) {
+        let now = self.now_ns;
+        let Some(live) = &self.live_accel else {
+            return;
+        };
+        const PERIOD_NS: u64 = 250_000;
+        // Continue the time line; after a long silence start 2 ms back (a fresh batch).
+        let mut t = self.accel_next_ns.max(now.saturating_sub(2_000_000));
+        let mut a = restraint::CrashAccelSample::EMPTY;
+        a.first_timestamp_ns = t;
+        a.sample_period_ns = PERIOD_NS as u32;
+        while t <= now && (a.count as usize) < a.accel_mps2.len() {
+            let dither = if (t / PERIOD_NS) % 2 == 0 { 0.05 } else { -0.05 };
+            let ms = t.saturating_sub(live.ramp_from_ns) as f64 * 1e-6;
+            let crash = (live.slope_mps2_per_ms * ms).min(40.0 * G_MPS2);
+            a.accel_mps2[a.count as usize] = (dither - crash) as f32;
+            a.count += 1;
+            t += PERIOD_NS;
+        }
+        if a.count > 0 {
+            self.accel_next_ns = t;
+            self.accel_sequence += 1;
+            a.sequence = self.accel_sequence;
+            self.push_accel(a);
+        }
+    }
+
     fn emit_generated(&mut self) {
+        self.emit_live_accel();
         let now = self.now_ns;
         if let Some(t) = self.track.as_mut() {
             if now >= t.next_ns {
@@ -223,9 +305,11 @@ impl Harness {
                 if let Ok(m) = EgoVehicleState::encode(
                     EgoVehicleStateBrakeState::Released,
                     g.ego_speed_mps,
-                    0.0,
+                    g.ego_long_accel_mps2,
                 ) {
-                    self.io.push_can(self.tx.seal(m));
+                    let f = self.tx.seal(m);
+                    self.fed.note_can(self.cycle.config(), &f);
+                    self.io.push_can(f);
                 }
             }
             if now >= g.next_occupant_ns {
@@ -273,15 +357,20 @@ impl Harness {
                             self.cycle.airbag_fired()
                         );
                         let cfg = self.cycle.config();
+                        let kind = self.cycle.crash_kind();
                         assert!(
-                            self.fed.confirmation_possible(cfg),
-                            "airbag fire sent although no accelerometer input could confirm a \
-                             crash: {} samples ≥ {} g (need {}), Δv {:.4} m/s (need {})",
+                            self.fed.confirmation_possible(cfg, kind),
+                            "airbag fire sent although no input could confirm the crash the way \
+                             it was confirmed ({kind:?}): {} samples ≥ {} g, {} ≥ {} g (generic \
+                             needs {}), Δv bound {:.4} m/s (needs {}), CAN crash decel {}",
+                            self.fed.over_wake,
+                            cfg.confirm_wake_g,
                             self.fed.over_threshold,
                             cfg.confirm_decel_g,
                             cfg.confirm_samples,
-                            self.fed.delta_v_mps,
-                            cfg.confirm_delta_v_mps
+                            self.fed.delta_v_bound_mps(),
+                            cfg.confirm_delta_v_mps,
+                            self.fed.can_crash_decel
                         );
                     }
                     m.cmd_source() == AirbagStageCmdCmdSource::Adaptive
@@ -362,6 +451,7 @@ fuzz_target!(|data: &[u8]| {
         tx: E2eProtector::new(),
         accel_next_ns: now_ns,
         accel_sequence: 0,
+        live_accel: None,
         fed: AccelFed::default(),
     };
     let mut r = Reader(body);
@@ -410,11 +500,13 @@ fuzz_target!(|data: &[u8]| {
                 }
                 let id = u32::from(u16::from_le_bytes([id_lo, id_hi]) & 0x7FF);
                 let extended = id_hi & 0x80 != 0;
-                h.io.push_can(RawFrame {
+                let f = RawFrame {
                     id: if extended { id | bus::CAN_EFF_FLAG } else { id },
                     len,
                     data,
-                });
+                };
+                h.fed.note_can(h.cycle.config(), &f);
+                h.io.push_can(f);
             }
             3 => {
                 let step = u64::from(r.u8().unwrap_or(1));
@@ -445,6 +537,11 @@ fuzz_target!(|data: &[u8]| {
                 let f = r.u8().unwrap_or(0b1101);
                 h.can_gen = (f & 0x20 == 0).then(|| CanGen {
                     ego_speed_mps: (0.4 * f32::from(speed)).min(100.0),
+                    ego_long_accel_mps2: if f & 0x40 != 0 {
+                        (-8.0 * G_MPS2) as f32
+                    } else {
+                        0.0
+                    },
                     occ_kg: 30.0 + 0.4 * f32::from(occ),
                     chest_mm: 150 + u16::from(chest) * 3 / 2,
                     buckle: buckle_of(f),
@@ -455,8 +552,17 @@ fuzz_target!(|data: &[u8]| {
             }
             6 => {
                 let level = r.u8().unwrap_or(40);
-                let n = usize::from(r.u8().unwrap_or(7) % 8) + 1;
-                let period_ns = (1 + u32::from(r.u8().unwrap_or(7) % 20)) * 125_000;
+                let n_byte = r.u8().unwrap_or(7);
+                let p_byte = r.u8().unwrap_or(7);
+                if n_byte >= 128 {
+                    h.live_accel = (n_byte & 0x40 == 0).then(|| LiveAccel {
+                        ramp_from_ns: now_ns,
+                        slope_mps2_per_ms: 0.1 * f64::from(level) * G_MPS2,
+                    });
+                    continue;
+                }
+                let n = usize::from(n_byte % 8) + 1;
+                let period_ns = (1 + u32::from(p_byte % 20)) * 125_000;
                 let span_ns = n as u64 * u64::from(period_ns);
                 // Continue the sensor's time line; never start in the future.
                 let first = h

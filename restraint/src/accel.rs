@@ -4,11 +4,11 @@
 //!
 //! | check | rule | reaction |
 //! |---|---|---|
-//! | **stale** | no batch received for `accel_timeout_ms` (by receipt time; none yet = stale) | `ACCEL_STALE` while it lasts |
+//! | **stale** | no batch received for `accel_timeout_ms` (50 ms; by receipt time; none yet = stale) | `ACCEL_STALE` while it lasts |
 //! | **time** | sample period 0 or > 10 ms; a batch that starts before the previous one ended (half a period of slack: non-monotonic time); a first sample older than the timeout or more than one cycle in the future | batch dropped, `ACCEL_INVALID` held |
 //! | **out of range** | a non-finite sample, or one beyond the sensor's measuring range (`accel_full_scale_g`) | sample dropped, `ACCEL_INVALID` held |
 //! | **saturated** | a sample at full scale (within 0.1 %: a sensor pinned at its rail) | sample dropped, `ACCEL_INVALID` held |
-//! | **stuck** | bit-identical readings for `accel_stuck_ms` | `ACCEL_INVALID` held |
+//! | **stuck** | bit-identical readings for `accel_stuck_ms` (20 ms) | `ACCEL_INVALID` held |
 //!
 //! `ACCEL_INVALID` is held for [`INVALID_HOLD_MS`] after the last implausible sample, so a
 //! flickering sensor cannot toggle the decision every cycle. Why a stuck sensor is caught by
@@ -208,9 +208,9 @@ mod tests {
         assert_eq!(s[3].decel_mps2, 4.0);
         assert_eq!(s[1].dt_s, 250e-6);
         assert!(!m.stale(10 * MS) && !m.invalid(10 * MS));
-        // Default timeout 20 ms: stale strictly after it.
-        assert!(!m.stale(30 * MS));
-        assert!(m.stale(30 * MS + 1));
+        // Default timeout 50 ms: stale strictly after it.
+        assert!(!m.stale(60 * MS));
+        assert!(m.stale(60 * MS + 1));
     }
 
     #[test]
@@ -238,15 +238,15 @@ mod tests {
         assert_eq!(n, 0);
         assert_eq!(m.faults.bad_time_batches, 1);
         // Older than the timeout, and 2 ms in the future.
-        m.feed(40 * MS, 15 * MS, 250_000, &[5.0; 4], &mut |_| n += 1);
-        m.feed(40 * MS, 42 * MS, 250_000, &[5.0; 4], &mut |_| n += 1);
-        m.feed(40 * MS, 39 * MS, 0, &[5.0; 4], &mut |_| n += 1);
+        m.feed(70 * MS, 15 * MS, 250_000, &[5.0; 4], &mut |_| n += 1);
+        m.feed(70 * MS, 72 * MS, 250_000, &[5.0; 4], &mut |_| n += 1);
+        m.feed(70 * MS, 69 * MS, 0, &[5.0; 4], &mut |_| n += 1);
         assert_eq!((n, m.faults.bad_time_batches), (0, 4));
-        assert!(m.invalid(40 * MS));
+        assert!(m.invalid(70 * MS));
         // A dropped batch is not a sign of life.
-        assert!(m.stale(40 * MS));
+        assert!(m.stale(70 * MS));
         // The next genuine batch continues.
-        assert_eq!(feed(&mut m, 41 * MS, [1.5, 2.0, 3.0, 4.0]).len(), 4);
+        assert_eq!(feed(&mut m, 71 * MS, [1.5, 2.0, 3.0, 4.0]).len(), 4);
     }
 
     #[test]

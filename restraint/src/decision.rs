@@ -14,7 +14,8 @@
 //!
 //! | confirmed by | when | plan | airbag |
 //! |---|---|---|---|
-//! | the pulse matching the prediction (or departing within the re-estimation range) | PRE-CRASH, not degraded, re-estimated at or above the no-fire line | the table at the re-estimated closing speed and the robust mass (`crash::plan_for`; the reference restraint where the table does not cover the situation) | at max(confirm, onset + t_ab) if the plan fires |
+//! | the pulse following the prediction (onset slope within ± `match_tolerance`) | PRE-CRASH, not degraded | the preset plan (table at the predicted speed and the robust mass; the reference restraint where the table does not cover the situation) | at max(confirm, onset + t_ab) if the plan fires |
+//! | the pulse departing from the prediction within the re-estimation range | PRE-CRASH, not degraded, re-estimated at or above the no-fire line | the table at the re-estimated closing speed and the robust mass (`crash::plan_for`) | as above |
 //! | the vehicle-dynamics deceleration on CAN (backup) | crash accelerometer faulty, a crash predicted above the no-fire line | reference restraint | at max(confirm, predicted contact + t_ab,ref) |
 //! | the generic thresholds (any other case: no prediction, degraded, pulse refuted or re-estimated below the no-fire line) | — | reference belt | only when the accelerometer-only algorithm decides must-fire: at max(decision, onset + t_ab,ref) |
 //!
@@ -208,6 +209,12 @@ impl Decision {
     fn crash_plan_for(&self, c: &Confirmation, x: &mut DecisionInputs<'_>) -> (RestraintPlan, AirbagGate) {
         let predicted = self.phase == Phase::PreCrash && !x.degraded;
         if let (ConfirmKind::Matched(e), true) = (c.kind, predicted) {
+            // Follows the prediction: the preset plan (the radar's speed is the better
+            // estimate; the onset slope mixes speed with the structures' stiffness, which
+            // differs by up to ±10 % between the classes). Departs: the re-estimated severity.
+            if e.follows {
+                return (self.plan, AirbagGate::Decided);
+            }
             if let Some(plan) = (x.replan)(e.closing_mps) {
                 return (plan, AirbagGate::Decided);
             }

@@ -197,19 +197,20 @@ fn without_a_prediction_a_bump_fires_nothing_and_a_severe_crash_fires_the_refere
 
 #[test]
 fn a_dead_accelerometer_is_on_the_bus_within_its_timeout_plus_one_status_period() {
+    // Timeout 50 ms, EcuStatus every 20 ms and on change: on the bus within 70 ms.
     let mut b = Bench::new(Some(test_lut()));
     idle_until(&mut b, T0 + 300 * MS);
     b.accel_live = false;
     let dead_from = b.now; // last sample at dead_from − 1 ms
     idle_until(&mut b, T0 + 500 * MS);
-    // Stale strictly after 20 ms without a batch (received at dead_from − 1 ms).
+    // Stale strictly after 50 ms without a batch (received at dead_from − 1 ms).
     assert_eq!(
         first_reason(&b, dead_from, Degraded::ACCEL_STALE),
-        Some(dead_from + 20 * MS)
+        Some(dead_from + 50 * MS)
     );
-    assert_eq!(b.mode_at(dead_from + 20 * MS), EcuMode::Degraded as u8);
+    assert_eq!(b.mode_at(dead_from + 50 * MS), EcuMode::Degraded as u8);
     let on_bus = first_accel_fault_on_bus(&b, dead_from).expect("FaultAccelSensor on the bus");
-    assert!(on_bus <= dead_from + 40 * MS, "{} ms", (on_bus - dead_from) / MS);
+    assert!(on_bus <= dead_from + 70 * MS, "{} ms", (on_bus - dead_from) / MS);
     // Back: healthy on the first batch.
     b.accel_live = true;
     let back = b.now;
@@ -304,7 +305,7 @@ fn a_predicted_crash_with_a_dead_accelerometer_is_confirmed_by_the_vehicle_decel
     let mut b = Bench::new(Some(test_lut()));
     dead_accel_crash(&mut b, 25.0, C + 2 * MS, 8.0);
     // Flagged long before the crash.
-    assert!(first_accel_fault_on_bus(&b, C - 400 * MS).is_some_and(|t| t < C - 350 * MS));
+    assert!(first_accel_fault_on_bus(&b, C - 400 * MS).is_some_and(|t| t <= C - 330 * MS));
     assert_eq!(b.first_mode(EcuMode::PreCrash), None, "degraded: no adaptive preset");
     // The first vehicle frame after the deceleration (every 10 ms: C + 10 ms) confirms.
     assert_eq!(b.ecu.crash_kind(), Some(ConfirmKind::Backup));

@@ -64,9 +64,8 @@ fn precrash_preset_pretensioner_at_planned_time_then_airbag_at_planned_time_and_
     };
     assert!((e.ratio - 1.0).abs() < 0.01 && e.follows, "{e:?}");
     assert!(e.onset_ns.abs_diff(C) < 20_000, "fitted onset {e:?}");
-    // Re-planned before anything is committed: the table at the re-estimated closing speed
-    // (and the robust mass).
-    let (v_re, m_robust) = (e.closing_mps * 3.6, m);
+    // The pulse follows the prediction: the preset plan (90 km/h, the robust mass) holds.
+    let (v_re, m_robust) = (v, m);
     let plan = b.ecu.crash_plan();
     assert!(
         (f64::from(plan.belt_limiter_kn) - belt_kn(v_re, m_robust)).abs() < 1e-4,
@@ -74,8 +73,8 @@ fn precrash_preset_pretensioner_at_planned_time_then_airbag_at_planned_time_and_
     );
     assert!((f64::from(plan.airbag_level_kn) - airbag_kn(v_re, m_robust)).abs() < 1e-4);
     assert!((f64::from(plan.airbag_time_ms) - airbag_ms(v_re, m_robust)).abs() < 1e-3);
-    // Airbag: first Fire in the cycle nearest onset + t_ab (≈ C + 14 ms), with the
-    // re-planned stage and level (5.4 kN: Stage 1, between 1 and 6 kN).
+    // Airbag: first Fire in the cycle nearest onset + t_ab (≈ C + 14 ms), with the planned
+    // stage and level (5.4 kN: Stage 1, between 1 and 6 kN).
     let due = e.onset_ns + (airbag_ms(v_re, m_robust) * 1e6) as u64;
     let fire_cycle = T0 + (due - T0 + MS / 2) / MS * MS;
     assert_eq!(fire_cycle, C + 14 * MS);

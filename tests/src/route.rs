@@ -160,7 +160,7 @@ pub const STARVED_INPUT_FLAGS: [&str; 5] = [
 
 /// Why a scenario run did not measure the bench because the machine starved it, if it did not:
 /// between the ECU's first Normal and the contact it raised a stale-input fault that the
-/// scenario does not inject (no dropout or freeze declared), or the airbag fired more than
+/// scenario does not inject (no dropout, freeze or accelerometer fault declared), or the airbag fired more than
 /// [`crate::FIRE_LATE_ALLOWANCE_MS`] after its plan. Under emulated timing such a run is run
 /// again ([`Allowances::time_limit_attempts`]); with real timers it is a failure like any other.
 pub fn starved_run(
@@ -168,7 +168,9 @@ pub fn starved_run(
     r: &actuator_stubs::report::Report,
 ) -> Option<String> {
     let mut why = Vec::new();
-    let injects = !scenario.sensor.dropouts.is_empty() || !scenario.sensor.freezes.is_empty();
+    let injects = !scenario.sensor.dropouts.is_empty()
+        || !scenario.sensor.freezes.is_empty()
+        || !scenario.sensor.accel_faults.is_empty();
     let first_normal = r
         .ecu_modes
         .iter()

@@ -187,3 +187,42 @@ fn a_misreported_closing_speed_up_to_5_mps_is_never_worse_than_the_reference() {
     eprintln!("{table}");
     assert!(bad.is_empty(), "{bad:#?}\n{table}");
 }
+
+/// The fault campaign's scenario variants (issue 14: misreported crashes, dead and stuck
+/// accelerometers, bumps with degraded inputs), and its LUT fault without a LUT, offline: the
+/// core meets the expectations the campaign will judge on the real processes.
+#[test]
+fn the_campaigns_scenario_variants_meet_their_expectations_offline() {
+    use e2e_tests::faults::{cases, lengthened_scenario, variant_scenario, Fault, CRASH_LEAD_S};
+    let dir = std::env::temp_dir().join(format!("offline-variants-{}", std::process::id()));
+    let mut bad = Vec::new();
+    let mut table = format!("{TABLE_HEADER}\n");
+    let mut n = 0;
+    for case in cases() {
+        let mut path = root().join(format!("scenarios/{}.toml", case.scenario));
+        let out = dir.join(case.name);
+        if case.scenario == e2e_tests::faults::CRASH_SCENARIO {
+            path = lengthened_scenario(&path, &out.join("long"), CRASH_LEAD_S).expect("lengthened");
+        }
+        let mut cfg = cfg();
+        match case.fault {
+            Fault::Variant(v) => {
+                path = variant_scenario(&path, &out, v).expect("variant");
+            }
+            Fault::Lut { .. } => cfg.lut = None,
+            _ => continue,
+        }
+        let mut s = Scenario::load(&path).expect("variant scenario");
+        if cfg.lut.is_none() {
+            // Without a table there is no pre-crash preset (the campaign does not judge it).
+            s.expect.pretensioner_before_contact = None;
+        }
+        let r = run(&s, &cfg).expect("offline run");
+        n += 1;
+        table.push_str(&format!("{:<22} {}\n", case.name, table_row(&r)));
+        bad.extend(problems(&s, &r).into_iter().map(|p| format!("{}: {p}", case.name)));
+    }
+    eprintln!("{table}");
+    assert!(n >= 15, "{n} variant cases");
+    assert!(bad.is_empty(), "{bad:#?}\n{table}");
+}

@@ -1,7 +1,7 @@
 //! Judging one run of the campaign: every check of [`judge`], and which of them are time
 //! limits (retried where the route's timing is emulated) rather than function checks.
 
-use super::{Case, CaseResult, Check, Fault, DELAY_MS};
+use super::{Case, CaseResult, Check, Fault, Variant, DELAY_MS};
 use crate::route::STARVED_INPUT_FLAGS;
 use crate::{RunResult, FIRE_LATE_ALLOWANCE_MS};
 use actuator_stubs::report::{Report, TimedAction};
@@ -253,6 +253,7 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
         fire,
         frames_injected,
         played.as_ref().map_or(f64::NAN, |s| s.duration_s),
+        must_fire,
     );
     // Same decision as without the fault where the fault is over before the threat.
     if window.is_some() || case.fault == Fault::StaleService {
@@ -269,6 +270,7 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
         .unwrap_or(0);
     let description = describe_reaction(
         case,
+        Some(r),
         &modes,
         reaction.degraded_after_ms,
         reaction.recovered_after_ms,
@@ -566,6 +568,7 @@ fn judge_reaction(
 
 /// The checks only some faults have: the LUT faults' start-up fallback, the stale service's
 /// usable services, the attacks' rejected frames, the flood's inputs.
+#[allow(clippy::too_many_arguments)]
 fn judge_fault(
     checks: &mut Checks,
     case: &Case,
@@ -574,6 +577,7 @@ fn judge_fault(
     fire: Option<&TimedAction>,
     frames_injected: u64,
     duration_s: f64,
+    must_fire: Option<bool>,
 ) {
     let ecu = run.ecu_report.as_ref();
     match case.fault {
@@ -597,12 +601,15 @@ fn judge_fault(
                 !modes.iter().any(|(_, m)| m == "Normal"),
                 format!("{} mode changes", modes.len()),
             );
-            checks.check(
-                "still protected: the reference restraint fires",
-                fire.is_some_and(|a| a.action.source == "reference"),
-                fire.map_or("no fire".into(), |a| format!("source {}", a.action.source)),
-            );
+            if must_fire != Some(false) {
+                checks.check(
+                    "still protected: the reference restraint fires",
+                    fire.is_some_and(|a| a.action.source == "reference"),
+                    fire.map_or("no fire".into(), |a| format!("source {}", a.action.source)),
+                );
+            }
         }
+        Fault::Variant(v) => judge_variant(checks, v, &run.report),
         Fault::StaleService => {
             let cleaned = ecu
                 .and_then(|e| e.pointer("/ipc/stale_nodes_cleaned"))
@@ -654,6 +661,57 @@ fn judge_fault(
     }
 }
 
+/// When the ECU first reported the crash accelerometer faulty [ms rel. contact].
+fn accel_fault_first_ms(r: &Report) -> Option<f64> {
+    r.ecu_faults
+        .iter()
+        .find(|(_, f)| f.iter().any(|n| n == "accel_sensor"))
+        .map(|(t, _)| *t)
+}
+
+/// Issue 14's checks of a scenario variant: a misreported crash is no worse than the reference
+/// restraint (judged on the commanded levels at the planned times where the route's timing is
+/// emulated, as the bench's library test does); a dead or stuck accelerometer is on the bus
+/// before the contact.
+fn judge_variant(checks: &mut Checks, v: Variant, r: &Report) {
+    match v {
+        Variant::MassMisreport { .. } | Variant::SpeedBias { .. } => {
+            let emulated = crate::Route::current().timing_emulated();
+            let verdict = r.outcome.as_ref().map(|o| {
+                let judged = match (&o.adaptive_planned, emulated) {
+                    (Some(planned), true) => planned,
+                    _ => &o.adaptive,
+                };
+                (
+                    actuator_stubs::outcome::no_worse(judged, &o.reference),
+                    format!(
+                        "{:+.1} % a_max + a_mean vs the reference restraint{}{}",
+                        o.change_pct,
+                        if judged.bottomed_out { ", bottomed out" } else { "" },
+                        if emulated { " (commanded levels at planned times)" } else { "" }
+                    ),
+                )
+            });
+            checks.check(
+                "no worse than the reference restraint",
+                verdict.as_ref().is_some_and(|(ok, _)| *ok),
+                verdict.map_or("no outcome (no contact?)".into(), |(_, d)| d),
+            );
+        }
+        Variant::AccelDead { .. } | Variant::AccelStuck { .. } => {
+            let t = accel_fault_first_ms(r);
+            checks.check(
+                "accelerometer fault on the bus before the crash",
+                t.is_some_and(|t| t < 0.0),
+                t.map_or("never reported".into(), |t| {
+                    format!("FaultAccelSensor at {t:+.0} ms rel. contact")
+                }),
+            );
+        }
+        Variant::AsIs | Variant::Dropout { .. } | Variant::Frozen { .. } => {}
+    }
+}
+
 /// The airbag plan (fire time, level) is the baseline's: a fault that is over before the
 /// threat leaves no trace in the decision.
 fn judge_same_plan(checks: &mut Checks, baseline: Option<&RunResult>, fire: Option<&TimedAction>) {
@@ -674,6 +732,7 @@ fn judge_same_plan(checks: &mut Checks, baseline: Option<&RunResult>, fire: Opti
 
 fn describe_reaction(
     case: &Case,
+    report: Option<&Report>,
     modes: &[(f64, String)],
     degraded: Option<f64>,
     recovered: Option<f64>,
@@ -694,6 +753,16 @@ fn describe_reaction(
         s.push_str("; ");
     } else if matches!(case.fault, Fault::Lut { .. }) {
         s.push_str("reference restraint from start; ");
+    }
+    if let (Fault::Variant(v), Some(r)) = (&case.fault, report) {
+        if let Some(t) = accel_fault_first_ms(r) {
+            let _ = write!(s, "accelerometer fault on the bus at {t:+.0} ms; ");
+        }
+        if let (Variant::MassMisreport { .. } | Variant::SpeedBias { .. }, Some(o)) =
+            (v, r.outcome.as_ref())
+        {
+            let _ = write!(s, "{:+.1} % vs reference; ", o.change_pct);
+        }
     }
     match fire {
         Some(a) => {

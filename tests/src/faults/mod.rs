@@ -105,6 +105,50 @@ pub enum Fault {
         /// Replays of the recorded pair.
         pairs: u32,
     },
+    /// The scenario itself is changed (a sensor that misreports, fails or goes silent; issue
+    /// 14): [`variant_scenario`] writes the variant, with the `[expect]` it must meet.
+    Variant(Variant),
+}
+
+/// What a [`Fault::Variant`] changes in the played scenario.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Variant {
+    /// The scenario as it is (a library case of its own).
+    AsIs,
+    /// The opponent truly `true_kg` (class by mass), reported as `reported_kg`.
+    MassMisreport {
+        /// True mass [kg].
+        true_kg: f64,
+        /// Reported mass [kg].
+        reported_kg: f64,
+    },
+    /// The closing speed reported with this systematic error [m/s].
+    SpeedBias {
+        /// Bias [m/s].
+        mps: f64,
+    },
+    /// The crash accelerometer silent from `before_contact_s` before the true contact on.
+    AccelDead {
+        /// Lead [s].
+        before_contact_s: f64,
+    },
+    /// The crash accelerometer stuck at its reading from `before_contact_s` before contact on.
+    AccelStuck {
+        /// Lead [s].
+        before_contact_s: f64,
+    },
+    /// The feed `target` (`object`, `vehicle`, `occupant`) silent from `from_s` to the end.
+    Dropout {
+        /// Scenario dropout target.
+        target: &'static str,
+        /// Start [scenario s].
+        from_s: f64,
+    },
+    /// The object list stuck (last sample repeated) from `from_s` to the end.
+    Frozen {
+        /// Start [scenario s].
+        from_s: f64,
+    },
 }
 
 /// One case of the campaign.
@@ -123,7 +167,7 @@ pub struct Case {
 /// The campaign: the baseline first (the replay case needs its recording).
 pub fn cases() -> Vec<Case> {
     let (from_s, to_s) = (FAULT_FROM_S, FAULT_TO_S);
-    vec![
+    let mut v = vec![
         Case {
             name: "baseline",
             scenario: CRASH_SCENARIO,
@@ -221,6 +265,132 @@ pub fn cases() -> Vec<Case> {
             fault: Fault::ReplayedFire { pairs: 32 },
             what: "the baseline run's genuine Fire command + authenticator replayed 32 times via cansend",
         },
+    ];
+    v.extend(crash_phase_cases());
+    v
+}
+
+/// Issue 14's cases: the crash with a misreported opponent or closing speed and with a dead or
+/// stuck accelerometer (the airbag fires, never worse than the reference restraint; the
+/// accelerometer fault is on the bus before the crash), and the 15 + 15 km/h bump and a slow
+/// barrier with every kind of degraded input (nothing fires).
+fn crash_phase_cases() -> Vec<Case> {
+    let v = |name, scenario, variant, what| Case {
+        name,
+        scenario,
+        fault: Fault::Variant(variant),
+        what,
+    };
+    vec![
+        v(
+            "mass-underestimated",
+            CRASH_SCENARIO,
+            Variant::MassMisreport {
+                true_kg: 2500.0,
+                reported_kg: 1300.0,
+            },
+            "opponent 2500 kg reported as 1300 kg (−1200 kg, 4 σ)",
+        ),
+        v(
+            "mass-overestimated",
+            CRASH_SCENARIO,
+            Variant::MassMisreport {
+                true_kg: 1300.0,
+                reported_kg: 2500.0,
+            },
+            "opponent 1300 kg reported as 2500 kg (+1200 kg)",
+        ),
+        v(
+            "speed-underestimated",
+            CRASH_SCENARIO,
+            Variant::SpeedBias { mps: -5.0 },
+            "closing speed reported 5 m/s too low",
+        ),
+        v(
+            "speed-overestimated",
+            CRASH_SCENARIO,
+            Variant::SpeedBias { mps: 5.0 },
+            "closing speed reported 5 m/s too high",
+        ),
+        v(
+            "accel-dead",
+            CRASH_SCENARIO,
+            Variant::AccelDead {
+                before_contact_s: 0.6,
+            },
+            "crash accelerometer silent from 0.6 s before contact",
+        ),
+        v(
+            "accel-stuck",
+            CRASH_SCENARIO,
+            Variant::AccelStuck {
+                before_contact_s: 0.6,
+            },
+            "crash accelerometer stuck at its reading from 0.6 s before contact",
+        ),
+        v(
+            "bump-objects-dead",
+            QUIET_SCENARIO,
+            Variant::Dropout {
+                target: "object",
+                from_s: 0.5,
+            },
+            "15 + 15 km/h bump, object list silent from 0.5 s",
+        ),
+        v(
+            "bump-objects-stuck",
+            QUIET_SCENARIO,
+            Variant::Frozen { from_s: 0.5 },
+            "15 + 15 km/h bump, object list stuck from 0.5 s",
+        ),
+        v(
+            "bump-vehicle-dead",
+            QUIET_SCENARIO,
+            Variant::Dropout {
+                target: "vehicle",
+                from_s: 0.5,
+            },
+            "15 + 15 km/h bump, EgoVehicleState silent from 0.5 s",
+        ),
+        v(
+            "bump-occupant-dead",
+            QUIET_SCENARIO,
+            Variant::Dropout {
+                target: "occupant",
+                from_s: 0.5,
+            },
+            "15 + 15 km/h bump, OccupantClassification silent from 0.5 s",
+        ),
+        v(
+            "bump-accel-dead",
+            QUIET_SCENARIO,
+            Variant::AccelDead {
+                before_contact_s: 0.6,
+            },
+            "15 + 15 km/h bump, crash accelerometer silent from 0.6 s before contact",
+        ),
+        Case {
+            name: "bump-e2e-burst",
+            scenario: QUIET_SCENARIO,
+            fault: Fault::Bus {
+                mode: "crc",
+                from_s: 1.2,
+                to_s: 1.55,
+            },
+            what: "15 + 15 km/h bump, a corrupted-CRC copy after every EgoVehicleState 1.2–1.55 s (over the contact at 1.5 s)",
+        },
+        Case {
+            name: "bump-lut-corrupt",
+            scenario: QUIET_SCENARIO,
+            fault: Fault::Lut { truncated: false },
+            what: "15 + 15 km/h bump, ECU started with a LUT file with one byte flipped",
+        },
+        v(
+            "slow-barrier-objects-dead",
+            "barrier-16-objects-dead",
+            Variant::AsIs,
+            "16 km/h rigid barrier, object list silent from 0.5 s",
+        ),
     ]
 }
 
@@ -621,6 +791,88 @@ pub(crate) fn frozen_scenario(src: &Path, dir: &Path, from_s: f64, to_s: f64) ->
     Ok(path)
 }
 
+/// The variant of a scenario a [`Fault::Variant`] plays, written to `dir`, with the `[expect]`
+/// it must meet: a misreported crash still fires (no worse than the reference restraint, the
+/// judge checks); a dead or stuck accelerometer is on the bus before the contact and the
+/// crash gets the reference restraint; every other variant keeps the base's expectations.
+pub fn variant_scenario(src: &Path, dir: &Path, v: Variant) -> Result<PathBuf> {
+    let base = sensor_feeds::Scenario::load(src).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let contact_s = sensor_feeds::Truth::new(&base)
+        .map_err(|e| anyhow::anyhow!("{e}"))?
+        .contact_s;
+    let text =
+        std::fs::read_to_string(src).with_context(|| format!("reading {}", src.display()))?;
+    let mut doc: toml::Table = text.parse().context("scenario TOML")?;
+    let table = |doc: &mut toml::Table, name: &str| -> Result<toml::Table> {
+        match doc.remove(name) {
+            Some(toml::Value::Table(t)) => Ok(t),
+            None => Ok(toml::Table::new()),
+            Some(_) => bail!("[{name}] is not a table"),
+        }
+    };
+    let mut sensor = table(&mut doc, "sensor")?;
+    let mut expect = table(&mut doc, "expect")?;
+    let window = |start_s: f64, extra: Option<(&str, &str)>| {
+        let mut w = toml::Table::new();
+        w.insert("start_s".into(), toml::Value::Float(start_s));
+        w.insert("end_s".into(), toml::Value::Float(1000.0));
+        if let Some((k, val)) = extra {
+            w.insert(k.into(), toml::Value::String(val.into()));
+        }
+        toml::Value::Array(vec![toml::Value::Table(w)])
+    };
+    let before_contact = |lead_s: f64| -> Result<f64> {
+        Ok((contact_s.context("the variant needs a contact")? - lead_s).max(0.0))
+    };
+    match v {
+        Variant::AsIs => {}
+        Variant::MassMisreport {
+            true_kg,
+            reported_kg,
+        } => {
+            let mut opp = table(&mut doc, "opponent")?;
+            opp.insert("mass_kg".into(), toml::Value::Float(true_kg));
+            opp.remove("class");
+            doc.insert("opponent".into(), toml::Value::Table(opp));
+            sensor.insert("mass_estimate_kg".into(), toml::Value::Float(reported_kg));
+        }
+        Variant::SpeedBias { mps } => {
+            sensor.insert("speed_bias_mps".into(), toml::Value::Float(mps));
+            // A bias that takes the prediction beyond the table gives no pre-crash preset.
+            expect.remove("pretensioner_before_contact");
+        }
+        Variant::AccelDead { before_contact_s } => {
+            let from = before_contact(before_contact_s)?;
+            sensor.insert("dropouts".into(), window(from, Some(("target", "accel"))));
+        }
+        Variant::AccelStuck { before_contact_s } => {
+            let from = before_contact(before_contact_s)?;
+            sensor.insert("accel_faults".into(), window(from, Some(("kind", "stuck"))));
+        }
+        Variant::Dropout { target, from_s } => {
+            sensor.insert("dropouts".into(), window(from_s, Some(("target", target))));
+            expect.insert("reference_fallback".into(), toml::Value::Boolean(true));
+        }
+        Variant::Frozen { from_s } => {
+            sensor.insert("freezes".into(), window(from_s, None));
+            expect.insert("reference_fallback".into(), toml::Value::Boolean(true));
+        }
+    }
+    if matches!(v, Variant::AccelDead { .. } | Variant::AccelStuck { .. }) {
+        expect.insert("accel_fault_before_contact".into(), toml::Value::Boolean(true));
+        expect.remove("pretensioner_before_contact");
+        if expect.get("airbag_fires") == Some(&toml::Value::Boolean(true)) {
+            expect.insert("reference_fallback".into(), toml::Value::Boolean(true));
+        }
+    }
+    doc.insert("sensor".into(), toml::Value::Table(sensor));
+    doc.insert("expect".into(), toml::Value::Table(expect));
+    std::fs::create_dir_all(dir)?;
+    let path = dir.join(src.file_name().context("scenario file name")?);
+    std::fs::write(&path, toml::to_string(&doc)?)?;
+    Ok(path)
+}
+
 /// A number from a TOML table (integers are numbers too).
 fn toml_f64(t: &toml::Table, key: &str) -> Option<f64> {
     match t.get(key)? {
@@ -635,7 +887,7 @@ fn toml_f64(t: &toml::Table, key: &str) -> Option<f64> {
 /// the same crash at `extra_s` later. In the QEMU TCG guest a restarted feed is back ≈ 1.2 s
 /// after its restart (measured; emulated CPUs), so it needs this head room to be back before
 /// the pre-crash phase.
-pub(crate) fn lengthened_scenario(src: &Path, dir: &Path, extra_s: f64) -> Result<PathBuf> {
+pub fn lengthened_scenario(src: &Path, dir: &Path, extra_s: f64) -> Result<PathBuf> {
     let text =
         std::fs::read_to_string(src).with_context(|| format!("reading {}", src.display()))?;
     let mut doc: toml::Table = text.parse().context("scenario TOML")?;
@@ -757,6 +1009,9 @@ fn run_case(
             ecu_args.push("--lut".to_owned());
             ecu_args.push(lut.display().to_string());
         }
+        Fault::Variant(v) => {
+            scenario = variant_scenario(&scenario, &out.join("scenario"), *v)?;
+        }
         Fault::ForgedFire { pairs } => frames = forged_frames(&cfg.bin_dir, *pairs)?,
         Fault::ReplayedFire { pairs } => {
             let base = baseline.context("the replay case needs the baseline's recording")?;
@@ -855,6 +1110,59 @@ mod tests {
         assert_eq!(s.duration_s, orig.duration_s);
         assert!(!s.sensor.frozen(0.39) && s.sensor.frozen(0.4) && !s.sensor.frozen(0.7));
         assert!(!orig.sensor.frozen(0.5));
+    }
+
+    #[test]
+    fn scenario_variants_change_what_they_say_and_expect_what_they_must() {
+        let d = tmp("variants");
+        let src = crate::repo_root().join("scenarios/taurus-48-48-abs.toml");
+        let load = |v| {
+            let p = variant_scenario(&src, &d, v).expect("variant");
+            sensor_feeds::Scenario::load(&p).expect("variant parses and validates")
+        };
+        let s = load(Variant::MassMisreport {
+            true_kg: 2500.0,
+            reported_kg: 1300.0,
+        });
+        assert_eq!(s.opponent.mass_kg, Some(2500.0));
+        // Class by mass: 2500 kg is class 6 ([2500, …) kg).
+        assert_eq!(s.opponent_class().map(|c| c.number()), Some(6));
+        assert_eq!(s.sensor.mass_estimate_kg, Some(1300.0));
+        assert_eq!(s.expect.airbag_fires, Some(true));
+        let contact = sensor_feeds::Truth::new(&s).unwrap().contact_s.unwrap();
+        let s = load(Variant::AccelDead {
+            before_contact_s: 0.6,
+        });
+        assert!(s.sensor.dropped(
+            sensor_feeds::scenario::DropoutTarget::Accel,
+            contact - 0.59
+        ));
+        assert!(!s.sensor.dropped(
+            sensor_feeds::scenario::DropoutTarget::Accel,
+            contact - 0.61
+        ));
+        assert_eq!(s.expect.accel_fault_before_contact, Some(true));
+        assert_eq!(s.expect.reference_fallback, Some(true));
+        let s = load(Variant::AccelStuck {
+            before_contact_s: 0.6,
+        });
+        assert!(s.sensor.accel_fault(contact).is_some());
+        let s = load(Variant::SpeedBias { mps: -5.0 });
+        assert_eq!(s.sensor.speed_bias_mps, -5.0);
+        let quiet = crate::repo_root().join("scenarios/low-speed-no-fire.toml");
+        let p = variant_scenario(
+            &quiet,
+            &d,
+            Variant::Dropout {
+                target: "vehicle",
+                from_s: 0.5,
+            },
+        )
+        .unwrap();
+        let s = sensor_feeds::Scenario::load(&p).unwrap();
+        assert!(s.sensor.dropped(sensor_feeds::scenario::DropoutTarget::Vehicle, 1.0));
+        assert_eq!(s.expect.airbag_fires, Some(false));
+        assert_eq!(s.expect.reference_fallback, Some(true));
     }
 
     #[test]
