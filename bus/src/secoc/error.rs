@@ -78,8 +78,22 @@ impl core::fmt::Display for SecOcError {
 #[cfg(feature = "std")]
 impl std::error::Error for SecOcError {}
 
-/// [`SecOcError`] without details, for counting.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+/// [`SecOcError`] without details, for counting. `COUNT`, `VARIANTS` (index order) and the
+/// report names (`name`) are derived (strum).
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    strum::EnumCount,
+    strum::VariantArray,
+    strum::IntoStaticStr,
+)]
+#[strum(serialize_all = "snake_case")]
 #[repr(u8)]
 pub enum SecOcReject {
     /// [`SecOcError::WrongDlc`] / [`SecOcError::WrongId`]
@@ -97,28 +111,10 @@ pub enum SecOcReject {
 }
 
 impl SecOcReject {
-    /// Number of reasons.
-    pub const COUNT: usize = 6;
-    /// All reasons in index order.
-    pub const ALL: [SecOcReject; Self::COUNT] = [
-        Self::Malformed,
-        Self::NoPendingCommand,
-        Self::Stale,
-        Self::Replay,
-        Self::FreshnessStale,
-        Self::MacMismatch,
-    ];
-    /// Stable short name for reports.
+    /// Stable short name for reports (`mac_mismatch`, …).
     #[must_use]
-    pub const fn name(self) -> &'static str {
-        match self {
-            Self::Malformed => "malformed",
-            Self::NoPendingCommand => "no_pending_command",
-            Self::Stale => "stale",
-            Self::Replay => "replay",
-            Self::FreshnessStale => "freshness_stale",
-            Self::MacMismatch => "mac_mismatch",
-        }
+    pub fn name(self) -> &'static str {
+        self.into()
     }
 }
 

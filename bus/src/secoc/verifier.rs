@@ -3,6 +3,8 @@
 use aes::Aes128;
 use cmac::Cmac;
 
+use strum::EnumCount;
+
 use super::mac::{auth_fields, mac40_ok, payload8};
 use super::{
     SecOcError, SecOcKey, SecOcReject, SecOcStream, FRESHNESS_TX_MASK, FRESHNESS_TX_SPAN,
