@@ -3,10 +3,11 @@
 #
 #   ./demo.sh [--scenario FILE] [--out DIR]
 #
-# Installs what it needs (tests/setup-host.sh: can-utils, user-mode-linux, a Python venv with
-# cantools), builds the bench, then runs `hil-bench` (candump + actuator-stubs + ecu +
-# sensor-feeds) for the scenario — on the host if its kernel has vcan, otherwise inside a
-# user-mode-Linux guest (vcan-setup.sh says which) — and decodes the CAN log with the DBC.
+# Installs what it needs (tests/setup-host.sh: can-utils, a Python venv with cantools, the vcan
+# route), builds the bench, then runs `hil-bench` (candump + actuator-stubs + ecu +
+# sensor-feeds) for the scenario — on the host if its kernel has vcan, otherwise inside a QEMU
+# guest with a real Debian kernel (vcan-setup.sh says which route) — and decodes the CAN log
+# with the DBC.
 # Default scenario: the paper's Taurus vs Taurus 48 + 48 km/h ABS case.
 set -euo pipefail
 cd "$(dirname "$0")"

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite, from a fresh Debian/Ubuntu machine with Rust:
 #   installs what it needs, checks formatting and lints, runs every test (those that need
-#   vcan run inside a user-mode-Linux guest when this kernel has no SocketCAN; a small
+#   vcan run inside a QEMU guest with a real Debian kernel when this kernel has no SocketCAN; a small
 #   characteristic diagram is built end to end), fuzzes every decoder and parser briefly,
 #   and checks the deterministic instruction-count budget of the worst-case ECU cycle.
 # Wall-clock budgets are a separate command (README, "Timing"): this VM is too noisy

@@ -1,49 +1,72 @@
-#!/bin/sh
-# vcan-setup.sh — bring up the bench's virtual CAN interface, or fall back to user-mode Linux.
+#!/usr/bin/env bash
+# vcan-setup.sh — where the bench finds vcan: the host's own kernel, or a QEMU guest running
+# a real Debian kernel (PREEMPT_RT flavour) with vcan up.
 #
-#   ./vcan-setup.sh [--iface NAME]                 set up vcan (idempotent); report the mode
-#   ./vcan-setup.sh [--iface NAME] --check         exit 0 if host vcan works, 3 if UML is needed,
-#                                                  4 if neither is available (no install attempted)
-#   ./vcan-setup.sh [--iface NAME] --uml -- CMD…   run CMD inside a UML guest with NAME up
-#   ./vcan-setup.sh [--iface NAME] --run -- CMD…   run CMD on the host if host vcan works,
-#                                                  otherwise inside UML (tests and demo use this)
+#   ./vcan-setup.sh [--iface NAME]                  set up (idempotent): host vcan, else prepare the guest; name the route
+#   ./vcan-setup.sh [--iface NAME] --check          print the route; exit 0 host, 3 guest, 4 none (reason on stderr)
+#   ./vcan-setup.sh [--iface NAME] --run -- CMD…    run CMD where vcan is: on the host, else inside the guest
+#   ./vcan-setup.sh [--iface NAME] --guest -- CMD…  always inside the guest (tests of the guest route)
 #
-# Environment: VCAN (interface name, default vcan0), VCAN_UML_MEM (guest RAM, default 1024M),
-# VCAN_PASS_ENV (extra variable names to pass into the guest), VCAN_NO_INSTALL=1 (never apt-get).
+# Routes (printed as route=…, and given to the command as $VCAN_ROUTE):
+#   host      the host kernel has SocketCAN: vcan is created here. Real timing.
+#   qemu-kvm  no SocketCAN here; QEMU with KVM runs Debian's kernel: real kernel, real timers.
+#   qemu-tcg  no SocketCAN and no KVM that can run a stock kernel (no VT-x/AMD-V, or a PVM
+#             /dev/kvm): QEMU software emulation. Kernel, vcan, iceoryx2 and the programs are
+#             real; timing is EMULATED and depends on the host's load — for function only.
+# No route is ever skipped silently: if none works the script says why and how to fix it (exit 4).
 #
-# Why UML: many kernels have no SocketCAN at all (CONFIG_CAN off: this project's CI machines,
-# WSL2, many containers). A user-mode Linux kernel (Debian package `user-mode-linux`) has the
-# vcan module; it mounts the host's / as its root (hostfs), so host-built binaries run unchanged.
-# Inside the guest /tmp and /dev/shm are fresh tmpfs (host paths under /tmp that matter — the
-# checkout, the working directory, the command's directory, CARGO_TARGET_DIR — are mounted back). Timing measured inside UML is meaningless (syscalls are
-# emulated): use it for function, not for latency.
-set -eu
+# The guest sees the host's / read-only (virtio-9p), so host-built binaries run unchanged; the
+# working directory, this checkout, $CARGO_TARGET_DIR and $VCAN_GUEST_RW (colon-separated) are
+# shared read-write at the same paths; /tmp, /run and /dev/shm are fresh tmpfs. The command
+# starts in the working directory with the caller's exported environment plus VCAN, VCAN_ROUTE,
+# VCAN_GUEST=1, VCAN_GUEST_KERNEL, VCAN_HOST_LOADAVG (the host's 1-min load at the start) and
+# VCAN_GUEST_SCHED (QEMU's scheduling);
+# its stdout and stderr come back separately, its exit status is ours.
+# Nothing is installed into /boot or /lib/modules: the kernel and busybox .debs (and QEMU's, when
+# qemu-system-x86 cannot be installed) are unpacked once into the cache (≈ 150 MB).
+#
+# Environment: VCAN (interface, default vcan0); VCAN_NO_INSTALL=1 (never apt-get);
+#   VCAN_GUEST_CACHE (default /var/tmp/vcan-guest), VCAN_GUEST_ACCEL (auto|kvm|tcg, default auto),
+#   VCAN_GUEST_FLAVOUR (rt|std, default rt), VCAN_GUEST_CPUS (2), VCAN_GUEST_MEM (MiB, 1024),
+#   VCAN_GUEST_TIMEOUT (s for the whole run, 3600), VCAN_GUEST_BOOT_TIMEOUT (s until the command
+#   runs under KVM, 60; a KVM guest that misses it falls back to TCG), VCAN_GUEST_RW,
+#   VCAN_GUEST_RT_PRIO (QEMU's SCHED_RR priority where permitted, default 5; 0 = normal),
+#   VCAN_GUEST_VERBOSE=1 (boot timing, keep the run directory).
+set -euo pipefail
 
 IFACE=${VCAN:-vcan0}
 MODE=setup
-UML_MEM=${VCAN_UML_MEM:-1024M}
+CACHE=${VCAN_GUEST_CACHE:-/var/tmp/vcan-guest}
+FLAVOUR=${VCAN_GUEST_FLAVOUR:-rt}
+CPUS=${VCAN_GUEST_CPUS:-2}
+MEM=${VCAN_GUEST_MEM:-1024}
+TIMEOUT=${VCAN_GUEST_TIMEOUT:-3600}
+# Bump when the guest's init below changes: the cached initramfs is rebuilt.
+INIT_REV=3
 
-usage() { sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,30p' "$0" | sed 's/^# \{0,1\}//'; }
 
 while [ $# -gt 0 ]; do
   case "$1" in
     --iface) [ $# -ge 2 ] || { usage >&2; exit 2; }; IFACE=$2; shift 2 ;;
     --iface=*) IFACE=${1#--iface=}; shift ;;
     --check) MODE=check; shift ;;
-    --uml) MODE=uml; shift ;;
-    --run) MODE=run; shift ;;
+    --run|run) MODE=run; shift ;;
+    --guest) MODE=guest; shift ;;
     setup) MODE=setup; shift ;;
-    run) MODE=run; shift ;;
     -h|--help) usage; exit 0 ;;
     --) shift; break ;;
     *) break ;;
   esac
 done
 case "$MODE" in
-  uml|run) [ $# -ge 1 ] || { echo "vcan-setup: --$MODE needs a command after --" >&2; exit 2; } ;;
+  run|guest) [ $# -ge 1 ] || { echo "vcan-setup: --$MODE needs a command after --" >&2; exit 2; } ;;
 esac
 
 say() { echo "vcan-setup: $*" >&2; }
+verbose() { [ "${VCAN_GUEST_VERBOSE:-0}" = 1 ] && say "$@" || true; }
+# No route: the reason and the fix, exit 4.
+no_route() { say "ERROR: no vcan route: $*"; exit 4; }
 
 as_root() {
   if [ "$(id -u)" -eq 0 ]; then "$@"
@@ -51,29 +74,27 @@ as_root() {
   else return 1; fi
 }
 
-# install_pkgs CMD:PKG ... — apt-get install only the packages whose command is missing.
+apt_updated=0
+apt_update() { [ $apt_updated = 1 ] || { as_root apt-get update -qq >/dev/null 2>&1 || true; apt_updated=1; }; }
+
+# install_pkgs CMD:PKG … — apt-get install the packages whose command is missing (never removes any).
 install_pkgs() {
-  missing=""
+  local missing=() pair
   for pair in "$@"; do
-    cmd=${pair%%:*}; pkg=${pair#*:}
-    command -v "$cmd" >/dev/null 2>&1 || missing="$missing $pkg"
+    command -v "${pair%%:*}" >/dev/null 2>&1 || missing+=("${pair#*:}")
   done
-  [ -n "$missing" ] || return 0
-  if [ "${VCAN_NO_INSTALL:-0}" = 1 ]; then
-    say "missing:$missing (VCAN_NO_INSTALL=1, not installing)"; return 1
-  fi
-  command -v apt-get >/dev/null 2>&1 || { say "missing:$missing and no apt-get: install them by hand"; return 1; }
-  say "installing:$missing"
-  # apt-get update only if the package is unknown to the cache.
-  # shellcheck disable=SC2086
-  if ! as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -q $missing >/dev/null 2>&1; then
-    as_root apt-get update -q >/dev/null 2>&1 || true
-    # shellcheck disable=SC2086
-    as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -q $missing >/dev/null || return 1
+  [ ${#missing[@]} -gt 0 ] || return 0
+  if [ "${VCAN_NO_INSTALL:-0}" = 1 ]; then say "missing: ${missing[*]} (VCAN_NO_INSTALL=1, not installing)"; return 1; fi
+  command -v apt-get >/dev/null 2>&1 || { say "missing: ${missing[*]} and no apt-get: install them by hand"; return 1; }
+  say "installing: ${missing[*]}"
+  if ! as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends --no-remove "${missing[@]}" >/dev/null 2>&1; then
+    apt_update
+    as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends --no-remove "${missing[@]}" >/dev/null || return 1
   fi
 }
 
-# Host vcan: 0 if IFACE exists as a CAN link and is up (creating it if we can).
+# ------------------------------------------------------------------------------ host route
+# host_vcan create|nocreate — 0 if IFACE is an up CAN link here (creating it if allowed).
 host_vcan() {
   command -v ip >/dev/null 2>&1 || return 1
   if ip link show "$IFACE" >/dev/null 2>&1; then
@@ -95,106 +116,370 @@ kernel_reason() {
   fi
 }
 
-uml_ready() { command -v linux.uml >/dev/null 2>&1 && [ -d /usr/lib/uml/modules ]; }
-
-ensure_uml() {
-  uml_ready || install_pkgs linux.uml:user-mode-linux || true
-  uml_ready || { say "user-mode Linux is not available (apt-get install user-mode-linux)"; return 1; }
+# ------------------------------------------------------------------------------ guest route
+# The acceleration: kvm where /dev/kvm can run a stock kernel, else tcg. Sets ACCEL and ACCEL_WHY.
+# A KVM that failed to boot the guest on this host boot is remembered (kvm-failed.<boot id>).
+choose_accel() {
+  local want=${VCAN_GUEST_ACCEL:-auto} boot_id
+  boot_id=$(cat /proc/sys/kernel/random/boot_id 2>/dev/null || echo unknown)
+  case "$want" in
+    kvm) ACCEL=kvm; ACCEL_WHY="VCAN_GUEST_ACCEL=kvm"; return ;;
+    tcg) ACCEL=tcg; ACCEL_WHY="VCAN_GUEST_ACCEL=tcg"; return ;;
+    auto) ;;
+    *) say "VCAN_GUEST_ACCEL must be auto, kvm or tcg"; exit 2 ;;
+  esac
+  ACCEL=tcg
+  if [ ! -e /dev/kvm ]; then ACCEL_WHY="no /dev/kvm"
+  elif [ ! -r /dev/kvm ] || [ ! -w /dev/kvm ]; then ACCEL_WHY="/dev/kvm is not read-writable by $(id -un)"
+  elif ! grep -qwE 'vmx|svm' /proc/cpuinfo; then
+    # PVM ("pagetable-based virtual machine", module kvm_pvm) offers /dev/kvm inside cloud VMs
+    # without VT-x/AMD-V but runs only kernels built as PVM guests, not Debian's.
+    if [ -d /sys/module/kvm_pvm ]; then ACCEL_WHY="/dev/kvm is PVM (kvm_pvm), which cannot run a stock kernel"
+    else ACCEL_WHY="the CPU offers no VT-x/AMD-V"; fi
+  elif [ -f "$CACHE/kvm-failed.$boot_id" ]; then ACCEL_WHY="KVM failed to boot the guest earlier on this host boot"
+  else ACCEL=kvm; ACCEL_WHY="/dev/kvm with hardware virtualisation"; fi
 }
 
-# run_uml CMD ARGS… — run inside a UML guest with IFACE up; exit code propagated.
-run_uml() {
-  ensure_uml || exit 4
-  work=$(mktemp -d "${TMPDIR:-/tmp}/vcan-uml.XXXXXX")
-  # Host directories under /tmp the guest must see again (its /tmp is a fresh tmpfs): this
-  # script's checkout, the working directory, the command's own directory, the cargo target.
-  repo_dir=$(cd "$(dirname "$0")" && pwd)
-  cmd_dir=$(cd "$(dirname "$1")" 2>/dev/null && pwd || true)
-  trap 'rm -rf "$work"' EXIT INT TERM
-  printf '%s\n' "$@" > "$work/argv"
-  # Environment for the guest: the kernel's init starts with an empty one.
-  : > "$work/env"
-  names="PATH HOME USER LANG LC_ALL TERM CARGO_TARGET_DIR CARGO_HOME RUSTUP_HOME RUST_LOG RUST_BACKTRACE RUST_TEST_THREADS RUST_MIN_STACK PYENV_ROOT PYENV_VERSION PYTHONPATH PYTHONHOME VIRTUAL_ENV NO_COLOR ${VCAN_PASS_ENV:-}"
-  names="$names $(env | sed -n 's/^\(BENCH_[A-Za-z0-9_]*\)=.*/\1/p; s/^\(VCAN_[A-Za-z0-9_]*\)=.*/\1/p' | tr '\n' ' ')"
-  for n in $names; do
-    eval "isset=\${$n+x}"
-    [ -n "$isset" ] || continue
-    eval "val=\$$n"
-    printf "export %s='%s'\n" "$n" "$(printf '%s' "$val" | sed "s/'/'\\\\''/g")" >> "$work/env"
-  done
-  printf "export VCAN='%s'\nexport VCAN_IN_UML=1\n" "$IFACE" >> "$work/env"
-  cat > "$work/init" <<EOF
-#!/bin/sh
-export PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin
-mount -t proc proc /proc; mount -t sysfs sys /sys
-mount -t tmpfs tmpfs /tmp; mkdir -p /dev/shm; mount -t tmpfs tmpfs /dev/shm
-# the fresh /tmp hides host paths under it: mount back the ones we need
-for d in "$work" "$repo_dir" "$PWD" "$cmd_dir" "${CARGO_TARGET_DIR:-}"; do
-  case "\$d" in /tmp/*) mkdir -p "\$d"; mount -t hostfs none "\$d" -o "\$d" ;; esac
-done
-M=/usr/lib/uml/modules/\$(uname -r)/kernel
-for m in net/can/can.ko net/can/can-raw.ko net/can/can-bcm.ko drivers/net/can/dev/can-dev.ko drivers/net/can/vcan.ko; do
-  insmod \$M/\$m 2>/dev/null || true
-done
-ip link set up lo 2>/dev/null || true
-if ! { ip link add dev "$IFACE" type vcan && ip link set up "$IFACE"; }; then
-  echo "vcan-setup: guest could not create $IFACE" >&2; echo 125 > "$work/rc"; poweroff -f
-fi
-. "$work/env"
-cd "$PWD"
-set --; while IFS= read -r a; do set -- "\$@" "\$a"; done < "$work/argv"
-echo "@@VCAN-START@@"
-"\$@"; echo \$? > "$work/rc"
-echo "@@VCAN-END@@"
-poweroff -f
-EOF
-  chmod +x "$work/init"
-  # con0 = our stdout; the guest's stdin is /dev/null. The kernel's own boot chatter is
-  # filtered out, the command's output streams through as it is produced.
-  ( linux.uml mem="$UML_MEM" rootfstype=hostfs rootflags=/ rw quiet init="$work/init" \
-      con=null con0=fd:0,fd:1 </dev/null 2>&1 || true ) \
-    | sed -u 's/\r$//' | tee "$work/console" \
-    | awk '/^@@VCAN-END@@/ { on = 0; next }
-           on && !/^(random: |reboot: |Powering off)/ { print; fflush() }
-           /^@@VCAN-START@@/ { on = 1 }' || true
-  if [ ! -f "$work/rc" ]; then
-    say "the UML guest did not finish the command; its console:"
-    cat "$work/console" >&2
-    exit 1
+route_name() { echo "qemu-$ACCEL"; }
+route_words() {
+  if [ "$ACCEL" = kvm ]; then echo "QEMU/KVM guest, Debian kernel $KVER: real timers"
+  else echo "QEMU guest under software emulation (TCG), Debian kernel $KVER: timing EMULATED ($ACCEL_WHY)"; fi
+}
+
+# deb_of PKG — the package's .deb in the cache (downloaded once); prints its path.
+deb_of() {
+  local f
+  f=$(ls "$CACHE"/debs/"$1"_*.deb 2>/dev/null | head -n1 || true)
+  if [ -z "$f" ]; then
+    [ "${VCAN_NO_INSTALL:-0}" != 1 ] || { say "$1 is not cached and VCAN_NO_INSTALL=1"; return 1; }
+    mkdir -p "$CACHE/debs"
+    (cd "$CACHE/debs" && apt-get download -qq "$1" >/dev/null 2>&1) ||
+      { apt_update; (cd "$CACHE/debs" && apt-get download -qq "$1" >/dev/null 2>&1); } || return 1
+    f=$(ls "$CACHE"/debs/"$1"_*.deb | head -n1)
   fi
-  rc=$(cat "$work/rc")
+  echo "$f"
+}
+
+# QEMU: the system's qemu-system-x86_64; else apt-get (never removing a package); else the
+# .debs unpacked into the cache (e.g. a host whose qemu-utils comes from backports, where
+# qemu-system-x86 from the main archive could only be installed by removing it). Sets QEMU.
+prepare_qemu() {
+  local q="$CACHE/qemu" p f libs=() missing
+  if command -v qemu-system-x86_64 >/dev/null 2>&1; then QEMU=(qemu-system-x86_64); return 0; fi
+  if [ ! -x "$q/usr/bin/qemu-system-x86_64" ]; then
+    if install_pkgs qemu-system-x86_64:qemu-system-x86 2>/dev/null && command -v qemu-system-x86_64 >/dev/null; then
+      QEMU=(qemu-system-x86_64); return 0
+    fi
+    say "unpacking QEMU into $q (qemu-system-x86 cannot be installed here without removing packages)"
+    rm -rf "$q.tmp"; mkdir -p "$q.tmp"
+    for p in qemu-system-x86 qemu-system-common qemu-system-data seabios ipxe-qemu; do
+      f=$(deb_of "$p") || { say "cannot download $p"; return 1; }
+      dpkg-deb -x "$f" "$q.tmp"
+    done
+    # QEMU's shared libraries are ordinary packages: install those not installed yet.
+    for p in $(apt-cache depends --no-recommends --no-suggests --no-conflicts --no-breaks \
+                 --no-replaces --no-enhances qemu-system-x86 qemu-system-common 2>/dev/null |
+               awk '$1=="Depends:" && $2 !~ /^[<]/ {print $2}' | grep -vE '^(qemu-|seabios|ipxe-qemu)' | sort -u); do
+      [ "$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)" = "install ok installed" ] || libs+=("$p")
+    done
+    if [ ${#libs[@]} -gt 0 ]; then
+      apt_update
+      as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends --no-remove "${libs[@]}" >/dev/null ||
+        { say "cannot install QEMU's libraries: ${libs[*]}"; return 1; }
+    fi
+    missing=$(ldd "$q.tmp/usr/bin/qemu-system-x86_64" | grep 'not found' || true)
+    [ -z "$missing" ] || { say "QEMU libraries missing: $(echo $missing)"; return 1; }
+    rm -rf "$q"; mv "$q.tmp" "$q"
+  fi
+  QEMU=("$q/usr/bin/qemu-system-x86_64" -L "$q/usr/share/qemu" -L "$q/usr/share/seabios" -L "$q/usr/lib/ipxe/qemu")
+}
+
+# The kernel and its initramfs, built once into $CACHE/<kernel version>/. The kernel version is
+# pinned on first use (delete the cache to move on). Sets K and KVER.
+prepare_kernel() {
+  local meta kpkg
+  case "$FLAVOUR" in rt) meta=linux-image-rt-amd64 ;; std) meta=linux-image-amd64 ;;
+    *) say "VCAN_GUEST_FLAVOUR must be rt or std"; exit 2 ;; esac
+  kpkg=$(cat "$CACHE/$meta.pin" 2>/dev/null || true)
+  if [ -z "$kpkg" ]; then
+    resolve() { apt-cache depends "$meta" 2>/dev/null | awk '$1=="Depends:" && $2 ~ /^linux-image-[0-9]/ {print $2; exit}'; }
+    kpkg=$(resolve)
+    [ -n "$kpkg" ] || { apt_update; kpkg=$(resolve); }
+    [ -n "$kpkg" ] || { say "apt knows no $meta (the guest needs Debian's kernel packages in the apt sources)"; return 1; }
+    echo "$kpkg" > "$CACHE/$meta.pin"
+  fi
+  KVER=${kpkg#linux-image-}
+  K="$CACHE/$KVER"
+  [ -f "$K/initrd.gz" ] && [ "$(cat "$K/rev" 2>/dev/null)" = "$INIT_REV" ] && return 0
+
+  say "preparing the guest kernel $KVER and its initramfs in $K (once per machine)"
+  local t="$K.tmp" moddir= d f
+  rm -rf "$t"; mkdir -p "$t/x" "$t/ir/bin" "$t/ir/proc" "$t/ir/sys" "$t/ir/dev"
+  f=$(deb_of "$kpkg") || { say "cannot download $kpkg"; return 1; }
+  dpkg-deb -x "$f" "$t/x"
+  cp "$t/x/boot/vmlinuz-$KVER" "$t/vmlinuz"
+  for d in "$t/x/lib/modules/$KVER" "$t/x/usr/lib/modules/$KVER"; do [ -d "$d" ] && moddir=$d && break; done
+  [ -n "$moddir" ] || { say "no modules in $kpkg"; return 1; }
+  f=$(deb_of busybox-static) || { say "cannot download busybox-static"; return 1; }
+  dpkg-deb -x "$f" "$t/bb"
+  cp "$t/bb/bin/busybox" "$t/ir/bin/busybox"
+
+  # The modules the guest loads, with their dependencies (each module's modinfo), in load
+  # order. A module built into the kernel is not found and simply skipped.
+  local order=()
+  add_mod() {
+    local name=$1 file dep m dec
+    for m in "${order[@]}"; do [ "$m" = "$name" ] && return 0; done
+    file=$(find "$moddir" \( -name "$name.ko*" -o -name "${name//_/-}.ko*" -o -name "${name//-/_}.ko*" \) | head -n1 || true)
+    [ -n "$file" ] || return 0
+    case "$file" in *.ko.xz) dec=(xz -dc) ;; *.ko.zst) dec=(zstd -dqc) ;; *.ko.gz) dec=(gzip -dc) ;; *) dec=(cat) ;; esac
+    "${dec[@]}" "$file" > "$t/ir/$name.ko" || { say "cannot unpack $file"; return 1; }
+    for dep in $(tr '\0' '\n' < "$t/ir/$name.ko" | sed -n 's/^depends=//p' | tr ',' ' '); do add_mod "$dep"; done
+    order+=("$name")
+  }
+  for m in virtio_pci 9pnet_virtio 9p virtio_console can can-raw can-bcm can-gw can-isotp vcan vxcan; do add_mod "$m"; done
+  printf '%s\n' "${order[@]}" > "$t/ir/modules"
+
+  # /init (busybox sh): modules, the shares, vcan, then the command chrooted into the host's
+  # root with stdout on hvc0 and stderr on hvc1; its exit status goes back through /ctl.
+  cat > "$t/ir/init" <<'INIT'
+#!/bin/busybox sh
+/bin/busybox --install -s /bin
+export PATH=/bin
+mount -t proc proc /proc; mount -t sysfs sys /sys; mount -t devtmpfs dev /dev
+while read -r m; do insmod /$m.ko 2>/dev/null || echo "insmod $m failed"; done < /modules
+mkdir -p /ctl /newroot
+mount -t 9p -o trans=virtio,version=9p2000.L,cache=none ctl /ctl || { echo "ctl mount failed"; poweroff -f; }
+. /ctl/config
+O="trans=virtio,version=9p2000.L,msize=262144"
+mount -t 9p -o "$O,ro,cache=loose" hostroot /newroot || { echo "root mount failed"; poweroff -f; }
+R=/newroot
+mount -t proc proc $R/proc; mount -t sysfs sys $R/sys; mount -t devtmpfs dev $R/dev
+mkdir -p $R/dev/shm $R/dev/pts $R/dev/mqueue
+mount -t tmpfs -o mode=1777 shm $R/dev/shm
+mount -t devpts -o mode=620,ptmxmode=666 devpts $R/dev/pts
+mount -t mqueue mqueue $R/dev/mqueue 2>/dev/null
+mount -t tmpfs -o mode=1777 tmp $R/tmp
+mount -t tmpfs -o mode=755 run $R/run
+mkdir -p $R/run/vcan-guest $R/run/lock
+mount -o bind /ctl $R/run/vcan-guest
+i=0
+for d in $SHARES; do
+  mkdir -p "$R$d" 2>/dev/null
+  mount -t 9p -o "$O,rw,cache=mmap" "rw$i" "$R$d" || echo "mount of $d failed"
+  i=$((i + 1))
+done
+hostname vcan-guest
+chroot $R /bin/sh -c "export PATH=/usr/sbin:/usr/bin:/sbin:/bin
+  ip link set lo up; ip link add dev $IFACE type vcan && ip link set $IFACE up" || echo "$IFACE setup failed"
+# stdout and stderr on two virtio consoles, raw (no \n -> \r\n); fds 3 and 4 stay open
+# because a console resets its settings on last close
+exec 3<>/dev/hvc0 4<>/dev/hvc1
+stty -opost <&3 2>/dev/null; stty -opost <&4 2>/dev/null
+cut -d' ' -f1 /proc/uptime > /ctl/booted
+chroot $R /bin/bash /run/vcan-guest/stage2 </dev/null >&3 2>&4
+echo $? > /ctl/rc
+sync
+poweroff -f
+INIT
+  chmod +x "$t/ir/init"
+  (cd "$t/ir" && find . | "$t/ir/bin/busybox" cpio -o -H newc 2>/dev/null | gzip -1) > "$t/initrd.gz"
+  echo "$INIT_REV" > "$t/rev"
+  rm -rf "$t/x" "$t/bb" "$t/ir" "$CACHE"/debs/"$kpkg"_*.deb
+  rm -rf "$K"; mv "$t" "$K"
+}
+
+# What the guest needs on the host, and the cached kernel and QEMU (under a lock: one
+# preparation at a time per cache).
+prepare_guest() {
+  [ "$(uname -m)" = x86_64 ] || no_route "$(kernel_reason), and the QEMU guest route supports x86-64 hosts only"
+  command -v apt-get >/dev/null 2>&1 ||
+    no_route "$(kernel_reason), and the QEMU guest route needs apt (Debian/Ubuntu) to fetch its kernel and QEMU"
+  mkdir -p "$CACHE" 2>/dev/null && [ -w "$CACHE" ] ||
+    no_route "cannot create the guest's cache $CACHE (set VCAN_GUEST_CACHE to a writable folder with ≈ 200 MB)"
+  install_pkgs ip:iproute2 candump:can-utils cyclictest:rt-tests xz:xz-utils zstd:zstd flock:util-linux ||
+    no_route "cannot install the packages the guest needs (run as root, or with sudo)"
+  exec 9>"$CACHE/.lock"
+  flock 9
+  prepare_qemu || no_route "QEMU is not available (apt-get install qemu-system-x86)"
+  prepare_kernel || no_route "the guest kernel could not be prepared (see above)"
+  flock -u 9
+}
+
+# The host directories the guest gets read-write: the working directory, this checkout,
+# $CARGO_TARGET_DIR and $VCAN_GUEST_RW, without nesting duplicates. Sets SHARES.
+shares() {
+  local cand=() d e keep out=()
+  cand+=("$(pwd -P)" "$(cd "$(dirname "$0")" && pwd -P)")
+  [ -n "${CARGO_TARGET_DIR:-}" ] && [ -d "$CARGO_TARGET_DIR" ] && cand+=("$(cd "$CARGO_TARGET_DIR" && pwd -P)")
+  local IFS=:
+  for d in ${VCAN_GUEST_RW:-}; do [ -d "$d" ] && cand+=("$(cd "$d" && pwd -P)"); done
+  unset IFS
+  for d in "${cand[@]}"; do
+    [ "$d" != / ] || continue
+    case "$d" in *[[:space:]]*) say "warning: cannot share $d (whitespace in the path)"; continue ;; esac
+    keep=1
+    for e in "${cand[@]}"; do
+      [ "$e" != / ] && [ "$e" != "$d" ] && case "$d/" in "$e"/*) keep=0 ;; esac
+    done
+    for e in "${out[@]}"; do [ "$e" = "$d" ] && keep=0; done
+    [ $keep = 1 ] && out+=("$d")
+  done
+  SHARES=("${out[@]}")
+}
+
+# QEMU's threads run at SCHED_RR (priority VCAN_GUEST_RT_PRIO, default 5; 0 = off) where that is
+# permitted, as the device under test on a bench would: the emulated CPUs then run whenever
+# they are runnable instead of queueing behind the host's other work. Measured under TCG with
+# two niced cargo builds beside it (load ≈ 6.5): cyclictest in the guest max 50.6 ms at normal
+# priority, 13.9 ms at nice -10, 9.4 ms at SCHED_RR 5 (a quiet host: 9.6 ms), and the demo's
+# ECU went from 575 to 91 overruns. The kernel's RT throttling keeps 5 % of each CPU for the
+# rest. Sets QEMU_SCHED (the command prefix) and QEMU_SCHED_WORDS.
+qemu_sched() {
+  local prio=${VCAN_GUEST_RT_PRIO:-5}
+  QEMU_SCHED=(); QEMU_SCHED_WORDS="normal priority"
+  if [ "$prio" = 0 ]; then QEMU_SCHED_WORDS="normal priority (VCAN_GUEST_RT_PRIO=0)"
+  elif chrt -r "$prio" true 2>/dev/null; then QEMU_SCHED=(chrt -r "$prio"); QEMU_SCHED_WORDS="SCHED_RR $prio"
+  else say "note: QEMU runs at normal priority (SCHED_RR not permitted): the guest's timing then follows the host's load"
+  fi
+}
+
+# run_guest CMD ARGS… — CMD inside the guest with IFACE up; exit status propagated.
+run_guest() {
+  shares
+  local opid epid t0 t1 acc fs i
+  # global: the EXIT trap reads them after this function returned
+  qpid=
+  run=$(mktemp -d "${TMPDIR:-/tmp}/vcan-guest.XXXXXX")
+  cleanup() {
+    [ -n "$qpid" ] && kill "$qpid" 2>/dev/null || true
+    if [ "${VCAN_GUEST_VERBOSE:-0}" = 1 ]; then say "run directory kept: $run"; else rm -rf "$run"; fi
+  }
+  trap cleanup EXIT
+  trap 'exit 130' INT TERM
+  { printf 'IFACE=%q\n' "$IFACE"; printf 'SHARES=%q\n' "${SHARES[*]}"; } > "$run/config"
+  # The caller's exported variables (minus those that describe this shell), then ours.
+  declare -px | grep -vE '^declare -[a-zA-Z-]* (PWD|OLDPWD|SHLVL|_|HOSTNAME)(=|$)' > "$run/env" || true
+  # the host's load when the guest starts and QEMU's scheduling: emulated timing depends on
+  # them, so reports name them
+  qemu_sched
+  printf 'export VCAN=%q VCAN_ROUTE=%q VCAN_GUEST=1 VCAN_GUEST_KERNEL=%q VCAN_HOST_LOADAVG=%q VCAN_GUEST_SCHED=%q\n' \
+    "$IFACE" "$(route_name)" "$KVER" "$(cut -d' ' -f1 /proc/loadavg)" "$QEMU_SCHED_WORDS" >> "$run/env"
+  {
+    echo 'source /run/vcan-guest/env'
+    echo '[ -z "${TMPDIR:-}" ] || [ -d "$TMPDIR" ] || unset TMPDIR'
+    # the host's root is read-only in the guest: caches (fontconfig for the plots) go to /tmp
+    echo 'mkdir -p /tmp/.cache && export XDG_CACHE_HOME=/tmp/.cache'
+    printf 'cd -- %q || exit 125\n' "$(pwd -P)"
+    printf 'exec'; printf ' %q' "$@"; echo
+  } > "$run/stage2"
+
+  if [ "$ACCEL" = kvm ]; then acc=(-accel kvm -cpu host); else acc=(-accel tcg -cpu max); fi
+  # passthrough keeps the host's owners and modes (root); without root QEMU cannot chown
+  if [ "$(id -u)" -eq 0 ]; then fs=security_model=passthrough,multidevs=remap; else fs=security_model=none,multidevs=remap; fi
+  local rw=()
+  for i in "${!SHARES[@]}"; do
+    rw+=(-fsdev "local,id=rw$i,path=${SHARES[$i]},$fs" -device "virtio-9p-pci,fsdev=rw$i,mount_tag=rw$i")
+  done
+  # The command's stdout and stderr arrive through FIFOs that cat copies to ours.
+  mkfifo "$run/out" "$run/err"
+  cat "$run/out" & opid=$!
+  cat "$run/err" >&2 & epid=$!
+  local boot_timeout=${VCAN_GUEST_BOOT_TIMEOUT:-60}
+  [ "$ACCEL" = tcg ] && boot_timeout=${VCAN_GUEST_BOOT_TIMEOUT_TCG:-240}
+  t0=$(date +%s.%N)
+  "${QEMU_SCHED[@]}" "${QEMU[@]}" "${acc[@]}" -m "$MEM" -smp "$CPUS" \
+    -nodefaults -no-user-config -display none -no-reboot -nic none \
+    -kernel "$K/vmlinuz" -initrd "$K/initrd.gz" \
+    -append "console=ttyS0 loglevel=4 panic=-1 ${VCAN_GUEST_APPEND:-}" \
+    -serial "file:$run/console.log" \
+    -fsdev "local,id=root,path=/,readonly=on,$fs" -device virtio-9p-pci,fsdev=root,mount_tag=hostroot \
+    "${rw[@]}" \
+    -fsdev "local,id=ctl,path=$run,$fs" -device virtio-9p-pci,fsdev=ctl,mount_tag=ctl \
+    -device virtio-serial-pci \
+    -chardev "file,id=out,path=$run/out" -device virtconsole,chardev=out \
+    -chardev "file,id=err,path=$run/err" -device virtconsole,chardev=err \
+    </dev/null >"$run/qemu.out" 2>"$run/qemu.err" &
+  qpid=$!
+
+  console() { say "guest console (tail):"; tail -n 30 "$run/console.log" >&2 2>/dev/null || true
+              tail -n 5 "$run/qemu.err" >&2 2>/dev/null || true; }
+  while [ ! -s "$run/booted" ]; do
+    if ! kill -0 "$qpid" 2>/dev/null; then
+      wait "$qpid" 2>/dev/null || true; qpid=
+      console
+      [ "$ACCEL" = kvm ] && return 77
+      no_route "QEMU exited before the guest started the command"
+    fi
+    if (( $(date +%s) - ${t0%.*} >= boot_timeout )); then
+      console
+      [ "$ACCEL" = kvm ] && { kill "$qpid" 2>/dev/null; wait "$qpid" 2>/dev/null || true; qpid=; return 77; }
+      no_route "the guest did not boot within ${boot_timeout} s"
+    fi
+    sleep 0.05
+  done
+  t1=$(date +%s.%N)
+  verbose "$(route_name) guest $KVER: command started $(awk -v a="$t0" -v b="$t1" 'BEGIN{printf "%.2f", b-a}') s after QEMU start (guest uptime $(cat "$run/booted") s)"
+  while kill -0 "$qpid" 2>/dev/null; do
+    if (( $(date +%s) - ${t0%.*} >= TIMEOUT )); then
+      say "the guest run exceeded VCAN_GUEST_TIMEOUT=${TIMEOUT} s: stopped"; kill "$qpid"; wait "$qpid" || true; qpid=; return 124
+    fi
+    sleep 0.1
+  done
+  wait "$qpid" 2>/dev/null || true; qpid=
+  wait "$opid" "$epid" 2>/dev/null || true
+  [ -s "$run/rc" ] || { console; say "the guest did not finish the command"; return 125; }
+  return "$(cat "$run/rc")"
+}
+
+# guest CMD… — run_guest, falling back from a KVM that cannot boot the guest to TCG.
+guest() {
+  local rc=0 why=$1; shift
+  prepare_guest
+  say "route=$(route_name): $why; running inside a $(route_words)"
+  run_guest "$@" || rc=$?
+  if [ "$rc" = 77 ]; then
+    # auto's choice is remembered for this host boot; a forced kvm is not a probe
+    [ "${VCAN_GUEST_ACCEL:-auto}" != auto ] ||
+      touch "$CACHE/kvm-failed.$(cat /proc/sys/kernel/random/boot_id 2>/dev/null || echo unknown)"
+    ACCEL=tcg; ACCEL_WHY="KVM could not boot the guest"
+    say "KVM could not boot the guest; route=$(route_name): $(route_words)"
+    rc=0; run_guest "$@" || rc=$?
+  fi
   exit "$rc"
 }
 
 case "$MODE" in
   check)
-    if host_vcan nocreate || host_vcan create; then exit 0; fi
-    uml_ready && exit 3
-    exit 4 ;;
+    if host_vcan nocreate || host_vcan create; then echo host; exit 0; fi
+    say "$(kernel_reason)"
+    choose_accel
+    prepare_guest
+    echo "$(route_name)"
+    say "route=$(route_name): $(route_words)"
+    exit 3 ;;
   setup)
-    install_pkgs candump:can-utils cansend:can-utils ip:iproute2 modprobe:kmod || say "warning: could not install CAN tools"
+    install_pkgs candump:can-utils cansend:can-utils ip:iproute2 modprobe:kmod || say "warning: could not install the CAN tools"
     if host_vcan create; then
-      say "$IFACE is up on the host kernel ($(uname -r)): mode=host"
+      say "route=host: $IFACE is up on this kernel ($(uname -r)); timing is real"
       say "watch it: candump -L $IFACE | python3 -m cantools decode bus/restraint.dbc"
       exit 0
     fi
     say "$(kernel_reason)."
-    say "FALLBACK: this kernel has no usable SocketCAN; the bench and tests will run inside a user-mode Linux (UML) guest that has $IFACE: mode=uml"
-    if ensure_uml; then
-      say "UML ready ($(command -v linux.uml)). Run a command there with:  $0 --iface $IFACE --run -- CMD [ARG...]"
-      exit 0
-    fi
-    say "ERROR: neither host vcan nor user-mode Linux is available"
-    exit 4 ;;
-  uml)
-    install_pkgs candump:can-utils ip:iproute2 || true
-    run_uml "$@" ;;
+    choose_accel
+    prepare_guest
+    say "route=$(route_name): the bench and the tests run inside a $(route_words)"
+    say "run a command there with: $0 --iface $IFACE --run -- CMD [ARG...]"
+    exit 0 ;;
+  guest)
+    choose_accel
+    guest "--guest asked for the guest" "$@" ;;
   run)
-    install_pkgs candump:can-utils ip:iproute2 || true
     if host_vcan nocreate || host_vcan create; then
-      export VCAN="$IFACE"
+      say "route=host: $IFACE on this kernel ($(uname -r)); timing is real"
+      export VCAN="$IFACE" VCAN_ROUTE=host
       exec "$@"
     fi
-    say "$(kernel_reason); running inside user-mode Linux (mode=uml)"
-    run_uml "$@" ;;
+    choose_accel
+    guest "$(kernel_reason)" "$@" ;;
 esac

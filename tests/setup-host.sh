@@ -1,14 +1,17 @@
 #!/usr/bin/env bash
 # Installs everything the bench and its test suite need on a fresh Debian/Ubuntu machine
-# with Rust: Debian packages (idempotent: only what is missing) and a Python venv with
-# cantools (fresh Debian/Ubuntu Pythons refuse system-wide pip installs, PEP 668).
+# with Rust: Debian packages (idempotent: only what is missing), a Python venv with cantools
+# (fresh Debian/Ubuntu Pythons refuse system-wide pip installs, PEP 668), and the vcan route
+# (vcan-setup.sh: the host's vcan, or the QEMU guest's kernel and QEMU, cached once per machine).
 # Prints the venv's bin directory on its last line so callers can put it on PATH.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 
-# can-utils: candump/cansend/cangen; kmod+iproute2: vcan; user-mode-linux: vcan where the
-# host kernel has no SocketCAN; rt-tests: cyclictest; valgrind: instruction-count gate.
-pkgs=(can-utils kmod iproute2 user-mode-linux rt-tests valgrind python3-venv)
+# can-utils: candump/cansend/cangen; kmod+iproute2: vcan; rt-tests: cyclictest; valgrind:
+# instruction-count gate; python3-venv: cantools; slurm-wlm + munge: the one-node Slurm
+# cluster of lut/tests/slurm.rs (tests/slurm-cluster.sh). (The QEMU guest's own needs are
+# installed by vcan-setup.sh, only where the host has no SocketCAN.)
+pkgs=(can-utils kmod iproute2 rt-tests valgrind python3-venv slurm-wlm munge)
 missing=()
 for p in "${pkgs[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -26,4 +29,7 @@ if ! "$venv/bin/python3" -c "import cantools" 2>/dev/null; then
     python3 -m venv "$venv" >&2
     "$venv/bin/pip" install -q --disable-pip-version-check "cantools>=39" >&2
 fi
+
+# The vcan route, prepared now (downloads happen here, not in the middle of a test) and named.
+"$here/vcan-setup.sh" >&2
 echo "$venv/bin"

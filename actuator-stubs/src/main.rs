@@ -52,12 +52,12 @@ struct Cli {
     secoc_keys: Option<PathBuf>,
     /// How long a held command waits for its authenticator, ms (SecOC pairing timeout; the
     /// ECU sends both in the same cycle). Longer only where the kernel stalls processes
-    /// (user-mode Linux): the bench names the value in the report.
+    /// (an emulator): the report names the value.
     #[arg(long, value_name = "MS", default_value_t = SecOcConfig::DEFAULT_PAIRING_TIMEOUT_US as f64 / 1e3)]
     secoc_pairing_timeout_ms: f64,
     /// SecOC freshness window, ms: an authenticator whose time stamp is further than this
     /// from our synchronized clock is rejected as stale (replays of earlier sessions). Wider
-    /// only where the kernel stalls processes (user-mode Linux); the bench names the value.
+    /// only where the kernel stalls processes (an emulator); the report names the value.
     #[arg(long, value_name = "MS", default_value_t = SecOcConfig::default().freshness_window_us as f64 / 1e3)]
     secoc_freshness_window_ms: f64,
     /// After the scenario is done, keep receiving until SIGTERM/SIGINT, then read what is

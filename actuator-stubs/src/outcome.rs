@@ -29,7 +29,7 @@ pub const LIMITER_LATCH_AFTER_CONTACT_S: f64 = 0.010;
 pub const NEVER_S: f64 = 100.0;
 
 /// Tolerance of the "adaptive no worse than reference" verdict on a_max + a_mean: command
-/// receive times carry scheduling jitter of a few ms (and UML's emulated timers), which moves
+/// receive times carry scheduling jitter of a few ms (more under an emulator), which moves
 /// the outcome by a few per cent even for identical settings.
 pub const NO_WORSE_TOLERANCE: f64 = 0.05;
 

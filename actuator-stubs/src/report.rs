@@ -77,10 +77,10 @@ pub struct Report {
     /// Commands that passed E2E but never got a valid authenticator (not acted on).
     #[serde(default)]
     pub secoc_commands_dropped: u64,
-    /// SecOC pairing timeout the stubs ran with [ms] (default 10; longer under user-mode Linux).
+    /// SecOC pairing timeout the stubs ran with [ms] (default 10).
     #[serde(default)]
     pub secoc_pairing_timeout_ms: f64,
-    /// SecOC freshness window the stubs ran with [ms] (default 100; wider under user-mode Linux).
+    /// SecOC freshness window the stubs ran with [ms] (default 100).
     #[serde(default)]
     pub secoc_freshness_window_ms: f64,
     /// Module actions in order.

@@ -1,5 +1,7 @@
 //! The measured work, shared by criterion benches and the callgrind binaries.
 //!
+//! Also the collision-prediction inputs ([`PredictionWorkload`]).
+//!
 //! Everything that runs per iteration here is allocation-free and panic-free (the same rules as
 //! the ECU cycle), so that what is timed is the stage and not the harness. Set-up (tables,
 //! pre-sealed frames, pulse buffers) happens once, outside the timed part.
@@ -15,6 +17,7 @@ use bus::{
     OccupantClassification, RawFrame,
 };
 use diagram::{AirbagThresholds, Axes, BuildInfo, Cell, Diagram, EgoVehicle, Header, Query};
+use physics::{CollisionInput, CombinedSpring};
 
 /// Alive counters are 4 bits: 16 pre-sealed frames per message replay as a valid stream forever.
 const COUNTER_PERIOD: usize = 16;
@@ -270,9 +273,97 @@ pub fn bench_queries(n: usize) -> Vec<Query> {
         .collect()
 }
 
+/// Collision predictions as the ECU makes them: the default ego (1785 kg, class 4) against
+/// opponents over the default table's opponent-mass and closing-speed axes (opponent class by
+/// mass), cycled so that consecutive calls see different inputs (no single-case favouritism).
+/// Shared by the `collision_*_varied` criterion benches and `icount_prediction`.
+pub struct PredictionWorkload {
+    springs: Vec<CombinedSpring>,
+    /// (spring index, opponent kg, closing m/s).
+    cases: Vec<(usize, f64, f64)>,
+}
+
+impl PredictionWorkload {
+    /// Default ego mass [kg] (the paper's Ford Taurus, class 4).
+    pub const EGO_KG: f64 = 1785.0;
+
+    /// 12 opponent masses (800–3000 kg) × 9 closing speeds (40–108 km/h) = 108 cases.
+    ///
+    /// # Panics
+    /// Never for the shipped class curves (a failure is a bench bug).
+    #[allow(clippy::missing_panics_doc)]
+    pub fn new() -> Self {
+        let ego = physics::MassClass::new(4).expect("class 4").curve();
+        let springs = (1..=6)
+            .map(|c| {
+                let opp = physics::MassClass::new(c).expect("class 1..=6").curve();
+                CombinedSpring::series(ego, Some(opp)).expect("shipped curves combine")
+            })
+            .collect();
+        let mut cases = Vec::new();
+        for m in (0..12).map(|i| 800.0 + 200.0 * f64::from(i)) {
+            let class = physics::class_for_mass_kg(m)
+                .expect("positive mass")
+                .number();
+            for kph in (0..9).map(|i| 40.0 + 8.5 * f64::from(i)) {
+                cases.push((usize::from(class - 1), m, physics::kph_to_mps(kph)));
+            }
+        }
+        PredictionWorkload { springs, cases }
+    }
+
+    /// Number of distinct cases.
+    pub fn len(&self) -> usize {
+        self.cases.len()
+    }
+
+    /// Never empty.
+    pub fn is_empty(&self) -> bool {
+        self.cases.is_empty()
+    }
+
+    /// Input of case `i` (modulo the number of cases) with the integrator step `step_s`.
+    pub fn input(&self, i: usize, step_s: f64) -> CollisionInput<'_> {
+        let (c, m, v) = self.cases[i % self.cases.len()];
+        CollisionInput {
+            step_s,
+            ..CollisionInput::with_defaults(&self.springs[c], Self::EGO_KG, m, v)
+        }
+    }
+}
+
+impl Default for PredictionWorkload {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn prediction_workload_spans_the_default_axes_with_valid_inputs() {
+        let w = PredictionWorkload::new();
+        assert_eq!(w.len(), 108);
+        let mut seen = std::collections::BTreeSet::new();
+        for i in 0..w.len() {
+            let input = w.input(i, 5e-4);
+            assert_eq!(input.ego_mass_kg, PredictionWorkload::EGO_KG);
+            assert!((800.0..=3000.0).contains(&input.opp_mass_kg));
+            let kph = input.closing_speed_mps * 3.6;
+            assert!((40.0 - 1e-9..=108.0 + 1e-9).contains(&kph), "{kph}");
+            let s = physics::predict_summary(&input).expect("valid prediction input");
+            assert!(s.vehicle.a_mean_mps2 > 0.0);
+            seen.insert((input.opp_mass_kg as u32, (kph * 10.0).round() as u32));
+        }
+        assert_eq!(seen.len(), 108, "cases are distinct");
+        // Cycled: case 108 is case 0 again.
+        assert_eq!(
+            w.input(108, 5e-4).closing_speed_mps,
+            w.input(0, 5e-4).closing_speed_mps
+        );
+    }
 
     #[test]
     fn input_frames_decode_to_what_was_sealed_for_many_cycles() {

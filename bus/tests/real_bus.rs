@@ -2,8 +2,8 @@
 //! decodes the same physical values (and an independent CRC check); frames that cantools encodes
 //! and `cansend` writes are decoded by our receive path.
 //!
-//! On a host without SocketCAN the visible test re-runs the `#[ignore]`d worker inside a
-//! user-mode Linux guest through `vcan-setup.sh --run`; with neither host vcan nor UML it FAILS.
+//! On a host without SocketCAN the visible test re-runs the `#[ignore]`d worker inside the
+//! QEMU guest of `vcan-setup.sh --run`; with no route it FAILS (never skipped).
 
 #[path = "support/vcan_rerun.rs"]
 mod vcan_rerun;
@@ -13,11 +13,11 @@ use std::time::{Duration, Instant, SystemTime};
 
 use bus::socket::BusSocket;
 use bus::{encode_values, message_info, signal_values, signals_of, E2eChecker, RawFrame, MESSAGES};
-use vcan_rerun::{iface, repo_root, run_here_or_in_uml};
+use vcan_rerun::{iface, repo_root, run_here_or_in_guest};
 
 #[test]
 fn real_bus_candump_cantools_cansend() {
-    run_here_or_in_uml("inner_real_bus_worker", real_bus_worker_body);
+    run_here_or_in_guest("inner_real_bus_worker", real_bus_worker_body);
 }
 
 #[test]

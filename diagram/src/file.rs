@@ -38,6 +38,9 @@ pub const PREAMBLE_LEN: usize = 20;
 /// Value of the `"format"` field of the JSON export.
 pub const JSON_FORMAT_NAME: &str = "restraint-characteristic-diagram";
 
+/// What [`FileProblem::BadMagic`] names for a diagram file.
+const DIAGRAM_FILE_KIND: &str = "restraint characteristic diagram";
+
 const CRC32C: Crc<u32> = Crc::<u32>::new(&CRC_32_ISCSI);
 
 /// A problem with a diagram file, naming the file.
@@ -66,10 +69,12 @@ pub enum FileProblem {
         need: usize,
     },
     /// Wrong magic number.
-    #[error("bad magic {found:02x?}: not a restraint characteristic diagram file")]
+    #[error("bad magic {found:02x?}: not a {kind} file")]
     BadMagic {
         /// The first 8 bytes.
         found: [u8; 8],
+        /// What kind of file was expected.
+        kind: &'static str,
     },
     /// Unknown format version.
     #[error("unsupported format version {found} (this build reads version {supported})")]
@@ -150,9 +155,9 @@ fn payload_of(data: &DiagramData) -> Vec<u8> {
     postcard::to_allocvec(data).unwrap_or_default()
 }
 
-fn preamble(version: u16, payload_len: u32) -> [u8; 16] {
+fn preamble(magic: &[u8; 8], version: u16, payload_len: u32) -> [u8; 16] {
     let mut p = [0u8; 16];
-    p[..8].copy_from_slice(&MAGIC);
+    p[..8].copy_from_slice(magic);
     p[8..10].copy_from_slice(&version.to_le_bytes());
     p[10..12].copy_from_slice(&0u16.to_le_bytes());
     p[12..16].copy_from_slice(&payload_len.to_le_bytes());
@@ -166,59 +171,44 @@ fn crc_of(pre: &[u8], payload: &[u8]) -> u32 {
     d.finalize()
 }
 
-/// Encode with an explicit version, WITHOUT validating (tests craft broken files with it).
-fn encode_with_version(data: &DiagramData, version: u16) -> Vec<u8> {
-    let payload = payload_of(data);
+/// Wrap `payload` in the checksummed envelope of the module docs (magic, version, length,
+/// CRC-32C). Shared with other files of the toolchain (the LUT builder's shard files) so that
+/// every file it writes detects truncation and corruption the same way.
+pub fn frame(magic: &[u8; 8], version: u16, payload: &[u8]) -> Vec<u8> {
     let len = u32::try_from(payload.len()).unwrap_or(u32::MAX);
-    let pre = preamble(version, len);
-    let crc = crc_of(&pre, &payload);
+    let pre = preamble(magic, version, len);
+    let crc = crc_of(&pre, payload);
     let mut out = Vec::with_capacity(PREAMBLE_LEN + payload.len());
     out.extend_from_slice(&pre);
     out.extend_from_slice(&crc.to_le_bytes());
-    out.extend_from_slice(&payload);
+    out.extend_from_slice(payload);
     out
 }
 
-pub(crate) fn checksum_of(data: &DiagramData) -> u32 {
-    let payload = payload_of(data);
-    let len = u32::try_from(payload.len()).unwrap_or(u32::MAX);
-    crc_of(&preamble(FORMAT_VERSION, len), &payload)
-}
-
-fn read_u16(b: &[u8], at: usize) -> u16 {
-    let mut a = [0u8; 2];
-    if let Some(s) = b.get(at..at + 2) {
-        a.copy_from_slice(s);
-    }
-    u16::from_le_bytes(a)
-}
-
-fn read_u32(b: &[u8], at: usize) -> u32 {
-    let mut a = [0u8; 4];
-    if let Some(s) = b.get(at..at + 4) {
-        a.copy_from_slice(s);
-    }
-    u32::from_le_bytes(a)
-}
-
-/// Decode the envelope and payload without validating the content.
-fn decode_unvalidated(bytes: &[u8]) -> Result<DiagramData, FileProblem> {
+/// Check the envelope written by [`frame`] (magic, version, reserved field, length, CRC-32C)
+/// and return the payload. `kind` names the expected file kind in the bad-magic error.
+pub fn unframe<'a>(
+    magic: &[u8; 8],
+    kind: &'static str,
+    version: u16,
+    bytes: &'a [u8],
+) -> Result<&'a [u8], FileProblem> {
     if bytes.len() < PREAMBLE_LEN {
         return Err(FileProblem::TruncatedPreamble {
             len: bytes.len(),
             need: PREAMBLE_LEN,
         });
     }
-    let mut magic = [0u8; 8];
-    magic.copy_from_slice(&bytes[..8]);
-    if magic != MAGIC {
-        return Err(FileProblem::BadMagic { found: magic });
+    let mut found = [0u8; 8];
+    found.copy_from_slice(&bytes[..8]);
+    if &found != magic {
+        return Err(FileProblem::BadMagic { found, kind });
     }
-    let version = read_u16(bytes, 8);
-    if version != FORMAT_VERSION {
+    let stored_version = read_u16(bytes, 8);
+    if stored_version != version {
         return Err(FileProblem::UnsupportedVersion {
-            found: version,
-            supported: FORMAT_VERSION,
+            found: stored_version,
+            supported: version,
         });
     }
     let reserved = read_u16(bytes, 10);
@@ -244,6 +234,39 @@ fn decode_unvalidated(bytes: &[u8]) -> Result<DiagramData, FileProblem> {
     if computed != stored {
         return Err(FileProblem::ChecksumMismatch { stored, computed });
     }
+    Ok(payload)
+}
+
+/// Encode with an explicit version, WITHOUT validating (tests craft broken files with it).
+fn encode_with_version(data: &DiagramData, version: u16) -> Vec<u8> {
+    frame(&MAGIC, version, &payload_of(data))
+}
+
+pub(crate) fn checksum_of(data: &DiagramData) -> u32 {
+    let payload = payload_of(data);
+    let len = u32::try_from(payload.len()).unwrap_or(u32::MAX);
+    crc_of(&preamble(&MAGIC, FORMAT_VERSION, len), &payload)
+}
+
+fn read_u16(b: &[u8], at: usize) -> u16 {
+    let mut a = [0u8; 2];
+    if let Some(s) = b.get(at..at + 2) {
+        a.copy_from_slice(s);
+    }
+    u16::from_le_bytes(a)
+}
+
+fn read_u32(b: &[u8], at: usize) -> u32 {
+    let mut a = [0u8; 4];
+    if let Some(s) = b.get(at..at + 4) {
+        a.copy_from_slice(s);
+    }
+    u32::from_le_bytes(a)
+}
+
+/// Decode the envelope and payload without validating the content.
+fn decode_unvalidated(bytes: &[u8]) -> Result<DiagramData, FileProblem> {
+    let payload = unframe(&MAGIC, DIAGRAM_FILE_KIND, FORMAT_VERSION, bytes)?;
     let (data, rest) = postcard::take_from_bytes::<DiagramData>(payload)
         .map_err(|e| FileProblem::Decode(e.to_string()))?;
     if !rest.is_empty() {
@@ -427,12 +450,22 @@ impl Diagram {
     }
 }
 
-fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), LoadError> {
+/// Write `bytes` to `path` atomically: a temporary file beside it, flushed to disk, then
+/// renamed over `path`, so a reader (or a crash) sees the old file or the new one, never a
+/// partial one.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), LoadError> {
     let name = path.display().to_string();
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(format!(".tmp{}", std::process::id()));
     let tmp = std::path::PathBuf::from(tmp);
-    fs::write(&tmp, bytes).map_err(|e| err(&name, e))?;
+    let written = fs::File::create(&tmp).and_then(|mut f| {
+        std::io::Write::write_all(&mut f, bytes)?;
+        f.sync_all()
+    });
+    if let Err(e) = written {
+        let _ = fs::remove_file(&tmp);
+        return Err(err(&name, e));
+    }
     fs::rename(&tmp, path).map_err(|e| {
         let _ = fs::remove_file(&tmp);
         err(&name, e)

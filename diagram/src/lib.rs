@@ -32,7 +32,10 @@ pub use validate::{limits, Problem};
 pub use view::{DiagramView, Lookup};
 
 #[cfg(feature = "std")]
-pub use file::{FileProblem, LoadError, FORMAT_VERSION, JSON_FORMAT_NAME, MAGIC, PREAMBLE_LEN};
+pub use file::{
+    frame, unframe, write_atomically, FileProblem, LoadError, FORMAT_VERSION, JSON_FORMAT_NAME,
+    MAGIC, PREAMBLE_LEN,
+};
 #[cfg(feature = "std")]
 pub use owned::{
     lut_id_of, Axes, BuildInfo, Diagram, DiagramData, EgoVehicle, GridPoint, Header,

@@ -4,8 +4,8 @@
 //! AirbagStageCmd and EcuStatus frames appear in candump's log, the pre-crash preset reaches
 //! the bus (CmdSource Adaptive, the LUT's pretensioner time), the heartbeat carries the LUT id.
 //!
-//! On a host without SocketCAN the visible test re-runs the `#[ignore]`d worker inside a
-//! user-mode Linux guest through `vcan-setup.sh --run`; with neither it FAILS (never skipped).
+//! On a host without SocketCAN the visible test re-runs the `#[ignore]`d worker inside the
+//! QEMU guest of `vcan-setup.sh --run`; with no route it FAILS (never skipped).
 
 #[path = "../../restraint/tests/cycle_support/mod.rs"]
 mod cycle_support;
@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 use bus::codec::BeltLimiterCmdCmdSource;
 use bus::socket::BusSocket;
 use ipc::{ObjectPublisher, ObjectState, ServiceNames, VALID};
-use vcan_rerun::{iface, repo_root, run_here_or_in_uml};
+use vcan_rerun::{iface, repo_root, run_here_or_in_guest};
 
 const ECU: &str = env!("CARGO_BIN_EXE_ecu");
 
@@ -29,11 +29,11 @@ fn monotonic_ns() -> u64 {
 
 #[test]
 fn ecu_process_on_vcan_sends_e2e_valid_commands() {
-    run_here_or_in_uml("inner_vcan_worker", worker_body);
+    run_here_or_in_guest("inner_vcan_worker", worker_body);
 }
 
 #[test]
-#[ignore = "worker: run by ecu_process_on_vcan_sends_e2e_valid_commands (host vcan or UML)"]
+#[ignore = "worker: run by ecu_process_on_vcan_sends_e2e_valid_commands (host vcan or the QEMU guest)"]
 fn inner_vcan_worker() {
     worker_body();
 }

@@ -1,11 +1,14 @@
 //! `lut build | merge | verify | inspect | plot | export-json`: the characteristic diagram.
 
+use crate::cmd_slurm::SlurmArgs;
 use crate::heatmap::{self, HeatPanel};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use diagram::{AxisId, Cell, Diagram, Query};
-use lut::table::{self, Grid, Shard};
-use std::path::{Path, PathBuf};
+use lut::distributed::{Job, TableJob};
+use lut::progress::Progress;
+use lut::table::{self, Grid, GridFile};
+use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct BuildArgs {
@@ -18,12 +21,21 @@ pub struct BuildArgs {
     /// Build only shard K of N (contiguous cell ranges; combine with `lut merge`).
     #[arg(long, value_name = "K/N")]
     pub shard: Option<String>,
-    /// Worker threads (default: all cores).
+    /// Worker threads [default: SLURM_CPUS_PER_TASK inside a Slurm job, else all cores].
     #[arg(long)]
     pub threads: Option<usize>,
     /// No progress output.
     #[arg(long)]
     pub quiet: bool,
+    /// With --slurm: cells of the merged table re-optimised before it is written (like
+    /// `lut verify --cells`).
+    #[arg(long, default_value_t = 8)]
+    pub verify_cells: usize,
+    /// With --slurm: seed of that check.
+    #[arg(long, default_value_t = 1)]
+    pub verify_seed: u64,
+    #[command(flatten)]
+    pub slurm: SlurmArgs,
 }
 
 fn parse_shard(s: &str) -> Result<(usize, usize)> {
@@ -37,9 +49,27 @@ fn parse_shard(s: &str) -> Result<(usize, usize)> {
 }
 
 pub fn run_build(a: &BuildArgs) -> Result<()> {
+    if let Some(n) = a.slurm.slurm {
+        if a.shard.is_some() {
+            bail!("--slurm splits the grid itself; drop --shard");
+        }
+        let out = a
+            .out
+            .clone()
+            .unwrap_or_else(|| PathBuf::from("data/default.lut"));
+        let spec = GridFile::load(&a.grid)?;
+        Grid::from_spec(&a.grid.display().to_string(), spec.clone())?;
+        let job = Job::Table(TableJob {
+            grid: spec,
+            verify_cells: a.verify_cells,
+            verify_seed: a.verify_seed,
+        });
+        return a.slurm.run(n, job, &out);
+    }
     let grid = Grid::load(&a.grid)?;
     let count = grid.axes.cell_count();
     let lens = grid.axes.lens();
+    let threads = a.threads.or_else(lut::slurm::cpus_per_task);
     match &a.shard {
         Some(spec) => {
             let (k, n) = parse_shard(spec)?;
@@ -52,8 +82,9 @@ pub fn run_build(a: &BuildArgs) -> Result<()> {
                 "building shard {k}/{n}: cells {range:?} of {count} ({lens:?}) from {}",
                 a.grid.display()
             );
-            let (shard, stats) = table::build_shard(&grid, k, n, a.threads, a.quiet)?;
-            write_atomic(&out, &shard.to_bytes()?)?;
+            let progress = Progress::new(range.len(), "optimising", "cells", a.quiet);
+            let (shard, stats) = table::build_shard(&grid, k, n, threads, &progress)?;
+            diagram::write_atomically(&out, &shard.to_bytes()?).map_err(|e| anyhow!("{e}"))?;
             report(&stats);
             eprintln!("shard written to {}", out.display());
         }
@@ -66,7 +97,7 @@ pub fn run_build(a: &BuildArgs) -> Result<()> {
                 "building {count} cells ({lens:?}) from {}",
                 a.grid.display()
             );
-            let (d, stats) = table::build_table(&grid, a.threads, a.quiet)?;
+            let (d, stats) = table::build_table(&grid, threads, a.quiet)?;
             d.save(&out).map_err(|e| anyhow!("{e}"))?;
             report(&stats);
             let bottoming = d.cells().iter().filter(|c| c.is_bottoming_out()).count();
@@ -88,12 +119,6 @@ fn report(s: &table::BuildStats) {
     );
 }
 
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, bytes).with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("renaming to {}", path.display()))
-}
-
 #[derive(Args, Debug)]
 pub struct MergeArgs {
     /// Shard files (any order).
@@ -110,10 +135,11 @@ pub fn run_merge(a: &MergeArgs) -> Result<()> {
         .iter()
         .map(|p| {
             let bytes = std::fs::read(p).with_context(|| format!("reading {}", p.display()))?;
-            Shard::from_bytes(&p.display().to_string(), &bytes)
+            let origin = p.display().to_string();
+            Ok((origin.clone(), table::read_shard(&origin, &bytes)?))
         })
         .collect::<Result<Vec<_>>>()?;
-    let d = table::merge_shards(&shards)?;
+    let d = table::merge_shards(&shards, None)?;
     d.save(&a.out).map_err(|e| anyhow!("{e}"))?;
     eprintln!(
         "merged {} shards into {} (LUT id 0x{:04x})",

@@ -7,10 +7,21 @@
 //! * [`optimise`] — particle swarm + Nelder–Mead over the four restraint variables, penalty
 //!   method for the no-bottoming-out constraint.
 //! * [`table`] — grid files, cell optimisation, build / shard / merge / verify.
+//! * [`shard`] — shard files a distributed run can trust (identity, range, checksum).
+//! * [`progress`] — progress bar / lines / progress file of long computations.
+//! * [`slurm`] — the Slurm client tools (sbatch, squeue, scontrol, scancel).
+//! * [`distributed`] — a computation split into N shards run as a Slurm job array plus a
+//!   dependent collect job: submit, watch, resume, status, collect.
+//! * [`robustness`] — the Monte-Carlo study of the pre-crash estimate's errors.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod distributed;
 pub mod optimise;
+pub mod progress;
 pub mod reference;
+pub mod robustness;
 pub mod scenario;
+pub mod shard;
+pub mod slurm;
 pub mod table;

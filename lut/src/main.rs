@@ -4,7 +4,9 @@
 //! and a module with `run(args)`.
 
 mod cmd_optim;
+mod cmd_robustness;
 mod cmd_simulate;
+mod cmd_slurm;
 mod cmd_stiffness;
 mod cmd_table;
 mod heatmap;
@@ -51,10 +53,24 @@ enum Command {
     Plot(cmd_table::PlotArgs),
     /// Export a table as JSON.
     ExportJson(cmd_table::ExportArgs),
+    /// Distributed runs (`--slurm N` of build / study robustness): status, collect, cancel.
+    #[command(subcommand)]
+    Slurm(cmd_slurm::SlurmCommand),
 }
 
 fn main() -> anyhow::Result<()> {
-    match Cli::parse().command {
+    let cli = Cli::parse();
+    // Inside a Slurm job without cgroups every core of the node is visible: size rayon's
+    // global pool (verify, studies) from the CPUs the job asked for.
+    if let (Some(n), None) = (
+        lut::slurm::cpus_per_task(),
+        std::env::var_os("RAYON_NUM_THREADS"),
+    ) {
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global();
+    }
+    match cli.command {
         Command::Simulate(args) => cmd_simulate::run(&args),
         Command::Study(cmd) => study::run(&cmd),
         Command::Stiffness(cmd) => cmd_stiffness::run(&cmd),
@@ -66,5 +82,6 @@ fn main() -> anyhow::Result<()> {
         Command::Inspect(args) => cmd_table::run_inspect(&args),
         Command::Plot(args) => cmd_table::run_plot(&args),
         Command::ExportJson(args) => cmd_table::run_export(&args),
+        Command::Slurm(cmd) => cmd_slurm::run(&cmd),
     }
 }

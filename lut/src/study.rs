@@ -19,6 +19,9 @@ pub enum StudyCommand {
     OpponentMass(crate::study_occ::OpponentMassArgs),
     /// Closing speed × occupant mass: reference restraint vs adaptive optimum, reductions in %.
     Reduction(crate::study_occ::ReductionArgs),
+    /// Monte-Carlo: the pre-crash estimate's errors (payload, speed, distance) → spread of the
+    /// occupant's outcome in one cell; locally or as a Slurm job array (--slurm N).
+    Robustness(crate::cmd_robustness::RobustnessArgs),
 }
 
 #[derive(Args, Debug)]
@@ -36,6 +39,7 @@ pub fn run(cmd: &StudyCommand) -> Result<()> {
         StudyCommand::Stiffness(args) => stiffness_study(args),
         StudyCommand::OpponentMass(args) => crate::study_occ::opponent_mass(args),
         StudyCommand::Reduction(args) => crate::study_occ::reduction(args),
+        StudyCommand::Robustness(args) => crate::cmd_robustness::run(args),
     }
 }
 

@@ -6,10 +6,12 @@
 //! or sharding, and `lut merge` of shards equals a full build.
 
 use crate::optimise::{self, Case, OptimiserConfig, SearchSpace};
+use crate::progress::Progress;
 use crate::scenario::{Ego, Opponent, Pulse};
+pub use crate::shard::shard_range;
+use crate::shard::{self, Payload, ShardFile, ShardHeader};
 use anyhow::{anyhow, bail, Context, Result};
 use diagram::{AirbagThresholds, Axes, BuildInfo, Cell, Diagram, EgoVehicle, GridPoint, Header};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use physics::{
     defaults, mps2_to_g, MassClass, OccupantInput, OccupantOutcome, RestraintHardware,
     RestraintSettings,
@@ -17,11 +19,9 @@ use physics::{
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::io::IsTerminal;
 use std::ops::Range;
 use std::path::Path;
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 /// Grid file schema (TOML), see data/default-grid.toml.
@@ -34,6 +34,15 @@ pub struct GridFile {
     pub optimiser: OptimiserSpec,
     /// Axis points.
     pub axes: AxesSpec,
+}
+
+impl GridFile {
+    /// Read a grid file (not validated: see [`Grid::from_spec`]).
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        toml::from_str(&text).with_context(|| format!("{}: invalid grid file", path.display()))
+    }
 }
 
 /// `[ego]` of a grid file.
@@ -102,6 +111,11 @@ impl Grid {
     pub fn parse(origin: &str, text: &str) -> Result<Self> {
         let f: GridFile =
             toml::from_str(text).with_context(|| format!("{origin}: invalid grid file"))?;
+        Self::from_spec(origin, f)
+    }
+
+    /// Validate a parsed grid file; `origin` names the source in errors.
+    pub fn from_spec(origin: &str, f: GridFile) -> Result<Self> {
         let class = MassClass::new(f.ego.class).map_err(|e| anyhow!("{origin}: ego.class: {e}"))?;
         if !(f.ego.mass_kg.is_finite() && f.ego.mass_kg > 100.0) {
             bail!("{origin}: ego.mass_kg must be a finite mass > 100 kg");
@@ -142,9 +156,7 @@ impl Grid {
     /// Read a grid file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read {}", path.display()))?;
-        Self::parse(&path.display().to_string(), &text)
+        Self::from_spec(&path.display().to_string(), GridFile::load(path)?)
     }
 
     /// The header a build of this grid writes. Contains no time stamp, host or thread count,
@@ -348,16 +360,6 @@ pub fn optimise_cell(grid: &Grid, index: usize) -> Result<CellResult> {
     optimise_point(grid, &p, &grid.cell_config(index))
 }
 
-/// Contiguous index range of shard `k` of `n` (1-based k) over `count` cells.
-pub fn shard_range(count: usize, k: usize, n: usize) -> Result<Range<usize>> {
-    if n == 0 || k == 0 || k > n {
-        bail!("shard {k}/{n}: need 1 ≤ K ≤ N");
-    }
-    let start = count * (k - 1) / n;
-    let end = count * k / n;
-    Ok(start..end)
-}
-
 /// Statistics of a build.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct BuildStats {
@@ -369,88 +371,13 @@ pub struct BuildStats {
     pub wall: Duration,
 }
 
-/// Progress reporting: an indicatif bar with ETA on a terminal, plain periodic lines otherwise
-/// (batch schedulers capture stderr into files; a bar would be invisible there).
-pub struct Progress {
-    bar: ProgressBar,
-    tty: bool,
-    total: usize,
-    done: AtomicUsize,
-    start: Instant,
-    last_line: Mutex<Instant>,
-    every: Duration,
-    quiet: bool,
-}
-
-impl Progress {
-    /// Progress over `total` cells; `quiet` suppresses all output (tests).
-    pub fn new(total: usize, label: &str, quiet: bool) -> Self {
-        let tty = std::io::stderr().is_terminal() && !quiet;
-        let bar = if tty {
-            let b = ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr());
-            if let Ok(style) = ProgressStyle::with_template(
-                "{msg} [{elapsed_precise}] {wide_bar} {pos}/{len} cells, ETA {eta}",
-            ) {
-                b.set_style(style);
-            }
-            b.set_message(label.to_string());
-            b
-        } else {
-            ProgressBar::hidden()
-        };
-        let now = Instant::now();
-        Progress {
-            bar,
-            tty,
-            total,
-            done: AtomicUsize::new(0),
-            start: now,
-            last_line: Mutex::new(now),
-            every: Duration::from_secs(10),
-            quiet,
-        }
-    }
-
-    /// One cell finished.
-    pub fn inc(&self) {
-        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
-        if self.tty {
-            self.bar.inc(1);
-        } else if !self.quiet {
-            let now = Instant::now();
-            let mut last = match self.last_line.lock() {
-                Ok(g) => g,
-                Err(p) => p.into_inner(),
-            };
-            if now.duration_since(*last) >= self.every || done == self.total {
-                *last = now;
-                let el = now.duration_since(self.start).as_secs_f64();
-                let eta = if done > 0 {
-                    el / done as f64 * (self.total - done) as f64
-                } else {
-                    f64::NAN
-                };
-                eprintln!(
-                    "progress: {done}/{} cells ({:.0} %), elapsed {el:.0} s, ETA {eta:.0} s",
-                    self.total,
-                    100.0 * done as f64 / self.total.max(1) as f64
-                );
-            }
-        }
-    }
-
-    /// Finish the bar.
-    pub fn finish(&self) {
-        self.bar.finish();
-    }
-}
-
-/// Optimise the cells of `range` in parallel (rayon; `threads` = None → all cores).
+/// Optimise the cells of `range` in parallel (rayon; `threads` = None → all cores), counting
+/// each finished cell on `progress`.
 pub fn build_cells(
     grid: &Grid,
     range: Range<usize>,
     threads: Option<usize>,
-    quiet: bool,
+    progress: &Progress,
 ) -> Result<(Vec<Cell>, BuildStats)> {
     let count = grid.axes.cell_count();
     if range.end > count {
@@ -463,7 +390,6 @@ pub fn build_cells(
     let pool = builder
         .build()
         .context("cannot start the rayon thread pool")?;
-    let progress = Progress::new(range.len(), "optimising", quiet);
     let sims = AtomicU64::new(0);
     let start = Instant::now();
     let cells: Result<Vec<Cell>> = pool.install(|| {
@@ -494,99 +420,105 @@ pub fn build_table(
     threads: Option<usize>,
     quiet: bool,
 ) -> Result<(Diagram, BuildStats)> {
-    let (cells, stats) = build_cells(grid, 0..grid.axes.cell_count(), threads, quiet)?;
+    let count = grid.axes.cell_count();
+    let progress = Progress::new(count, "optimising", "cells", quiet);
+    let (cells, stats) = build_cells(grid, 0..count, threads, &progress)?;
     let d = Diagram::from_cells(grid.header(), grid.axes.clone(), cells)
         .map_err(|e| anyhow!("built table is invalid: {e}"))?;
     Ok((d, stats))
 }
 
-/// Identifies shard files.
-pub const SHARD_FORMAT: &str = "restraint-lut-shard";
-/// Shard file version.
-pub const SHARD_VERSION: u16 = 1;
+/// Kind tag of table shard files.
+pub const TABLE_SHARD_KIND: &str = "table";
 
-/// A shard: a contiguous range of cells plus everything needed to check that shards belong
-/// together (header and axes must be identical).
+/// What a table shard carries besides its header: the table's header and axes (so that
+/// `lut merge` needs no grid file) and the cells of its range in row-major order.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Shard {
-    /// [`SHARD_FORMAT`].
-    pub format: String,
-    /// [`SHARD_VERSION`].
-    pub version: u16,
-    /// Shard number K (1-based) of N.
-    pub k: u32,
-    /// Shard count N.
-    pub n: u32,
-    /// First cell index.
-    pub start: u64,
+pub struct TableCells {
     /// Header of the table.
     pub header: Header,
     /// Axes of the table.
     pub axes: Axes,
-    /// Cells start.. in row-major order.
+    /// Cells start..end.
     pub cells: Vec<Cell>,
 }
 
-impl Shard {
-    /// Serialise (postcard; deterministic).
-    pub fn to_bytes(&self) -> Result<Vec<u8>> {
-        postcard::to_allocvec(self).context("encoding shard")
-    }
-    /// Deserialise and check the format tag.
-    pub fn from_bytes(origin: &str, bytes: &[u8]) -> Result<Self> {
-        let s: Shard =
-            postcard::from_bytes(bytes).with_context(|| format!("{origin}: not a shard file"))?;
-        if s.format != SHARD_FORMAT || s.version != SHARD_VERSION {
-            bail!(
-                "{origin}: shard format {:?} v{} (expected {SHARD_FORMAT:?} v{SHARD_VERSION})",
-                s.format,
-                s.version
-            );
-        }
-        Ok(s)
+impl Payload for TableCells {
+    fn item_count(&self) -> usize {
+        self.cells.len()
     }
 }
 
-/// Build shard `k` of `n`.
+/// A table shard file.
+pub type Shard = ShardFile<TableCells>;
+
+/// Identity of a table build: SHA-256 of the header (ego, seed, optimiser effort, physics
+/// defaults hash, tool version) and the axes — everything a cell's value depends on.
+pub fn table_identity(header: &Header, axes: &Axes) -> Result<String> {
+    shard::identity_of(TABLE_SHARD_KIND, &(header, axes))
+}
+
+impl Grid {
+    /// Identity of this grid's table ([`table_identity`]).
+    pub fn identity(&self) -> Result<String> {
+        table_identity(&self.header(), &self.axes)
+    }
+}
+
+/// Build shard `k` of `n`, counting cells on `progress`.
 pub fn build_shard(
     grid: &Grid,
     k: usize,
     n: usize,
     threads: Option<usize>,
-    quiet: bool,
+    progress: &Progress,
 ) -> Result<(Shard, BuildStats)> {
-    let range = shard_range(grid.axes.cell_count(), k, n)?;
-    let start = range.start as u64;
-    let (cells, stats) = build_cells(grid, range, threads, quiet)?;
-    Ok((
-        Shard {
-            format: SHARD_FORMAT.into(),
-            version: SHARD_VERSION,
-            k: k as u32,
-            n: n as u32,
-            start,
-            header: grid.header(),
-            axes: grid.axes.clone(),
-            cells,
-        },
-        stats,
-    ))
+    let count = grid.axes.cell_count();
+    let header = ShardHeader::new(TABLE_SHARD_KIND, &grid.identity()?, k, n, count)?;
+    let (cells, stats) = build_cells(grid, header.range(), threads, progress)?;
+    let payload = TableCells {
+        header: grid.header(),
+        axes: grid.axes.clone(),
+        cells,
+    };
+    Ok((ShardFile { header, payload }, stats))
 }
 
-/// Merge shards (any order) into the full table; rejects mismatched headers/axes, overlaps and
-/// gaps.
-pub fn merge_shards(shards: &[Shard]) -> Result<Diagram> {
-    let first = shards.first().ok_or_else(|| anyhow!("no shard given"))?;
-    for s in shards {
-        if s.header != first.header || s.axes != first.axes {
-            bail!("shard {}/{} was built from a different grid or build configuration than shard {}/{}", s.k, s.n, first.k, first.n);
-        }
+/// Read and check one table shard file on its own (see [`crate::shard`]); also that its
+/// identity is the hash of the header and axes it carries.
+pub fn read_shard(origin: &str, bytes: &[u8]) -> Result<Shard> {
+    let s = Shard::from_bytes(origin, TABLE_SHARD_KIND, bytes)?;
+    let id = table_identity(&s.payload.header, &s.payload.axes)?;
+    if id != s.header.identity {
+        bail!("{origin}: corrupt shard file: its header and axes do not hash to its identity");
     }
-    let cells = shards.iter().flat_map(|s| {
-        s.cells
+    if s.header.total as usize != s.payload.axes.cell_count() {
+        bail!(
+            "{origin}: {} of {} cells, but its axes have {} cells",
+            s.header.describe(),
+            s.header.total,
+            s.payload.axes.cell_count()
+        );
+    }
+    Ok(s)
+}
+
+/// Merge shards (any order; each named by its origin, e.g. the file name) into the full
+/// table. Refuses shards of another grid (`expected` identity, or the first shard's),
+/// overlapping or missing ranges, naming the files.
+pub fn merge_shards(shards: &[(String, Shard)], expected: Option<&str>) -> Result<Diagram> {
+    let heads: Vec<(&str, &ShardHeader)> = shards
+        .iter()
+        .map(|(o, s)| (o.as_str(), &s.header))
+        .collect();
+    shard::check_tiling(&heads, expected)?;
+    let first = &shards[0].1.payload;
+    let cells = shards.iter().flat_map(|(_, s)| {
+        s.payload
+            .cells
             .iter()
             .enumerate()
-            .map(move |(i, c)| (s.start as usize + i, *c))
+            .map(move |(i, c)| (s.header.start as usize + i, *c))
     });
     Diagram::from_indexed_cells(first.header.clone(), first.axes.clone(), cells)
         .map_err(|e| anyhow!("merge: {e}"))

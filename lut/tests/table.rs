@@ -2,6 +2,7 @@
 //! byte-identical → shards merged equal the full build → verify → inspect (the binary).
 
 use diagram::Diagram;
+use lut::progress::Progress;
 use lut::table::{self, Grid};
 use std::path::PathBuf;
 use std::process::Command;
@@ -29,23 +30,47 @@ fn ci_grid_end_to_end() {
 
     // Shards (merged out of order) equal the full build.
     let n = 3;
+    let quiet = Progress::new(0, "", "cells", true);
     let mut shards: Vec<_> = (1..=n)
-        .map(|k| table::build_shard(&grid, k, n, Some(1), true).unwrap().0)
+        .map(|k| table::build_shard(&grid, k, n, Some(1), &quiet).unwrap().0)
         .collect();
     shards.reverse();
     let shard_bytes: Vec<Vec<u8>> = shards.iter().map(|s| s.to_bytes().unwrap()).collect();
     let decoded: Vec<_> = shard_bytes
         .iter()
-        .map(|b| table::Shard::from_bytes("t", b).unwrap())
+        .enumerate()
+        .map(|(i, b)| (format!("s{i}"), table::read_shard("t", b).unwrap()))
         .collect();
-    let merged = table::merge_shards(&decoded).unwrap();
+    let merged = table::merge_shards(&decoded, Some(&grid.identity().unwrap())).unwrap();
     assert_eq!(
         merged.to_bytes(),
         bytes,
         "merged shards differ from the full build"
     );
     // A missing shard is an error naming the gap, not a silently smaller table.
-    assert!(table::merge_shards(&decoded[..2]).is_err());
+    let e = table::merge_shards(&decoded[..2], None)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("items 0..8 missing"), "{e}");
+    // A shard of another grid (other seed) is refused, naming the file.
+    let mut other = grid.clone();
+    other.optimiser.seed += 1;
+    let foreign = table::build_shard(&other, 1, n, Some(1), &quiet).unwrap().0;
+    let mut mixed = decoded[..2].to_vec();
+    mixed.push(("foreign.bin".into(), foreign));
+    let e = table::merge_shards(&mixed, None).unwrap_err().to_string();
+    assert!(e.starts_with("foreign.bin: shard of another grid"), "{e}");
+    // A corrupt shard file is refused, naming the file and the reason.
+    let mut bad = shard_bytes[0].clone();
+    let mid = bad.len() / 2;
+    bad[mid] ^= 1;
+    let e = table::read_shard("dir/shard-3-of-3.bin", &bad)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("dir/shard-3-of-3.bin: corrupt shard file: checksum mismatch"),
+        "{e}"
+    );
 
     // Every cell's optimum lies inside the hardware bounds and its prediction is self-consistent.
     for c in full.cells() {

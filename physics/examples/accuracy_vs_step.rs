@@ -1,12 +1,13 @@
 //! Prints the accuracy of the collision model versus the integration step (README table):
-//! (a) the Table 5 case with the combined curve against a 1 µs reference run,
+//! (a) the Table 5 case with the combined curve against the closed-form solution
+//!     (`physics::exact`),
 //! (b) a linear spring (e = 1) against the closed-form peak force v√(kμ) and duration π√(μ/k).
 //!
 //! Run: `cargo run -p physics --release --example accuracy_vs_step`
 
 use physics::{
     collision::{simulate_collision, CollisionInput, PulseBuffer},
-    stiffness, CombinedSpring,
+    predict_summary, stiffness, CombinedSpring,
 };
 
 fn main() {
@@ -19,7 +20,10 @@ fn main() {
         input.restitution = e;
         simulate_collision(&input, buf).unwrap()
     };
-    let reference = run(&spring, 1e-6, 0.1, &mut buf);
+    let reference = predict_summary(&CollisionInput::with_defaults(
+        &spring, 1785.0, 1785.0, 30.0,
+    ))
+    .unwrap();
     let k = 1.5e6;
     let linear = CombinedSpring::linear(k).unwrap();
     let mu = 1785.0 / 2.0;

@@ -104,6 +104,32 @@ pub struct CollisionSummary {
     pub samples_written: usize,
 }
 
+impl VehicleResult {
+    /// All zero (no collision).
+    pub const ZERO: VehicleResult = VehicleResult {
+        crush_m: 0.0,
+        a_max_mps2: 0.0,
+        a_mean_mps2: 0.0,
+        delta_v_mps: 0.0,
+    };
+}
+
+impl CollisionSummary {
+    /// All zero (no collision) — `Default` as a const, for statics and const constructors.
+    pub const ZERO: CollisionSummary = CollisionSummary {
+        vehicle: VehicleResult::ZERO,
+        opponent: VehicleResult::ZERO,
+        contact_duration_s: 0.0,
+        reversal_time_s: 0.0,
+        max_deflection_m: 0.0,
+        peak_force_n: 0.0,
+        unloading_stiffness_n_per_m: 0.0,
+        separation_speed_mps: 0.0,
+        absorbed_energy_j: 0.0,
+        samples_written: 0,
+    };
+}
+
 /// Caller-owned, fixed-capacity storage of both compartment pulses (structure of arrays so that
 /// each channel is a plain slice, e.g. for the occupant model or the accelerometer feed).
 #[derive(Clone, Debug)]
@@ -197,15 +223,21 @@ impl<const N: usize> PulseBuffer<N> {
         }
     }
 
+    /// Set the sampling grid of the next write: `len` samples (at most N) at `step_s`.
+    pub(crate) fn start(&mut self, step_s: f64, len: usize) {
+        self.step_s = step_s;
+        self.len = len.min(N);
+    }
+
     #[inline(always)]
-    fn write(&mut self, k: usize, s: &Sample) {
+    pub(crate) fn write(&mut self, k: usize, s: &PulseSample) {
         if k < N {
-            self.ego_accel_mps2[k] = s.ego_accel;
-            self.ego_vel_mps[k] = s.ego_vel;
-            self.ego_crush_m[k] = s.ego_crush;
-            self.opp_accel_mps2[k] = s.opp_accel;
-            self.opp_vel_mps[k] = s.opp_vel;
-            self.opp_crush_m[k] = s.opp_crush;
+            self.ego_accel_mps2[k] = s.ego_accel_mps2;
+            self.ego_vel_mps[k] = s.ego_vel_mps;
+            self.ego_crush_m[k] = s.ego_crush_m;
+            self.opp_accel_mps2[k] = s.opp_accel_mps2;
+            self.opp_vel_mps[k] = s.opp_vel_mps;
+            self.opp_crush_m[k] = s.opp_crush_m;
         }
     }
 }
@@ -246,16 +278,180 @@ impl CompartmentPulse<'_> {
     }
 }
 
-struct Sample {
-    ego_accel: f64,
-    ego_vel: f64,
-    ego_crush: f64,
-    opp_accel: f64,
-    opp_vel: f64,
-    opp_crush: f64,
+/// State of both compartments at one instant after first contact (the pulse channels of
+/// [`PulseBuffer`] at one sample; sign conventions in the module documentation).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PulseSample {
+    /// Ego compartment acceleration [m/s²] (negative = deceleration).
+    pub ego_accel_mps2: f64,
+    /// Ego velocity change since first contact [m/s] (0 → −Δv).
+    pub ego_vel_mps: f64,
+    /// Ego crush [m].
+    pub ego_crush_m: f64,
+    /// Opponent compartment acceleration [m/s²] (own axes; 0 for a barrier).
+    pub opp_accel_mps2: f64,
+    /// Opponent velocity change since first contact [m/s] (own axes).
+    pub opp_vel_mps: f64,
+    /// Opponent crush [m].
+    pub opp_crush_m: f64,
 }
 
-fn validate(input: &CollisionInput<'_>) -> Result<(), PhysicsError> {
+impl PulseSample {
+    /// At rest, no force, no crush (the state at first contact and without a collision).
+    pub const ZERO: PulseSample = PulseSample {
+        ego_accel_mps2: 0.0,
+        ego_vel_mps: 0.0,
+        ego_crush_m: 0.0,
+        opp_accel_mps2: 0.0,
+        opp_vel_mps: 0.0,
+        opp_crush_m: 0.0,
+    };
+}
+
+/// The mass terms of one collision and what follows from them alone: the reduced mass, each
+/// vehicle's share of the relative velocity change (momentum conservation), the per-vehicle
+/// pulse sample of a relative state and the summary. Shared by the integrator and the exact
+/// solution ([`crate::exact`]) so that both report the same quantities the same way.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Masses {
+    pub inv_m_ego: f64,
+    pub inv_m_opp: f64,
+    /// Reduced mass μ = m_ego m_opp / (m_ego + m_opp) [kg] (= m_ego for a barrier).
+    pub mu: f64,
+    pub inv_mu: f64,
+    pub ratio_ego: f64,
+    pub ratio_opp: f64,
+    /// Closing speed at first contact [m/s].
+    pub v0: f64,
+}
+
+/// The reversal (maximum crush) and the unloading that follows from it.
+pub(crate) struct Reversal {
+    pub t_rev: f64,
+    pub x_rev: f64,
+    pub f_rev: f64,
+    pub x_ego_rev: f64,
+}
+
+/// Linear unloading from the reversal point: y(t) = x_r − δ (1 − cos ω (t − t_rev)).
+pub(crate) struct Unloading {
+    pub delta: f64,
+    pub omega: f64,
+    pub k_u: f64,
+    pub t_sep: f64,
+    pub v_sep: f64,
+}
+
+impl Masses {
+    pub const ZERO: Masses = Masses {
+        inv_m_ego: 0.0,
+        inv_m_opp: 0.0,
+        mu: 0.0,
+        inv_mu: 0.0,
+        ratio_ego: 0.0,
+        ratio_opp: 0.0,
+        v0: 0.0,
+    };
+
+    pub fn new(input: &CollisionInput<'_>) -> Self {
+        let inv_m_ego = 1.0 / input.ego_mass_kg;
+        let inv_m_opp = if input.opp_mass_kg.is_infinite() {
+            0.0
+        } else {
+            1.0 / input.opp_mass_kg
+        };
+        let inv_mu = inv_m_ego + inv_m_opp;
+        let mu = 1.0 / inv_mu;
+        Masses {
+            inv_m_ego,
+            inv_m_opp,
+            mu,
+            inv_mu,
+            ratio_ego: mu * inv_m_ego,
+            ratio_opp: mu * inv_m_opp,
+            v0: input.closing_speed_mps,
+        }
+    }
+
+    /// Both compartments at contact force `force_n`, closing speed `closing_mps` and crushes.
+    #[inline(always)]
+    pub fn sample(&self, force_n: f64, closing_mps: f64, x_ego: f64, x_opp: f64) -> PulseSample {
+        PulseSample {
+            ego_accel_mps2: -force_n * self.inv_m_ego,
+            ego_vel_mps: -self.ratio_ego * (self.v0 - closing_mps),
+            ego_crush_m: x_ego,
+            opp_accel_mps2: -force_n * self.inv_m_opp,
+            opp_vel_mps: -self.ratio_opp * (self.v0 - closing_mps),
+            opp_crush_m: x_opp,
+        }
+    }
+
+    /// Unloading line from the reversal point, δ = μ (e v₀)² / F_r (bounded by the crush) — the
+    /// model's definition, in one place.
+    pub fn unloading(&self, restitution: f64, rev: &Reversal) -> Unloading {
+        let v_sep = restitution * self.v0;
+        if v_sep > 0.0 && rev.f_rev > 0.0 {
+            let delta = (self.mu * v_sep * v_sep / rev.f_rev).min(rev.x_rev);
+            let k_u = rev.f_rev / delta;
+            let omega = libm::sqrt(k_u * self.inv_mu);
+            Unloading {
+                delta,
+                omega,
+                k_u,
+                t_sep: rev.t_rev + core::f64::consts::FRAC_PI_2 / omega,
+                v_sep,
+            }
+        } else {
+            Unloading {
+                delta: 0.0,
+                omega: 0.0,
+                k_u: f64::INFINITY,
+                t_sep: rev.t_rev,
+                v_sep,
+            }
+        }
+    }
+
+    /// The summary of a collision from its reversal and unloading.
+    pub fn summary(&self, rev: &Reversal, unl: &Unloading, samples: usize) -> CollisionSummary {
+        let dv_rel = self.v0 + unl.v_sep;
+        let duration = unl.t_sep;
+        let vehicle_result = |inv_m: f64, ratio: f64, crush: f64| {
+            let dv = ratio * dv_rel;
+            VehicleResult {
+                crush_m: crush,
+                a_max_mps2: rev.f_rev * inv_m,
+                a_mean_mps2: if duration > 0.0 { dv / duration } else { 0.0 },
+                delta_v_mps: dv,
+            }
+        };
+        CollisionSummary {
+            vehicle: vehicle_result(self.inv_m_ego, self.ratio_ego, rev.x_ego_rev),
+            opponent: vehicle_result(self.inv_m_opp, self.ratio_opp, rev.x_rev - rev.x_ego_rev),
+            contact_duration_s: duration,
+            reversal_time_s: rev.t_rev,
+            max_deflection_m: rev.x_rev,
+            peak_force_n: rev.f_rev,
+            unloading_stiffness_n_per_m: unl.k_u,
+            separation_speed_mps: unl.v_sep,
+            absorbed_energy_j: 0.5 * self.mu * (self.v0 * self.v0 - unl.v_sep * unl.v_sep),
+            samples_written: samples,
+        }
+    }
+}
+
+/// Number of samples of the grid 0..=duration at `step_s`, bounded by the capacity.
+pub(crate) fn sample_count(duration_s: f64, step_s: f64, capacity: usize) -> usize {
+    let wanted = libm::floor(duration_s / step_s + 1.0e-9) + 1.0;
+    if wanted >= capacity as f64 {
+        capacity
+    } else {
+        wanted as usize
+    }
+}
+
+/// The physical inputs (masses, speed, restitution, spring): what the exact solution needs.
+pub(crate) fn validate_physics(input: &CollisionInput<'_>) -> Result<(), PhysicsError> {
     if !(input.ego_mass_kg.is_finite() && input.ego_mass_kg > 0.0) {
         return Err(PhysicsError::InvalidInput(
             "ego mass must be finite and > 0",
@@ -279,19 +475,24 @@ fn validate(input: &CollisionInput<'_>) -> Result<(), PhysicsError> {
             "restitution must be within 0..=1",
         ));
     }
-    if !defaults::STEP_BOUNDS_S.contains(input.step_s) {
+    if input.spring.len < 2 {
+        return Err(PhysicsError::InvalidCurve(
+            "combined spring has fewer than 2 points",
+        ));
+    }
+    Ok(())
+}
+
+/// The sampling grid (step and pulse length).
+pub(crate) fn validate_grid(step_s: f64, duration_s: f64) -> Result<(), PhysicsError> {
+    if !defaults::STEP_BOUNDS_S.contains(step_s) {
         return Err(PhysicsError::InvalidInput(
             "step must be within 1 µs..=5 ms",
         ));
     }
-    if !(input.duration_s.is_finite() && input.duration_s >= 0.0 && input.duration_s <= 10.0) {
+    if !(0.0..=10.0).contains(&duration_s) {
         return Err(PhysicsError::InvalidInput(
             "duration must be within 0..=10 s",
-        ));
-    }
-    if input.spring.len < 2 {
-        return Err(PhysicsError::InvalidCurve(
-            "combined spring has fewer than 2 points",
         ));
     }
     Ok(())
@@ -304,45 +505,20 @@ pub fn simulate_collision<const N: usize>(
     input: &CollisionInput<'_>,
     out: &mut PulseBuffer<N>,
 ) -> Result<CollisionSummary, PhysicsError> {
-    validate(input)?;
+    validate_physics(input)?;
+    validate_grid(input.step_s, input.duration_s)?;
     let spring = input.spring;
     let dt = input.step_s;
-    let inv_m_ego = 1.0 / input.ego_mass_kg;
-    let inv_m_opp = if input.opp_mass_kg.is_infinite() {
-        0.0
-    } else {
-        1.0 / input.opp_mass_kg
-    };
-    let mu = 1.0 / (inv_m_ego + inv_m_opp);
-    let inv_mu = inv_m_ego + inv_m_opp;
-    // Share of the relative velocity change that each vehicle takes (momentum conservation).
-    let ratio_ego = mu * inv_m_ego;
-    let ratio_opp = mu * inv_m_opp;
-    let v0 = input.closing_speed_mps;
-    let e = input.restitution;
+    let m = Masses::new(input);
+    let inv_mu = m.inv_mu;
+    let v0 = m.v0;
     // Samples to write: the pulse grid 0..=duration, bounded by the buffer.
-    let n_out = {
-        let wanted = libm::floor(input.duration_s / dt + 1.0e-9) + 1.0;
-        if wanted >= N as f64 {
-            N
-        } else {
-            wanted as usize
-        }
-    };
-    out.step_s = dt;
-    out.len = n_out;
+    let n_out = sample_count(input.duration_s, dt, N);
+    out.start(dt, n_out);
 
     if v0 == 0.0 {
-        let zero = Sample {
-            ego_accel: 0.0,
-            ego_vel: 0.0,
-            ego_crush: 0.0,
-            opp_accel: 0.0,
-            opp_vel: 0.0,
-            opp_crush: 0.0,
-        };
         for k in 0..n_out {
-            out.write(k, &zero);
+            out.write(k, &PulseSample::default());
         }
         return Ok(CollisionSummary {
             samples_written: n_out,
@@ -351,28 +527,20 @@ pub fn simulate_collision<const N: usize>(
     }
 
     let max_steps = libm::ceil(defaults::MAX_CONTACT_S / dt) as usize;
-    let sample = |force_n: f64, closing_mps: f64, x_ego: f64, x_opp: f64| Sample {
-        ego_accel: -force_n * inv_m_ego,
-        ego_vel: -ratio_ego * (v0 - closing_mps),
-        ego_crush: x_ego,
-        opp_accel: -force_n * inv_m_opp,
-        opp_vel: -ratio_opp * (v0 - closing_mps),
-        opp_crush: x_opp,
-    };
-    out.write(0, &sample(0.0, v0, 0.0, 0.0));
+    out.write(0, &m.sample(0.0, v0, 0.0, 0.0));
 
     // ---- loading: velocity Verlet with a segment cursor (x only grows while loading).
     let (mut x, mut u, mut f) = (0.0f64, v0, 0.0f64);
     let mut seg = 0usize;
     let mut k = 0usize;
-    let (x_new, u_new) = loop {
+    let u_new = loop {
         let u_half = u - 0.5 * f * inv_mu * dt;
         let xn = x + u_half * dt;
         seg = spring.segment_from(seg, xn);
         let fnew = spring.force_n[seg] + (xn - spring.x_m[seg]) * spring.stiffness_n_per_m[seg];
         let un = u_half - 0.5 * fnew * inv_mu * dt;
         if un <= 0.0 {
-            break (xn, un);
+            break un;
         }
         x = xn;
         u = un;
@@ -380,13 +548,12 @@ pub fn simulate_collision<const N: usize>(
         k += 1;
         if k < n_out {
             let x_ego = spring.ego_m[seg] + (x - spring.x_m[seg]) * spring.ego_share[seg];
-            out.write(k, &sample(f, u, x_ego, x - x_ego));
+            out.write(k, &m.sample(f, u, x_ego, x - x_ego));
         }
         if k >= max_steps {
             return Err(PhysicsError::ContactTooLong);
         }
     };
-    let _ = x_new;
 
     // ---- reversal inside step k → k+1: closing speed falls from u > 0 to u_new ≤ 0.
     let tau = if u - u_new > 0.0 {
@@ -394,40 +561,39 @@ pub fn simulate_collision<const N: usize>(
     } else {
         0.0
     };
-    let t_rev = k as f64 * dt + tau;
     let x_rev = x + 0.5 * u * tau;
-    let f_rev = spring.force_at_n(x_rev);
-    let x_ego_rev = spring.ego_deflection_m(x_rev);
-    let ego_frac = if x_rev > 0.0 { x_ego_rev / x_rev } else { 1.0 };
-    let v_sep = e * v0;
-    // δ = μ (e v0)² / F_r; linear unloading y(t) = x_p + δ cos(ω (t − t_rev)).
-    let (delta, omega, t_sep, k_u) = if v_sep > 0.0 && f_rev > 0.0 {
-        let delta = (mu * v_sep * v_sep / f_rev).min(x_rev);
-        let k_u = f_rev / delta;
-        let omega = libm::sqrt(k_u * inv_mu);
-        (
-            delta,
-            omega,
-            t_rev + core::f64::consts::FRAC_PI_2 / omega,
-            k_u,
-        )
-    } else {
-        (0.0, 0.0, t_rev, f64::INFINITY)
+    let rev = Reversal {
+        t_rev: k as f64 * dt + tau,
+        x_rev,
+        f_rev: spring.force_at_n(x_rev),
+        x_ego_rev: spring.ego_deflection_m(x_rev),
     };
-    let x_perm = x_rev - delta;
-    let final_sample = sample(0.0, -v_sep, ego_frac * x_perm, (1.0 - ego_frac) * x_perm);
+    let ego_frac = if x_rev > 0.0 {
+        rev.x_ego_rev / x_rev
+    } else {
+        1.0
+    };
+    // Linear unloading y(t) = x_p + δ cos(ω (t − t_rev)), in closed form.
+    let unl = m.unloading(input.restitution, &rev);
+    let x_perm = x_rev - unl.delta;
+    let final_sample = m.sample(
+        0.0,
+        -unl.v_sep,
+        ego_frac * x_perm,
+        (1.0 - ego_frac) * x_perm,
+    );
     let mut kk = k + 1;
     while kk < n_out {
         let t = kk as f64 * dt;
-        if t < t_sep && omega > 0.0 {
-            let phase = omega * (t - t_rev);
+        if t < unl.t_sep && unl.omega > 0.0 {
+            let phase = unl.omega * (t - rev.t_rev);
             let (s, c) = (libm::sin(phase), libm::cos(phase));
-            let y = x_perm + delta * c;
+            let y = x_perm + unl.delta * c;
             out.write(
                 kk,
-                &sample(
-                    f_rev * c,
-                    -delta * omega * s,
+                &m.sample(
+                    rev.f_rev * c,
+                    -unl.delta * unl.omega * s,
                     ego_frac * y,
                     (1.0 - ego_frac) * y,
                 ),
@@ -437,28 +603,5 @@ pub fn simulate_collision<const N: usize>(
         }
         kk += 1;
     }
-
-    let dv_rel = v0 + v_sep;
-    let duration = t_sep;
-    let vehicle_result = |inv_m: f64, ratio: f64, crush: f64| {
-        let dv = ratio * dv_rel;
-        VehicleResult {
-            crush_m: crush,
-            a_max_mps2: f_rev * inv_m,
-            a_mean_mps2: if duration > 0.0 { dv / duration } else { 0.0 },
-            delta_v_mps: dv,
-        }
-    };
-    Ok(CollisionSummary {
-        vehicle: vehicle_result(inv_m_ego, ratio_ego, x_ego_rev),
-        opponent: vehicle_result(inv_m_opp, ratio_opp, x_rev - x_ego_rev),
-        contact_duration_s: duration,
-        reversal_time_s: t_rev,
-        max_deflection_m: x_rev,
-        peak_force_n: f_rev,
-        unloading_stiffness_n_per_m: k_u,
-        separation_speed_mps: v_sep,
-        absorbed_energy_j: 0.5 * mu * (v0 * v0 - v_sep * v_sep),
-        samples_written: n_out,
-    })
+    Ok(m.summary(&rev, &unl, n_out))
 }

@@ -4,6 +4,8 @@
 //!   classes (generated at build time from `data/stiffness-classes.toml`).
 //! * [`collision`] — two masses joined by one combined non-linear spring with restitution-exact
 //!   unloading; writes the compartment pulses into a caller-owned fixed buffer.
+//! * [`exact`] — the same model solved in closed form segment by segment (no step size): the
+//!   cheap summary, any-instant states, sampled pulses. The integrator stays as its oracle.
 //! * [`occupant`] — one rigid occupant body with belt, airbag + column, seat friction,
 //!   bottoming-out detection, and the ideal constant-force bound a*.
 //! * [`j211`] — SAE J211 CFC filter (phaseless, in place, no allocation).
@@ -24,6 +26,7 @@ pub mod defaults;
 #[cfg(feature = "std")]
 pub mod derive;
 mod error;
+pub mod exact;
 pub mod j211;
 pub mod occupant;
 pub mod paper;
@@ -33,9 +36,10 @@ pub mod stiffness;
 
 pub use collision::{
     simulate_collision, CollisionInput, CollisionSummary, CompartmentPulse, DefaultPulseBuffer,
-    PulseBuffer, VehicleResult,
+    PulseBuffer, PulseSample, VehicleResult,
 };
 pub use error::PhysicsError;
+pub use exact::{predict_summary, simulate_collision_exact, ExactCollision};
 pub use occupant::{
     ideal_constant_force_decel_mps2, simulate_occupant, simulate_occupant_observed, OccupantInput,
     OccupantOutcome, RestraintHardware, RestraintSettings,

@@ -6,7 +6,35 @@ use physics::{
     j211, simulate_occupant, stiffness, CombinedSpring, CompartmentPulse, Curve, OccupantInput,
     RestraintHardware, RestraintSettings,
 };
+use physics::{
+    exact::{predict_summary, simulate_collision_exact, ExactCollision},
+    CollisionSummary, PulseSample,
+};
 use proptest::prelude::*;
+
+fn summary_is_finite(s: &CollisionSummary) -> bool {
+    [s.vehicle, s.opponent].iter().all(|v| {
+        [v.crush_m, v.a_max_mps2, v.a_mean_mps2, v.delta_v_mps]
+            .iter()
+            .all(|x| x.is_finite())
+    }) && s.contact_duration_s.is_finite()
+        && s.reversal_time_s.is_finite()
+        && s.max_deflection_m.is_finite()
+        && s.peak_force_n.is_finite()
+}
+
+fn sample_is_finite(p: &PulseSample) -> bool {
+    [
+        p.ego_accel_mps2,
+        p.ego_vel_mps,
+        p.ego_crush_m,
+        p.opp_accel_mps2,
+        p.opp_vel_mps,
+        p.opp_crush_m,
+    ]
+    .iter()
+    .all(|x| x.is_finite())
+}
 
 fn any_f64() -> impl Strategy<Value = f64> {
     prop_oneof![
@@ -36,6 +64,30 @@ proptest! {
         if let Ok(s) = simulate_collision(&input, &mut buf) {
             prop_assert!(s.vehicle.crush_m.is_finite() && s.vehicle.a_max_mps2.is_finite());
             prop_assert!(buf.ego_accel_mps2().iter().all(|a| a.is_finite()));
+        }
+    }
+
+    #[test]
+    fn exact_collision_never_panics(m1 in any_f64(), m2 in any_f64(), v in any_f64(), e in any_f64(),
+                                    dt in any_f64(), dur in any_f64(), t in any_f64(), class in 0usize..7) {
+        let curve = if class < 6 { &stiffness::CLASS_CURVES[class] } else { &stiffness::COMBINED_CURVE };
+        let spring = CombinedSpring::series(curve, Some(curve)).unwrap();
+        let input = CollisionInput { spring: &spring, ego_mass_kg: m1, opp_mass_kg: m2, closing_speed_mps: v,
+                                     restitution: e, step_s: dt, duration_s: dur };
+        if let Ok(s) = predict_summary(&input) {
+            prop_assert!(summary_is_finite(&s), "{s:?}");
+        }
+        let mut buf = Box::new(PulseBuffer::<256>::new());
+        if simulate_collision_exact(&input, &mut buf).is_ok() {
+            prop_assert!(buf.ego_accel_mps2().iter().chain(buf.opp_crush_m()).all(|a| a.is_finite()));
+        }
+        if let Ok(sol) = ExactCollision::solve(&input) {
+            prop_assert!(sample_is_finite(&sol.state_at(t)));
+            if let Ok(it) = sol.samples(dt) {
+                for p in it.take(64) {
+                    prop_assert!(sample_is_finite(&p));
+                }
+            }
         }
     }
 

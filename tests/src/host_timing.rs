@@ -1,9 +1,10 @@
 //! Deadline misses attributable to faults, measured where timers are real: the iceoryx2 faults
 //! of the campaign (feeds killed and restarted, stale object data, a stale service left by a
 //! killed process) run on the HOST kernel with the ECU at SCHED_FIFO 80, mlockall, pinned to
-//! one CPU. This host has no SocketCAN, so **the ECU's and the feeds' CAN side is switched off
-//! (`--no-can`)** — the report says so; the bus faults are covered functionally by the vcan
-//! campaign (in user-mode Linux, where timing is emulated).
+//! one CPU. The project's CI hosts have no SocketCAN and no KVM that runs a stock kernel, so
+//! **the ECU's and the feeds' CAN side is switched off (`--no-can`)** — the report says so; the
+//! bus faults are covered functionally by the vcan campaign (in the QEMU TCG guest there, where
+//! timing is emulated; on a host with vcan or KVM that campaign has real timers itself).
 //!
 //! A fault "costs" deadlines when its run has more overruns (or a worse wake-up tail) than the
 //! clean runs around it. The VM is noisy: the baseline runs first and last, and the report puts

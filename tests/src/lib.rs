@@ -9,7 +9,10 @@
 
 pub mod faults;
 pub mod host_timing;
+pub mod route;
 pub mod timeline;
+
+pub use route::{Allowances, Route};
 
 use actuator_stubs::report::Report;
 use anyhow::{bail, Context, Result};
@@ -40,44 +43,25 @@ pub struct RunConfig {
     pub stubs_args: Vec<String>,
 }
 
-/// SecOC pairing timeout the stubs get inside user-mode Linux, ms. There the emulated kernel
-/// stalls processes for 20–35 ms now and then, also between the ECU's command frame and its
-/// authenticator (sent in the same cycle), which made ~1 genuine command in 8 000 go stale at
-/// the 10 ms default. The security properties do not depend on it (the MAC binds the exact
-/// payload and a fresh counter); it only bounds how old a held command may be when acted on.
-pub const UML_SECOC_PAIRING_TIMEOUT_MS: f64 = 50.0;
-
-/// SecOC freshness window the stubs get inside user-mode Linux, ms (default 100): the ECU
-/// stamps an authenticator with the synchronized time of its cycle, and an emulator stall
-/// inside that cycle delays the frame. A replay of an earlier session is still far outside.
-pub const UML_SECOC_FRESHNESS_WINDOW_MS: f64 = 250.0;
-
 /// The ECU as it is meant to run: SCHED_FIFO 80 and locked memory. Without the privileges
-/// it says so on stderr and in its report (`rt`) and runs on. On the one emulated CPU of the
-/// user-mode-Linux guest this is what keeps a busy neighbour (candump writing a flooded bus
-/// to disk) from delaying the cycle, exactly as on a real bench.
+/// it says so on stderr and in its report (`rt`) and runs on. In the guest (PREEMPT_RT kernel)
+/// as on a real bench, this is what keeps a busy neighbour (candump writing a flooded bus to
+/// disk) from delaying the cycle.
 pub fn default_ecu_args() -> Vec<String> {
     ["--sched-fifo", "80", "--mlockall"]
         .map(str::to_owned)
         .to_vec()
 }
 
-/// True inside the user-mode-Linux guest of `vcan-setup.sh --run` (it sets `VCAN_IN_UML`).
-pub fn in_uml_guest() -> bool {
-    std::env::var_os("VCAN_IN_UML").is_some()
-}
+/// A fire command may arrive this much after its planned time: crash confirmation needs a few
+/// accelerometer samples (≈ 5.5 ms after contact), plus the ECU cycle and the CAN hop.
+pub const FIRE_LATE_ALLOWANCE_MS: f64 = 15.0;
 
-/// The stubs' bench arguments: receive until stopped after the ECU (so every command it sent
-/// is received and counted), and the user-mode-Linux pairing timeout where it applies.
+/// The stubs' bench arguments: receive until stopped after the ECU, so every command it sent
+/// is received and counted. The SecOC windows are the defaults on every route (10 ms pairing,
+/// 100 ms freshness): the QEMU guest's real kernel delivers in time (see [`route`]).
 pub fn default_stubs_args() -> Vec<String> {
-    let mut v = vec!["--until-signal".to_owned()];
-    if in_uml_guest() {
-        v.push("--secoc-pairing-timeout-ms".to_owned());
-        v.push(format!("{UML_SECOC_PAIRING_TIMEOUT_MS}"));
-        v.push("--secoc-freshness-window-ms".to_owned());
-        v.push(format!("{UML_SECOC_FRESHNESS_WINDOW_MS}"));
-    }
-    v
+    vec!["--until-signal".to_owned()]
 }
 
 /// What a run needs to know to disturb it (fault campaign).
@@ -210,27 +194,27 @@ pub mod harness {
         });
     }
 
-    /// How these tests reach vcan, checked once: `false` = the host kernel has it, `true` =
-    /// inside user-mode Linux. With neither the test PANICS: these tests are never skipped.
-    pub fn vcan_in_uml() -> bool {
-        static IN_UML: OnceLock<bool> = OnceLock::new();
-        *IN_UML.get_or_init(|| {
-            let check = Command::new(super::repo_root().join("vcan-setup.sh"))
+    /// The route these tests reach vcan by (`vcan-setup.sh --check`), checked once: the host
+    /// kernel, or a QEMU guest (KVM or TCG). With none the test PANICS with the script's reason:
+    /// these tests are never skipped.
+    pub fn vcan_route() -> super::Route {
+        static ROUTE: OnceLock<super::Route> = OnceLock::new();
+        *ROUTE.get_or_init(|| {
+            let o = Command::new(super::repo_root().join("vcan-setup.sh"))
                 .arg("--check")
-                .status()
+                .stderr(std::process::Stdio::piped())
+                .output()
                 .expect("vcan-setup.sh --check");
-            match check.code() {
-                Some(0) => {
-                    eprintln!("e2e: host vcan");
-                    false
+            let printed = String::from_utf8_lossy(&o.stdout);
+            match (o.status.code(), super::Route::parse(&printed)) {
+                (Some(0 | 3), Some(r)) => {
+                    eprintln!("e2e: vcan route {}: {}", r.name(), r.describe());
+                    r
                 }
-                Some(3) => {
-                    eprintln!("e2e: no SocketCAN in this kernel — running inside user-mode Linux");
-                    true
-                }
-                other => panic!(
-                    "neither host vcan nor user-mode Linux is available (vcan-setup.sh --check → {other:?}); \
-                     install user-mode-linux (tests/setup-host.sh) — these tests are never skipped"
+                (code, _) => panic!(
+                    "no vcan route (vcan-setup.sh --check → {code:?}, printed {printed:?}):\n{}\n\
+                     these tests are never skipped",
+                    String::from_utf8_lossy(&o.stderr)
                 ),
             }
         })
@@ -306,7 +290,7 @@ fn forward_stderr(
 }
 
 /// Waits for a child's ready line (see [`forward_stderr`]); an error if it exits first or
-/// takes longer than a slow user-mode-Linux start could explain.
+/// takes longer than a slow start in an emulated guest on a busy host could explain.
 fn wait_ready(ready: std::sync::mpsc::Receiver<()>, child: &mut Child, what: &str) -> Result<()> {
     let until = Instant::now() + Duration::from_secs(30);
     while Instant::now() < until {
@@ -431,8 +415,8 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
         "actuator-stubs",
     )?;
     // The ECU starts only once the stubs listen on the bus: its first commands would otherwise
-    // go out before the receiver's socket exists (under load, or inside user-mode Linux where
-    // a process takes up to a second to start, that was several cycles of commands).
+    // go out before the receiver's socket exists (under load, or in an emulated guest where a
+    // process takes up to a second to start, that was several cycles of commands).
     let (stubs_stderr, stubs_ready) = forward_stderr(&mut stubs, None, Some(STUBS_READY));
     if let Err(e) = wait_ready(stubs_ready, &mut stubs, "actuator-stubs") {
         let _ = terminate(&mut stubs, "actuator-stubs", Duration::from_secs(2));
@@ -572,6 +556,13 @@ pub fn summarise(
     let mut s = String::new();
     let _ = writeln!(s, "=== {} ===", r.scenario);
     let _ = writeln!(s, "{}", scenario.description);
+    let route = Route::current();
+    let _ = writeln!(
+        s,
+        "route: {} — {}",
+        route.name(),
+        route.describe_with_load()
+    );
     match &r.true_crash {
         Some(c) => {
             let _ = writeln!(
@@ -797,8 +788,9 @@ pub fn summarise(
             rt("sched"),
             rt("mlockall")
         );
-        if std::env::var_os("VCAN_IN_UML").is_some() {
-            let _ = writeln!(s, "  (inside user-mode Linux: syscalls are emulated, these timings are meaningless — measure on a real kernel)");
+        let route = Route::current();
+        if route.timing_emulated() {
+            let _ = writeln!(s, "  (route {}: {} — these timings describe the emulator; measure on the host: README, Timing)", route.name(), route.describe());
         }
     } else {
         let _ = writeln!(s, "\nECU timing: no ecu-report.json");

@@ -33,11 +33,7 @@ pub fn draw_timeline(c: &Campaign, path: &Path) -> Result<()> {
         .caption(
             format!(
                 "fault campaign: ECU mode on EcuStatus ({}) — hatched: fault, |: contact, ◆: airbag fire",
-                if c.in_uml {
-                    "user-mode Linux"
-                } else {
-                    "host vcan"
-                }
+                c.route.name()
             ),
             ("sans-serif", 16),
         )

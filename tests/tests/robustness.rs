@@ -1,6 +1,6 @@
 //! The fault-injection campaign (tests/src/faults/) end to end: real ecu, sensor-feeds,
 //! actuator-stubs, candump, cansend, cangen and bus-inject on vcan — on the host if its kernel
-//! has vcan, else inside ONE user-mode-Linux boot; with neither the tests FAIL (never skipped).
+//! has vcan, else inside ONE boot of the QEMU guest; with no route the tests FAIL (never skipped).
 //! The campaign runs once (first test to get here) and writes `target/robustness/campaign.json`,
 //! which `test.sh` prints as the robustness report together with the fuzzing figures.
 
@@ -10,8 +10,9 @@ use std::path::PathBuf;
 use std::process::Command;
 use std::sync::{Mutex, OnceLock};
 
-/// The UML campaign and the host timing runs take turns: run side by side they would measure
-/// each other (2 vCPUs; the timed ECU runs at SCHED_FIFO).
+/// The campaign and the host timing runs take turns: run side by side they would measure each
+/// other (2 vCPUs; the timed ECU runs at SCHED_FIFO, an emulated guest's timing follows the
+/// host's load).
 static SERIAL: Mutex<()> = Mutex::new(());
 
 fn root() -> PathBuf {
@@ -33,7 +34,7 @@ fn campaign() -> &'static Campaign {
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner);
         build_bench_bins();
-        e2e_tests::harness::vcan_in_uml();
+        e2e_tests::harness::vcan_route();
         let script = root().join("vcan-setup.sh");
         let out = bin_dir().join("robustness");
         let _ = std::fs::remove_dir_all(&out);

@@ -1,5 +1,6 @@
-//! The fault-injection campaign (issue 8): real bench processes on vcan (user-mode Linux where
-//! the host has no SocketCAN), one fault per run, judged against a clean baseline run.
+//! The fault-injection campaign (issue 8): real bench processes on vcan (a QEMU guest with a
+//! real Debian kernel where the host has no SocketCAN), one fault per run, judged against a
+//! clean baseline run.
 //!
 //! Each [`Case`] is a scenario run through [`crate::run_disturbed`] with one [`Fault`]. What the
 //! ECU did is read from the bus (EcuStatus modes as the actuator stubs received them), the
@@ -18,14 +19,15 @@
 //!   after the fault began and back to Normal after it ended, with the rejection reason the
 //!   fault should produce; or the documented start-up fallback.
 //!
-//! Times inside user-mode Linux carry an allowance ([`UML_SLACK_MS`]): its emulated timers
-//! stall processes for tens of ms. Deadline misses are reported as overruns relative to the
-//! baseline run; inside UML they measure the emulator, and the report says so.
+//! Time limits carry an allowance only where the route's timing is emulated (QEMU TCG:
+//! [`crate::Allowances`], named in the report). Deadline misses are reported as overruns
+//! relative to the baseline run; under emulation they measure the emulator, and the report
+//! says so.
 
 mod judge;
 mod report;
 
-pub use judge::{judge, FIRE_LATE_ALLOWANCE_MS, UML_SLACK_MS};
+pub use judge::judge;
 pub use report::report_text;
 
 use crate::{Disturbance, RunConfig, RunCtx, RunResult, SideProcess};
@@ -46,18 +48,13 @@ pub const CRASH_LEAD_S: f64 = 2.0;
 pub const QUIET_SCENARIO: &str = "low-speed-no-fire";
 
 /// Fault window of the pre-crash faults, scenario seconds: late enough that every injector has
-/// started (first start of a binary in user-mode Linux: up to ≈ 0.7 s), early enough that the
-/// documented recovery (E2E hold 500 ms, a restarted feed ≈ 0.5–1 s) completes before the
-/// pre-crash phase (≈ 3.4 s with [`CRASH_LEAD_S`]).
+/// started (a process start in the QEMU TCG guest: ≈ 0.2 s), early enough that the documented
+/// recovery (E2E hold 500 ms; a restarted feed is back ≈ 1.2 s after its restart in the TCG
+/// guest, measured) completes before the pre-crash phase (≈ 3.4 s with [`CRASH_LEAD_S`]).
 const FAULT_FROM_S: f64 = 1.0;
 const FAULT_TO_S: f64 = 1.3;
 /// Delay of the `delay` mirror's copies, ms.
 const DELAY_MS: f64 = 200.0;
-
-/// Runs a case may take inside user-mode Linux when only time limits fail: its emulated
-/// timers stall processes for 100 ms and more now and then (a stall before the fault leaves the
-/// ECU already degraded, and the detection cannot be measured). Function checks never retry.
-const UML_ATTEMPTS: u32 = 3;
 
 /// What is done to a run.
 #[derive(Clone, Debug, PartialEq)]
@@ -251,8 +248,8 @@ pub struct Check {
     pub ok: bool,
     /// Measured value / reason.
     pub detail: String,
-    /// A timing check (a time limit, not a function): inside user-mode Linux a case that fails
-    /// only timing checks is run once more, because its timers are emulated.
+    /// A timing check (a time limit, not a function): where the route's timing is emulated a
+    /// case that fails only timing checks is run again ([`crate::Allowances`]).
     #[serde(default)]
     pub timing: bool,
 }
@@ -288,8 +285,8 @@ pub struct CaseResult {
     pub commands_lost: u64,
     /// Of those, displaced by attacker frames that passed E2E (attack cases only).
     pub commands_denied_by_attack: u64,
-    /// Genuine commands refused as stale because they arrived late (see `judge`; not in
-    /// `commands_lost` inside user-mode Linux).
+    /// Genuine commands refused as stale because they arrived late (see `judge`; also counted
+    /// in `commands_lost`).
     #[serde(default)]
     pub commands_late: u64,
     /// Frames the attacker/faulty node put on the bus (0 when not counted).
@@ -304,7 +301,7 @@ pub struct CaseResult {
     pub checks: Vec<Check>,
     /// All checks passed.
     pub pass: bool,
-    /// Runs it took (> 1: the earlier ones failed only time limits inside user-mode Linux).
+    /// Runs it took (> 1: the earlier ones failed only time limits under emulated timing).
     #[serde(default)]
     pub attempts: u32,
     /// What the earlier runs missed ("run N: check: detail; …"), one entry per earlier run.
@@ -342,16 +339,26 @@ pub struct FuzzTarget {
 /// The whole campaign.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct Campaign {
-    /// Inside user-mode Linux (timing emulated).
-    pub in_uml: bool,
+    /// The vcan route the campaign ran on.
+    pub route: crate::Route,
+    /// The allowances in force on that route, each with its reason (empty: none).
+    pub allowances: Vec<String>,
+    /// What the timing depended on besides the route ([`crate::Route::conditions`]: the host's
+    /// load at the start, QEMU's scheduling).
+    #[serde(default)]
+    pub conditions: String,
     /// Cases.
     pub cases: Vec<CaseResult>,
 }
 
 /// Runs every case (or those named in `only`), the baseline always first.
 pub fn run_campaign(cfg: &CampaignConfig, only: &[String]) -> Result<Campaign> {
+    let route = crate::Route::current();
+    let allow = route.allowances();
     let mut out = Campaign {
-        in_uml: crate::in_uml_guest(),
+        route,
+        allowances: allow.named(),
+        conditions: crate::Route::conditions(),
         cases: Vec::new(),
     };
     let all = cases();
@@ -373,8 +380,7 @@ pub fn run_campaign(cfg: &CampaignConfig, only: &[String]) -> Result<Campaign> {
         let (mut run, mut result) = run_case(cfg, case, i, baseline.as_ref().map(|b| &b.0))?;
         let mut attempts = 1;
         let mut earlier = Vec::new();
-        while out.in_uml
-            && attempts < UML_ATTEMPTS
+        while attempts < allow.time_limit_attempts
             && !result.pass
             && result.checks.iter().all(|c| c.ok || c.timing)
         {
@@ -385,8 +391,10 @@ pub fn run_campaign(cfg: &CampaignConfig, only: &[String]) -> Result<Campaign> {
                 .map(|c| format!("{}: {}", c.what, c.detail))
                 .collect();
             eprintln!(
-                "fault-campaign: {}: only time limits failed inside user-mode Linux (emulated timers): {}; running it again",
+                "fault-campaign: {}: only time limits failed ({}: {}): {}; running it again",
                 case.name,
+                route.name(),
+                route.describe(),
                 missed.join("; ")
             );
             earlier.push(format!("run {attempts}: {}", missed.join("; ")));
@@ -548,8 +556,9 @@ impl Disturbance for CaseDisturbance<'_> {
         feeds.wait()?;
         ctx.sleep_until_s(restart_s);
         // Same time base: the restarted feeds resume at the current scenario time. They are
-        // back once they announce the epoch (start-up takes a while inside UML); recovery is
-        // measured from then.
+        // back once they announce the epoch (≈ 1.2 s after the restart in the QEMU TCG guest:
+        // iceoryx2 set-up and the true-crash pre-computation, emulated); recovery is measured
+        // from then.
         let mut again = ctx
             .feeds_command()
             .stdout(Stdio::piped())
@@ -624,9 +633,9 @@ fn toml_f64(t: &toml::Table, key: &str) -> Option<f64> {
 
 /// The scenario with `extra_s` more of steady approach before everything happens: longer
 /// duration, braking `extra_s` later, the opponent further away by `extra_s` × closing speed —
-/// the same crash at `extra_s` later. In user-mode Linux a bench process takes ≈ 0.5 s to start
-/// (iceoryx2 node and services: emulated syscalls), so a killed and restarted feed needs this
-/// head room to be back before the pre-crash phase.
+/// the same crash at `extra_s` later. In the QEMU TCG guest a restarted feed is back ≈ 1.2 s
+/// after its restart (measured; emulated CPUs), so it needs this head room to be back before
+/// the pre-crash phase.
 pub(crate) fn lengthened_scenario(src: &Path, dir: &Path, extra_s: f64) -> Result<PathBuf> {
     let text =
         std::fs::read_to_string(src).with_context(|| format!("reading {}", src.display()))?;

@@ -10,13 +10,18 @@ pub fn report_text(c: &Campaign, fuzz: Option<&[FuzzTarget]>) -> String {
     let _ = writeln!(s, "=== robustness report ===");
     let _ = writeln!(
         s,
-        "fault campaign on vcan ({}):",
-        if c.in_uml {
-            "inside user-mode Linux: timing emulated"
+        "fault campaign on vcan, route {}: {}{}",
+        c.route.name(),
+        c.route.describe(),
+        if c.conditions.is_empty() {
+            String::new()
         } else {
-            "host kernel"
+            format!(" ({})", c.conditions)
         }
     );
+    for a in &c.allowances {
+        let _ = writeln!(s, "  allowance: {a}");
+    }
     let _ = writeln!(
         s,
         "  {:<14} {:<5} {:>6} {:>7} {:>6} {:>8} {:>9}  reaction",
@@ -96,18 +101,13 @@ pub fn report_text(c: &Campaign, fuzz: Option<&[FuzzTarget]>) -> String {
     let _ = writeln!(s, "denied by attack   {denied}   (genuine frames displaced by attacker frames; resent next cycle)");
     let _ = writeln!(
         s,
-        "arrived late       {late}   (genuine commands refused as stale: delivered after the freshness window{})",
-        if c.in_uml {
-            "; user-mode Linux delivery delays, not counted as lost"
-        } else {
-            "; counted as lost"
-        }
+        "arrived late       {late}   (genuine commands refused as stale: delivered after the freshness window; counted as lost)"
     );
     let _ = writeln!(
         s,
         "deadline misses    {extra_overruns} beyond the baseline's {base_overruns} (sum over fault cases){}",
-        if c.in_uml {
-            " — user-mode Linux: emulated timers, not a real-time figure"
+        if c.route.timing_emulated() {
+            " — emulated timers, not a real-time figure"
         } else {
             ""
         }
@@ -208,10 +208,15 @@ mod tests {
             },
         ];
         let c = Campaign {
-            in_uml: true,
+            route: crate::Route::QemuTcg,
+            allowances: crate::Route::QemuTcg.allowances().named(),
+            conditions: "host load 0.50 at the start, QEMU at SCHED_RR 5".into(),
             cases: vec![case("baseline", true), flood, bad],
         };
         let text = report_text(&c, None);
+        assert!(text.contains("route qemu-tcg"), "{text}");
+        assert!(text.contains("host load 0.50"), "{text}");
+        assert!(text.contains("allowance: "), "{text}");
         assert!(
             text.contains("time limit missed in run 1: fire command on time"),
             "{text}"
@@ -223,8 +228,8 @@ mod tests {
             "verdict            FAILED: can-crc (recovers after the fault)"
         );
         let ok = Campaign {
-            in_uml: true,
             cases: vec![case("baseline", true)],
+            ..Campaign::default()
         };
         assert!(report_text(&ok, None).ends_with("verdict            every case passed\n"));
     }

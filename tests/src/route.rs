@@ -1,0 +1,290 @@
+//! Where the bench runs — the route `vcan-setup.sh` chose — and the only allowances the
+//! end-to-end verdicts make for it. One place for all of them, each with its measured reason,
+//! so every report can name the route and what was allowed.
+//!
+//! On the host kernel and in a QEMU/KVM guest the timers are real: no allowance. Under QEMU's
+//! software emulation (TCG) the kernel, vcan, iceoryx2 and the processes are real but time is
+//! not: the guest's clock runs at host speed while its CPUs run 5–50× slower and stall when the
+//! host is busy, so a time limit measures the emulator and the host's load. Verdicts there
+//! separate the logic (what was commanded, for when: never relaxed) from delivery times
+//! (allowed for, and named).
+
+use serde::{Deserialize, Serialize};
+
+/// The vcan route of `vcan-setup.sh`: `$VCAN_ROUTE` in the command it runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Route {
+    /// The host kernel has vcan: real timing.
+    #[default]
+    Host,
+    /// A QEMU/KVM guest with a real Debian kernel: real timers.
+    QemuKvm,
+    /// A QEMU guest under software emulation (TCG): emulated timing.
+    QemuTcg,
+}
+
+impl Route {
+    /// The route of this process: `$VCAN_ROUTE` as `vcan-setup.sh` sets it (host when unset:
+    /// a process started by hand on a kernel with vcan).
+    pub fn current() -> Self {
+        std::env::var("VCAN_ROUTE")
+            .ok()
+            .and_then(|s| Self::parse(&s))
+            .unwrap_or_default()
+    }
+
+    /// `host`, `qemu-kvm`, `qemu-tcg` (what `vcan-setup.sh --check` prints).
+    pub fn parse(s: &str) -> Option<Self> {
+        match s.trim() {
+            "host" => Some(Self::Host),
+            "qemu-kvm" => Some(Self::QemuKvm),
+            "qemu-tcg" => Some(Self::QemuTcg),
+            _ => None,
+        }
+    }
+
+    /// The route's name as `vcan-setup.sh` prints it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Host => "host",
+            Self::QemuKvm => "qemu-kvm",
+            Self::QemuTcg => "qemu-tcg",
+        }
+    }
+
+    /// One line for reports: where, and whether its timing means anything.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Host => "host kernel (native): real timing",
+            Self::QemuKvm => "QEMU/KVM guest, Debian kernel: real timers",
+            Self::QemuTcg => {
+                "QEMU guest under software emulation (TCG), Debian kernel: timing EMULATED"
+            }
+        }
+    }
+
+    /// True where time limits measure the emulator rather than the bench.
+    pub fn timing_emulated(self) -> bool {
+        self == Self::QemuTcg
+    }
+
+    /// The host's 1-minute load average when the guest started (`$VCAN_HOST_LOADAVG`; on the
+    /// host route, the current one). Emulated timing follows it, so reports print it.
+    pub fn host_load() -> Option<f64> {
+        std::env::var("VCAN_HOST_LOADAVG")
+            .ok()
+            .or_else(|| std::fs::read_to_string("/proc/loadavg").ok())
+            .and_then(|s| s.split_whitespace().next()?.parse().ok())
+    }
+
+    /// What the run's timing depended on besides the route: the host's load when it started
+    /// and, in the guest, QEMU's scheduling (`$VCAN_GUEST_SCHED`), e.g. "host load 0.52 at the
+    /// start, QEMU at SCHED_RR 5"; empty when unknown.
+    pub fn conditions() -> String {
+        let mut v = Vec::new();
+        if let Some(l) = Self::host_load() {
+            v.push(format!("host load {l:.2} at the start"));
+        }
+        if let Ok(sched) = std::env::var("VCAN_GUEST_SCHED") {
+            v.push(format!("QEMU at {sched}"));
+        }
+        v.join(", ")
+    }
+
+    /// One line for reports: the route, what it means, and [`Self::conditions`].
+    pub fn describe_with_load(self) -> String {
+        match Self::conditions() {
+            c if c.is_empty() => self.describe().to_owned(),
+            c => format!("{} ({c})", self.describe()),
+        }
+    }
+
+    /// The allowances of this route.
+    pub fn allowances(self) -> Allowances {
+        if self.timing_emulated() {
+            Allowances::EMULATED
+        } else {
+            Allowances::REAL
+        }
+    }
+}
+
+/// What the end-to-end verdicts allow for on a route. Logic checks (what was commanded, which
+/// commands were authenticated, whether the airbag fired) are never relaxed, and the time
+/// limits themselves are the same on every route (the documented limits + 20 ms).
+///
+/// Measured in the TCG guest on this 2-vCPU VM (fault campaign judged by the real-timer rules):
+/// on a quiet host 12 of 12 faults passed at the first run, no command late or lost, with the
+/// default SecOC windows (10 ms pairing, 100 ms freshness) — the widened windows, the 100 ms
+/// slack and the "late, not lost" excuse that user-mode Linux needed are gone. With a niced
+/// `cargo build` beside it the same campaign failed 13 of 13 cases on time limits (fires
+/// +55…+1 800 ms late, inputs starved into the reference restraint): emulated timing follows
+/// the host's load, which a CI run does not choose. With QEMU at SCHED_RR (vcan-setup.sh's
+/// default) and three niced builds beside it, 10 of 12 passed at the first run. What remains
+/// is what absorbs the rest.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Allowances {
+    /// Runs a fault case may take when only time limits failed (1 = no retry).
+    pub time_limit_attempts: u32,
+    /// A reference-restraint fire while the ECU's only faults were stale inputs and overruns
+    /// counts as a time limit (the emulator starved the inputs), not a function failure.
+    pub starved_fire_is_timing: bool,
+}
+
+impl Allowances {
+    /// Real timers: none.
+    pub const REAL: Self = Self {
+        time_limit_attempts: 1,
+        starved_fire_is_timing: false,
+    };
+
+    /// Emulated timing (QEMU TCG).
+    pub const EMULATED: Self = Self {
+        time_limit_attempts: 3,
+        starved_fire_is_timing: true,
+    };
+
+    /// Every allowance in force, with its reason, for the reports (empty: none).
+    pub fn named(&self) -> Vec<String> {
+        let mut v = Vec::new();
+        if self.time_limit_attempts > 1 {
+            v.push(format!(
+                "a fault case that misses only time limits, or a scenario run whose inputs were starved or whose fire came late, runs again (≤ {} runs): emulated timing follows the host's load",
+                self.time_limit_attempts
+            ));
+        }
+        if self.starved_fire_is_timing {
+            v.push(
+                "a reference fire caused only by starved inputs (stale-input/overrun flags) counts as a time limit"
+                    .to_owned(),
+            );
+        }
+        v
+    }
+}
+
+/// EcuStatus fault flags of the inputs (missing, stale or out of range) and of overruns: what
+/// a stalled machine causes, as opposed to E2E failures, a bad LUT or a bad configuration.
+pub const STARVED_INPUT_FLAGS: [&str; 5] = [
+    "vehicle_input",
+    "occupant_input",
+    "object_input",
+    "accel_sensor",
+    "overrun",
+];
+
+/// Why a scenario run did not measure the bench because the machine starved it, if it did not:
+/// between the ECU's first Normal and the contact it raised a stale-input fault that the
+/// scenario does not inject (no dropout or freeze declared), or the airbag fired more than
+/// [`crate::FIRE_LATE_ALLOWANCE_MS`] after its plan. Under emulated timing such a run is run
+/// again ([`Allowances::time_limit_attempts`]); with real timers it is a failure like any other.
+pub fn starved_run(
+    scenario: &sensor_feeds::Scenario,
+    r: &actuator_stubs::report::Report,
+) -> Option<String> {
+    let mut why = Vec::new();
+    let injects = !scenario.sensor.dropouts.is_empty() || !scenario.sensor.freezes.is_empty();
+    let first_normal = r
+        .ecu_modes
+        .iter()
+        .find(|(_, m)| m == "Normal")
+        .map(|(t, _)| *t);
+    let contact = if r.contact_ns != 0 { 0.0 } else { f64::MAX };
+    if let (false, Some(from)) = (injects, first_normal) {
+        if let Some((t, flags)) = r.ecu_faults.iter().find(|(t, flags)| {
+            *t > from
+                && *t < contact
+                && flags
+                    .iter()
+                    .any(|f| f != "overrun" && STARVED_INPUT_FLAGS.contains(&f.as_str()))
+        }) {
+            why.push(format!(
+                "inputs starved at {t:+.0} ms ({})",
+                flags.join("+")
+            ));
+        }
+    }
+    if let Some(a) = r.action("airbag_fire") {
+        if let Some(t) = a.t_ms {
+            let late = t - a.action.planned_ms;
+            if late > crate::FIRE_LATE_ALLOWANCE_MS {
+                why.push(format!(
+                    "airbag fired {late:+.1} ms after its plan ({:+.1} ms)",
+                    a.action.planned_ms
+                ));
+            }
+        }
+    }
+    (!why.is_empty()).then(|| why.join("; "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn routes_parse_as_vcan_setup_prints_them() {
+        for r in [Route::Host, Route::QemuKvm, Route::QemuTcg] {
+            assert_eq!(Route::parse(r.name()), Some(r));
+            assert_eq!(Route::parse(&format!("{}\n", r.name())), Some(r));
+        }
+        assert_eq!(Route::parse("uml"), None);
+        assert_eq!(
+            serde_json::to_string(&Route::QemuTcg).unwrap(),
+            "\"qemu-tcg\""
+        );
+    }
+
+    #[test]
+    fn only_emulated_timing_gets_allowances() {
+        assert!(Route::Host.allowances().named().is_empty());
+        assert!(Route::QemuKvm.allowances().named().is_empty());
+        assert!(!Route::QemuTcg.allowances().named().is_empty());
+        assert!(Route::QemuTcg.timing_emulated() && !Route::QemuKvm.timing_emulated());
+    }
+
+    fn report(faults: &str, fire: &str) -> actuator_stubs::report::Report {
+        serde_json::from_str(&format!(
+            r#"{{"scenario": "x", "stop_reason": "done", "start_ns": 1, "contact_ns": 5,
+                "frames": {{}}, "e2e_accepted": 0, "e2e_rejected": {{}},
+                "actions": [{fire}], "ecu_modes": [[-2000.0, "ReferenceFallback"], [-1600.0, "Normal"]],
+                "ecu_faults": {faults}, "ecu_diag_modes": [],
+                "pretensioner_before_contact": true, "pretensioner_released": false, "airbag_fired": true}}"#
+        ))
+        .expect("report JSON")
+    }
+
+    fn scenario(name: &str) -> sensor_feeds::Scenario {
+        sensor_feeds::Scenario::load(crate::repo_root().join(format!("scenarios/{name}.toml")))
+            .expect("scenario")
+    }
+
+    const FIRE_AT_7: &str = r#"{"t_ns": 9, "what": "airbag_fire", "level_kn": 4.5, "planned_ms": 3.0, "source": "adaptive", "t_ms": 7.0}"#;
+
+    #[test]
+    fn a_run_is_starved_by_stale_inputs_before_contact_or_a_late_fire_only() {
+        let s = scenario("taurus-48-48-abs");
+        // start-up faults before the first Normal and the object list ending after contact
+        // are the scenario's own course
+        let clean = r#"[[-2000.0, ["object_input"]], [-1600.0, []], [30.0, ["object_input"]]]"#;
+        assert_eq!(starved_run(&s, &report(clean, FIRE_AT_7)), None);
+        // overruns alone do not starve anything
+        let overrun = r#"[[-2000.0, ["object_input"]], [-1600.0, ["overrun"]]]"#;
+        assert_eq!(starved_run(&s, &report(overrun, FIRE_AT_7)), None);
+        let starved = r#"[[-2000.0, ["object_input"]], [-1600.0, []], [-894.0, ["object_input", "overrun"]]]"#;
+        let why = starved_run(&s, &report(starved, FIRE_AT_7)).expect("starved");
+        assert!(
+            why.contains("-894 ms") && why.contains("object_input"),
+            "{why}"
+        );
+        let late = FIRE_AT_7.replace(r#""t_ms": 7.0"#, r#""t_ms": 19.9"#);
+        let why = starved_run(&s, &report(clean, &late)).expect("late fire");
+        assert!(why.contains("+16.9 ms after its plan"), "{why}");
+        // a scenario that injects a dropout owns its input faults
+        assert_eq!(
+            starved_run(&scenario("sensor-dropout"), &report(starved, FIRE_AT_7)),
+            None
+        );
+    }
+}
