@@ -513,9 +513,10 @@ pub struct Campaign {
     pub route: crate::Route,
     /// The allowances in force on that route, each with its reason (empty: none).
     pub allowances: Vec<String>,
-    /// The host's 1-minute load average when the run started (emulated timing follows it).
+    /// What the timing depended on besides the route ([`crate::Route::conditions`]: the host's
+    /// load at the start, QEMU's scheduling).
     #[serde(default)]
-    pub host_load: Option<f64>,
+    pub conditions: String,
     /// Cases.
     pub cases: Vec<CaseResult>,
 }
@@ -527,7 +528,7 @@ pub fn run_campaign(cfg: &CampaignConfig, only: &[String]) -> Result<Campaign> {
     let mut out = Campaign {
         route,
         allowances: allow.named(),
-        host_load: crate::Route::host_load(),
+        conditions: crate::Route::conditions(),
         cases: Vec::new(),
     };
     let all = cases();
@@ -651,7 +652,8 @@ impl Disturbance for CaseDisturbance<'_> {
             Fault::Bus { mode, from_s, to_s } => {
                 let child = spawn_piped(
                     Command::new(ctx.bin("bus-inject"))
-                        .args(["mirror", "--can", can, "--mode", mode, "--id", "0x0A0"])
+                        .args(["mirror", "--can", can, "--mode", mode, "--id"])
+                        .arg(format!("{:#05x}", bus::EgoVehicleState::RAW_ID))
                         .arg("--epoch-ns")
                         .arg(ctx.epoch_ns.to_string())
                         .arg("--from-s")
@@ -945,14 +947,16 @@ pub fn recorded_fire_pair(candump_log: &Path) -> Result<(String, String)> {
             continue;
         };
         match (id, &fire) {
-            (0x030, None) => {
+            (bus::AirbagStageCmd::RAW_ID, None) => {
                 if let Ok(bus::Messages::AirbagStageCmd(m)) = bus::decode(id, &bytes) {
                     if matches!(m.fire(), bus::codec::AirbagStageCmdFire::Fire) {
                         fire = Some(frame.to_owned());
                     }
                 }
             }
-            (0x031, Some(cmd)) => return Ok((cmd.clone(), frame.to_owned())),
+            (bus::AirbagStageAuth::RAW_ID, Some(cmd)) => {
+                return Ok((cmd.clone(), frame.to_owned()))
+            }
             _ => {}
         }
     }
@@ -1060,7 +1064,7 @@ mod tests {
     /// `ID#HEX` of an AirbagStageCmd with the given Fire bit and a valid CRC.
     fn airbag(fire: bool, counter: u8) -> String {
         let mut f = bus::encode_values(
-            0x030,
+            bus::AirbagStageCmd::RAW_ID,
             &[
                 0.0,
                 f64::from(counter),
@@ -1073,7 +1077,7 @@ mod tests {
             ],
         )
         .expect("encode");
-        let data_id = bus::message_info(0x030)
+        let data_id = bus::message_info(bus::AirbagStageCmd::RAW_ID)
             .and_then(|i| i.e2e_data_id)
             .expect("id");
         f.data[0] = bus::e2e_crc(data_id, 0, f.payload());
