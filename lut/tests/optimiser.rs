@@ -296,7 +296,10 @@ fn worst_lateness_of_the_earliest_plan_ms() -> f64 {
             let confirm_ms = samples
                 .iter()
                 .find_map(|s| {
-                    m.push(s, &mut || Some(pred));
+                    m.push(s, &mut |slot| {
+                        *slot = pred;
+                        true
+                    });
                     match m.state() {
                         MatchState::Confirmed(e) => {
                             Some((e.confirm_ns as f64 - contact_ns as f64) * 1e-6)

@@ -17,10 +17,15 @@
 //! (80 samples at 4 kHz) do not happen by chance. A sensor with a coarse LSB and little noise
 //! needs a longer `accel_stuck_ms`.
 //!
-//! Plausible samples are handed on one by one, in time order, as [`AccelSample`]s.
+//! Plausible samples come out in time order, as [`AccelSample`]s in a fixed-capacity batch
+//! ([`PlausibleBatch`]: no allocation, and the detectors are called without dynamic dispatch).
 
 use crate::config::{ms_to_ns, CycleConfig};
 use crate::confirm::G_MPS2;
+use crate::signals::ACCEL_BATCH_CAPACITY;
+
+/// The plausible samples of one batch.
+pub type PlausibleBatch = heapless::Vec<AccelSample, ACCEL_BATCH_CAPACITY>;
 
 /// How long an implausible accelerometer sample keeps `ACCEL_INVALID` set, ms.
 pub const INVALID_HOLD_MS: f64 = 500.0;
@@ -101,15 +106,17 @@ impl AccelMonitor {
     }
 
     /// Checks one batch received at `now` (`first_ns`, `period_ns`, samples in m/s²,
-    /// negative = deceleration) and hands each plausible sample to `sink`, in time order.
+    /// negative = deceleration; at most [`ACCEL_BATCH_CAPACITY`] are read) and puts its
+    /// plausible samples into `out` (cleared first), in time order.
     pub fn feed(
         &mut self,
         now: u64,
         first_ns: u64,
         period_ns: u32,
         samples: &[f32],
-        sink: &mut dyn FnMut(&AccelSample),
+        out: &mut PlausibleBatch,
     ) {
+        out.clear();
         let too_old = now.saturating_sub(first_ns) > self.timeout_ns;
         let in_future = first_ns > now.saturating_add(FUTURE_SLACK_NS);
         let backwards = self.next_from_ns.is_some_and(|t| first_ns < t);
@@ -123,7 +130,7 @@ impl AccelMonitor {
         let dt_s = f64::from(period_ns) * 1.0e-9;
         let half = u64::from(period_ns / 2);
         let mut t = first_ns;
-        for &a in samples {
+        for &a in samples.iter().take(ACCEL_BATCH_CAPACITY) {
             let t_ns = t;
             t = t.saturating_add(u64::from(period_ns));
             self.next_from_ns = Some(t_ns.saturating_add(half));
@@ -154,7 +161,8 @@ impl AccelMonitor {
                 self.implausible(now);
                 continue;
             }
-            sink(&AccelSample {
+            // Cannot fail: at most ACCEL_BATCH_CAPACITY samples are read.
+            let _ = out.push(AccelSample {
                 t_ns,
                 dt_s,
                 decel_mps2: -v,
@@ -193,9 +201,9 @@ mod tests {
 
     /// Feeds one 4-sample 4 kHz batch ending at `now`; returns the samples passed on.
     fn feed(m: &mut AccelMonitor, now: u64, v: [f32; 4]) -> Vec<AccelSample> {
-        let mut out = Vec::new();
-        m.feed(now, now - 750_000, 250_000, &v, &mut |s| out.push(*s));
-        out
+        let mut out = PlausibleBatch::new();
+        m.feed(now, now - 750_000, 250_000, &v, &mut out);
+        out.to_vec()
     }
 
     #[test]
@@ -233,14 +241,16 @@ mod tests {
         let mut m = monitor();
         assert_eq!(feed(&mut m, 10 * MS, [1.0, 2.0, 3.0, 4.0]).len(), 4);
         // The same batch again (a replayed or duplicated batch): starts before the last ended.
-        let mut n = 0;
-        m.feed(11 * MS, 10 * MS - 750_000, 250_000, &[5.0; 4], &mut |_| n += 1);
-        assert_eq!(n, 0);
+        let mut out = PlausibleBatch::new();
+        m.feed(11 * MS, 10 * MS - 750_000, 250_000, &[5.0; 4], &mut out);
+        assert!(out.is_empty());
         assert_eq!(m.faults.bad_time_batches, 1);
         // Older than the timeout, and 2 ms in the future.
-        m.feed(70 * MS, 15 * MS, 250_000, &[5.0; 4], &mut |_| n += 1);
-        m.feed(70 * MS, 72 * MS, 250_000, &[5.0; 4], &mut |_| n += 1);
-        m.feed(70 * MS, 69 * MS, 0, &[5.0; 4], &mut |_| n += 1);
+        let mut n = 0;
+        for (first, period) in [(15 * MS, 250_000), (72 * MS, 250_000), (69 * MS, 0)] {
+            m.feed(70 * MS, first, period, &[5.0; 4], &mut out);
+            n += out.len();
+        }
         assert_eq!((n, m.faults.bad_time_batches), (0, 4));
         assert!(m.invalid(70 * MS));
         // A dropped batch is not a sign of life.

@@ -105,6 +105,17 @@ impl Onset {
         self.awake.then_some(self.onset_ns)
     }
 
+    /// An event is in progress.
+    pub fn awake(&self) -> bool {
+        self.awake
+    }
+
+    /// A quiet sample (below the wake threshold, no event in progress: [`Onset::push`] would
+    /// return [`OnsetStep::Quiet`]): only its deceleration is kept for the next trapezoid.
+    pub fn note_quiet(&mut self, decel_mps2: f64) {
+        self.prev_decel_mps2 = decel_mps2;
+    }
+
     /// Δv integrated since the onset, m/s (0 when quiet).
     pub fn delta_v_mps(&self) -> f64 {
         self.delta_v_mps
@@ -146,6 +157,16 @@ impl CrashDetector {
                 self.confirmed = Some((s.t_ns, onset));
             }
         }
+    }
+
+    /// An event is in progress (and not yet confirmed).
+    pub fn awake(&self) -> bool {
+        self.confirmed.is_none() && self.onset.awake()
+    }
+
+    /// See [`Onset::note_quiet`].
+    pub fn note_quiet(&mut self, decel_mps2: f64) {
+        self.onset.note_quiet(decel_mps2);
     }
 
     /// Time of confirmation, if confirmed (latched).

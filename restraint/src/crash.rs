@@ -20,7 +20,7 @@ use crate::accel::AccelSample;
 use crate::config::{ms_to_ns, CycleConfig};
 use crate::confirm::{ConfirmParams, CrashDetector, G_MPS2};
 use crate::counters::CycleCounters;
-use crate::crash_match::{MatchParams, MatchState, PredictedPulse, PulseMatch, SeverityEstimate};
+use crate::crash_match::{MatchParams, MatchState, PulseMatch, SeverityEstimate};
 use crate::estimate::{equivalent_barrier_speed_kph, Estimator, Situation};
 use crate::fallback::{FallbackAlgorithm, FallbackDecision};
 use crate::inputs::InputMonitor;
@@ -97,12 +97,26 @@ impl CrashMonitor {
         }
     }
 
-    /// One plausible accelerometer sample for all three detectors.
+    /// One plausible accelerometer sample for all three detectors. A quiet sample (below the
+    /// wake threshold, no event in progress) only updates their integrators' previous value:
+    /// the common case, every cycle of a drive.
     pub(crate) fn on_sample(&mut self, s: &AccelSample, ctx: &FreezeContext<'_, '_>) {
-        self.matcher.push(s, &mut || {
-            let sit = ctx.situation.filter(|_| ctx.armed)?;
-            let spring = ctx.estimator.spring_for(sit.opponent_mass_kg)?;
-            PredictedPulse::solve(
+        if s.decel_mps2 < self.onset_params.wake_mps2
+            && !(self.matcher.awake() || self.generic.awake() || self.fallback.awake())
+        {
+            self.matcher.note_quiet(s.decel_mps2);
+            self.generic.note_quiet(s.decel_mps2);
+            self.fallback.note_quiet(s.decel_mps2);
+            return;
+        }
+        self.matcher.push(s, &mut |slot| {
+            let Some(sit) = ctx.situation.filter(|_| ctx.armed) else {
+                return false;
+            };
+            let Some(spring) = ctx.estimator.spring_for(sit.opponent_mass_kg) else {
+                return false;
+            };
+            slot.solve_in_place(
                 spring,
                 ctx.estimator.ego_mass_kg(),
                 sit.opponent_mass_kg,

@@ -78,6 +78,16 @@ pub struct PredictedPulse {
 }
 
 impl PredictedPulse {
+    /// No prediction (the storage a [`PulseMatch`] solves into).
+    pub const EMPTY: Self = Self {
+        collision: ExactCollision::new(),
+        contact_ns: 0,
+        closing_mps: 0.0,
+        opponent_mass_kg: 0.0,
+        slope_mps2_per_ms: 0.0,
+        knee_ms: 0.0,
+    };
+
     /// Solves the predicted collision (`None`: no contact, or input the model refuses).
     pub fn solve(
         spring: &CombinedSpring,
@@ -86,22 +96,39 @@ impl PredictedPulse {
         closing_mps: f64,
         contact_ns: u64,
     ) -> Option<Self> {
-        let mut collision = ExactCollision::new();
-        let input = CollisionInput::with_defaults(spring, ego_mass_kg, opponent_mass_kg, closing_mps);
-        collision.solve_in_place(&input).ok()?;
-        let knee_s = collision.segments().first()?.end_s;
+        let mut p = Self::EMPTY;
+        p.solve_in_place(spring, ego_mass_kg, opponent_mass_kg, closing_mps, contact_ns)
+            .then_some(p)
+    }
+
+    /// [`PredictedPulse::solve`] into this value without moving it (a few kB): false when the
+    /// model refuses the input or there is no contact.
+    pub fn solve_in_place(
+        &mut self,
+        spring: &CombinedSpring,
+        ego_mass_kg: f64,
+        opponent_mass_kg: f64,
+        closing_mps: f64,
+        contact_ns: u64,
+    ) -> bool {
+        let input =
+            CollisionInput::with_defaults(spring, ego_mass_kg, opponent_mass_kg, closing_mps);
+        if self.collision.solve_in_place(&input).is_err() {
+            return false;
+        }
+        let Some(knee_s) = self.collision.segments().first().map(|s| s.end_s) else {
+            return false;
+        };
         // Slope at the start of the ramp, from the model's own state (sin ωτ ≈ ωτ: the
         // reference instant is a quarter of the ramp, or 0.25 ms).
         let tau_s = (0.25 * knee_s).min(0.25e-3);
-        let slope = -collision.state_at(tau_s).ego_accel_mps2 / (tau_s * 1e3);
-        (slope > 0.0 && slope.is_finite() && knee_s > 0.0).then_some(Self {
-            collision,
-            contact_ns,
-            closing_mps,
-            opponent_mass_kg,
-            slope_mps2_per_ms: slope,
-            knee_ms: knee_s * 1e3,
-        })
+        let slope = -self.collision.state_at(tau_s).ego_accel_mps2 / (tau_s * 1e3);
+        self.contact_ns = contact_ns;
+        self.closing_mps = closing_mps;
+        self.opponent_mass_kg = opponent_mass_kg;
+        self.slope_mps2_per_ms = slope;
+        self.knee_ms = knee_s * 1e3;
+        slope > 0.0 && slope.is_finite() && knee_s > 0.0
     }
 }
 
@@ -187,7 +214,9 @@ impl LineFit {
 pub struct PulseMatch {
     params: MatchParams,
     onset: Onset,
-    prediction: Option<PredictedPulse>,
+    /// The prediction of the current event (valid while `frozen`); solved in place.
+    prediction: PredictedPulse,
+    frozen: bool,
     fit: LineFit,
     state: MatchState,
 }
@@ -198,7 +227,8 @@ impl PulseMatch {
         Self {
             params,
             onset: Onset::default(),
-            prediction: None,
+            prediction: PredictedPulse::EMPTY,
+            frozen: false,
             fit: LineFit::default(),
             state: MatchState::Idle,
         }
@@ -211,17 +241,23 @@ impl PulseMatch {
 
     /// The prediction frozen for the current (or confirmed) event.
     pub fn prediction(&self) -> Option<&PredictedPulse> {
-        self.prediction.as_ref()
+        self.frozen.then_some(&self.prediction)
     }
 
     /// An accelerometer event is in progress (the pre-crash prediction is then moot).
     pub fn awake(&self) -> bool {
-        self.onset.onset_ns().is_some()
+        self.onset.awake()
     }
 
-    /// Feeds one plausible sample. `freeze` is called at a wake-up: the prediction of the
-    /// coming crash, or `None` when there is none (not in PRE-CRASH).
-    pub fn push(&mut self, s: &AccelSample, freeze: &mut dyn FnMut() -> Option<PredictedPulse>) {
+    /// See [`Onset::note_quiet`](crate::confirm::Onset::note_quiet).
+    pub fn note_quiet(&mut self, decel_mps2: f64) {
+        self.onset.note_quiet(decel_mps2);
+    }
+
+    /// Feeds one plausible sample. `freeze` is called at a wake-up: it solves the prediction
+    /// of the coming crash into the storage it is given and says whether there is one (false:
+    /// not in PRE-CRASH, or the model refused the situation).
+    pub fn push(&mut self, s: &AccelSample, freeze: &mut dyn FnMut(&mut PredictedPulse) -> bool) {
         if matches!(self.state, MatchState::Confirmed(_)) {
             return;
         }
@@ -229,13 +265,13 @@ impl PulseMatch {
             OnsetStep::Quiet => return,
             OnsetStep::Reset => {
                 self.state = MatchState::Idle;
-                self.prediction = None;
+                self.frozen = false;
                 return;
             }
             OnsetStep::Woke => {
                 self.fit = LineFit::default();
-                self.prediction = freeze();
-                self.state = if self.prediction.is_some() {
+                self.frozen = freeze(&mut self.prediction);
+                self.state = if self.frozen {
                     MatchState::Fitting
                 } else {
                     MatchState::Idle
@@ -246,9 +282,10 @@ impl PulseMatch {
         if self.state != MatchState::Fitting {
             return;
         }
-        let (Some(p), Some(wake_ns)) = (self.prediction, self.onset.onset_ns()) else {
+        let (true, Some(wake_ns)) = (self.frozen, self.onset.onset_ns()) else {
             return;
         };
+        let p = &self.prediction;
         if s.decel_mps2 < self.params.onset.wake_mps2 {
             self.state = MatchState::Mismatch(Mismatch::Shape);
             return;
@@ -263,7 +300,7 @@ impl PulseMatch {
         let span_ns = (self.fit.x_last * 1e6) as u64;
         let enough = span_ns >= self.params.min_span_ns && self.fit.n >= 3.0;
         if enough || !in_ramp {
-            self.state = self.decide(&p, wake_ns, s.t_ns);
+            self.state = self.decide(p, wake_ns, s.t_ns);
         }
     }
 
@@ -346,7 +383,10 @@ mod tests {
                 dt_s: 250e-6,
                 decel_mps2: -actual.state_at(k as f64 * 250e-6).ego_accel_mps2,
             };
-            m.push(&s, &mut || Some(pred));
+            m.push(&s, &mut |slot| {
+                *slot = pred;
+                true
+            });
             if !matches!(m.state(), MatchState::Idle | MatchState::Fitting) {
                 break;
             }
@@ -415,7 +455,10 @@ mod tests {
                 dt_s: 250e-6,
                 decel_mps2: decel,
             };
-            m.push(&s, &mut || Some(pred));
+            m.push(&s, &mut |slot| {
+                *slot = pred;
+                true
+            });
         }
         assert_eq!(m.state(), MatchState::Mismatch(Mismatch::Shape));
         // Without a prediction an event is not matched at all.
@@ -426,7 +469,7 @@ mod tests {
                 dt_s: 250e-6,
                 decel_mps2: -actual.state_at(k as f64 * 250e-6).ego_accel_mps2,
             };
-            m.push(&s, &mut || None);
+            m.push(&s, &mut |_| false);
         }
         assert_eq!(m.state(), MatchState::Idle);
     }

@@ -178,7 +178,13 @@ impl Activity for RestraintCycle<'_> {
             estimator: &self.estimate,
         };
         let crash = &mut self.crash;
-        io.drain_accel(&mut |a| inputs.on_accel(a, now, c, &mut |s| crash.on_sample(s, &freeze)));
+        let mut plausible = crate::accel::PlausibleBatch::new();
+        io.drain_accel(&mut |a| {
+            inputs.on_accel(a, now, c, &mut plausible);
+            for s in &plausible {
+                crash.on_sample(s, &freeze);
+            }
+        });
         inputs.on_receive_errors(io.receive_errors(), now);
         let lut_present = self.estimate.lut().is_some();
         self.reasons = self.inputs.reasons(now, io.can_enabled(), lut_present);

@@ -140,6 +140,16 @@ impl FallbackAlgorithm {
     pub fn onset_ns(&self) -> Option<u64> {
         self.onset.onset_ns()
     }
+
+    /// An event is in progress and not yet fired.
+    pub fn awake(&self) -> bool {
+        !matches!(self.decision, FallbackDecision::Fire(_)) && self.onset.awake()
+    }
+
+    /// See [`Onset::note_quiet`](crate::confirm::Onset::note_quiet).
+    pub fn note_quiet(&mut self, decel_mps2: f64) {
+        self.onset.note_quiet(decel_mps2);
+    }
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@ use bus::codec::{OccupantClassificationBeltBuckle, OccupantClassificationOccupan
 use bus::{E2eChecker, Messages, RawFrame, RejectReason, CAN_EFF_FLAG};
 use heapless::Deque;
 
-use crate::accel::{AccelMonitor, AccelSample, INVALID_HOLD_MS};
+use crate::accel::{AccelMonitor, PlausibleBatch, INVALID_HOLD_MS};
 use crate::config::{ms_to_ns, CycleConfig, MAX_E2E_BURST};
 use crate::contract::ReceiveErrors;
 use crate::counters::CycleCounters;
@@ -292,20 +292,20 @@ impl InputMonitor {
     }
 
     /// One received accelerometer batch: checked by the [`AccelMonitor`], its plausible
-    /// samples handed to `sink` in time order.
+    /// samples put into `out` in time order.
     pub(crate) fn on_accel(
         &mut self,
         a: &CrashAccelSample,
         now: u64,
         counters: &mut CycleCounters,
-        sink: &mut dyn FnMut(&AccelSample),
+        out: &mut PlausibleBatch,
     ) {
         counters.accel_batches_rx = counters.accel_batches_rx.saturating_add(1);
         let s = a.samples();
         counters.accel_samples_rx = counters.accel_samples_rx.saturating_add(s.len() as u64);
         self.last_accel_sequence = a.sequence;
         self.accel
-            .feed(now, a.first_timestamp_ns, a.sample_period_ns, s, sink);
+            .feed(now, a.first_timestamp_ns, a.sample_period_ns, s, out);
     }
 
     /// The I/O's receive-error totals at `now`: new errors on a port hold its fault.
