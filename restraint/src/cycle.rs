@@ -189,6 +189,10 @@ impl Activity for RestraintCycle<'_> {
             detector: &self.inputs.detector,
         };
         self.decision.step(now, &x);
+        // The diagnostics pulse is sampled in the cycles that have time (estimate::pulse).
+        if !self.inputs.new_object && !matches!(self.phase(), Phase::Crash | Phase::PostCrash) {
+            self.estimate.fill_pulse();
+        }
         let c = &mut self.counters;
         self.outputs
             .write(info, io, &self.decision, &self.inputs, self.reasons, c);
@@ -220,6 +224,9 @@ impl Activity for RestraintCycle<'_> {
             ("can_frames_rx", c.can_frames_rx),
             ("can_accepted", e2e.accepted),
             ("can_lost_frames", e2e.lost_frames),
+            ("track_starts", c.track_starts),
+            ("track_outliers", c.track_outliers),
+            ("track_refused", c.track_refused),
             ("predictions", c.predictions),
             ("prediction_errors", c.prediction_errors),
             ("lut_lookups", c.lut_lookups),

@@ -1,25 +1,26 @@
-//! The estimate: what the newest object sample says about the coming collision, and what the
+//! The estimate: what the object track says about the coming collision, and what the
 //! restraint should do about it.
 //!
-//! Time to contact, closing speed at contact, conservative opponent mass and equivalent barrier
-//! speed ([`Situation`]); the two-mass collision prediction ([`physics::simulate_collision`])
-//! into a preallocated pulse buffer; the characteristic-diagram query ([`Lut`]). Everything is
-//! built in [`Estimator::new`]; [`Estimator::update`] allocates nothing.
-//!
-//! This is where a track filter belongs (the estimation work: a nalgebra Kalman filter over
-//! the object samples, smoothing distance, closing speed and acceleration before
-//! [`time_to_contact`]); the decision only consumes [`Situation`].
+//! Per new object sample: the track filter ([`track`]: distance, closing speed and closing
+//! acceleration, latency-corrected, outliers gated, opponent mass fused) → time to contact,
+//! closing speed at contact and opponent mass with their σ at the cycle's time
+//! ([`Situation`]) → the collision prediction in closed form ([`physics::ExactCollision`]: no
+//! step size) → the characteristic-diagram query ([`Lut`]). The diagnostics pulse of the
+//! prediction is sampled a chunk per cycle ([`pulse`]). Everything is built in
+//! [`Estimator::new`]; nothing here allocates.
+
+pub mod pulse;
+pub mod track;
 
 use diagram::{AirbagThresholds, DiagramView, Query};
-use physics::{
-    simulate_collision, CollisionInput, CollisionSummary, CombinedSpring, DefaultPulseBuffer,
-    MassClass,
-};
+use physics::{CollisionInput, CollisionSummary, CombinedSpring, ExactCollision, MassClass};
 
 use crate::config::{ms_to_ns, ConfigError, CycleConfig};
 use crate::counters::CycleCounters;
 use crate::inputs::InputMonitor;
 use crate::plan::RestraintPlan;
+use pulse::DiagnosticsPulse;
+use track::{TrackEstimate, TrackEvent, TrackFilter};
 
 /// Predicted contact of a constant-relative-acceleration approach.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -142,30 +143,45 @@ pub fn check_lut<'a>(
     }
 }
 
-/// The estimated situation from the newest object sample.
+/// The estimated situation: the track's contact estimate at the cycle's time.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Situation {
-    /// Predicted first contact, CLOCK_MONOTONIC ns.
+    /// The contact instant the decision plans with: estimate − k·σ
+    /// (`track.contact_time_k`), CLOCK_MONOTONIC ns.
     pub contact_ns: u64,
+    /// The estimated contact instant, CLOCK_MONOTONIC ns.
+    pub contact_estimate_ns: u64,
+    /// σ of the contact instant, s.
+    pub contact_sigma_s: f64,
     /// Closing speed at contact, m/s.
     pub closing_speed_mps: f64,
-    /// Conservative opponent mass m + k·σ, kg.
+    /// σ of the closing speed at contact, m/s.
+    pub closing_speed_sigma_mps: f64,
+    /// Conservative opponent mass m + k·σ (`conservative_mass_k`), kg: the prediction's and
+    /// the LUT's.
     pub opponent_mass_kg: f64,
+    /// Fused opponent mass estimate, kg.
+    pub opponent_mass_estimate_kg: f64,
+    /// σ of the fused opponent mass, kg.
+    pub opponent_mass_sigma_kg: f64,
     /// Ego equivalent barrier speed, km/h.
     pub ebs_kph: f64,
     /// Below the no-fire threshold.
     pub low_speed: bool,
 }
 
-/// State of the estimate: situation, prediction (springs, pulse buffer) and the LUT.
+/// State of the estimate: track, situation, prediction (springs, kept solution, diagnostics
+/// pulse) and the LUT.
 pub struct Estimator<'a> {
     ego_mass_kg: f64,
     conservative_mass_k: f64,
+    contact_time_k: f64,
     no_fire_ebs_kph: f64,
-    prediction_step_ms: f64,
     exit_horizon_ns: u64,
     springs: [Option<CombinedSpring>; 6],
-    pulse: DefaultPulseBuffer,
+    track: TrackFilter,
+    solution: ExactCollision,
+    pulse: DiagnosticsPulse,
     lut: Option<Lut<'a>>,
     reference: RestraintPlan,
     /// Newest situation estimate.
@@ -175,8 +191,8 @@ pub struct Estimator<'a> {
 }
 
 impl<'a> Estimator<'a> {
-    /// Precomputes the six combined springs (ego class × opponent class) and the pulse
-    /// buffer; `lut` has passed [`check_lut`].
+    /// Precomputes the six combined springs (ego class × opponent class); `lut` has passed
+    /// [`check_lut`].
     pub fn new(
         cfg: &CycleConfig,
         lut: Option<Lut<'a>>,
@@ -198,11 +214,13 @@ impl<'a> Estimator<'a> {
         Ok(Self {
             ego_mass_kg: cfg.ego_mass_kg,
             conservative_mass_k: cfg.conservative_mass_k,
+            contact_time_k: cfg.track.contact_time_k,
             no_fire_ebs_kph: cfg.no_fire_ebs_kph,
-            prediction_step_ms: cfg.prediction_step_ms,
             exit_horizon_ns: horizon_ns.saturating_add(ms_to_ns(cfg.preset_exit_hysteresis_ms)),
             springs,
-            pulse: DefaultPulseBuffer::new(),
+            track: TrackFilter::new(&cfg.track, cfg.object_timeout_ms),
+            solution: ExactCollision::new(),
+            pulse: DiagnosticsPulse::new(),
             lut,
             reference,
             situation: None,
@@ -220,14 +238,27 @@ impl<'a> Estimator<'a> {
         self.lut.as_ref()
     }
 
-    /// The predicted pulse of the newest prediction (ego acceleration, m/s²) and its step, s.
-    pub(crate) fn pulse(&self) -> (&[f64], f64) {
-        (self.pulse.ego_accel_mps2(), self.pulse.step_s())
+    /// The track filter.
+    pub fn track(&self) -> &TrackFilter {
+        &self.track
     }
 
-    /// Situation from the newest object sample; runs the prediction and the LUT lookup when
-    /// contact is within the exit horizon. Returns the plan when one was looked up.
-    /// Called only when a new sample (or a changed occupant) arrived.
+    /// The newest prediction's diagnostics pulse: ego acceleration, m/s², at
+    /// k · [`pulse::PULSE_DT_S`] after contact, and how many points are valid yet.
+    pub(crate) fn pulse(&self) -> (&[f32; crate::signals::PULSE_POINTS], usize) {
+        (self.pulse.points(), self.pulse.filled())
+    }
+
+    /// Samples the next chunk of the diagnostics pulse (every cycle; nothing once complete).
+    #[inline(always)]
+    pub(crate) fn fill_pulse(&mut self) {
+        self.pulse.fill(&self.solution);
+    }
+
+    /// The situation from the track: a new object sample goes into the track filter first (a
+    /// refused sample changes nothing). Runs the prediction and the LUT lookup when contact
+    /// is within the exit horizon. Returns the plan when one was looked up. Called only when
+    /// a new sample (or a changed occupant) arrived.
     #[inline(always)]
     pub(crate) fn update(
         &mut self,
@@ -235,37 +266,68 @@ impl<'a> Estimator<'a> {
         inputs: &InputMonitor,
         counters: &mut CycleCounters,
     ) -> Option<RestraintPlan> {
-        self.situation = None;
-        if !inputs.object_present || inputs.object_invalid {
+        if inputs.new_object {
+            let o = &inputs.object;
+            if !o.is_valid() {
+                self.track.end(); // the sensor reports no object: this track is over
+            }
+            if !inputs.object_present || inputs.object_invalid {
+                self.situation = None;
+                return None;
+            }
+            match self.track.update(o) {
+                TrackEvent::Updated => {}
+                TrackEvent::Started => {
+                    counters.track_starts = counters.track_starts.saturating_add(1);
+                }
+                TrackEvent::Outlier => {
+                    counters.track_outliers = counters.track_outliers.saturating_add(1);
+                }
+                TrackEvent::Refused(_) => {
+                    // Nothing new: the situation and plan of the last sample stand.
+                    counters.track_refused = counters.track_refused.saturating_add(1);
+                    return None;
+                }
+            }
+        } else if !inputs.object_present || inputs.object_invalid {
+            self.situation = None;
             return None;
         }
-        let o = inputs.object;
-        let c = time_to_contact(
-            f64::from(o.distance_m),
-            f64::from(o.closing_speed_mps),
-            f64::from(o.relative_accel_mps2),
-        )?;
-        let meas_ns = o.timestamp_ns.min(now);
-        let contact_ns = meas_ns.saturating_add((c.ttc_s * 1.0e9) as u64);
-        let m = f64::from(o.opponent_mass_kg);
-        let sigma = f64::from(o.opponent_mass_sigma_kg);
-        let opp_kg = m + self.conservative_mass_k * sigma;
-        let ebs_kph = equivalent_barrier_speed_kph(c.closing_speed_mps, self.ego_mass_kg, opp_kg);
-        let sit = Situation {
-            contact_ns,
-            closing_speed_mps: c.closing_speed_mps,
-            opponent_mass_kg: opp_kg,
-            ebs_kph,
-            low_speed: !(ebs_kph >= self.no_fire_ebs_kph),
+        let Some(e) = self.track.estimate_at(now) else {
+            self.situation = None; // no track, or it does not reach us
+            return None;
         };
+        let sit = self.situation_of(&e);
         self.situation = Some(sit);
         // Predict only what can become relevant before the next sample: contact within the
         // exit horizon (bounds the work to objects that matter).
-        if contact_ns.saturating_sub(now) > self.exit_horizon_ns || sit.low_speed {
+        if sit.contact_estimate_ns.saturating_sub(now) > self.exit_horizon_ns || sit.low_speed {
             return None;
         }
         self.predict(&sit, counters);
         Some(self.lookup(&sit, inputs, counters))
+    }
+
+    /// The situation of a track estimate.
+    fn situation_of(&self, e: &TrackEstimate) -> Situation {
+        let to_ns = |t_s: f64| (t_s * 1.0e9) as u64; // saturating, NaN → 0
+        let contact_estimate_ns = e.at_ns.saturating_add(to_ns(e.contact.ttc_s));
+        let early_ns = to_ns(self.contact_time_k * e.ttc_sigma_s);
+        let opp_kg = e.mass_kg + self.conservative_mass_k * e.mass_sigma_kg;
+        let v = e.contact.closing_speed_mps;
+        let ebs_kph = equivalent_barrier_speed_kph(v, self.ego_mass_kg, opp_kg);
+        Situation {
+            contact_ns: contact_estimate_ns.saturating_sub(early_ns),
+            contact_estimate_ns,
+            contact_sigma_s: e.ttc_sigma_s,
+            closing_speed_mps: v,
+            closing_speed_sigma_mps: e.closing_speed_sigma_mps,
+            opponent_mass_kg: opp_kg,
+            opponent_mass_estimate_kg: e.mass_kg,
+            opponent_mass_sigma_kg: e.mass_sigma_kg,
+            ebs_kph,
+            low_speed: !(ebs_kph >= self.no_fire_ebs_kph),
+        }
     }
 
     #[inline(always)]
@@ -280,22 +342,24 @@ impl<'a> Estimator<'a> {
             .and_then(Option::as_ref);
         let Some(spring) = spring else {
             self.summary = None;
+            self.pulse.clear();
             counters.prediction_errors = counters.prediction_errors.saturating_add(1);
             return;
         };
-        let input = CollisionInput {
-            step_s: self.prediction_step_ms * 1e-3,
-            ..CollisionInput::with_defaults(
-                spring,
-                self.ego_mass_kg,
-                sit.opponent_mass_kg,
-                sit.closing_speed_mps,
-            )
-        };
-        match simulate_collision(&input, &mut self.pulse) {
-            Ok(s) => self.summary = Some(s),
+        let input = CollisionInput::with_defaults(
+            spring,
+            self.ego_mass_kg,
+            sit.opponent_mass_kg,
+            sit.closing_speed_mps,
+        );
+        match self.solution.solve_in_place(&input) {
+            Ok(s) => {
+                self.summary = Some(*s);
+                self.pulse.restart();
+            }
             Err(_) => {
                 self.summary = None;
+                self.pulse.clear();
                 counters.prediction_errors = counters.prediction_errors.saturating_add(1);
             }
         }
