@@ -6,10 +6,10 @@
 //! picture nobody acts on within the cycle. The prediction itself (the summary: Δv, a_max,
 //! a_mean, contact duration) is complete in the cycle that makes it; the pulse follows from a
 //! kept [`SampleCursor`] (no re-entry cost) in the cycles *without* a new object sample (they
-//! run no filter, prediction or LUT query), [`POINTS_PER_CYCLE`] points or one segment entry
-//! per cycle, whichever comes first — ≈ 650 instructions at most. A 64-point pulse over a
-//! ten-segment crush curve is complete after 8–14 such cycles, i.e. before the next sample of
-//! a 20 ms object list. In CRASH and POST-CRASH nothing is filled (those cycles belong to
+//! run no filter, prediction or LUT query), [`POINTS_PER_CYCLE`] points or
+//! [`ENTRIES_PER_CYCLE`] segment entries per cycle, whichever comes first — ≈ 1 000
+//! instructions at most. A 64-point pulse over a ten-segment crush curve is complete after 8–9
+//! such cycles, i.e. before the next sample of a 10 ms object list. In CRASH and POST-CRASH nothing is filled (those cycles belong to
 //! the crash confirmation). The record always says how many points are valid
 //! (`pulse_points`); a newer prediction restarts the fill. Fewer points or a lower rate were
 //! the alternatives: fewer points lose the pulse's shape (64 points over 150 ms are 2.3 ms
@@ -22,6 +22,9 @@ use crate::signals::PULSE_POINTS;
 
 /// Points sampled per cycle.
 pub const POINTS_PER_CYCLE: usize = 8;
+
+/// Segment entries per cycle (an entry costs ≈ 300 instructions, a plain point ≈ 40).
+pub const ENTRIES_PER_CYCLE: usize = 2;
 
 /// Time between two diagnostics points, s (the 150 ms prediction window over 64 points).
 pub const PULSE_DT_S: f64 = PULSE_DURATION_S / PULSE_POINTS as f64;
@@ -59,20 +62,21 @@ impl DiagnosticsPulse {
     }
 
     /// Samples the next chunk of `sol` (the prediction this fill was restarted for): up to
-    /// [`POINTS_PER_CYCLE`] points, with at most one segment entry (the expensive step).
+    /// [`POINTS_PER_CYCLE`] points, with at most [`ENTRIES_PER_CYCLE`] segment entries (the
+    /// expensive step).
     #[inline(always)]
     pub(crate) fn fill(&mut self, sol: &ExactCollision) {
         let Some(cursor) = self.cursor.as_mut() else {
             return;
         };
         let end = (self.filled + POINTS_PER_CYCLE).min(PULSE_POINTS);
-        let mut entered = false;
+        let mut entries = 0;
         for p in self.points.iter_mut().take(end).skip(self.filled) {
             if cursor.next_enters(sol) {
-                if entered {
+                if entries == ENTRIES_PER_CYCLE {
                     break;
                 }
-                entered = true;
+                entries += 1;
             }
             *p = cursor.next(sol).ego_accel_mps2 as f32;
             self.filled += 1;
