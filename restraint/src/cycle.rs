@@ -170,10 +170,10 @@ impl Activity for RestraintCycle<'_> {
         if degraded {
             c.degraded_cycles = c.degraded_cycles.saturating_add(1);
         }
-        // Recompute the prediction only when its inputs changed materially.
-        if self.inputs.new_object
-            || (self.inputs.occupant_changed && self.estimate.situation.is_some())
-        {
+        // Recompute the situation only when its inputs changed materially.
+        let estimated = self.inputs.new_object
+            || (self.inputs.occupant_changed && self.estimate.situation.is_some());
+        if estimated {
             if let Some(plan) = self.estimate.update(now, &self.inputs, c) {
                 self.decision.plan = plan;
             }
@@ -189,9 +189,9 @@ impl Activity for RestraintCycle<'_> {
             detector: &self.inputs.detector,
         };
         self.decision.step(now, &x);
-        // The diagnostics pulse is sampled in the cycles that have time (estimate::pulse).
-        if !self.inputs.new_object && !matches!(self.phase(), Phase::Crash | Phase::PostCrash) {
-            self.estimate.fill_pulse();
+        // Prediction and diagnostics pulse in the cycles that have time (estimate docs).
+        if !estimated && !matches!(self.phase(), Phase::Crash | Phase::PostCrash) {
+            self.estimate.background(&mut self.counters);
         }
         let c = &mut self.counters;
         self.outputs

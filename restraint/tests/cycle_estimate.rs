@@ -134,19 +134,23 @@ fn an_out_of_order_sample_is_refused() {
 }
 
 #[test]
-fn the_diagnostics_pulse_is_the_prediction_sampled_and_completes_between_samples() {
+fn the_prediction_and_its_pulse_follow_the_sample_and_complete_before_the_next() {
     let mut b = Bench::oracle(Some(test_lut()));
-    // Up to the cycle of the sample at C − 150 ms (PRE-CRASH: predicted), then 9 idle cycles.
+    // Up to the cycle of the sample at C − 150 ms (PRE-CRASH: LUT looked up), then the next
+    // cycle (no sample: the prediction is solved), then 8 more (the pulse is sampled).
     approach(&mut b, C - 149 * MS, 0, &mut |_, _| {});
+    let predictions = b.ecu.counters().predictions;
+    b.run_ms(1);
+    assert_eq!(b.ecu.counters().predictions, predictions + 1);
     let d0 = *b.diagnostics.last().unwrap();
     assert!(d0.predicted_delta_v_mps > 5.0, "{d0:?}");
     assert_eq!(
         d0.pulse_points, 0,
         "nothing sampled in the prediction's own cycle"
     );
-    b.run_ms(9);
+    b.run_ms(8);
     let mut last = 0;
-    for d in &b.diagnostics[b.diagnostics.len() - 9..] {
+    for d in &b.diagnostics[b.diagnostics.len() - 8..] {
         assert!(d.pulse_points >= last, "monotonic fill");
         last = d.pulse_points;
     }

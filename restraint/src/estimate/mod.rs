@@ -4,10 +4,16 @@
 //! Per new object sample: the track filter ([`track`]: distance, closing speed and closing
 //! acceleration, latency-corrected, outliers gated, opponent mass fused) → time to contact,
 //! closing speed at contact and opponent mass with their σ at the cycle's time
-//! ([`Situation`]) → the collision prediction in closed form ([`physics::ExactCollision`]: no
-//! step size) → the characteristic-diagram query ([`Lut`]). The diagnostics pulse of the
-//! prediction is sampled a chunk per cycle ([`pulse`]). Everything is built in
-//! [`Estimator::new`]; nothing here allocates.
+//! ([`Situation`]) → the characteristic-diagram query ([`Lut`]) → the plan. That is the
+//! decision's path, done in the sample's cycle.
+//!
+//! The collision prediction in closed form ([`physics::ExactCollision`]: no step size) and
+//! its diagnostics pulse ([`pulse`]) are not on that path — no decision reads them; the
+//! diagnostics and the crash-phase work do — so they run in the following cycles that have
+//! time ([`Estimator::background`]: cycles without a new sample, outside CRASH): the pending
+//! prediction first (≈ 1 100 instructions), then the pulse a chunk per cycle. With object
+//! samples ≥ 5 ms apart the prediction of a sample is there 1 ms after it. Everything is
+//! built in [`Estimator::new`]; nothing here allocates.
 
 pub mod pulse;
 pub mod track;
@@ -181,6 +187,9 @@ pub struct Estimator<'a> {
     springs: [Option<CombinedSpring>; 6],
     track: TrackFilter,
     solution: ExactCollision,
+    /// The prediction the newest situation asks for, not yet solved: (spring index,
+    /// conservative opponent kg, closing speed m/s).
+    pending: Option<(usize, f64, f64)>,
     pulse: DiagnosticsPulse,
     lut: Option<Lut<'a>>,
     reference: RestraintPlan,
@@ -220,6 +229,7 @@ impl<'a> Estimator<'a> {
             springs,
             track: TrackFilter::new(&cfg.track, cfg.object_timeout_ms),
             solution: ExactCollision::new(),
+            pending: None,
             pulse: DiagnosticsPulse::new(),
             lut,
             reference,
@@ -249,16 +259,22 @@ impl<'a> Estimator<'a> {
         (self.pulse.points(), self.pulse.filled())
     }
 
-    /// Samples the next chunk of the diagnostics pulse (every cycle; nothing once complete).
+    /// The work no decision waits for, in a cycle that has time: the pending prediction if
+    /// there is one, else the next chunk of its diagnostics pulse (nothing once complete).
     #[inline(always)]
-    pub(crate) fn fill_pulse(&mut self) {
-        self.pulse.fill(&self.solution);
+    pub(crate) fn background(&mut self, counters: &mut CycleCounters) {
+        match self.pending.take() {
+            Some((spring, opp_kg, closing_mps)) => {
+                self.predict(spring, opp_kg, closing_mps, counters);
+            }
+            None => self.pulse.fill(&self.solution),
+        }
     }
 
     /// The situation from the track: a new object sample goes into the track filter first (a
-    /// refused sample changes nothing). Runs the prediction and the LUT lookup when contact
-    /// is within the exit horizon. Returns the plan when one was looked up. Called only when
-    /// a new sample (or a changed occupant) arrived.
+    /// refused sample changes nothing). Looks the LUT up and asks for a prediction
+    /// ([`Self::background`]) when contact is within the exit horizon. Returns the plan when
+    /// one was looked up. Called only when a new sample (or a changed occupant) arrived.
     #[inline(always)]
     pub(crate) fn update(
         &mut self,
@@ -304,7 +320,12 @@ impl<'a> Estimator<'a> {
         if sit.contact_estimate_ns.saturating_sub(now) > self.exit_horizon_ns || sit.low_speed {
             return None;
         }
-        self.predict(&sit, counters);
+        // Opponent class by the conservative mass; beyond the classes, the heaviest.
+        let class = physics::class_for_mass_kg(sit.opponent_mass_kg)
+            .map(MassClass::number)
+            .unwrap_or(6);
+        let spring = usize::from(class.saturating_sub(1));
+        self.pending = Some((spring, sit.opponent_mass_kg, sit.closing_speed_mps));
         Some(self.lookup(&sit, inputs, counters))
     }
 
@@ -330,28 +351,17 @@ impl<'a> Estimator<'a> {
         }
     }
 
+    /// Solves the collision of the opponent `spring` (index of the six combined springs).
     #[inline(always)]
-    fn predict(&mut self, sit: &Situation, counters: &mut CycleCounters) {
-        counters.predictions = counters.predictions.saturating_add(1);
-        let class = physics::class_for_mass_kg(sit.opponent_mass_kg)
-            .map(MassClass::number)
-            .unwrap_or(6);
-        let spring = self
-            .springs
-            .get(usize::from(class.saturating_sub(1)))
-            .and_then(Option::as_ref);
-        let Some(spring) = spring else {
+    fn predict(&mut self, spring: usize, opp_kg: f64, closing_mps: f64, c: &mut CycleCounters) {
+        c.predictions = c.predictions.saturating_add(1);
+        let Some(spring) = self.springs.get(spring).and_then(Option::as_ref) else {
             self.summary = None;
             self.pulse.clear();
-            counters.prediction_errors = counters.prediction_errors.saturating_add(1);
+            c.prediction_errors = c.prediction_errors.saturating_add(1);
             return;
         };
-        let input = CollisionInput::with_defaults(
-            spring,
-            self.ego_mass_kg,
-            sit.opponent_mass_kg,
-            sit.closing_speed_mps,
-        );
+        let input = CollisionInput::with_defaults(spring, self.ego_mass_kg, opp_kg, closing_mps);
         match self.solution.solve_in_place(&input) {
             Ok(s) => {
                 self.summary = Some(*s);
@@ -360,7 +370,7 @@ impl<'a> Estimator<'a> {
             Err(_) => {
                 self.summary = None;
                 self.pulse.clear();
-                counters.prediction_errors = counters.prediction_errors.saturating_add(1);
+                c.prediction_errors = c.prediction_errors.saturating_add(1);
             }
         }
     }

@@ -21,7 +21,7 @@ use physics::{defaults::PULSE_DURATION_S, ExactCollision, SampleCursor};
 use crate::signals::PULSE_POINTS;
 
 /// Points sampled per cycle.
-pub const POINTS_PER_CYCLE: usize = 8;
+pub const POINTS_PER_CYCLE: usize = 10;
 
 /// Segment entries per cycle (an entry costs ≈ 300 instructions, a plain point ≈ 40).
 pub const ENTRIES_PER_CYCLE: usize = 2;

@@ -273,11 +273,28 @@ fn predict_covariance(p: &Matrix3<f64>, tau: f64, q: f64) -> Matrix3<f64> {
 /// Q(τ) of the module docs for jerk density `q`.
 #[inline(always)]
 fn process_noise(q: f64, tau: f64) -> Matrix3<f64> {
-    let t2 = tau * tau;
-    let t3 = t2 * tau;
-    let (dd, dv, da) = (q * t3 * t2 / 20.0, -q * t2 * t2 / 8.0, -q * t3 / 6.0);
-    let (vv, va, aa) = (q * t3 / 3.0, q * t2 / 2.0, q * tau);
+    let q1 = q * tau;
+    let q2 = q1 * tau;
+    let q3 = q2 * tau;
+    let (dd, dv, da) = (0.05 * q3 * tau * tau, -0.125 * q3 * tau, -q3 * (1.0 / 6.0));
+    let (vv, va, aa) = (q3 * (1.0 / 3.0), 0.5 * q2, q1);
     Matrix3::new(dd, dv, da, dv, vv, va, da, va, aa)
+}
+
+/// A B for 3×3 matrices, written out (the generic product is not inlined into the cycle).
+#[inline(always)]
+fn product(a: &Matrix3<f64>, b: &Matrix3<f64>) -> Matrix3<f64> {
+    Matrix3::from_fn(|i, j| a[(i, 0)] * b[(0, j)] + a[(i, 1)] * b[(1, j)] + a[(i, 2)] * b[(2, j)])
+}
+
+/// A v for a 3×3 matrix, written out.
+#[inline(always)]
+fn apply(a: &Matrix3<f64>, v: &Vector3<f64>) -> Vector3<f64> {
+    Vector3::new(
+        a.m11 * v.x + a.m12 * v.y + a.m13 * v.z,
+        a.m21 * v.x + a.m22 * v.y + a.m23 * v.z,
+        a.m31 * v.x + a.m32 * v.y + a.m33 * v.z,
+    )
 }
 
 /// gᵀ P g for a symmetric P.
@@ -319,7 +336,8 @@ fn symmetric_inverse(s: &Matrix3<f64>) -> Option<Matrix3<f64>> {
 /// is computed and mirrored (column j of P is its row j).
 #[inline(always)]
 fn symmetric_product(k: &Matrix3<f64>, p: &Matrix3<f64>) -> Matrix3<f64> {
-    let e = |i: usize, j: usize| k.row(i).dot(&p.row(j));
+    let e =
+        |i: usize, j: usize| k[(i, 0)] * p[(0, j)] + k[(i, 1)] * p[(1, j)] + k[(i, 2)] * p[(2, j)];
     let (m11, m21, m31, m22, m32, m33) = (e(0, 0), e(1, 0), e(2, 0), e(1, 1), e(2, 1), e(2, 2));
     Matrix3::new(m11, m21, m31, m21, m22, m32, m31, m32, m33)
 }
@@ -416,8 +434,8 @@ impl TrackFilter {
             s.p = p_pred;
             return TrackEvent::Outlier;
         }
-        let k = p_pred * s_inv;
-        let x = x_pred + k * y;
+        let k = product(&p_pred, &s_inv);
+        let x = x_pred + apply(&k, &y);
         // P − K P⁻ is symmetric in exact arithmetic; computing one triangle keeps it exactly so.
         let p = p_pred - symmetric_product(&k, &p_pred);
         if !(x.iter().all(|v| v.is_finite()) && p.iter().all(|v| v.is_finite())) {
