@@ -3,9 +3,8 @@
 //!
 //! * `decision_only` — PRE-CRASH, no new input (inputs refreshed in untimed cycles): state
 //!   machine, scheduled fires, cyclic command/heartbeat encode + E2E, diagnostics record.
-//! * `full_precrash_worst_case` — PRE-CRASH with a NEW object sample every cycle: TTC
-//!   estimate + full collision prediction (150 ms pulse at the ECU's
-//!   `prediction_step_ms`) + LUT interpolation + state machine + command encode.
+//! * `full_precrash_worst_case` — PRE-CRASH with a NEW object sample every cycle: track
+//!   filter + LUT interpolation + state machine + command encode (the hand-picked path).
 //! * `crash_confirmation` — the cycle whose 8-sample accelerometer batch confirms the crash
 //!   (detector + transition + fire scheduling + commands); state rebuilt outside the timing.
 
