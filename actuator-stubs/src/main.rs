@@ -280,7 +280,7 @@ fn build_report(
     let rel_ms = |t: u64| (contact_ns != 0).then_some((t as f64 - contact_ns as f64) * 1e-6);
     let since_start_s =
         |t: u64| (truth.start_ns != 0).then_some((t as f64 - truth.start_ns as f64) * 1e-9);
-    let e2e_rejected = bus::RejectReason::ALL
+    let e2e_rejected = <bus::RejectReason as bus::VariantArray>::VARIANTS
         .iter()
         .map(|r| {
             (

@@ -161,7 +161,7 @@ impl Receiver {
 
     /// SecOC rejections by reason (only reasons that occurred), both streams.
     pub fn secoc_rejected(&self) -> BTreeMap<String, u64> {
-        SecOcReject::ALL
+        <SecOcReject as bus::VariantArray>::VARIANTS
             .iter()
             .map(|r| {
                 let n: u64 = self

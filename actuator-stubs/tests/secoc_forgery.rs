@@ -99,7 +99,7 @@ fn forged_fire_commands_do_not_fire_and_are_counted() {
     assert_eq!(rejected.get("no_pending_command"), Some(&1));
     assert_eq!(rejected.len(), 2, "{rejected:?}");
     // Authenticators are not E2E frames: no E2E rejection on this sequence.
-    let e2e_rejected: u64 = bus::RejectReason::ALL
+    let e2e_rejected: u64 = <bus::RejectReason as bus::VariantArray>::VARIANTS
         .iter()
         .map(|r| rx.checker().stats().rejected_for(*r))
         .sum();

@@ -504,7 +504,13 @@ fn info_at(now: u64, cycle: u64) -> CycleInfo {
 pub fn prepare(case: &CycleCase) -> anyhow::Result<Prepared> {
     let case = case.clone().clamped();
     let lut = if case.lut {
-        Some(ecu::lut_input(default_table()?))
+        let d = default_table()?;
+        Some(restraint::Lut {
+            view: d.view(),
+            id: d.lut_id(),
+            ego_mass_kg: d.header().ego.mass_kg,
+            ego_class: d.header().ego.class,
+        })
     } else {
         None
     };

@@ -33,6 +33,8 @@ mod meta {
     use crate::codec::*;
     include!(concat!(env!("OUT_DIR"), "/restraint_meta.rs"));
 }
+pub use strum::{EnumCount, VariantArray};
+
 pub use meta::{
     encode_values, message_name, signal_values, signals_of, E2E_MESSAGE_COUNT, MESSAGES,
 };
@@ -408,8 +410,22 @@ pub enum RxError {
     OutOfRange(&'static str),
 }
 
-/// [`RxError`] without its details, for counting rejections by reason.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+/// [`RxError`] without its details, for counting rejections by reason. `COUNT`,
+/// `VARIANTS` (index order) and the report names (`name`) are derived (strum).
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    strum::EnumCount,
+    strum::VariantArray,
+    strum::IntoStaticStr,
+)]
+#[strum(serialize_all = "snake_case")]
 #[repr(u8)]
 pub enum RejectReason {
     /// [`RxError::UnknownId`]
@@ -427,28 +443,10 @@ pub enum RejectReason {
 }
 
 impl RejectReason {
-    /// Number of reasons (size of [`RxStats::rejected`]).
-    pub const COUNT: usize = 6;
-    /// All reasons, in index order.
-    pub const ALL: [RejectReason; Self::COUNT] = [
-        Self::UnknownId,
-        Self::WrongDlc,
-        Self::CrcMismatch,
-        Self::CounterRepeated,
-        Self::CounterSkipped,
-        Self::OutOfRange,
-    ];
-    /// Stable short name for reports.
+    /// Stable short name for reports (`crc_mismatch`, …).
     #[must_use]
-    pub const fn name(self) -> &'static str {
-        match self {
-            Self::UnknownId => "unknown_id",
-            Self::WrongDlc => "wrong_dlc",
-            Self::CrcMismatch => "crc_mismatch",
-            Self::CounterRepeated => "counter_repeated",
-            Self::CounterSkipped => "counter_skipped",
-            Self::OutOfRange => "out_of_range",
-        }
+    pub fn name(self) -> &'static str {
+        self.into()
     }
 }
 

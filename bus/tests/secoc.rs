@@ -565,7 +565,10 @@ fn pairing_timeout_orphans_and_superseded_commands() {
 
 #[test]
 fn reject_reasons_have_stable_distinct_names() {
-    let names: Vec<&str> = SecOcReject::ALL.iter().map(|r| r.name()).collect();
+    let names: Vec<&str> = <SecOcReject as bus::VariantArray>::VARIANTS
+        .iter()
+        .map(|r| r.name())
+        .collect();
     assert_eq!(
         names,
         [
@@ -577,7 +580,10 @@ fn reject_reasons_have_stable_distinct_names() {
             "mac_mismatch"
         ]
     );
-    for (i, r) in SecOcReject::ALL.iter().enumerate() {
+    for (i, r) in <SecOcReject as bus::VariantArray>::VARIANTS
+        .iter()
+        .enumerate()
+    {
         assert_eq!(*r as usize, i);
     }
     let e = SecOcError::FreshnessStale {

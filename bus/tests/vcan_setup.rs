@@ -111,7 +111,8 @@ fn guest_mode_runs_a_real_kernel_with_vcan_and_shares_the_working_directory() {
         .args(["--guest", "--", "sh", "-c"])
         .arg(
             "test \"$VCAN_GUEST\" = 1 && test -d /proc/net/can && ip -d link show vcan0 | grep -q 'vcan' \
-             && uname -r > kernel.txt && echo \"$VCAN_ROUTE\" >> kernel.txt",
+             && uname -r > kernel.txt && echo \"$VCAN_ROUTE\" >> kernel.txt \
+             && echo \"$VCAN_GUEST_SCHED\" >> kernel.txt",
         )
         .current_dir(&dir)
         .stdin(Stdio::null())
@@ -124,6 +125,7 @@ fn guest_mode_runs_a_real_kernel_with_vcan_and_shares_the_working_directory() {
     let mut lines = written.lines();
     let guest_kernel = lines.next().unwrap_or_default();
     let guest_route = lines.next().unwrap_or_default();
+    let guest_sched = lines.next().unwrap_or_default();
     let host_kernel = text(&Command::new("uname").arg("-r").output().unwrap().stdout);
     assert!(
         guest_kernel.contains("amd64") && guest_kernel != host_kernel.trim(),
@@ -134,6 +136,16 @@ fn guest_mode_runs_a_real_kernel_with_vcan_and_shares_the_working_directory() {
         "{written}"
     );
     assert_eq!(route_named(&err).as_deref(), Some(guest_route), "{err}");
+    // root may run QEMU at SCHED_RR, and the guest is told how it ran
+    let root = text(&Command::new("id").arg("-u").output().unwrap().stdout).trim() == "0";
+    assert!(
+        if root {
+            guest_sched == "SCHED_RR 5"
+        } else {
+            guest_sched.starts_with("normal priority") || guest_sched.starts_with("SCHED_RR")
+        },
+        "QEMU's scheduling: {guest_sched:?}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 
     let o = run(&["--guest", "--", "false"]);

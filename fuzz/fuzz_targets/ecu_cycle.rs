@@ -138,8 +138,6 @@ struct CanGen {
     next_occupant_ns: u64,
 }
 
-}
-
 /// What the accelerometer input made possible so far (the independent fire oracle).
 #[derive(Default)]
 struct AccelFed {

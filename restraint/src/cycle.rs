@@ -6,7 +6,7 @@
 //! panic (property-tested and counted in `tests/cycle_*.rs`).
 
 use bus::secoc::SecOcTx;
-use bus::RejectReason;
+use bus::{EnumCount, RejectReason, VariantArray};
 use physics::CollisionSummary;
 
 use crate::config::{ConfigError, CycleConfig};
@@ -38,7 +38,7 @@ pub struct RestraintCycle<'lut> {
     counters: CycleCounters,
 }
 
-/// Report-counter names of the E2E rejections, in [`RejectReason::ALL`] order.
+/// Report-counter names of the E2E rejections, in [`RejectReason::VARIANTS`] order.
 const E2E_COUNTER_NAMES: [&str; RejectReason::COUNT] = [
     "can_rejected_unknown_id",
     "can_rejected_wrong_dlc",
@@ -241,8 +241,8 @@ impl Activity for RestraintCycle<'_> {
         ] {
             out(name, v);
         }
-        for (name, reason) in E2E_COUNTER_NAMES.iter().zip(RejectReason::ALL) {
-            out(name, e2e.rejected_for(reason));
+        for (name, reason) in E2E_COUNTER_NAMES.iter().zip(RejectReason::VARIANTS) {
+            out(name, e2e.rejected_for(*reason));
         }
     }
 }

@@ -112,9 +112,11 @@ impl Default for CrashAccelSample {
 /// Points of the predicted pulse carried in [`EcuDiagnostics`].
 pub const PULSE_POINTS: usize = 64;
 
-/// ECU operating mode as carried in diagnostics (`EcuDiagnostics::mode`).
+/// ECU operating mode as carried in diagnostics (`EcuDiagnostics::mode`). Byte values and
+/// display names (kebab case) are derived (strum).
 #[repr(u8)]
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, strum::FromRepr, strum::IntoStaticStr)]
+#[strum(serialize_all = "kebab-case")]
 pub enum EcuMode {
     /// Runtime up, cycle logic not yet running.
     Startup = 0,
@@ -133,27 +135,12 @@ pub enum EcuMode {
 impl EcuMode {
     /// Decodes a raw mode byte; unknown values map to `None`.
     pub fn from_u8(v: u8) -> Option<Self> {
-        Some(match v {
-            0 => Self::Startup,
-            1 => Self::Monitoring,
-            2 => Self::PreCrash,
-            3 => Self::Crash,
-            4 => Self::PostCrash,
-            5 => Self::Degraded,
-            _ => return None,
-        })
+        Self::from_repr(v)
     }
 
-    /// Short display name.
+    /// Short display name (`pre-crash`, …).
     pub fn name(self) -> &'static str {
-        match self {
-            Self::Startup => "startup",
-            Self::Monitoring => "monitoring",
-            Self::PreCrash => "pre-crash",
-            Self::Crash => "crash",
-            Self::PostCrash => "post-crash",
-            Self::Degraded => "degraded",
-        }
+        self.into()
     }
 }
 
@@ -340,6 +327,17 @@ mod tests {
             assert_eq!(EcuMode::from_u8(m).map(|x| x as u8), Some(m));
         }
         assert_eq!(EcuMode::from_u8(6), None);
+        // The names monitors and reports print.
+        let names = [0, 2, 4, 5].map(|m| EcuMode::from_u8(m).map(EcuMode::name));
+        assert_eq!(
+            names,
+            [
+                Some("startup"),
+                Some("pre-crash"),
+                Some("post-crash"),
+                Some("degraded")
+            ]
+        );
     }
 
     #[test]

@@ -343,9 +343,10 @@ pub struct Campaign {
     pub route: crate::Route,
     /// The allowances in force on that route, each with its reason (empty: none).
     pub allowances: Vec<String>,
-    /// The host's 1-minute load average when the run started (emulated timing follows it).
+    /// What the timing depended on besides the route ([`crate::Route::conditions`]: the host's
+    /// load at the start, QEMU's scheduling).
     #[serde(default)]
-    pub host_load: Option<f64>,
+    pub conditions: String,
     /// Cases.
     pub cases: Vec<CaseResult>,
 }
@@ -357,7 +358,7 @@ pub fn run_campaign(cfg: &CampaignConfig, only: &[String]) -> Result<Campaign> {
     let mut out = Campaign {
         route,
         allowances: allow.named(),
-        host_load: crate::Route::host_load(),
+        conditions: crate::Route::conditions(),
         cases: Vec::new(),
     };
     let all = cases();

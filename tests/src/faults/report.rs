@@ -13,9 +13,11 @@ pub fn report_text(c: &Campaign, fuzz: Option<&[FuzzTarget]>) -> String {
         "fault campaign on vcan, route {}: {}{}",
         c.route.name(),
         c.route.describe(),
-        c.host_load.map_or(String::new(), |l| format!(
-            " (host load {l:.2} at the start)"
-        ))
+        if c.conditions.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", c.conditions)
+        }
     );
     for a in &c.allowances {
         let _ = writeln!(s, "  allowance: {a}");
@@ -208,7 +210,7 @@ mod tests {
         let c = Campaign {
             route: crate::Route::QemuTcg,
             allowances: crate::Route::QemuTcg.allowances().named(),
-            host_load: Some(0.5),
+            conditions: "host load 0.50 at the start, QEMU at SCHED_RR 5".into(),
             cases: vec![case("baseline", true), flood, bad],
         };
         let text = report_text(&c, None);
