@@ -239,16 +239,31 @@ impl CycleCase {
     }
 }
 
-/// Loads a case file (JSON), clamped.
+/// Reads a case file: one JSON case or a list of them, each clamped.
 ///
 /// # Errors
 /// I/O or syntax errors, naming the file.
-pub fn load_case(path: &Path) -> anyhow::Result<CycleCase> {
+pub fn load_cases(path: &Path) -> anyhow::Result<Vec<CycleCase>> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let c: CycleCase = serde_json::from_str(&text)
-        .with_context(|| format!("{}: not a cycle case", path.display()))?;
-    Ok(c.clamped())
+    let v: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
+    let list = match v {
+        serde_json::Value::Array(a) => a,
+        one => vec![one],
+    };
+    list.into_iter()
+        .map(|c| {
+            let c: CycleCase = serde_json::from_value(c)
+                .with_context(|| format!("{}: not a cycle case", path.display()))?;
+            Ok(c.clamped())
+        })
+        .collect()
+}
+
+/// The committed seed of the gate's worst-case row (SecOC off), `benches/worst-case/seed.json`.
+pub fn seed_path() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("worst-case/seed.json")
 }
 
 /// The shipped table, loaded once per process.
@@ -273,7 +288,8 @@ fn secoc_tx() -> anyhow::Result<bus::secoc::SecOcTx> {
         .tx())
 }
 
-/// A cycle about to run the measured step of a case.
+/// A cycle about to run the measured step of a case (`Clone`: a bench replays it).
+#[derive(Clone)]
 pub struct Prepared {
     /// The cycle.
     pub ecu: RestraintCycle<'static>,

@@ -28,6 +28,8 @@ pub struct StartupNotes {
 
 /// The restraint decision activity. `'lut` is the life of the characteristic diagram it
 /// borrows (the shell keeps the loaded table alive as long as the cycle).
+/// `Clone` so a bench can replay one prepared cycle many times (the state is plain data).
+#[derive(Clone)]
 pub struct RestraintCycle<'lut> {
     cfg: CycleConfig,
     inputs: InputMonitor,

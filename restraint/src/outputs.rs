@@ -107,6 +107,7 @@ impl<T: PartialEq + Copy> Cyclic<T> {
 }
 
 /// State of the outputs.
+#[derive(Clone)]
 pub struct Outputs {
     protector: E2eProtector,
     secoc: Option<SecOcTx>,

@@ -67,20 +67,6 @@ enum Cmd {
     },
 }
 
-fn read_cases(path: &Path) -> anyhow::Result<Vec<CycleCase>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let v: serde_json::Value =
-        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
-    let list = match v {
-        serde_json::Value::Array(a) => a,
-        one => vec![one],
-    };
-    list.into_iter()
-        .map(|c| Ok(serde_json::from_value::<CycleCase>(c)?.clamped()))
-        .collect()
-}
-
 /// Instructions of each case's measured cycle (one callgrind run of `eval`) and its path.
 fn evaluate(cases: &[CycleCase], dir: &Path) -> anyhow::Result<Vec<(u64, String)>> {
     let file = dir.join(format!("worst-cycle-cases.{}.json", std::process::id()));
@@ -125,7 +111,7 @@ fn search(
     let survivors = (population / 4).max(1);
     let mut starts = vec![("hand-picked".to_owned(), CycleCase::hand_picked())];
     for p in start.iter().filter(|p| p.exists()) {
-        for c in read_cases(p)? {
+        for c in worst_case::load_cases(p)? {
             starts.push((p.display().to_string(), c));
         }
     }
@@ -153,7 +139,7 @@ fn search(
             .zip(cases)
             .map(|((n, path), c)| (n, c, path))
             .collect();
-        scored.sort_by(|a, b| b.0.cmp(&a.0));
+        scored.sort_by_key(|s| std::cmp::Reverse(s.0));
         for (n, c, _) in &scored {
             if budget.is_some_and(|b| *n > b) {
                 over.push((*n, c.clone()));
@@ -216,7 +202,7 @@ fn search(
 fn main() {
     let cli = Cli::parse();
     let r = match cli.command {
-        Cmd::Eval { cases } => read_cases(&cases).and_then(|cases| {
+        Cmd::Eval { cases } => worst_case::load_cases(&cases).and_then(|cases| {
             for c in &cases {
                 println!("{}", serde_json::to_string(&worst_case::run(c)?)?);
             }

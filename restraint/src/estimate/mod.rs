@@ -178,6 +178,7 @@ pub struct Situation {
 
 /// State of the estimate: track, situation, prediction (springs, kept solution, diagnostics
 /// pulse) and the LUT.
+#[derive(Clone)]
 pub struct Estimator<'a> {
     ego_mass_kg: f64,
     conservative_mass_k: f64,

@@ -284,7 +284,31 @@ fn process_noise(q: f64, tau: f64) -> Matrix3<f64> {
 /// A B for 3×3 matrices, written out (the generic product is not inlined into the cycle).
 #[inline(always)]
 fn product(a: &Matrix3<f64>, b: &Matrix3<f64>) -> Matrix3<f64> {
-    Matrix3::from_fn(|i, j| a[(i, 0)] * b[(0, j)] + a[(i, 1)] * b[(1, j)] + a[(i, 2)] * b[(2, j)])
+    let e =
+        |i: usize, j: usize| a[(i, 0)] * b[(0, j)] + a[(i, 1)] * b[(1, j)] + a[(i, 2)] * b[(2, j)];
+    Matrix3::new(
+        e(0, 0),
+        e(0, 1),
+        e(0, 2),
+        e(1, 0),
+        e(1, 1),
+        e(1, 2),
+        e(2, 0),
+        e(2, 1),
+        e(2, 2),
+    )
+}
+
+/// Whether every value is finite: a NaN or an infinity anywhere makes the sum non-finite
+/// (one check instead of one per value; finite values summing past f64::MAX also count as
+/// not finite, which only restarts a track that is far outside any physics anyway).
+#[inline(always)]
+fn all_finite<const N: usize>(values: [f64; N]) -> bool {
+    let mut sum = 0.0;
+    for v in values {
+        sum += v;
+    }
+    sum.is_finite()
 }
 
 /// A v for a 3×3 matrix, written out.
@@ -403,7 +427,7 @@ impl TrackFilter {
             f64::from(o.opponent_mass_kg),
             f64::from(o.opponent_mass_sigma_kg),
         );
-        if !(z.iter().all(|v| v.is_finite()) && m.is_finite() && sigma.is_finite()) {
+        if !all_finite([z.x, z.y, z.z, m, sigma]) {
             return TrackEvent::Refused(Refused::NonFinite);
         }
         let Some(s) = self.state.as_mut() else {
@@ -438,7 +462,10 @@ impl TrackFilter {
         let x = x_pred + apply(&k, &y);
         // P − K P⁻ is symmetric in exact arithmetic; computing one triangle keeps it exactly so.
         let p = p_pred - symmetric_product(&k, &p_pred);
-        if !(x.iter().all(|v| v.is_finite()) && p.iter().all(|v| v.is_finite())) {
+        let sym = [p.m11, p.m12, p.m13, p.m22, p.m23, p.m33]; // P is symmetric by construction
+        if !all_finite([
+            x.x, x.y, x.z, sym[0], sym[1], sym[2], sym[3], sym[4], sym[5],
+        ]) {
             return self.start(o, z, m, sigma);
         }
         s.t_ns = o.timestamp_ns;
