@@ -22,6 +22,9 @@ pub enum StudyCommand {
     /// Monte-Carlo: the pre-crash estimate's errors (payload, speed, distance) → spread of the
     /// occupant's outcome in one cell; locally or as a Slurm job array (--slurm N).
     Robustness(crate::cmd_robustness::RobustnessArgs),
+    /// The ECU's track filter against the newest sample alone over the scenario library and
+    /// noisier sensors: errors at contact, occupant outcome, a plot of one case.
+    Estimation(crate::cmd_estimation::EstimationArgs),
 }
 
 #[derive(Args, Debug)]
@@ -40,6 +43,7 @@ pub fn run(cmd: &StudyCommand) -> Result<()> {
         StudyCommand::OpponentMass(args) => crate::study_occ::opponent_mass(args),
         StudyCommand::Reduction(args) => crate::study_occ::reduction(args),
         StudyCommand::Robustness(args) => crate::cmd_robustness::run(args),
+        StudyCommand::Estimation(args) => crate::cmd_estimation::run(args),
     }
 }
 

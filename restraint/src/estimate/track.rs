@@ -23,6 +23,21 @@
 //! track is restarted from the newest sample: then the world, not the samples, changed (a
 //! manoeuvre the motion model did not expect).
 //!
+//! **Noise adaptation.** The configured R is the sensor's specification; in rain or fog it is
+//! noisier, and a filter that trusts R then gates good samples out and reports too small a σ.
+//! The filter keeps a scale λ ≥ 1 of R (covariance matching): the innovation y = z − x⁻ has
+//! E[y ᵀR⁻¹y] = tr(R⁻¹P⁻) + 3λ, so λ̂ = (y ᵀR⁻¹y − tr(R⁻¹P⁻))/3 is an unbiased one-sample
+//! estimate, averaged as λ ← (1 − α)λ + α·λ̂ (α = `noise_adaptation`, 0 = off), at least 1
+//! (never more trust than the specification), at most 100; when λ changes, the state's
+//! covariance scales by the same factor (it came from samples whose noise was misjudged
+//! alike; without this, a track started in bad weather keeps an overconfident covariance and
+//! corrects too slowly). The gate then uses the updated λ. Each λ̂ is clipped to
+//! [0, λ·gate/3], so one wild sample raises λ by at most a factor 1 + α(gate/3 − 1), while a
+//! sensor ten times noisier than specified — whose samples all start outside the gate — is
+//! recognised within a few samples instead of being rejected for ever. Outliers count for λ
+//! (clipped) but never move the state. λ belongs to the sensor, not to a track: a new track
+//! keeps it.
+//!
 //! **New track.** The state restarts from the sample (x = z, P = R) on the first sample, on
 //! a new tracker object id, after a gap longer than the object timeout, after a "no object"
 //! record ([`TrackFilter::end`]) and after `max_outliers` outliers in a row.
@@ -74,6 +89,9 @@ pub struct TrackConfig {
     /// Outliers in a row after which the track restarts from the newest sample
     /// (*default* 3: 60 ms of a 20 ms object list).
     pub max_outliers: u32,
+    /// Weight α of a sample in the measurement-noise scale λ (*default* 0.2: about the
+    /// last five samples; 0 switches the adaptation off; see the module docs).
+    pub noise_adaptation: f64,
     /// Share ρ of a mass sample's reported variance that is common to all samples
     /// (systematic), 0..=1 (*default* 0.5; see the module docs).
     pub mass_sigma_correlation: f64,
@@ -92,6 +110,7 @@ impl Default for TrackConfig {
             jerk_density_m2ps5: 200.0,
             gate_chi2: 16.27,
             max_outliers: 3,
+            noise_adaptation: 0.2,
             mass_sigma_correlation: 0.5,
             contact_time_k: 1.0,
         }
@@ -129,6 +148,7 @@ impl TrackConfig {
             1.0,
             100.0,
         )?;
+        range("track.noise_adaptation", self.noise_adaptation, 0.0, 1.0)?;
         range(
             "track.mass_sigma_correlation",
             self.mass_sigma_correlation,
@@ -224,6 +244,11 @@ pub struct TrackFilter {
     q: f64,
     gate_chi2: f64,
     max_outliers: u32,
+    alpha: f64,
+    /// Scale of R learnt from the innovations (≥ 1; see the module docs).
+    lambda: f64,
+    /// The diagonal of R.
+    r_diag: Vector3<f64>,
     gap_ns: u64,
     rho: f64,
     state: Option<State>,
@@ -370,16 +395,20 @@ impl TrackFilter {
     /// A filter with no track yet. `object_timeout_ms`: a gap longer than this between two
     /// samples restarts the track (the same limit after which the ECU calls the object stale).
     pub fn new(cfg: &TrackConfig, object_timeout_ms: f64) -> Self {
-        let r = Matrix3::from_diagonal(&Vector3::new(
+        let r_diag = Vector3::new(
             cfg.distance_sigma_m * cfg.distance_sigma_m,
             cfg.closing_speed_sigma_mps * cfg.closing_speed_sigma_mps,
             cfg.accel_sigma_mps2 * cfg.accel_sigma_mps2,
-        ));
+        );
+        let r = Matrix3::from_diagonal(&r_diag);
         Self {
             r,
             q: cfg.jerk_density_m2ps5,
             gate_chi2: cfg.gate_chi2,
             max_outliers: cfg.max_outliers.max(1),
+            alpha: cfg.noise_adaptation.clamp(0.0, 1.0),
+            lambda: 1.0,
+            r_diag,
             gap_ns: ms_to_ns(object_timeout_ms),
             rho: cfg.mass_sigma_correlation.clamp(0.0, 1.0),
             state: None,
@@ -396,6 +425,11 @@ impl TrackFilter {
         self.state = None;
     }
 
+    /// The measurement-noise scale λ learnt so far (1: the sensor is as specified).
+    pub fn noise_scale(&self) -> f64 {
+        self.lambda
+    }
+
     /// The state (d m, v m/s, a m/s²) and its covariance at the newest sample's time.
     pub fn state(&self) -> Option<(u64, Vector3<f64>, Matrix3<f64>)> {
         self.state.map(|s| (s.t_ns, s.x, s.p))
@@ -408,7 +442,7 @@ impl TrackFilter {
             object_id: o.object_id,
             t_ns: o.timestamp_ns,
             x: z,
-            p: self.r,
+            p: self.lambda * self.r,
             outliers_in_row: 0,
             mass,
         });
@@ -443,7 +477,21 @@ impl TrackFilter {
         let x_pred = predict_state(&s.x, tau);
         let p_pred = predict_covariance(&s.p, tau, self.q);
         let y = z - x_pred;
-        let Some(s_inv) = symmetric_inverse(&(p_pred + self.r)) else {
+        // Noise adaptation (module docs): E[yᵀR⁻¹y] = tr(R⁻¹P⁻) + 3λ, so each sample gives an
+        // unbiased estimate of λ; one sample moves λ by at most a factor 1 + α(gate/3 − 1).
+        let r = &self.r_diag;
+        let yry = y.x * y.x / r.x + y.y * y.y / r.y + y.z * y.z / r.z;
+        let trp = p_pred.m11 / r.x + p_pred.m22 / r.y + p_pred.m33 / r.z;
+        let seen = ((yry - trp) * (1.0 / 3.0)).clamp(0.0, self.lambda * self.gate_chi2 / 3.0);
+        let lambda = ((1.0 - self.alpha) * self.lambda + self.alpha * seen).clamp(1.0, 100.0);
+        // NaN (never from finite inputs) keeps the old value. The state's covariance came from
+        // samples whose noise was misjudged by the same factor: it scales with λ.
+        let mut p_pred = p_pred;
+        if lambda != self.lambda {
+            p_pred *= lambda / self.lambda;
+            self.lambda = lambda;
+        }
+        let Some(s_inv) = symmetric_inverse(&(p_pred + self.lambda * self.r)) else {
             return self.start(o, z, m, sigma);
         };
         let d2 = quadratic_form(&s_inv, &y);
