@@ -39,7 +39,7 @@ pub struct EstimationArgs {
     #[arg(long)]
     pub plot: Option<PathBuf>,
     /// Scenario of the plot.
-    #[arg(long, default_value = "taurus-48-48-abs")]
+    #[arg(long, default_value = "noisy-mass-estimate")]
     pub plot_scenario: String,
     /// Variation of the plot (index into the study's variations: 0 nominal, 1 noise ×3, …).
     #[arg(long, default_value_t = 1)]
@@ -270,7 +270,7 @@ impl plot::Figure for TraceFigure<'_> {
             m,
             &|h| h.mass_kg,
             &|h| h.mass_sigma_kg,
-            600.0,
+            1500.0,
         )?;
         Ok(())
     }

@@ -172,9 +172,13 @@ impl Activity for RestraintCycle<'_> {
         if degraded {
             c.degraded_cycles = c.degraded_cycles.saturating_add(1);
         }
-        // Recompute the situation only when its inputs changed materially.
-        let estimated = self.inputs.new_object
-            || (self.inputs.occupant_changed && self.estimate.situation.is_some());
+        // Recompute the situation only when its inputs changed materially, and only before
+        // the crash: from confirmation on the plan is latched and the estimate frozen (the
+        // tracker sees the opponent at the bumper; its cycles belong to the crash phase).
+        let crashed = matches!(self.decision.phase(), Phase::Crash | Phase::PostCrash);
+        let estimated = !crashed
+            && (self.inputs.new_object
+                || (self.inputs.occupant_changed && self.estimate.situation.is_some()));
         if estimated {
             if let Some(plan) = self.estimate.update(now, &self.inputs, c) {
                 self.decision.plan = plan;

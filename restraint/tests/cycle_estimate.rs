@@ -183,3 +183,33 @@ fn the_prediction_and_its_pulse_follow_the_sample_and_complete_before_the_next()
     }
     assert!(d.pulse_accel_mps2.iter().any(|a| *a < -100.0));
 }
+
+#[test]
+fn the_estimate_is_frozen_from_crash_confirmation_on() {
+    // Approach, then a 15 g pulse from contact: confirmed at C + 3 ms. Object samples that
+    // keep arriving afterwards (a tracker still reporting the opponent) run no filter and no
+    // LUT query: the plan is latched, those cycles belong to the crash phase.
+    let mut b = Bench::oracle(Some(test_lut()));
+    approach(&mut b, C, 0, &mut |_, _| {});
+    while b.now < C + 5 * MS {
+        b.push_accel(b.now, -15.0 * 9.806_65);
+        b.step();
+    }
+    assert!(matches!(
+        b.ecu.phase(),
+        restraint::Phase::Crash | restraint::Phase::PostCrash
+    ));
+    let (lookups, starts) = (b.ecu.counters().lut_lookups, b.ecu.counters().track_starts);
+    let situation = b.ecu.situation();
+    for k in 0..5u64 {
+        let mut o = object(b.now, 25.0, 1500.0, 100.0);
+        o.distance_m = 0.1 * k as f32;
+        b.io.push_object(o);
+        b.push_accel(b.now, -15.0 * 9.806_65);
+        b.run_ms(2);
+    }
+    assert_eq!(b.ecu.counters().lut_lookups, lookups);
+    assert_eq!(b.ecu.counters().track_starts, starts);
+    assert_eq!(b.ecu.situation(), situation);
+    assert!(b.ecu.counters().objects_rx >= 5);
+}

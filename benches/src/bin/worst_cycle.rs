@@ -3,8 +3,8 @@
 //! * `worst_cycle eval CASES.json` — prepares each case (a JSON case or list of cases) and
 //!   runs its measured cycle once, printing its path; what the search and the gate run under
 //!   callgrind, which counts only `measured_step`.
-//! * `worst_cycle search [--generations G] [--population P] [--seed S] [--secoc on|off]
-//!   [--start FILE]… [--budget N] [--out FILE]` — a seeded (μ + λ) evolution of cases,
+//! * `worst_cycle search [--generations G] [--population P] [--seed S] [--secoc on|off|any]
+//!   [--crash-phase] [--start FILE]… [--budget N] [--out FILE]` — a seeded (μ + λ) evolution of cases,
 //!   one callgrind run per generation; starts from the `--start` cases (the committed seeds)
 //!   and the hand-picked case plus random ones; writes the best case found to `--out`; exits 1
 //!   if any evaluated case exceeded `--budget` instructions (printing it).
@@ -55,6 +55,10 @@ enum Cmd {
         /// SecOC in the cases.
         #[arg(long, value_enum, default_value_t = Secoc::Off)]
         secoc: Secoc,
+        /// Count only measured cycles that start in CRASH or POST-CRASH (after the
+        /// confirmation: the cycles of the crash-phase work); others score 0.
+        #[arg(long)]
+        crash_phase: bool,
         /// Cases to start from (e.g. the committed seed); missing files are skipped.
         #[arg(long)]
         start: Vec<PathBuf>,
@@ -95,12 +99,18 @@ fn force_secoc(mut c: CycleCase, s: Secoc) -> CycleCase {
     c
 }
 
+/// Whether a path (the JSON line `eval` printed) starts in CRASH or POST-CRASH.
+fn starts_in_crash(path: &str) -> bool {
+    path.contains("\"phase_before\":\"crash\"") || path.contains("\"phase_before\":\"post-crash\"")
+}
+
 #[allow(clippy::too_many_arguments)]
 fn search(
     generations: u32,
     population: usize,
     seed: u64,
     secoc: Secoc,
+    crash_phase: bool,
     start: &[PathBuf],
     budget: Option<u64>,
     out: Option<&Path>,
@@ -137,7 +147,14 @@ fn search(
         let mut scored: Vec<(u64, CycleCase, String)> = results
             .into_iter()
             .zip(cases)
-            .map(|((n, path), c)| (n, c, path))
+            .map(|((n, path), c)| {
+                let n = if crash_phase && !starts_in_crash(&path) {
+                    0
+                } else {
+                    n
+                };
+                (n, c, path)
+            })
             .collect();
         scored.sort_by_key(|s| std::cmp::Reverse(s.0));
         for (n, c, _) in &scored {
@@ -174,7 +191,10 @@ fn search(
         }
     }
     let (n, case, path) = best.context("no generation evaluated")?;
-    println!("searched {evaluated} cases in {generations} generations of {population} (seed {seed}, SecOC {secoc:?})");
+    println!(
+        "searched {evaluated} cases in {generations} generations of {population} (seed {seed}, SecOC {secoc:?}{})",
+        if crash_phase { ", cycles after the confirmation only" } else { "" }
+    );
     println!("worst case found: {n} instructions; path {path}");
     for (name, c) in &start_counts {
         println!("  start case {name}: {c} instructions");
@@ -213,6 +233,7 @@ fn main() {
             population,
             seed,
             secoc,
+            crash_phase,
             start,
             budget,
             out,
@@ -221,6 +242,7 @@ fn main() {
             population,
             seed,
             secoc,
+            crash_phase,
             &start,
             budget,
             out.as_deref(),
