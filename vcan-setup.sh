@@ -391,7 +391,7 @@ run_guest() {
   "${QEMU_SCHED[@]}" "${QEMU[@]}" "${acc[@]}" -m "$MEM" -smp "$CPUS" \
     -nodefaults -no-user-config -display none -no-reboot -nic none \
     -kernel "$K/vmlinuz" -initrd "$K/initrd.gz" \
-    -append "console=ttyS0 loglevel=4 panic=-1 ${VCAN_GUEST_APPEND:-}" \
+    -append "console=ttyS0 loglevel=4 panic=-1 no_timer_check ${VCAN_GUEST_APPEND:-}" \
     -serial "file:$run/console.log" \
     -fsdev "local,id=root,path=/,readonly=on,$fs" -device virtio-9p-pci,fsdev=root,mount_tag=hostroot \
     "${rw[@]}" \

@@ -10,6 +10,16 @@ fn script() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../vcan-setup.sh")
 }
 
+/// One guest at a time: QEMU runs at SCHED_RR, and guests booting side by side on two CPUs
+/// take turns in 100 ms slices (6 parallel boots took ≈ 180 s, one after the other ≈ 50 s).
+static GUEST: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn one_at_a_time() -> std::sync::MutexGuard<'static, ()> {
+    GUEST
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
 fn run(args: &[&str]) -> Output {
     Command::new(script())
         .args(args)
@@ -36,6 +46,7 @@ fn route_named(stderr: &str) -> Option<String> {
 
 #[test]
 fn setup_twice_is_harmless_and_names_the_route() {
+    let _guest = one_at_a_time();
     let a = run(&[]);
     let b = run(&[]);
     for o in [&a, &b] {
@@ -64,6 +75,7 @@ fn setup_twice_is_harmless_and_names_the_route() {
 
 #[test]
 fn check_prints_the_route_and_its_exit_code() {
+    let _guest = one_at_a_time();
     let o = run(&["--check"]);
     let printed = text(&o.stdout);
     match (o.status.code(), printed.trim()) {
@@ -78,6 +90,7 @@ fn check_prints_the_route_and_its_exit_code() {
 
 #[test]
 fn run_mode_propagates_exit_code_streams_env_and_iface() {
+    let _guest = one_at_a_time();
     let o = Command::new(script())
         .args(["--iface", "vcan7", "--run", "--", "sh", "-c"])
         .arg("ip -d link show \"$VCAN\" | grep -q 'vcan' && echo \"iface=$VCAN bench=$BENCH_PROBE arg=$0 pwd=$(pwd) route=$VCAN_ROUTE\"; echo oops >&2; exit 42")
@@ -104,6 +117,7 @@ fn run_mode_propagates_exit_code_streams_env_and_iface() {
 
 #[test]
 fn guest_mode_runs_a_real_kernel_with_vcan_and_shares_the_working_directory() {
+    let _guest = one_at_a_time();
     // A directory under /tmp: the guest's own /tmp is a fresh tmpfs, so this proves the share.
     let dir = std::env::temp_dir().join(format!("vcan-setup-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -154,6 +168,7 @@ fn guest_mode_runs_a_real_kernel_with_vcan_and_shares_the_working_directory() {
 
 #[test]
 fn a_kvm_that_cannot_boot_the_guest_falls_back_to_tcg() {
+    let _guest = one_at_a_time();
     // Forced KVM: where /dev/kvm runs a stock kernel the guest boots under KVM; where it does
     // not (no /dev/kvm, a PVM /dev/kvm as on this project's CI VMs) the script must say so and
     // run the command under TCG instead — never fail or skip.
@@ -176,6 +191,7 @@ fn a_kvm_that_cannot_boot_the_guest_falls_back_to_tcg() {
 
 #[test]
 fn no_route_fails_loudly_with_the_reason_and_the_fix() {
+    let _guest = one_at_a_time();
     // A guest that cannot be prepared (its cache cannot be created): exit 4, said why.
     let o = Command::new(script())
         .args(["--guest", "--", "true"])

@@ -131,16 +131,19 @@ fn forge_fire(counter: u8, freshness: u32, mac: u64) -> Result<(RawFrame, RawFra
     }
     // Crc, AliveCounter, Arm, Fire, CmdSource (adaptive), Stage (both), ForceLevel, FireTime.
     let mut cmd = bus::encode_values(
-        0x030,
+        bus::AirbagStageCmd::RAW_ID,
         &[0.0, f64::from(counter), 1.0, 1.0, 0.0, 3.0, 6.0, 0.0],
     )
     .map_err(|e| anyhow::anyhow!("encoding the forged command: {e:?}"))?;
-    let data_id = bus::message_info(0x030)
+    let data_id = bus::message_info(bus::AirbagStageCmd::RAW_ID)
         .and_then(|i| i.e2e_data_id)
         .context("AirbagStageCmd has an E2E data id in the DBC")?;
     cmd.data[0] = bus::e2e_crc(data_id, 0, cmd.payload());
-    let auth = bus::encode_values(0x031, &[f64::from(freshness), mac as f64])
-        .map_err(|e| anyhow::anyhow!("encoding the forged authenticator: {e:?}"))?;
+    let auth = bus::encode_values(
+        bus::AirbagStageAuth::RAW_ID,
+        &[f64::from(freshness), mac as f64],
+    )
+    .map_err(|e| anyhow::anyhow!("encoding the forged authenticator: {e:?}"))?;
     Ok((cmd, auth))
 }
 
@@ -233,11 +236,12 @@ mod tests {
 
     /// A genuine EgoVehicleState with alive counter 3 and a correct CRC.
     fn genuine() -> (u16, RawFrame) {
-        let data_id = bus::message_info(0x0A0)
+        let data_id = bus::message_info(bus::EgoVehicleState::RAW_ID)
             .and_then(|i| i.e2e_data_id)
             .expect("E2E id");
         // Crc, AliveCounter, BrakeState, EgoSpeed, EgoLongAccel.
-        let mut f = bus::encode_values(0x0A0, &[0.0, 3.0, 0.0, 13.0, 0.0]).expect("encode");
+        let mut f = bus::encode_values(bus::EgoVehicleState::RAW_ID, &[0.0, 3.0, 0.0, 13.0, 0.0])
+            .expect("encode");
         f.data[0] = bus::e2e_crc(data_id, 0, f.payload());
         (data_id, f)
     }
@@ -271,7 +275,9 @@ mod tests {
             .collect();
         assert_eq!(cansend_arg(&auth).split_once('#').map(|p| p.0), Some("031"));
         let mut checker = bus::E2eChecker::new();
-        let msg = checker.check(0x030, &bytes).expect("valid E2E");
+        let msg = checker
+            .check(bus::AirbagStageCmd::RAW_ID, &bytes)
+            .expect("valid E2E");
         match msg {
             bus::Messages::AirbagStageCmd(m) => {
                 assert!(

@@ -156,6 +156,12 @@ impl Checks {
     }
 
     fn check(&mut self, what: &str, ok: bool, detail: String) {
+        self.check_timed(what, ok, detail, false);
+    }
+
+    /// [`Self::check`] for a check that is a time limit in this run only (`timing`), e.g.
+    /// commands lost only because they arrived late.
+    fn check_timed(&mut self, what: &str, ok: bool, detail: String, timing: bool) {
         // A fire of the reference restraint with the ECU degraded only by inputs that went
         // stale is the specified fallback; under emulation the emulator's stalls can starve
         // the inputs, so a check it fails is a timing failure there (run again) and a
@@ -171,7 +177,8 @@ impl Checks {
             what: what.to_owned(),
             ok,
             detail,
-            timing: TIMING_CHECKS.contains(&what)
+            timing: timing
+                || TIMING_CHECKS.contains(&what)
                 || (starved_fire && crate::Route::current().allowances().starved_fire_is_timing),
         });
     }
@@ -347,6 +354,15 @@ struct Commands {
     late: u64,
 }
 
+/// Whether the commands lost beyond the `allowed` ones are all accounted for by `late` ones.
+/// Commands lost only because they came after the freshness window are a time limit: a
+/// failure with real timers, run again where the route's timing is emulated (the emulator
+/// stalled the ECU or the stubs); a command lost any other way is a function failure on every
+/// route.
+fn lost_only_late(lost: u64, allowed: u64, late: u64) -> bool {
+    lost > allowed && lost - allowed <= late
+}
+
 /// Checks that every genuine command was acted on and nothing else.
 fn judge_commands(
     checks: &mut Checks,
@@ -394,7 +410,8 @@ fn judge_commands(
         _ => 0,
     };
     let denied = lost.min(e2e_passing_attacks);
-    checks.check(
+    let lost_only_late = lost_only_late(lost, e2e_passing_attacks, late);
+    checks.check_timed(
         "no genuine command lost",
         lost <= e2e_passing_attacks,
         format!(
@@ -412,6 +429,7 @@ fn judge_commands(
                 String::new()
             }
         ),
+        lost_only_late,
     );
     Commands {
         sent,
@@ -713,6 +731,21 @@ fn describe_reaction(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn commands_lost_only_by_lateness_are_a_time_limit_and_others_are_not() {
+        assert!(!lost_only_late(0, 0, 0), "nothing lost: no failure at all");
+        assert!(lost_only_late(1, 0, 1));
+        assert!(
+            lost_only_late(3, 1, 2),
+            "beyond the attack allowance, all late"
+        );
+        assert!(!lost_only_late(2, 0, 1), "one lost without being late");
+        assert!(
+            !lost_only_late(1, 1, 0),
+            "within the attack allowance: passes anyway"
+        );
+    }
 
     #[test]
     fn flood_frames_on_the_command_ids_are_the_receptions_beyond_the_genuine_pairs() {

@@ -482,7 +482,8 @@ impl Disturbance for CaseDisturbance<'_> {
             Fault::Bus { mode, from_s, to_s } => {
                 let child = spawn_piped(
                     Command::new(ctx.bin("bus-inject"))
-                        .args(["mirror", "--can", can, "--mode", mode, "--id", "0x0A0"])
+                        .args(["mirror", "--can", can, "--mode", mode, "--id"])
+                        .arg(format!("{:#05x}", bus::EgoVehicleState::RAW_ID))
                         .arg("--epoch-ns")
                         .arg(ctx.epoch_ns.to_string())
                         .arg("--from-s")
@@ -694,14 +695,16 @@ pub fn recorded_fire_pair(candump_log: &Path) -> Result<(String, String)> {
             continue;
         };
         match (id, &fire) {
-            (0x030, None) => {
+            (bus::AirbagStageCmd::RAW_ID, None) => {
                 if let Ok(bus::Messages::AirbagStageCmd(m)) = bus::decode(id, &bytes) {
                     if matches!(m.fire(), bus::codec::AirbagStageCmdFire::Fire) {
                         fire = Some(frame.to_owned());
                     }
                 }
             }
-            (0x031, Some(cmd)) => return Ok((cmd.clone(), frame.to_owned())),
+            (bus::AirbagStageAuth::RAW_ID, Some(cmd)) => {
+                return Ok((cmd.clone(), frame.to_owned()))
+            }
             _ => {}
         }
     }
@@ -806,7 +809,7 @@ mod tests {
     /// `ID#HEX` of an AirbagStageCmd with the given Fire bit and a valid CRC.
     fn airbag(fire: bool, counter: u8) -> String {
         let mut f = bus::encode_values(
-            0x030,
+            bus::AirbagStageCmd::RAW_ID,
             &[
                 0.0,
                 f64::from(counter),
@@ -819,7 +822,7 @@ mod tests {
             ],
         )
         .expect("encode");
-        let data_id = bus::message_info(0x030)
+        let data_id = bus::message_info(bus::AirbagStageCmd::RAW_ID)
             .and_then(|i| i.e2e_data_id)
             .expect("id");
         f.data[0] = bus::e2e_crc(data_id, 0, f.payload());
