@@ -33,6 +33,13 @@ FUZZ_SECONDS=$FUZZ_SECONDS FUZZ_REPORT_JSON="$PWD/target/robustness/fuzz.json" t
 step "deterministic budget: instructions per worst-case ECU cycle (valgrind)"
 cargo run --release -q -p cycle-benches --bin budget -- --no-criterion
 
+step "worst-case search: a short run from the committed seeds, no case above the budget"
+# Seconds; the long search that found the seeds is in benches/README.md ("Worst case, searched").
+cargo run --release -q -p cycle-benches --bin worst_cycle -- search --generations 3 \
+  --population 16 --start benches/worst-case/seed.json --budget 6000
+cargo run --release -q -p cycle-benches --bin worst_cycle -- search --generations 3 \
+  --population 16 --secoc on --start benches/worst-case/seed-secoc.json --budget 9000
+
 step "robustness report (fault campaign of the tests above + fuzz smoke)"
 target/release/fault-campaign report --campaign target/robustness/campaign.json \
   --fuzz target/robustness/fuzz.json --host-timing target/robustness/host-timing.json

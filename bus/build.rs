@@ -143,10 +143,20 @@ fn generate_meta(dbc: &Dbc) -> String {
                 "{}: the CRC must be one whole byte",
                 msg.name
             );
-            assert!(ctr.size == 4, "{}: the alive counter is 4 bit", msg.name);
+            assert!(
+                ctr.size == 4 && ctr.byte_order == ByteOrder::LittleEndian,
+                "{}: the alive counter is 4 bit, Intel",
+                msg.name
+            );
             let slot = e2e_slot;
             e2e_slot += 1;
-            (data_id, crc.start_bit / 8, slot)
+            (
+                data_id,
+                crc.start_bit / 8,
+                slot,
+                crc.start_bit,
+                ctr.start_bit,
+            )
         });
 
         let cycle_s = cycle.map_or("None".to_string(), |c| format!("Some({c})"));
@@ -160,7 +170,7 @@ fn generate_meta(dbc: &Dbc) -> String {
         .unwrap();
         writeln!(name_arms, "        Messages::{ty}(_) => {:?},", msg.name).unwrap();
 
-        if let Some((data_id, crc_byte, slot)) = e2e {
+        if let Some((data_id, crc_byte, slot, crc_start, ctr_start)) = e2e {
             writeln!(
                 o,
                 "impl E2eMessage for {ty} {{
@@ -171,9 +181,9 @@ fn generate_meta(dbc: &Dbc) -> String {
     #[inline]
     fn payload(&self) -> &[u8] {{ self.raw() }}
     #[inline]
-    fn e2e_counter(&self) -> u8 {{ self.{ctr}_raw_val() }}
+    fn e2e_counter(&self) -> u8 {{ intel_raw(le_word(self.raw()), {ctr_start}, 4, false) as u8 }}
     #[inline]
-    fn e2e_crc(&self) -> u8 {{ self.{crc}_raw_val() }}
+    fn e2e_crc(&self) -> u8 {{ intel_raw(le_word(self.raw()), {crc_start}, 8, false) as u8 }}
     #[inline]
     fn set_e2e_counter(&mut self, counter: u8) {{ self.set_{ctr}_raw_val(counter & 0x0F) }}
     #[inline]
@@ -196,6 +206,12 @@ fn generate_meta(dbc: &Dbc) -> String {
 
         // Typed constructor with rounding, NaN rejection and range checks, plus the dynamic
         // (index-based) encode/decode used by tests, fuzzers and loggers.
+        // Every signal of this bus is Intel (little-endian); a Motorola signal would make the
+        // generator fall back to dbc-codegen's setters for its message.
+        let intel = msg
+            .signals
+            .iter()
+            .all(|s| s.byte_order == ByteOrder::LittleEndian && s.size < 64);
         let mut params = Vec::new();
         let mut body = String::new();
         let mut sig_rows = String::new();
@@ -270,9 +286,17 @@ fn generate_meta(dbc: &Dbc) -> String {
                 params.push(format!("{pname}: {rt}"));
                 writeln!(body, "        let raw = i128::from({pname});").unwrap();
             }
+            let store = if intel {
+                format!(
+                    "w = with_intel_raw(w, {}, {}, raw as i64);",
+                    s.start_bit, s.size
+                )
+            } else {
+                format!("m.set_{field}_raw_val(raw as {rt});")
+            };
             writeln!(
                 body,
-                "        if raw < {raw_min} || raw > {raw_max} {{ return Err({err}, kind: EncodeErrorKind::OutOfRange }}); }}\n        m.set_{field}_raw_val(raw as {rt});"
+                "        if raw < {raw_min} || raw > {raw_max} {{ return Err({err}, kind: EncodeErrorKind::OutOfRange }}); }}\n        {store}"
             )
             .unwrap();
         }
@@ -295,6 +319,27 @@ fn generate_meta(dbc: &Dbc) -> String {
             }
         }
         let nsig = msg.signals.len();
+        let new_err = format!(
+            "EncodeError {{ message: {:?}, signal: \"\", kind: EncodeErrorKind::OutOfRange }}",
+            msg.name
+        );
+        let (enc_head, enc_tail) = if intel {
+            (
+                "        let mut w = 0u64;\n".to_owned(),
+                format!(
+                    "        Self::try_from(&w.to_le_bytes()[..{}]).map_err(|_| {new_err})",
+                    msg.size
+                ),
+            )
+        } else {
+            (
+                format!(
+                    "        let mut m = Self::try_from(&[0u8; {}][..]).map_err(|_| {new_err})?;\n",
+                    msg.size
+                ),
+                "        Ok(m)".to_owned(),
+            )
+        };
         let e2e_note = if e2e.is_some() {
             "\n    /// `Crc` and `AliveCounter` are left 0: [`E2eProtector::protect`](crate::E2eProtector::protect) sets them."
         } else {
@@ -310,8 +355,7 @@ fn generate_meta(dbc: &Dbc) -> String {
     /// rejected with the signal's name.{e2e_note}
     #[allow(clippy::too_many_arguments, clippy::cast_possible_truncation, clippy::manual_range_contains, unused_comparisons)]
     pub fn encode({}) -> Result<Self, EncodeError> {{
-        let mut m = Self::try_from(&[0u8; {size}][..]).map_err(|_| EncodeError {{ message: {name:?}, signal: \"\", kind: EncodeErrorKind::OutOfRange }})?;
-{body}        Ok(m)
+{enc_head}{body}{enc_tail}
     }}
     /// The signals of this message, in DBC order (generated).
     pub const SIGNALS: &'static [SignalInfo] = &[
@@ -319,8 +363,6 @@ fn generate_meta(dbc: &Dbc) -> String {
 {value_tables}}}
 ",
             params.join(", "),
-            size = msg.size,
-            name = msg.name,
         )
         .unwrap();
         writeln!(sig_tables, "        {:#05x} => Some({ty}::SIGNALS),", id).unwrap();
@@ -351,10 +393,19 @@ fn generate_meta(dbc: &Dbc) -> String {
             if raw_min <= full_min && raw_max >= full_max {
                 continue; // every raw value is valid
             }
-            let raw = format!("(m.{field}_raw_val() as i128)");
+            let read = if intel {
+                format!(
+                    "i128::from(intel_raw(w, {}, {}, {}))",
+                    s.start_bit,
+                    s.size,
+                    s.value_type == ValueType::Signed
+                )
+            } else {
+                format!("m.{field}_raw_val() as i128")
+            };
             writeln!(
                 checks,
-                "            if {raw} < {raw_min} || {raw} > {raw_max} {{ return Some({:?}); }}",
+                "            let raw = {read};\n            if raw < {raw_min} || raw > {raw_max} {{ return Some({:?}); }}",
                 s.name
             )
             .unwrap();
@@ -362,9 +413,14 @@ fn generate_meta(dbc: &Dbc) -> String {
         if checks.is_empty() {
             writeln!(range_arms, "        Messages::{ty}(_) => None,").unwrap();
         } else {
+            let word = if intel {
+                "            let w = le_word(m.raw());\n"
+            } else {
+                ""
+            };
             writeln!(
                 range_arms,
-                "        Messages::{ty}(m) => {{\n{checks}            None\n        }}"
+                "        Messages::{ty}(m) => {{\n{word}{checks}            None\n        }}"
             )
             .unwrap();
         }

@@ -371,8 +371,8 @@ fn build_report(
         return Ok(report);
     }
     let t = Truth::new(scenario).map_err(|e| anyhow::anyhow!(e))?;
-    let Some(judged) =
-        outcome::evaluate(scenario, &t, modules, contact_ns, reference).map_err(|e| anyhow::anyhow!(e))?
+    let Some(judged) = outcome::evaluate(scenario, &t, modules, contact_ns, reference)
+        .map_err(|e| anyhow::anyhow!(e))?
     else {
         anyhow::bail!("bench truth reports a contact but the scenario's true physics has none");
     };

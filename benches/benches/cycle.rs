@@ -3,14 +3,17 @@
 //!
 //! * `decision_only` — PRE-CRASH, no new input (inputs refreshed in untimed cycles): state
 //!   machine, scheduled fires, cyclic command/heartbeat encode + E2E, diagnostics record.
-//! * `full_precrash_worst_case` — PRE-CRASH with a NEW object sample every cycle: TTC
-//!   estimate + full collision prediction (150 ms pulse at the ECU's
-//!   `prediction_step_ms`) + LUT interpolation + state machine + command encode.
+//! * `full_precrash_worst_case` — PRE-CRASH with a NEW object sample every cycle: track
+//!   filter + LUT interpolation + state machine + command encode (the hand-picked path).
 //! * `crash_confirmation` — the cycle whose 8-sample accelerometer batch confirms the crash
 //!   (detector + transition + fire scheduling + commands); state rebuilt outside the timing.
+//! * `searched_worst_case` — the measured cycle of the committed seed of the worst-case
+//!   search (`benches/worst-case/seed.json`, `worst_case::measured_step`), replayed from a
+//!   clone of the prepared cycle (the clone is outside the timing).
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use cycle_benches::ecu_cycle::{self, DecisionOnly, WorstCasePreCrash};
+use cycle_benches::worst_case;
 use restraint::Activity;
 use restraint::Phase;
 use std::hint::black_box;
@@ -49,6 +52,15 @@ fn bench_cycle(c: &mut Criterion) {
                 ecu
             },
             BatchSize::LargeInput,
+        )
+    });
+    let seed = worst_case::load_cases(&worst_case::seed_path()).expect("committed seed");
+    let prepared = worst_case::prepare(seed.first().expect("one case")).expect("set-up");
+    g.bench_function("searched_worst_case", |b| {
+        b.iter_batched_ref(
+            || prepared.clone(),
+            worst_case::measured_step,
+            BatchSize::SmallInput,
         )
     });
     g.finish();

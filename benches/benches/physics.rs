@@ -1,7 +1,7 @@
 //! Physics: one collision prediction (150 ms of crash, symmetric Table 5 case with the
-//! combined curve) at the offline 0.1 ms step (LUT building) and at the ECU's per-cycle step
-//! (`restraint::CycleConfig::default().prediction_step_ms`, 0.5 ms — what runs inside the
-//! cycle), and one occupant simulation on that pulse (LUT building, thousands per cell).
+//! combined curve) at the offline 0.1 ms step (LUT building) and at the 0.5 ms step the ECU
+//! integrated at before it switched to the closed form (`FORMER_ECU_STEP_S`, for comparison),
+//! and one occupant simulation on that pulse (LUT building, thousands per cell).
 //!
 //! The closed-form solution (`physics::exact`) of the same cases: the summary alone (what the
 //! ECU needs per cycle), solve + the 64 diagnostics points, and the 150 ms pulse at 0.1 ms
@@ -9,7 +9,7 @@
 //! default table's opponent-mass × closing-speed axes) for both methods.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use cycle_benches::workload::PredictionWorkload;
+use cycle_benches::workload::{PredictionWorkload, FORMER_ECU_STEP_S};
 use physics::{
     collision::{simulate_collision, CollisionInput, DefaultPulseBuffer},
     kph_to_mps, predict_summary, simulate_collision_exact, simulate_occupant, stiffness,
@@ -27,7 +27,7 @@ fn bench_physics(c: &mut Criterion) {
         b.iter(|| simulate_collision(black_box(&input), &mut buf).expect("valid"))
     });
     let ecu_input = CollisionInput {
-        step_s: restraint::CycleConfig::default().prediction_step_ms * 1e-3,
+        step_s: FORMER_ECU_STEP_S,
         ..input
     };
     c.bench_function("collision_prediction_150ms_ecu_step", |b| {

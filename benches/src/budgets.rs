@@ -67,6 +67,15 @@ pub struct IcountBudget {
     /// Iteration counts of the two callgrind runs (difference excludes start-up).
     #[serde(default = "default_iterations")]
     pub iterations: [u64; 2],
+    /// Instead of two runs: one run of `bin args…` in which callgrind collects only inside
+    /// this function (its demangled path); the row measures the most expensive call
+    /// (`icount::collected_totals`). For paths whose set-up is not a loop of the same
+    /// iteration, e.g. the searched worst-case cycle.
+    #[serde(default)]
+    pub collect: Option<String>,
+    /// Arguments of `bin` for a `collect` row (paths relative to the budgets file's folder).
+    #[serde(default)]
+    pub args: Vec<String>,
     /// Why this budget.
     #[serde(default)]
     pub note: String,

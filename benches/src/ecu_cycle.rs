@@ -2,11 +2,11 @@
 //! the `cycle` criterion bench and the `icount_cycle` callgrind binary so both time the same
 //! code on the same inputs:
 //!
-//! * [`WorstCasePreCrash`] — steady PRE-CRASH with a NEW object sample every cycle: TTC
-//!   estimate + full collision prediction (at the ECU's configured
-//!   `CycleConfig::prediction_step_ms`) + LUT interpolation + state machine + command encode
-//!   and E2E seal + diagnostics record. The bounded worst case of a cycle (objects arrive every
-//!   10–20 ms, so at most every 10th cycle pays this).
+//! * [`WorstCasePreCrash`] — the hand-picked worst case of issue 7: steady PRE-CRASH with a
+//!   NEW object sample every cycle: track filter + LUT interpolation + state machine +
+//!   command encode and E2E seal + diagnostics record (since issue 15 the closed-form
+//!   collision prediction runs in the next cycle without a sample, so a sample every cycle
+//!   never pays it; the searched worst case, `worst_case`, covers every path).
 //! * [`DecisionOnly`] — PRE-CRASH with no new input: state machine, scheduled fires, cyclic
 //!   command/heartbeat encode, diagnostics (the common cycle). Inputs are refreshed in untimed
 //!   extra cycles.
@@ -45,9 +45,9 @@ const CAN_EVERY: u64 = 8;
 
 /// Object 6.25 m ahead closing at 25 m/s in even and 25.5 m/s in odd cycles (~250 ms to
 /// contact): steady PRE-CRASH, inside the prediction horizon, so every new sample runs the
-/// full prediction + LUT; the alternating speed changes the LUT plan every cycle, so the
-/// airbag and belt commands are re-encoded and sealed every cycle (they are sent on change,
-/// else only every command period) — the worst case of the output stage too.
+/// track filter + LUT; the alternating speed moves the filtered estimate and with it the
+/// LUT plan, so the airbag and belt commands are re-encoded and sealed in most cycles (they
+/// are sent on change, else only every command period).
 pub fn object(now_ns: u64) -> ObjectState {
     let odd = (now_ns / MS) % 2 == 1;
     ObjectState {
@@ -245,22 +245,19 @@ impl WorstCasePreCrash {
         self.now_ns += MS;
     }
 
-    /// Checks that every measured cycle stayed in PRE-CRASH and ran the prediction and the
-    /// LUT lookup and re-sent the airbag and belt commands, and that no CAN input was
+    /// Checks that every measured cycle stayed in PRE-CRASH and ran the track filter and the
+    /// LUT lookup, that most re-sent the airbag and belt commands, and that no CAN input was
     /// rejected.
     ///
     /// # Errors
-    /// The measurement did not measure the worst-case path.
+    /// The measurement did not measure the hand-picked path.
     pub fn verify(&self) -> anyhow::Result<()> {
         anyhow::ensure!(self.ecu.phase() == Phase::PreCrash, "left PRE-CRASH");
-        let predicted = self.ecu.counters().predictions - self.predictions_before;
-        anyhow::ensure!(
-            predicted >= self.k,
-            "{predicted} predictions in {} cycles",
-            self.k
-        );
         let c = self.ecu.counters();
-        anyhow::ensure!(c.prediction_errors == 0, "prediction errors");
+        anyhow::ensure!(
+            c.predictions == self.predictions_before,
+            "a prediction ran in a sample cycle"
+        );
         let looked_up = c.lut_lookups - self.lookups_before;
         anyhow::ensure!(
             looked_up >= self.k,
@@ -269,8 +266,8 @@ impl WorstCasePreCrash {
         );
         let sent = self.io.can_tx_total - self.sent_before;
         anyhow::ensure!(
-            sent >= 2 * self.k,
-            "{sent} command frames in {} cycles (airbag + belt expected every cycle)",
+            sent >= self.k * 3 / 2,
+            "{sent} command frames in {} cycles (airbag + belt expected in most cycles)",
             self.k
         );
         let rej = rejected(&self.ecu) - self.rejected_before;

@@ -61,6 +61,59 @@ pub fn instructions_per_iteration(bin: &Path, n: [u64; 2], out_dir: &Path) -> an
     Ok((b - a) as f64 / (n[1] - n[0]) as f64)
 }
 
+/// Instructions of every call of `function` (a demangled path, e.g.
+/// `cycle_benches::worst_case::measured_step`) in one run of `bin args…`, in call order:
+/// callgrind collects only inside the function (`--collect-atstart=no --toggle-collect`) and
+/// dumps after each call (`--dump-after`), so start-up, set-up and everything between the
+/// calls is excluded exactly. Also returns the program's stdout.
+///
+/// # Errors
+/// valgrind missing or failing, or a dump without totals.
+pub fn collected_totals(
+    bin: &Path,
+    args: &[&str],
+    function: &str,
+    out_dir: &Path,
+) -> anyhow::Result<(Vec<u64>, String)> {
+    let stem = out_dir.join(format!(
+        "callgrind.{}.collect.{}",
+        bin.file_name().and_then(|f| f.to_str()).unwrap_or("bin"),
+        std::process::id()
+    ));
+    let out = Command::new("valgrind")
+        .arg("--tool=callgrind")
+        .arg("--collect-atstart=no")
+        .arg(format!("--toggle-collect={function}"))
+        .arg(format!("--dump-after={function}"))
+        .arg(format!("--callgrind-out-file={}", stem.display()))
+        .arg(bin)
+        .args(args)
+        .output()
+        .map_err(|e| anyhow::anyhow!("cannot start valgrind (apt-get install valgrind): {e}"))?;
+    let mut totals = Vec::new();
+    // Dump k goes to `<stem>.k`; the final file (nothing collected after the last call) is
+    // `<stem>`.
+    for k in 1.. {
+        let part = std::path::PathBuf::from(format!("{}.{k}", stem.display()));
+        let Ok(text) = std::fs::read_to_string(&part) else {
+            break;
+        };
+        let _ = std::fs::remove_file(&part);
+        totals.push(
+            parse_callgrind_total(&text)
+                .ok_or_else(|| anyhow::anyhow!("no totals in {}", part.display()))?,
+        );
+    }
+    let _ = std::fs::remove_file(&stem);
+    anyhow::ensure!(
+        out.status.success(),
+        "valgrind {} {args:?} failed: {}",
+        bin.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    Ok((totals, String::from_utf8_lossy(&out.stdout).into_owned()))
+}
+
 /// Iteration count from `argv[1]` for the `icount_*` binaries (default 1000).
 pub fn iterations_from_args() -> u64 {
     std::env::args()

@@ -12,6 +12,8 @@
 //! * [`gate`] — reading criterion's `estimates.json` and comparing with the budgets.
 //! * [`icount`] — instructions per iteration from two callgrind runs.
 //! * [`latency`] — cyclictest histogram and ECU report parsing for the loop harness.
+//! * [`worst_case`] — the search space of one cycle's inputs and state, searched for the
+//!   case with the most instructions (`worst_cycle`), the gate's worst-case row.
 
 pub mod budgets;
 pub mod ecu_cycle;
@@ -19,3 +21,4 @@ pub mod gate;
 pub mod icount;
 pub mod latency;
 pub mod workload;
+pub mod worst_case;

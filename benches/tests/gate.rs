@@ -107,3 +107,48 @@ fn instruction_count_gate_fails_below_and_passes_above_the_measured_count() {
         let _ = std::fs::remove_file(p);
     }
 }
+
+#[test]
+fn collected_count_of_the_searched_worst_case_fails_below_and_passes_above() {
+    if Command::new("valgrind").arg("--version").output().is_err() {
+        panic!("valgrind is required for the instruction-count gate (apt-get install valgrind)");
+    }
+    // The committed seed's one measured cycle is thousands of instructions: 10 is far below,
+    // 1 000 000 far above. The seed path is relative to the budgets file's folder, so the row
+    // names it absolutely here (the temporary file lives elsewhere).
+    let seed = concat!(env!("CARGO_MANIFEST_DIR"), "/worst-case/seed.json");
+    let row = |budget: f64| {
+        format!(
+            "[[icount]]\nstage = \"searched\"\nbin = \"worst_cycle\"\ncollect = \"cycle_benches::worst_case::measured_step\"\nargs = [\"eval\", \"{seed}\"]\nbudget_instructions = {budget}\n"
+        )
+    };
+    let low = budgets_file("collect-low", &row(10.0));
+    let (code, text) = gate(&low, &["--no-criterion"]);
+    assert_eq!(code, 1, "{text}");
+    assert!(
+        verdict_line(&text, "worst_cycle").contains("FAIL"),
+        "{text}"
+    );
+    let high = budgets_file("collect-high", &row(1e6));
+    let (code, text) = gate(&high, &["--no-criterion"]);
+    assert_eq!(code, 0, "{text}");
+    let line = verdict_line(&text, "worst_cycle");
+    assert!(
+        line.contains("PASS") && line.contains("max of 1 call"),
+        "{text}"
+    );
+    // A function that is never called is MISSING, not a pass with 0 instructions.
+    let wrong = budgets_file(
+        "collect-wrong",
+        &row(1e6).replace("measured_step", "no_such_function"),
+    );
+    let (code, text) = gate(&wrong, &["--no-criterion"]);
+    assert_eq!(code, 1, "{text}");
+    assert!(
+        verdict_line(&text, "worst_cycle").contains("MISSING"),
+        "{text}"
+    );
+    for p in [low, high, wrong] {
+        let _ = std::fs::remove_file(p);
+    }
+}

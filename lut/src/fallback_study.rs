@@ -185,7 +185,11 @@ impl Crash {
                     _ => 0.0,
                 }
             };
-            let braking = if crash > 0.0 { sensor.braking_mps2 } else { 0.0 };
+            let braking = if crash > 0.0 {
+                sensor.braking_mps2
+            } else {
+                0.0
+            };
             out.push(AccelSample {
                 t_ns: (t * 1e9).round() as u64,
                 dt_s: dt,
@@ -321,8 +325,10 @@ pub fn derive_boundary(curves: &[Vec<(f64, f64)>], margin: f64, floor_mps: f64) 
 pub fn families() -> Vec<Family> {
     let mut f = vec![Family::Barrier];
     f.extend(
-        [800.0, 1000.0, 1300.0, 1600.0, 1785.0, 2200.0, 2600.0, 3000.0]
-            .map(|m| Family::Car { opponent_kg: m }),
+        [
+            800.0, 1000.0, 1300.0, 1600.0, 1785.0, 2200.0, 2600.0, 3000.0,
+        ]
+        .map(|m| Family::Car { opponent_kg: m }),
     );
     f
 }
@@ -516,13 +522,20 @@ pub fn calibrate(rows: &[Row], no_fire_line_kph: f64, margin: f64) -> [f64; KNOT
 
 /// Every requirement a sweep's results break: a fire in a no-fire case; a must-fire case
 /// (EBS ≥ `must_kph`) not fired, or fired after its deadline.
-pub fn violations(rows: &[Row], no_fire_line_kph: f64, must_kph: f64, t_ref_ms: f64) -> Vec<String> {
+pub fn violations(
+    rows: &[Row],
+    no_fire_line_kph: f64,
+    must_kph: f64,
+    t_ref_ms: f64,
+) -> Vec<String> {
     let mut bad = Vec::new();
     for r in rows {
         let e = r.req.ebs_kph;
         let label = r.spec.family.label();
         if r.spec.no_fire(e, no_fire_line_kph) && r.fires(t_ref_ms) {
-            bad.push(format!("{label}, EBS {e:.1} km/h: fired below the no-fire line"));
+            bad.push(format!(
+                "{label}, EBS {e:.1} km/h: fired below the no-fire line"
+            ));
         }
         if e >= must_kph {
             for i in 0..r.measured.len() {

@@ -13,10 +13,13 @@
 //! * [`distributed`] — a computation split into N shards run as a Slurm job array plus a
 //!   dependent collect job: submit, watch, resume, status, collect.
 //! * [`robustness`] — the Monte-Carlo study of the pre-crash estimate's errors.
+//! * [`estimation`] — the ECU's track filter against the newest-sample estimate over the
+//!   scenario library and noisier sensors (`lut study estimation`).
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
 pub mod distributed;
+pub mod estimation;
 pub mod fallback_study;
 pub mod optimise;
 pub mod progress;

@@ -3,6 +3,7 @@
 //! Each sub-command lives in its own module; add new ones by adding a variant to [`Command`]
 //! and a module with `run(args)`.
 
+mod cmd_estimation;
 mod cmd_optim;
 mod cmd_robustness;
 mod cmd_simulate;

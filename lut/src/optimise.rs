@@ -189,7 +189,7 @@ pub struct OptimiserConfig {
 /// (+3 ms): its prediction-matched confirmation at the table's slowest closing speed (40 km/h)
 /// comes 3.6 ms after contact with the slowest accelerometer a scenario may have (1 kHz;
 /// 2.2 ms at the bench's 4 kHz), the batch is read up to two 1 ms cycles later: 2.6 ms late,
-/// + the CAN transfer, rounded up (`lut/tests/optimiser.rs` recomputes it with the ECU core's
+/// plus the CAN transfer, rounded up (`lut/tests/optimiser.rs` recomputes it with the ECU core's
 /// matcher).
 pub const DEFAULT_FIRE_DELAY_TOLERANCE_S: f64 = 0.003;
 

@@ -260,7 +260,38 @@ pub struct Sampler {
     pulse: Pulse,
     reference: RestraintSettings,
     hw: RestraintHardware,
-    job: RobustnessJob,
+    situation: Situation,
+    errors: EstimateErrors,
+    seed: u64,
+}
+
+/// What the ECU made of the situation: the LUT query's closing speed and opponent mass and
+/// the error of the contact instant it plans the pre-crash pretensioner with.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Estimate {
+    /// Closing speed the table is queried at [km/h].
+    pub closing_speed_kph: f64,
+    /// Opponent mass the table is queried at [kg] (the ECU's conservative m + k·σ).
+    pub opponent_mass_kg: f64,
+    /// Planned contact minus true contact [s] (a pre-crash pretensioner fires this late).
+    pub contact_error_s: f64,
+}
+
+/// The occupant's outcome with the restraint set for an [`Estimate`], on the true pulse.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Outcome {
+    /// Resulting error of a pre-crash pretensioner's firing time [ms] (0 if none).
+    pub pretensioner_shift_ms: f64,
+    /// The estimate was outside the table: reference restraint used.
+    pub fallback: bool,
+    /// Occupant peak acceleration [g].
+    pub a_max_g: f64,
+    /// Occupant mean acceleration [g].
+    pub a_mean_g: f64,
+    /// Maximum forward excursion [mm].
+    pub excursion_mm: f64,
+    /// Bottoming-out.
+    pub bottoming_out: bool,
 }
 
 impl Sampler {
@@ -276,19 +307,31 @@ impl Sampler {
                 job.table_crc32c
             );
         }
+        Ok(Sampler {
+            errors: job.errors,
+            seed: job.seed,
+            ..Self::with_table(table, job.situation)?
+        })
+    }
+
+    /// A sampler of one true situation with a loaded table (no error distribution: for
+    /// [`Sampler::outcome`] at estimates made elsewhere, e.g. `lut study estimation`). An
+    /// infinite opponent mass is a rigid barrier.
+    pub fn with_table(table: Diagram, situation: Situation) -> Result<Self> {
         let h = table.header();
         let ego = Ego {
             mass_kg: f64::from(h.ego.mass_kg),
             class: MassClass::new(h.ego.class)?,
         };
-        let s = &job.situation;
-        let pulse = Pulse::predict(
-            &ego,
+        let s = &situation;
+        let opponent = if s.opponent_mass_kg.is_infinite() {
+            Opponent::Barrier
+        } else {
             Opponent::Car {
                 mass_kg: s.opponent_mass_kg,
-            },
-            s.closing_speed_kph,
-        )?;
+            }
+        };
+        let pulse = Pulse::predict(&ego, opponent, s.closing_speed_kph)?;
         let reference = crate::reference::ReferenceRestraint::builtin()
             .map_err(|e| anyhow!("reference restraint: {e}"))?
             .settings();
@@ -297,22 +340,26 @@ impl Sampler {
             pulse,
             reference,
             hw: RestraintHardware::default(),
-            job: job.clone(),
+            situation,
+            errors: EstimateErrors {
+                mass_error_kg: 0.0,
+                speed_sigma_kph: 0.0,
+                distance_sigma_m: 0.0,
+                measurement_ttc_ms: 0.0,
+            },
+            seed: 0,
         })
     }
 
-    /// Outcome with the given estimate errors.
-    pub fn evaluate(
-        &self,
-        mass_err_kg: f64,
-        speed_err_kph: f64,
-        dist_err_m: f64,
-    ) -> Result<Sample> {
-        let s = &self.job.situation;
-        let est_kph = s.closing_speed_kph + speed_err_kph;
+    /// The occupant's outcome when the ECU looks the table up at `e` (interpolated, out of
+    /// range → the conventional reference restraint, as the ECU does) and the occupant rides
+    /// down the **true** pulse; a pretensioner planned before contact fires `e.contact_error_s`
+    /// late, airbag and post-contact pretensioner times count from the measured contact.
+    pub fn outcome(&self, e: &Estimate) -> Result<Outcome> {
+        let s = &self.situation;
         let q = Query {
-            closing_speed_kph: est_kph as f32,
-            opponent_mass_kg: (s.opponent_mass_kg + mass_err_kg) as f32,
+            closing_speed_kph: e.closing_speed_kph as f32,
+            opponent_mass_kg: e.opponent_mass_kg as f32,
             occupant_mass_kg: s.occupant_mass_kg as f32,
             seat_distance_mm: s.seat_distance_mm as f32,
         };
@@ -328,15 +375,10 @@ impl Sampler {
                 airbag_time_s: f64::from(l.values.airbag_time_ms) * 1e-3,
             }
         };
-        // Predicted contact from the disturbed distance and speed at the last object sample.
-        let t_s = self.job.errors.measurement_ttc_ms * 1e-3;
-        let v_mps = s.closing_speed_kph / 3.6;
-        let est_ttc_s = (v_mps * t_s + dist_err_m) / (est_kph / 3.6);
         let mut shift_ms = 0.0;
-        if set.pretensioner_time_s < 0.0 && est_ttc_s.is_finite() {
-            let shift_s = est_ttc_s - t_s;
-            set.pretensioner_time_s += shift_s;
-            shift_ms = shift_s * 1e3;
+        if set.pretensioner_time_s < 0.0 && e.contact_error_s.is_finite() {
+            set.pretensioner_time_s += e.contact_error_s;
+            shift_ms = e.contact_error_s * 1e3;
         }
         let q_true = Query {
             closing_speed_kph: s.closing_speed_kph as f32,
@@ -345,10 +387,7 @@ impl Sampler {
             seat_distance_mm: s.seat_distance_mm as f32,
         };
         let o = simulate_occupant(&self.pulse.ego(), &occupant_at(&q_true), &set, &self.hw)?;
-        Ok(Sample {
-            mass_error_kg: mass_err_kg,
-            speed_error_kph: speed_err_kph,
-            distance_error_m: dist_err_m,
+        Ok(Outcome {
             pretensioner_shift_ms: shift_ms,
             fallback,
             a_max_g: mps2_to_g(o.max_decel_mps2),
@@ -358,9 +397,41 @@ impl Sampler {
         })
     }
 
+    /// Outcome with the given estimate errors: the table is queried at the disturbed speed
+    /// and mass; the contact is predicted from the disturbed distance and speed at the last
+    /// object sample (`measurement_ttc_ms` before contact), i.e. off by `d_est/v_est − d/v`.
+    pub fn evaluate(
+        &self,
+        mass_err_kg: f64,
+        speed_err_kph: f64,
+        dist_err_m: f64,
+    ) -> Result<Sample> {
+        let s = &self.situation;
+        let est_kph = s.closing_speed_kph + speed_err_kph;
+        let t_s = self.errors.measurement_ttc_ms * 1e-3;
+        let v_mps = s.closing_speed_kph / 3.6;
+        let est_ttc_s = (v_mps * t_s + dist_err_m) / (est_kph / 3.6);
+        let o = self.outcome(&Estimate {
+            closing_speed_kph: est_kph,
+            opponent_mass_kg: s.opponent_mass_kg + mass_err_kg,
+            contact_error_s: est_ttc_s - t_s,
+        })?;
+        Ok(Sample {
+            mass_error_kg: mass_err_kg,
+            speed_error_kph: speed_err_kph,
+            distance_error_m: dist_err_m,
+            pretensioner_shift_ms: o.pretensioner_shift_ms,
+            fallback: o.fallback,
+            a_max_g: o.a_max_g,
+            a_mean_g: o.a_mean_g,
+            excursion_mm: o.excursion_mm,
+            bottoming_out: o.bottoming_out,
+        })
+    }
+
     /// Sample `index`.
     pub fn sample(&self, index: u64) -> Result<Sample> {
-        let (m, v, d) = draw_errors(&self.job.errors, self.job.seed, index);
+        let (m, v, d) = draw_errors(&self.errors, self.seed, index);
         self.evaluate(m, v, d)
     }
 

@@ -26,6 +26,9 @@ pub enum StudyCommand {
     /// crashes: no-fire and must-fire lines, fire times against the occupant's deadline;
     /// `--derive` calibrates its boundary.
     Fallback(crate::study_fallback::FallbackArgs),
+    /// The ECU's track filter against the newest sample alone over the scenario library and
+    /// noisier sensors: errors at contact, occupant outcome, a plot of one case.
+    Estimation(crate::cmd_estimation::EstimationArgs),
 }
 
 #[derive(Args, Debug)]
@@ -45,6 +48,7 @@ pub fn run(cmd: &StudyCommand) -> Result<()> {
         StudyCommand::Reduction(args) => crate::study_occ::reduction(args),
         StudyCommand::Robustness(args) => crate::cmd_robustness::run(args),
         StudyCommand::Fallback(args) => crate::study_fallback::run(args),
+        StudyCommand::Estimation(args) => crate::cmd_estimation::run(args),
     }
 }
 

@@ -100,7 +100,9 @@ pub fn run(args: &FallbackArgs) -> Result<()> {
             .filter(|r| r.req.ebs_kph >= must)
             .flat_map(|r| (0..r.measured.len()).map(move |i| (r, i)))
             .filter_map(|(r, i)| {
-                Some(r.deadline_ms(i, t_ref_ms)? - r.airbag_ms(i, t_ref_ms).unwrap_or(f64::INFINITY))
+                Some(
+                    r.deadline_ms(i, t_ref_ms)? - r.airbag_ms(i, t_ref_ms).unwrap_or(f64::INFINITY),
+                )
             })
             .fold(f64::INFINITY, f64::min);
         // Fired below the EBS line where the onset looked severe (a light opponent).
@@ -135,7 +137,11 @@ pub fn run(args: &FallbackArgs) -> Result<()> {
             ms(m.decision_ms),
             ms(r.airbag_ms(0, t_ref_ms)),
             ms(r.deadline_ms(0, t_ref_ms)),
-            if r.req.ebs_kph >= must { "  must fire" } else { "" }
+            if r.req.ebs_kph >= must {
+                "  must fire"
+            } else {
+                ""
+            }
         );
     }
     let bad = violations(&rows, no_fire, must, t_ref_ms);
@@ -170,13 +176,23 @@ pub fn run(args: &FallbackArgs) -> Result<()> {
     Ok(())
 }
 
-fn draw(path: &std::path::Path, rows: &[Row], no_fire: f64, must: f64, t_ref_ms: f64) -> Result<()> {
+fn draw(
+    path: &std::path::Path,
+    rows: &[Row],
+    no_fire: f64,
+    must: f64,
+    t_ref_ms: f64,
+) -> Result<()> {
     let mut data: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
     for family in [
         Family::Barrier,
         Family::Car { opponent_kg: 800.0 },
-        Family::Car { opponent_kg: 1785.0 },
-        Family::Car { opponent_kg: 3000.0 },
+        Family::Car {
+            opponent_kg: 1785.0,
+        },
+        Family::Car {
+            opponent_kg: 3000.0,
+        },
     ] {
         let (x, y): (Vec<f64>, Vec<f64>) = rows
             .iter()

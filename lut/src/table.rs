@@ -265,12 +265,17 @@ pub fn defaults_hash() -> String {
         defaults::PULSE_DURATION_S,
         defaults::RESTITUTION
     );
+    format!("{:016x}", fnv1a(text.as_bytes()))
+}
+
+/// FNV-1a (64 bit) of `bytes`.
+pub fn fnv1a(bytes: &[u8]) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in text.bytes() {
-        h ^= u64::from(b);
+    for b in bytes {
+        h ^= u64::from(*b);
         h = h.wrapping_mul(0x0000_0100_0000_01b3);
     }
-    format!("{h:016x}")
+    h
 }
 
 /// The belted occupant of a grid point.

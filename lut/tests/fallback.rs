@@ -41,9 +41,10 @@ fn it_also_holds_on_crashes_it_was_not_calibrated_on() {
         ebs_to_kph: 63.5,
         step_kph: 1.3,
         families: std::iter::once(Family::Barrier)
-            .chain([900.0, 1150.0, 1450.0, 2000.0, 2400.0, 2800.0].map(|m| Family::Car {
-                opponent_kg: m,
-            }))
+            .chain(
+                [900.0, 1150.0, 1450.0, 2000.0, 2400.0, 2800.0]
+                    .map(|m| Family::Car { opponent_kg: m }),
+            )
             .collect(),
         sensors: vec![
             SensorSpec::bench(11),

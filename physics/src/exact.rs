@@ -418,21 +418,9 @@ impl ExactCollision {
     /// multiply-adds per sample), re-entering each segment from its exact start state.
     /// `step_s` must be finite and > 0.
     pub fn samples(&self, step_s: f64) -> Result<Samples<'_>, PhysicsError> {
-        if !(step_s.is_finite() && step_s > 0.0) {
-            return Err(PhysicsError::InvalidInput(
-                "sampling step must be finite and > 0",
-            ));
-        }
         Ok(Samples {
             sol: self,
-            segs: self.segments(),
-            step_s,
-            k: 0,
-            seg: 0,
-            fresh: true,
-            sn: 0.0,
-            cn: 0.0,
-            state: (0.0, 0.0, 0.0),
+            cursor: SampleCursor::new(step_s)?,
         })
     }
 
@@ -454,15 +442,36 @@ impl ExactCollision {
     }
 }
 
-/// Iterator of [`ExactCollision::samples`].
+/// Iterator of [`ExactCollision::samples`]: a [`SampleCursor`] over a borrowed solution.
 #[derive(Clone, Debug)]
 pub struct Samples<'a> {
     sol: &'a ExactCollision,
-    segs: &'a [Segment],
+    cursor: SampleCursor,
+}
+
+impl Iterator for Samples<'_> {
+    type Item = PulseSample;
+
+    // Inlined into the caller's loop so that channels the caller does not read are never
+    // computed (the ECU's diagnostics read only the ego acceleration).
+    #[inline(always)]
+    fn next(&mut self) -> Option<PulseSample> {
+        Some(self.cursor.next(self.sol))
+    }
+}
+
+/// Where a sampler stands in a solution (next sample index, segment, the segment's one-step
+/// flow map and the previous state), without borrowing the solution: a caller that keeps its
+/// [`ExactCollision`] can sample a few points per call and resume later (the ECU fills its
+/// diagnostics pulse a chunk per cycle this way), at the cost of the iterator, with no
+/// re-entry. Used with another solution than the one it started on it yields that solution's
+/// states at wrong instants, but never panics.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SampleCursor {
     step_s: f64,
     /// Index of the next sample (signed: one-instruction conversion to f64).
     k: i64,
-    /// Segment of the next sample (cursor; = `segs.len()` after separation).
+    /// Segment of the next sample (cursor; = number of segments after separation).
     seg: usize,
     /// The cursor moved since the last sample: evaluate from the segment's start state.
     fresh: bool,
@@ -473,19 +482,61 @@ pub struct Samples<'a> {
     state: (f64, f64, f64),
 }
 
-impl Iterator for Samples<'_> {
-    type Item = PulseSample;
+impl SampleCursor {
+    /// Before the sample at t = 0 of a grid with `step_s` (finite, > 0).
+    pub fn new(step_s: f64) -> Result<Self, PhysicsError> {
+        if !(step_s.is_finite() && step_s > 0.0) {
+            return Err(PhysicsError::InvalidInput(
+                "sampling step must be finite and > 0",
+            ));
+        }
+        Ok(SampleCursor {
+            step_s,
+            k: 0,
+            seg: 0,
+            fresh: true,
+            sn: 0.0,
+            cn: 0.0,
+            state: (0.0, 0.0, 0.0),
+        })
+    }
 
-    // Inlined into the caller's loop so that channels the caller does not read are never
-    // computed (the ECU's diagnostics read only the ego acceleration).
+    /// Index of the sample the next [`SampleCursor::next`] returns.
+    pub fn index(&self) -> u64 {
+        self.k.max(0) as u64
+    }
+
+    /// The sampling step, s.
+    pub fn step_s(&self) -> f64 {
+        self.step_s
+    }
+
+    /// Whether the next [`SampleCursor::next`] on `sol` enters a segment — evaluates the
+    /// segment's flow from its start (a `sincos` and a `sqrt` each for the entry state and the
+    /// one-step map, ≈ 300 instructions) instead of one multiply-add step (≈ 40). A caller
+    /// with a per-call work limit stops before it.
+    pub fn next_enters(&self, sol: &ExactCollision) -> bool {
+        let t = self.k as f64 * self.step_s;
+        let segs = sol.segments();
+        let next = segs
+            .iter()
+            .skip(self.seg)
+            .position(|s| t < s.end_s)
+            .map(|i| i + self.seg);
+        next.is_some_and(|i| self.fresh || i != self.seg)
+    }
+
+    /// The state of `sol` at t = index · step, then moves on by one step. Within a segment it
+    /// advances with the segment's exact flow map over one step (a rotation for s > 0, a few
+    /// multiply-adds), re-entering each segment from its exact start state.
     #[inline(always)]
-    fn next(&mut self) -> Option<PulseSample> {
+    pub fn next(&mut self, sol: &ExactCollision) -> PulseSample {
         let t = self.k as f64 * self.step_s;
         self.k = self.k.saturating_add(1);
         loop {
-            let Some(seg) = self.segs.get(self.seg) else {
+            let Some(seg) = sol.segments().get(self.seg) else {
                 // After separation (or no contact at all).
-                return Some(self.sol.after);
+                return sol.after;
             };
             if t >= seg.end_s {
                 self.seg += 1;
@@ -504,7 +555,7 @@ impl Iterator for Samples<'_> {
                 self.state = (dx0 + ddx, u1, a1);
             }
             let (dx, u, a) = self.state;
-            return Some(self.sol.sample_of(seg, dx, u, a));
+            return sol.sample_of(seg, dx, u, a);
         }
     }
 }

@@ -39,7 +39,7 @@ pub use collision::{
     PulseBuffer, PulseSample, VehicleResult,
 };
 pub use error::PhysicsError;
-pub use exact::{predict_summary, simulate_collision_exact, ExactCollision};
+pub use exact::{predict_summary, simulate_collision_exact, ExactCollision, SampleCursor};
 pub use occupant::{
     ideal_constant_force_decel_mps2, simulate_occupant, simulate_occupant_observed, OccupantInput,
     OccupantOutcome, RestraintHardware, RestraintSettings,

@@ -5,7 +5,7 @@
 use physics::{
     class_for_mass_kg,
     collision::{simulate_collision, CollisionInput, CollisionSummary, PulseBuffer},
-    exact::{predict_summary, simulate_collision_exact, ExactCollision},
+    exact::{predict_summary, simulate_collision_exact, ExactCollision, SampleCursor},
     kph_to_mps, stiffness, CombinedSpring, Curve, PhysicsError,
 };
 use proptest::prelude::*;
@@ -418,6 +418,46 @@ fn sample_iterator_equals_direct_evaluation() {
             }
         }
     }
+}
+
+#[test]
+fn cursor_resumed_in_chunks_equals_the_iterator() {
+    // The ECU fills its diagnostics pulse a few points per cycle with a kept cursor: the
+    // chunks must join into exactly the iterator's sequence (same arithmetic, bit for bit).
+    let spring = table5_spring();
+    let sol = ExactCollision::solve(&input(&spring, 1785.0, 1500.0, 25.0, 0.1)).unwrap();
+    let step = 0.150 / 64.0;
+    let mut cursor = SampleCursor::new(step).unwrap();
+    let whole: Vec<f64> = sol
+        .samples(step)
+        .unwrap()
+        .take(64)
+        .map(|p| p.ego_accel_mps2)
+        .collect();
+    let mut chunked = Vec::new();
+    let mut entries = 0;
+    while chunked.len() < 64 {
+        assert_eq!(cursor.index(), chunked.len() as u64);
+        for _ in 0..8 {
+            entries += usize::from(cursor.next_enters(&sol));
+            chunked.push(cursor.next(&sol).ego_accel_mps2);
+        }
+    }
+    assert_eq!(chunked, whole);
+    // Every segment the 64 points touch is entered exactly once (the first point enters the
+    // first segment); after separation nothing is entered.
+    let touched = sol
+        .segments()
+        .iter()
+        .filter(|sg| (0..64).any(|k| (sg.start_s..sg.end_s).contains(&(k as f64 * step))))
+        .count();
+    assert_eq!(entries, touched, "{:?}", sol.segments());
+    assert!(touched >= 3, "a pulse over several segments: {touched}");
+    assert!(whole.iter().any(|a| *a < -100.0), "a real pulse: {whole:?}");
+    assert!(SampleCursor::new(0.0).is_err() && SampleCursor::new(f64::INFINITY).is_err());
+    // A cursor taken to another solution yields finite states, never a panic.
+    let other = ExactCollision::new();
+    assert!(cursor.next(&other).ego_accel_mps2.is_finite());
 }
 
 #[test]

@@ -120,8 +120,7 @@ impl AccelMonitor {
         let too_old = now.saturating_sub(first_ns) > self.timeout_ns;
         let in_future = first_ns > now.saturating_add(FUTURE_SLACK_NS);
         let backwards = self.next_from_ns.is_some_and(|t| first_ns < t);
-        if period_ns == 0 || period_ns > MAX_SAMPLE_PERIOD_NS || too_old || in_future || backwards
-        {
+        if period_ns == 0 || period_ns > MAX_SAMPLE_PERIOD_NS || too_old || in_future || backwards {
             self.faults.bad_time_batches = self.faults.bad_time_batches.saturating_add(1);
             self.implausible(now);
             return;
@@ -137,7 +136,8 @@ impl AccelMonitor {
             let v = f64::from(a);
             let magnitude = v.abs();
             if !(magnitude <= self.full_scale_mps2 * (1.0 + SATURATION_BAND)) {
-                self.faults.out_of_range_samples = self.faults.out_of_range_samples.saturating_add(1);
+                self.faults.out_of_range_samples =
+                    self.faults.out_of_range_samples.saturating_add(1);
                 self.implausible(now);
                 continue;
             }
@@ -272,7 +272,10 @@ mod tests {
         assert_eq!(passed, 80);
         assert!(!m.invalid(now));
         passed += feed(&mut m, now, [-7.25; 4]).len();
-        assert_eq!(passed, 80, "from 20 ms on the repeated reading is not a measurement");
+        assert_eq!(
+            passed, 80,
+            "from 20 ms on the repeated reading is not a measurement"
+        );
         assert!(m.invalid(now));
         assert_eq!(m.faults.stuck_events, 1);
         // It moves again: plausible, but held invalid for the hold time.

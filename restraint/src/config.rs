@@ -7,6 +7,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::estimate::track::TrackConfig;
+
 /// Decision-logic configuration. Every key is optional (defaults below).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -16,13 +18,6 @@ pub struct CycleConfig {
     pub ego_mass_kg: f64,
     /// Ego stiffness class 1..=6 (*default* 4 for 1785 kg).
     pub ego_class: u8,
-
-    /// Integration step of the per-cycle collision prediction, ms (*default* 0.5). Why not the
-    /// offline 0.1 ms: the prediction runs inside the 1 ms cycle, and 0.5 ms cuts its cost
-    /// five-fold while staying within 0.1 % on peak and 0.03 % on mean deceleration
-    /// (physics/README.md, "Accuracy vs step") — far below the ±300 kg opponent-mass
-    /// uncertainty that dominates the prediction error. Range 0.05..=2 ms.
-    pub prediction_step_ms: f64,
 
     /// k of the conservative opponent mass m + k·σ used for prediction and LUT lookup
     /// (*default* 1.0). Why: an opponent heavier than estimated raises the ego Δv and pulse,
@@ -138,6 +133,11 @@ pub struct CycleConfig {
     /// Alive-counter gap tolerated without rejection (AUTOSAR MaxDeltaCounter − 1;
     /// *default* 1: one lost frame on a loaded bus is not a fault).
     pub e2e_max_lost: u8,
+
+    /// The track filter of the object samples (`[cycle.track]`; see
+    /// [`crate::estimate::track`]). The collision prediction has no setting: it is solved in
+    /// closed form (no step size).
+    pub track: TrackConfig,
 }
 
 impl Default for CycleConfig {
@@ -145,7 +145,6 @@ impl Default for CycleConfig {
         Self {
             ego_mass_kg: 1785.0,
             ego_class: 4,
-            prediction_step_ms: 0.5,
             conservative_mass_k: 1.0,
             preset_horizon_ms: 300.0,
             preset_exit_hysteresis_ms: 200.0,
@@ -175,6 +174,7 @@ impl Default for CycleConfig {
             e2e_burst_window_ms: 100.0,
             e2e_hold_ms: 500.0,
             e2e_max_lost: 1,
+            track: TrackConfig::default(),
         }
     }
 }
@@ -204,7 +204,6 @@ impl CycleConfig {
         )?;
         range("avoided_margin_ms", self.avoided_margin_ms, 0.0, 1000.0)?;
         range("min_confidence", self.min_confidence, 0.0, 1.0)?;
-        range("prediction_step_ms", self.prediction_step_ms, 0.05, 2.0)?;
         range("no_fire_ebs_kph", self.no_fire_ebs_kph, 0.0, 100.0)?;
         range("confirm_wake_g", self.confirm_wake_g, 0.1, 50.0)?;
         range(
@@ -229,7 +228,12 @@ impl CycleConfig {
         range("match_min_ms", self.match_min_ms, 0.1, 20.0)?;
         range("match_window_ms", self.match_window_ms, 1.0, 500.0)?;
         range("match_tolerance", self.match_tolerance, 0.0, 1.0)?;
-        range("match_ratio_min", self.match_ratio_min, 0.1, 1.0 - self.match_tolerance)?;
+        range(
+            "match_ratio_min",
+            self.match_ratio_min,
+            0.1,
+            1.0 - self.match_tolerance,
+        )?;
         range(
             "match_ratio_max",
             self.match_ratio_max,
@@ -264,7 +268,7 @@ impl CycleConfig {
         )?;
         range("e2e_hold_ms", self.e2e_hold_ms, 0.0, 60_000.0)?;
         range("e2e_max_lost", f64::from(self.e2e_max_lost), 0.0, 14.0)?;
-        Ok(())
+        self.track.validate()
     }
 }
 

@@ -229,7 +229,11 @@ mod tests {
         // 1.2 g braking for a long time: below the wake threshold.
         feed(&mut d, 20_000_000, &[11.8; 800]);
         assert_eq!(d.confirmed_at_ns(), None);
-        assert_eq!(d.onset_ns(), None, "the spike's event reset after 10 ms quiet");
+        assert_eq!(
+            d.onset_ns(),
+            None,
+            "the spike's event reset after 10 ms quiet"
+        );
     }
 
     #[test]

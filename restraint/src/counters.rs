@@ -16,6 +16,13 @@ pub struct CycleCounters {
     pub accel_samples_rx: u64,
     /// CAN frames received.
     pub can_frames_rx: u64,
+    /// Object tracks started (first sample, new object id, after a gap or after outliers in
+    /// a row).
+    pub track_starts: u64,
+    /// Object samples rejected by the track filter's gate (not trusted).
+    pub track_outliers: u64,
+    /// Object samples refused by the track filter (not newer than the track, non-finite).
+    pub track_refused: u64,
     /// Collision predictions computed.
     pub predictions: u64,
     /// Predictions that failed (input outside the physics model).

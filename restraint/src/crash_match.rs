@@ -97,8 +97,14 @@ impl PredictedPulse {
         contact_ns: u64,
     ) -> Option<Self> {
         let mut p = Self::EMPTY;
-        p.solve_in_place(spring, ego_mass_kg, opponent_mass_kg, closing_mps, contact_ns)
-            .then_some(p)
+        p.solve_in_place(
+            spring,
+            ego_mass_kg,
+            opponent_mass_kg,
+            closing_mps,
+            contact_ns,
+        )
+        .then_some(p)
     }
 
     /// [`PredictedPulse::solve`] into this value without moving it (a few kB): false when the
@@ -402,7 +408,11 @@ mod tests {
         let p = predicted(&spring, 26.0);
         let k = 175.6e3 / 0.040 / 2.0;
         let oracle = k * 26.0 / 1785.0 * 1e-3;
-        assert!((p.slope_mps2_per_ms / oracle - 1.0).abs() < 2e-3, "{} vs {oracle}", p.slope_mps2_per_ms);
+        assert!(
+            (p.slope_mps2_per_ms / oracle - 1.0).abs() < 2e-3,
+            "{} vs {oracle}",
+            p.slope_mps2_per_ms
+        );
         // First knee at x = 80 mm of relative deflection, reached after ≈ 80 mm / 26 m/s.
         assert!((p.knee_ms - 80.0 / 26.0).abs() < 0.1, "{}", p.knee_ms);
     }
@@ -445,7 +455,10 @@ mod tests {
             MatchState::Mismatch(Mismatch::Timing)
         );
         let slow = predicted(&spring, 8.0).collision;
-        assert_eq!(run(pred, &slow, CONTACT), MatchState::Mismatch(Mismatch::Severity));
+        assert_eq!(
+            run(pred, &slow, CONTACT),
+            MatchState::Mismatch(Mismatch::Severity)
+        );
         // A pothole: 5 g for 1 ms, then nothing.
         let mut m = PulseMatch::new(params());
         for k in 0..40u64 {

@@ -29,6 +29,8 @@ pub struct StartupNotes {
 
 /// The restraint decision activity. `'lut` is the life of the characteristic diagram it
 /// borrows (the shell keeps the loaded table alive as long as the cycle).
+/// `Clone` so a bench can replay one prepared cycle many times (the state is plain data).
+#[derive(Clone)]
 pub struct RestraintCycle<'lut> {
     cfg: CycleConfig,
     inputs: InputMonitor,
@@ -199,12 +201,17 @@ impl Activity for RestraintCycle<'_> {
         if degraded {
             c.degraded_cycles = c.degraded_cycles.saturating_add(1);
         }
-        // Recompute the prediction only when its inputs changed materially — and not once the
-        // accelerometer shows a crash in progress (the object list then predicts nothing new).
-        if (self.inputs.new_object
-            || (self.inputs.occupant_changed && self.estimate.situation.is_some()))
+        // Recompute the situation only when its inputs changed materially, and only before
+        // the crash: from confirmation on the plan is latched and the estimate frozen (the
+        // tracker sees the opponent at the bumper; its cycles belong to the crash phase), and
+        // not once the accelerometer shows a crash in progress (the object list then predicts
+        // nothing new; the crash matcher keeps its own frozen prediction).
+        let crashed = matches!(self.decision.phase(), Phase::Crash | Phase::PostCrash);
+        let estimated = !crashed
             && !self.crash.awake()
-        {
+            && (self.inputs.new_object
+                || (self.inputs.occupant_changed && self.estimate.situation.is_some()));
+        if estimated {
             if let Some(plan) = self.estimate.update(now, &self.inputs, c) {
                 self.decision.plan = plan;
             }
@@ -239,6 +246,14 @@ impl Activity for RestraintCycle<'_> {
             replan: &mut replan,
         };
         self.decision.step(now, &mut x);
+        // Prediction and diagnostics pulse in the cycles that have time (estimate docs): not
+        // in a crash, nor while the accelerometer shows one in progress.
+        if !estimated
+            && !matches!(self.phase(), Phase::Crash | Phase::PostCrash)
+            && !self.crash.awake()
+        {
+            self.estimate.background(&mut self.counters);
+        }
         let c = &mut self.counters;
         self.outputs
             .write(info, io, &self.decision, &self.inputs, self.reasons, c);
@@ -273,6 +288,9 @@ impl Activity for RestraintCycle<'_> {
             ("can_frames_rx", c.can_frames_rx),
             ("can_accepted", e2e.accepted),
             ("can_lost_frames", e2e.lost_frames),
+            ("track_starts", c.track_starts),
+            ("track_outliers", c.track_outliers),
+            ("track_refused", c.track_refused),
             ("predictions", c.predictions),
             ("prediction_errors", c.prediction_errors),
             ("lut_lookups", c.lut_lookups),

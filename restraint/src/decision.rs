@@ -206,7 +206,11 @@ impl Decision {
     }
 
     /// The crash plan and its airbag gate for confirmation `c` (table in the module docs).
-    fn crash_plan_for(&self, c: &Confirmation, x: &mut DecisionInputs<'_>) -> (RestraintPlan, AirbagGate) {
+    fn crash_plan_for(
+        &self,
+        c: &Confirmation,
+        x: &mut DecisionInputs<'_>,
+    ) -> (RestraintPlan, AirbagGate) {
         let predicted = self.phase == Phase::PreCrash && !x.degraded;
         if let (ConfirmKind::Matched(e), true) = (c.kind, predicted) {
             // Follows the prediction: the preset plan (the radar's speed is the better

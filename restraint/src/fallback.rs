@@ -193,7 +193,10 @@ mod tests {
         validate_thresholds(&t).expect("default boundary is valid");
         let mut bad = t;
         bad[3] = bad[2] - 0.1;
-        assert_eq!(validate_thresholds(&bad).unwrap_err().key, "fallback_dv_mps");
+        assert_eq!(
+            validate_thresholds(&bad).unwrap_err().key,
+            "fallback_dv_mps"
+        );
         bad = t;
         bad[0] = 0.0;
         assert!(validate_thresholds(&bad).is_err());
@@ -207,7 +210,10 @@ mod tests {
         // Δv after n samples of a from rest (trapezoidal): (n − ½)·a·1 ms, at τ = n − 1 ms.
         let mut f = FallbackAlgorithm::new(lin);
         run(&mut f, 5.0, 80); // a = 49.03 m/s²: (n − ½)·0.04903 ≥ 0.075 + 0.025 n → n ≥ 4.14
-        assert_eq!(f.decision(), FallbackDecision::Fire(1_000_000_000 + 4_000_000));
+        assert_eq!(
+            f.decision(),
+            FallbackDecision::Fire(1_000_000_000 + 4_000_000)
+        );
         // 2 g: (n − ½)·0.0196 ≥ 0.075 + 0.025 n never holds (slope 0.0196 < 0.025): no fire,
         // closed at the first sample after the 60 ms window.
         let mut f = FallbackAlgorithm::new(lin);
@@ -222,7 +228,10 @@ mod tests {
     fn braking_never_wakes_it_and_a_new_event_after_the_quiet_gap_is_judged_afresh() {
         let mut f = FallbackAlgorithm::new(DEFAULT_DV_MPS);
         run(&mut f, 1.2, 200);
-        assert_eq!((f.decision(), f.onset_ns()), (FallbackDecision::Pending, None));
+        assert_eq!(
+            (f.decision(), f.onset_ns()),
+            (FallbackDecision::Pending, None)
+        );
         let mut f = FallbackAlgorithm::new([0.1; KNOTS]);
         run(&mut f, 2.0, 1); // Δv 0.0196 < 0.1: pending
         assert_eq!(f.decision(), FallbackDecision::Pending);

@@ -1,9 +1,10 @@
 //! The restraint ECU's logic, as a `no_std` core with no allocator.
 //!
 //! Per cycle: drain inputs (CAN through the bus crate's E2E checker, object states,
-//! accelerometer batches) → estimate (time to contact, closing speed at contact, conservative
-//! opponent mass, occupant) → collision prediction (`physics`, only when a new object sample
-//! arrived) → characteristic-diagram query (`diagram::DiagramView`) → decision state machine →
+//! accelerometer batches) → estimate (a track filter over the object samples: time to contact,
+//! closing speed at contact and opponent mass with their σ; occupant) → collision prediction
+//! (`physics::ExactCollision`, closed form, only when a new object sample arrived) →
+//! characteristic-diagram query (`diagram::DiagramView`) → decision state machine →
 //! E2E-protected, SecOC-authenticated CAN commands (on change and cyclically) → diagnostics
 //! record. One module per job, each with its own state:
 //!
@@ -15,7 +16,7 @@
 //! | [`crash_match`] | prediction-matched confirmation and the in-crash severity estimate |
 //! | [`fallback`] | the accelerometer-only airbag algorithm (no usable prediction) |
 //! | [`crash`] | the crash phase's evidence: which path confirmed, the backup, the re-plan |
-//! | [`estimate`] | situation, collision prediction, LUT query (the place for a track filter) |
+//! | [`estimate`] | track filter ([`estimate::track`]), situation, closed-form collision prediction, LUT query, diagnostics pulse |
 //! | [`decision`] | the state machine: preset, arm, fire, release, fall back |
 //! | [`outputs`] | command, status and diagnostics encoding, clock-timed cyclic sends |
 //! | [`contract`] | the activity contract a shell runs the cycle through |
@@ -57,6 +58,7 @@ pub use contract::{Activity, CycleInfo, CycleIo, IoError, ReceiveErrors, Startup
 pub use counters::CycleCounters;
 pub use cycle::{RestraintCycle, StartupNotes};
 pub use decision::{Phase, Pretensioner};
+pub use estimate::track::{Refused, TrackConfig, TrackEstimate, TrackEvent, TrackFilter};
 pub use estimate::{
     equivalent_barrier_speed_kph, time_to_contact, Contact, Lut, LutMismatch, Situation,
 };

@@ -18,10 +18,10 @@ use diagram::AirbagStage;
 use crate::contract::{CycleInfo, CycleIo};
 use crate::counters::CycleCounters;
 use crate::decision::{Decision, Phase, Pretensioner};
-use crate::estimate::Estimator;
+use crate::estimate::{pulse::PULSE_DT_S, Estimator};
 use crate::inputs::InputMonitor;
 use crate::plan::PlanSource;
-use crate::signals::{Degraded, EcuDiagnostics, PULSE_POINTS};
+use crate::signals::{Degraded, EcuDiagnostics};
 
 /// Contents of a belt-limiter command (for change detection).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -107,6 +107,7 @@ impl<T: PartialEq + Copy> Cyclic<T> {
 }
 
 /// State of the outputs.
+#[derive(Clone)]
 pub struct Outputs {
     protector: E2eProtector,
     secoc: Option<SecOcTx>,
@@ -346,12 +347,12 @@ pub(crate) fn publish_diagnostics(
 ) {
     let plan = d.active_plan();
     let mode = d.phase().mode() as u8;
-    let ttc_s = est.situation.map_or(f32::NAN, |s| {
-        ((s.contact_ns as f64 - info.now_ns as f64) * 1.0e-9) as f32
+    let sit = est.situation;
+    let ttc_s = sit.map_or(f32::NAN, |s| {
+        ((s.contact_estimate_ns as f64 - info.now_ns as f64) * 1.0e-9) as f32
     });
     let summary = est.summary;
-    let (pulse, step_s) = est.pulse();
-    let stride = pulse.len().div_ceil(PULSE_POINTS).max(1);
+    let (pulse, pulse_points) = est.pulse();
     let (objects_rx, accel_rx) = (counters.objects_rx, counters.accel_batches_rx);
     let last_obj = inputs.object.sequence;
     let last_acc = inputs.last_accel_sequence;
@@ -374,17 +375,10 @@ pub(crate) fn publish_diagnostics(
                 rec.predicted_a_max_mps2 = s.vehicle.a_max_mps2 as f32;
                 rec.predicted_a_mean_mps2 = s.vehicle.a_mean_mps2 as f32;
                 rec.predicted_contact_time_s = s.contact_duration_s as f32;
-                let mut n = 0usize;
-                // Every `stride`-th sample: the first of each chunk (cheaper than `step_by`).
-                for (dst, chunk) in rec.pulse_accel_mps2.iter_mut().zip(pulse.chunks(stride)) {
-                    *dst = chunk.first().map_or(0.0, |v| *v as f32);
-                    n += 1;
-                }
-                for dst in rec.pulse_accel_mps2.iter_mut().skip(n) {
-                    *dst = 0.0;
-                }
-                rec.pulse_points = n as u32;
-                rec.pulse_dt_s = (step_s * stride as f64) as f32;
+                // Filled a chunk per cycle after the prediction (estimate::pulse).
+                rec.pulse_accel_mps2 = *pulse;
+                rec.pulse_points = pulse_points as u32;
+                rec.pulse_dt_s = PULSE_DT_S as f32;
             }
             None => {
                 let z = &EcuDiagnostics::ZERO;
@@ -398,6 +392,12 @@ pub(crate) fn publish_diagnostics(
             }
         }
         rec.time_to_contact_s = ttc_s;
+        let nan = f32::NAN;
+        rec.time_to_contact_sigma_s = sit.map_or(nan, |s| s.contact_sigma_s as f32);
+        rec.closing_speed_mps = sit.map_or(nan, |s| s.closing_speed_mps as f32);
+        rec.closing_speed_sigma_mps = sit.map_or(nan, |s| s.closing_speed_sigma_mps as f32);
+        rec.opponent_mass_kg = sit.map_or(nan, |s| s.opponent_mass_estimate_kg as f32);
+        rec.opponent_mass_sigma_kg = sit.map_or(nan, |s| s.opponent_mass_sigma_kg as f32);
         rec.belt_force_limit_n = plan.belt_limiter_kn * 1000.0;
         rec.pretensioner_time_s = plan.pretensioner_time_ms * 1.0e-3;
         rec.airbag_time_s = plan.airbag_time_ms * 1.0e-3;

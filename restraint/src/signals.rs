@@ -217,6 +217,17 @@ pub struct EcuDiagnostics {
     pub predicted_contact_time_s: f32,
     /// Predicted time to contact, s (negative/NaN when none).
     pub time_to_contact_s: f32,
+    /// σ of the time to contact (the track filter's), s (NaN when none).
+    pub time_to_contact_sigma_s: f32,
+    /// Estimated closing speed at contact, m/s (NaN when none).
+    pub closing_speed_mps: f32,
+    /// σ of the closing speed at contact, m/s (NaN when none).
+    pub closing_speed_sigma_mps: f32,
+    /// Fused opponent mass estimate, kg (NaN when none; the prediction and the LUT use the
+    /// conservative m + k·σ).
+    pub opponent_mass_kg: f32,
+    /// σ of the fused opponent mass, kg (NaN when none).
+    pub opponent_mass_sigma_kg: f32,
     /// Time between consecutive `pulse_accel_mps2` points, s.
     pub pulse_dt_s: f32,
     /// Predicted pulse, ego acceleration m/s², from contact on.
@@ -258,6 +269,11 @@ impl EcuDiagnostics {
         predicted_a_mean_mps2: 0.0,
         predicted_contact_time_s: 0.0,
         time_to_contact_s: f32::NAN,
+        time_to_contact_sigma_s: f32::NAN,
+        closing_speed_mps: f32::NAN,
+        closing_speed_sigma_mps: f32::NAN,
+        opponent_mass_kg: f32::NAN,
+        opponent_mass_sigma_kg: f32::NAN,
         pulse_dt_s: 0.0,
         pulse_accel_mps2: [0.0; PULSE_POINTS],
         pulse_points: 0,

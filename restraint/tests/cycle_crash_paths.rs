@@ -127,7 +127,16 @@ fn a_pothole_at_the_predicted_contact_of_an_avoided_collision_fires_nothing() {
     // pothole hits the car at the predicted contact: 8 g for 2 ms. No ramp, no Δv: nothing
     // confirms, nothing fires, the pretensioner is released.
     let mut b = Bench::new(Some(test_lut()));
-    run_scenario(&mut b, C - 30 * MS, T0 + 200 * MS, C, 25.0, C, None, &|_| 0.0);
+    run_scenario(
+        &mut b,
+        C - 30 * MS,
+        T0 + 200 * MS,
+        C,
+        25.0,
+        C,
+        None,
+        &|_| 0.0,
+    );
     let mut o = object(b.now, -2.0, 1500.0, 100.0);
     o.distance_m = 3.0;
     b.io.push_object(o);
@@ -177,17 +186,38 @@ fn without_a_prediction_a_bump_fires_nothing_and_a_severe_crash_fires_the_refere
     // Monitoring ("no track" objects): a 4.5 g bump (Δv grows 0.044 m/s per ms, under the
     // boundary), and a 20 g crash (0.196 m/s per ms: over the boundary at τ = 1 ms).
     let mut b = Bench::new(Some(test_lut()));
-    run_scenario(&mut b, C + 100 * MS, u64::MAX, 0, 0.0, u64::MAX, Some(C), &|ms| {
-        if ms < 40 {
-            4.5
-        } else {
-            0.0
-        }
-    });
-    assert!(b.first_mode(EcuMode::Crash).is_some(), "the bump is a crash for the belt");
+    run_scenario(
+        &mut b,
+        C + 100 * MS,
+        u64::MAX,
+        0,
+        0.0,
+        u64::MAX,
+        Some(C),
+        &|ms| {
+            if ms < 40 {
+                4.5
+            } else {
+                0.0
+            }
+        },
+    );
+    assert!(
+        b.first_mode(EcuMode::Crash).is_some(),
+        "the bump is a crash for the belt"
+    );
     assert!(no_airbag_fired(&b));
     let mut b = Bench::new(Some(test_lut()));
-    run_scenario(&mut b, C + 100 * MS, u64::MAX, 0, 0.0, u64::MAX, Some(C), &|_| 20.0);
+    run_scenario(
+        &mut b,
+        C + 100 * MS,
+        u64::MAX,
+        0,
+        0.0,
+        u64::MAX,
+        Some(C),
+        &|_| 20.0,
+    );
     let (t, f) = first_fire(&b).expect("reference airbag");
     assert_eq!(f.cmd_source(), AirbagStageCmdCmdSource::Reference);
     assert_eq!(t, C + 10 * MS);
@@ -210,7 +240,11 @@ fn a_dead_accelerometer_is_on_the_bus_within_its_timeout_plus_one_status_period(
     );
     assert_eq!(b.mode_at(dead_from + 50 * MS), EcuMode::Degraded as u8);
     let on_bus = first_accel_fault_on_bus(&b, dead_from).expect("FaultAccelSensor on the bus");
-    assert!(on_bus <= dead_from + 70 * MS, "{} ms", (on_bus - dead_from) / MS);
+    assert!(
+        on_bus <= dead_from + 70 * MS,
+        "{} ms",
+        (on_bus - dead_from) / MS
+    );
     // Back: healthy on the first batch.
     b.accel_live = true;
     let back = b.now;
@@ -306,7 +340,11 @@ fn a_predicted_crash_with_a_dead_accelerometer_is_confirmed_by_the_vehicle_decel
     dead_accel_crash(&mut b, 25.0, C + 2 * MS, 8.0);
     // Flagged long before the crash.
     assert!(first_accel_fault_on_bus(&b, C - 400 * MS).is_some_and(|t| t <= C - 330 * MS));
-    assert_eq!(b.first_mode(EcuMode::PreCrash), None, "degraded: no adaptive preset");
+    assert_eq!(
+        b.first_mode(EcuMode::PreCrash),
+        None,
+        "degraded: no adaptive preset"
+    );
     // The first vehicle frame after the deceleration (every 10 ms: C + 10 ms) confirms.
     assert_eq!(b.ecu.crash_kind(), Some(ConfirmKind::Backup));
     let (t, f) = first_fire(&b).expect("reference airbag");

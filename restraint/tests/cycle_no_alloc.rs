@@ -70,9 +70,15 @@ fn no_allocation_in_precrash_and_crash_cycles() {
         a.count = 8;
         for (i, s) in a.accel_mps2.iter_mut().enumerate() {
             let t = a.first_timestamp_ns + i as u64 * 125_000;
-            let dither = if (k + i as u64).is_multiple_of(2) { 0.05 } else { -0.05 };
+            let dither = if (k + i as u64).is_multiple_of(2) {
+                0.05
+            } else {
+                -0.05
+            };
             let pulse = if t >= contact_ns {
-                crash.state_at((t - contact_ns) as f64 * 1e-9).ego_accel_mps2
+                crash
+                    .state_at((t - contact_ns) as f64 * 1e-9)
+                    .ego_accel_mps2
             } else {
                 0.0
             };

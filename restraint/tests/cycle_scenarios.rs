@@ -2,11 +2,12 @@
 //!
 //! Expected times and values are closed form: the test LUT's cells are linear in closing
 //! speed and opponent mass (multilinear interpolation reproduces them exactly), objects move
-//! at constant speed (TTC = d / v), and the crash pulse is either the onset ramp of the
-//! predicted collision (slope k·v/m_ego, k the series stiffness of the two fronts' first
-//! segments: the prediction-matched path) or a constant deceleration (Δv after n samples =
-//! (n − ½)·a·1 ms, trapezoidal from rest: the generic confirmation and the accelerometer-only
-//! algorithm). Every command is decoded with the bus crate (CRC checked).
+//! at constant speed (TTC = d / v; the track filter reproduces such noise-free samples
+//! exactly, see `cycle_support::oracle_config`), and the crash pulse is either the onset ramp
+//! of the predicted collision (slope k·v/m_ego, k the series stiffness of the two fronts'
+//! first segments: the prediction-matched path) or a constant deceleration (Δv after n
+//! samples = (n − ½)·a·1 ms, trapezoidal from rest: the generic confirmation and the
+//! accelerometer-only algorithm). Every command is decoded with the bus crate (CRC checked).
 
 mod cycle_support;
 
@@ -23,7 +24,7 @@ const C: u64 = T0 + 1_000 * MS;
 
 #[test]
 fn precrash_preset_pretensioner_at_planned_time_then_airbag_at_planned_time_and_level() {
-    let mut b = Bench::new(Some(test_lut()));
+    let mut b = Bench::oracle(Some(test_lut()));
     run_scenario(
         &mut b,
         C + 200 * MS,
@@ -127,18 +128,45 @@ fn precrash_preset_pretensioner_at_planned_time_then_airbag_at_planned_time_and_
 
 #[test]
 fn avoided_collision_releases_pretensioner_and_never_fires_the_airbag() {
-    let mut b = Bench::new(Some(test_lut()));
+    let mut b = Bench::oracle(Some(test_lut()));
     // Approach as before until the pretensioner has fired (C − 45 ms) ...
-    run_scenario(&mut b, C - 30 * MS, T0 + 200 * MS, C, 25.0, C, None, &|_| 0.0);
+    run_scenario(
+        &mut b,
+        C - 30 * MS,
+        T0 + 200 * MS,
+        C,
+        25.0,
+        C,
+        None,
+        &|_| 0.0,
+    );
     assert_eq!(b.ecu.pretensioner(), Pretensioner::Fired);
-    // ... then the opponent turns away: receding object.
-    let mut o = cycle_support::object(b.now, -2.0, 1500.0, 100.0);
-    o.distance_m = 3.0;
-    b.io.push_object(o);
-    let t_avoid = b.now;
-    b.step();
+    // ... then the opponent turns away: receding object. The track filter does not trust
+    // the first samples that contradict the track (outliers, counted); the third in a row
+    // (`track.max_outliers`) restarts the track from the newest sample, which recedes.
+    let max_outliers = b.ecu.config().track.max_outliers;
+    let mut t_avoid = b.now;
+    for k in 0..max_outliers {
+        assert_eq!(b.ecu.phase(), Phase::PreCrash, "sample {k}");
+        let mut o = cycle_support::object(b.now, -2.0, 1500.0, 100.0);
+        o.distance_m = 3.0 + 0.02 * k as f32;
+        b.io.push_object(o);
+        t_avoid = b.now;
+        b.step();
+        b.run_ms(9);
+    }
+    assert_eq!(b.ecu.counters().track_outliers, u64::from(max_outliers - 1));
     assert_eq!(b.ecu.phase(), Phase::Monitoring);
-    run_scenario(&mut b, C + 300 * MS, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
+    run_scenario(
+        &mut b,
+        C + 300 * MS,
+        u64::MAX,
+        0,
+        0.0,
+        u64::MAX,
+        None,
+        &|_| 0.0,
+    );
     let belts = b.belt_frames();
     let (t_rel, _) = belts
         .iter()
@@ -155,11 +183,29 @@ fn avoided_collision_releases_pretensioner_and_never_fires_the_airbag() {
 
 #[test]
 fn lost_object_counts_as_avoided() {
-    let mut b = Bench::new(Some(test_lut()));
-    run_scenario(&mut b, C - 20 * MS, T0 + 200 * MS, C, 25.0, C, None, &|_| 0.0);
+    let mut b = Bench::oracle(Some(test_lut()));
+    run_scenario(
+        &mut b,
+        C - 20 * MS,
+        T0 + 200 * MS,
+        C,
+        25.0,
+        C,
+        None,
+        &|_| 0.0,
+    );
     assert_eq!(b.ecu.phase(), Phase::PreCrash);
     // Tracker reports "no object" (valid = 0) from C − 20 ms on.
-    run_scenario(&mut b, C + 200 * MS, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
+    run_scenario(
+        &mut b,
+        C + 200 * MS,
+        u64::MAX,
+        0,
+        0.0,
+        u64::MAX,
+        None,
+        &|_| 0.0,
+    );
     assert_eq!(b.mode_at(C - 20 * MS), EcuMode::Monitoring as u8);
     assert_eq!(b.ecu.pretensioner(), Pretensioner::Released);
     assert!(!b.ecu.airbag_fired());
@@ -167,7 +213,7 @@ fn lost_object_counts_as_avoided() {
 
 #[test]
 fn stale_object_data_degrades_after_the_timeout_and_the_reference_fires() {
-    let mut b = Bench::new(Some(test_lut()));
+    let mut b = Bench::oracle(Some(test_lut()));
     // "No track" samples until T0 + 300 ms (last one at T0 + 290 ms), then silence.
     let crash = T0 + 600 * MS;
     run_scenario(
@@ -212,7 +258,7 @@ fn stale_object_data_degrades_after_the_timeout_and_the_reference_fires() {
 #[test]
 fn crash_without_pre_crash_detection_fires_the_reference() {
     // The sensor is alive but never sees the opponent ("no track" throughout).
-    let mut b = Bench::new(Some(test_lut()));
+    let mut b = Bench::oracle(Some(test_lut()));
     let crash = T0 + 500 * MS;
     run_scenario(
         &mut b,
@@ -237,7 +283,7 @@ fn crash_without_pre_crash_detection_fires_the_reference() {
 
 #[test]
 fn sensor_dropout_before_pre_crash_then_crash_fires_the_reference() {
-    let mut b = Bench::new(Some(test_lut()));
+    let mut b = Bench::oracle(Some(test_lut()));
     // Approach seen from T0 + 200 ms, but the sensor dies at C − 400 ms (before the horizon).
     run_scenario(
         &mut b,
@@ -265,7 +311,7 @@ fn sensor_dropout_before_pre_crash_then_crash_fires_the_reference() {
 
 #[test]
 fn e2e_failure_burst_degrades_for_the_hold_time() {
-    let mut b = Bench::new(Some(test_lut()));
+    let mut b = Bench::oracle(Some(test_lut()));
     let mut bad_tx = bus::E2eProtector::new();
     let corrupt = |tx: &mut bus::E2eProtector| {
         let m = bus::OccupantClassification::encode(
@@ -282,7 +328,16 @@ fn e2e_failure_burst_degrades_for_the_hold_time() {
         f
     };
     // Two rejections 150 ms apart: no burst.
-    run_scenario(&mut b, T0 + 200 * MS, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
+    run_scenario(
+        &mut b,
+        T0 + 200 * MS,
+        u64::MAX,
+        0,
+        0.0,
+        u64::MAX,
+        None,
+        &|_| 0.0,
+    );
     for _ in 0..2 {
         b.io.push_can(corrupt(&mut bad_tx));
         let end = b.now + 150 * MS;
@@ -297,7 +352,16 @@ fn e2e_failure_burst_degrades_for_the_hold_time() {
         let end = b.now + 10 * MS;
         run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
     }
-    run_scenario(&mut b, t3 + 700 * MS, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
+    run_scenario(
+        &mut b,
+        t3 + 700 * MS,
+        u64::MAX,
+        0,
+        0.0,
+        u64::MAX,
+        None,
+        &|_| 0.0,
+    );
     assert_eq!(b.first_mode(EcuMode::Degraded), Some(t3));
     let i = b.step_times.iter().position(|&t| t == t3).unwrap();
     assert_ne!(
@@ -317,7 +381,7 @@ fn e2e_failure_burst_degrades_for_the_hold_time() {
 
 #[test]
 fn missing_lut_runs_degraded_from_the_start_and_fires_the_reference() {
-    let mut b = Bench::new(None);
+    let mut b = Bench::oracle(None);
     run_scenario(
         &mut b,
         C + 50 * MS,
@@ -347,13 +411,22 @@ fn missing_lut_runs_degraded_from_the_start_and_fires_the_reference() {
 
 #[test]
 fn low_closing_speed_never_fires_the_airbag_but_the_belt_follows_the_reference() {
-    let mut b = Bench::new(Some(test_lut()));
+    let mut b = Bench::oracle(Some(test_lut()));
     // 4 m/s against 1600 kg (conservative): EBS = 4·1600/3385·3.6 = 6.8 km/h < 20 km/h.
     // 4.5 g: Δv = (n − ½)·0.04413 m/s after n samples → ≥ 0.5 m/s at n = 12 (C + 11 ms).
     // The accelerometer-only algorithm decides the airbag: Δv(τ) = 0.0221 + 0.0441·τ stays
     // under its boundary (0.25 m/s at 4 ms, then rising 0.11–0.16 m/s per ms) until the
     // 60 ms window closes.
-    run_scenario(&mut b, C + 100 * MS, T0 + 200 * MS, C, 4.0, C, Some(C), &|_| 4.5);
+    run_scenario(
+        &mut b,
+        C + 100 * MS,
+        T0 + 200 * MS,
+        C,
+        4.0,
+        C,
+        Some(C),
+        &|_| 4.5,
+    );
     assert_eq!(b.first_mode(EcuMode::PreCrash), None);
     assert_eq!(b.first_mode(EcuMode::Crash), Some(C + 11 * MS));
     assert!(matches!(
@@ -379,8 +452,17 @@ fn low_closing_speed_never_fires_the_airbag_but_the_belt_follows_the_reference()
 
 #[test]
 fn nan_object_fields_degrade_until_a_valid_sample_arrives() {
-    let mut b = Bench::new(Some(test_lut()));
-    run_scenario(&mut b, T0 + 200 * MS, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
+    let mut b = Bench::oracle(Some(test_lut()));
+    run_scenario(
+        &mut b,
+        T0 + 200 * MS,
+        u64::MAX,
+        0,
+        0.0,
+        u64::MAX,
+        None,
+        &|_| 0.0,
+    );
     let mut o = cycle_support::object(b.now, f32::NAN, 1500.0, 100.0);
     o.distance_m = f32::INFINITY;
     b.io.push_object(o);
@@ -403,7 +485,7 @@ fn nan_object_fields_degrade_until_a_valid_sample_arrives() {
 /// rejected.
 #[test]
 fn restarted_sender_is_accepted_after_its_timeout_but_a_counter_jump_is_not() {
-    let mut b = Bench::new(Some(test_lut()));
+    let mut b = Bench::oracle(Some(test_lut()));
     // "No track" object samples keep the object input fresh throughout.
     let idle = |b: &mut Bench, ms: u64| {
         let end = b.now + ms * MS;
@@ -458,7 +540,7 @@ fn restarted_sender_is_accepted_after_its_timeout_but_a_counter_jump_is_not() {
 /// object timeout, and recovers on the first fresh record.
 #[test]
 fn stuck_no_track_records_degrade_like_stale_samples() {
-    let mut b = Bench::new(Some(test_lut()));
+    let mut b = Bench::oracle(Some(test_lut()));
     let end = b.now + 300 * MS;
     run_scenario(&mut b, end, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
     assert_eq!(b.mode_at(b.now - MS), EcuMode::Monitoring as u8);

@@ -170,7 +170,8 @@ impl Player {
                     match kind {
                         AccelFaultKind::Stuck => self.last_accel,
                         AccelFaultKind::Saturated => {
-                            -(self.sensor.accel_full_scale_g * physics::defaults::STANDARD_GRAVITY_MPS2)
+                            -(self.sensor.accel_full_scale_g
+                                * physics::defaults::STANDARD_GRAVITY_MPS2)
                                 as f32
                         }
                     }
@@ -206,8 +207,7 @@ impl Player {
             let tp = self.next_veh_s;
             self.next_veh_s += self.sensor.vehicle_period_ms * 1e-3;
             if !self.sensor.dropped(DropoutTarget::Vehicle, tp) {
-                out.can
-                    .push(self.protector.seal(self.model.ego_frame(tp)?));
+                out.can.push(self.protector.seal(self.model.ego_frame(tp)?));
                 self.counts.can_frames += 1;
             }
         }
@@ -215,7 +215,8 @@ impl Player {
             let tp = self.next_occ_s;
             self.next_occ_s += self.sensor.occupant_period_ms * 1e-3;
             if !self.sensor.dropped(DropoutTarget::Occupant, tp) {
-                out.can.push(self.protector.seal(self.model.occupant_frame()?));
+                out.can
+                    .push(self.protector.seal(self.model.occupant_frame()?));
                 self.counts.can_frames += 1;
             }
         }

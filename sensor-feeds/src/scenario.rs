@@ -202,6 +202,10 @@ pub struct SensorModel {
     pub distance_noise_m: f64,
     /// Gaussian noise on the closing speed [m/s, 1σ].
     pub speed_noise_mps: f64,
+    /// Gaussian noise on the relative acceleration the tracker reports [m/s², 1σ] (a
+    /// tracker differentiates it; 0 = the true value, and no random draw, so the noise of the
+    /// other fields stays what it was without this key).
+    pub relative_accel_noise_mps2: f64,
     /// Systematic error of the opponent-mass estimate [kg] (e.g. unknown payload).
     pub mass_bias_kg: f64,
     /// Per-sample Gaussian noise of the mass estimate [kg, 1σ].
@@ -242,6 +246,7 @@ impl Default for SensorModel {
             range_m: 80.0,
             distance_noise_m: 0.05,
             speed_noise_mps: 0.1,
+            relative_accel_noise_mps2: 0.0,
             mass_bias_kg: 0.0,
             mass_noise_kg: 0.0,
             speed_bias_mps: 0.0,
@@ -612,9 +617,22 @@ impl Scenario {
             10.0,
             "m/s",
         )?;
+        range(
+            "sensor.relative_accel_noise_mps2",
+            s.relative_accel_noise_mps2,
+            0.0,
+            50.0,
+            "m/s²",
+        )?;
         range("sensor.mass_bias_kg", s.mass_bias_kg, -3000.0, 3000.0, "kg")?;
         range("sensor.mass_noise_kg", s.mass_noise_kg, 0.0, 3000.0, "kg")?;
-        range("sensor.speed_bias_mps", s.speed_bias_mps, -30.0, 30.0, "m/s")?;
+        range(
+            "sensor.speed_bias_mps",
+            s.speed_bias_mps,
+            -30.0,
+            30.0,
+            "m/s",
+        )?;
         range("sensor.mass_sigma_kg", s.mass_sigma_kg, 0.0, 3000.0, "kg")?;
         if let Some(m) = s.mass_estimate_kg {
             range("sensor.mass_estimate_kg", m, 100.0, 100000.0, "kg")?;

@@ -72,7 +72,13 @@ impl SensorModelSim {
         o.closing_speed_mps = (w.closing_speed_mps
             + s.speed_bias_mps
             + s.speed_noise_mps * gauss(&mut self.rng)) as f32;
-        o.relative_accel_mps2 = w.relative_accel_mps2 as f32;
+        // Drawn only when configured: files without the key keep their noise streams.
+        let accel_noise = if s.relative_accel_noise_mps2 > 0.0 {
+            s.relative_accel_noise_mps2 * gauss(&mut self.rng)
+        } else {
+            0.0
+        };
+        o.relative_accel_mps2 = (w.relative_accel_mps2 + accel_noise) as f32;
         o.opponent_mass_kg = mass.max(1.0) as f32;
         o.opponent_mass_sigma_kg = s.mass_sigma_kg as f32;
         o.confidence = s.confidence as f32;
@@ -200,6 +206,29 @@ mod tests {
         // Sample sd of 4000 normal draws: within ±6 % of σ = 100 kg (≈ 4 standard errors).
         assert!((sd - 100.0).abs() < 6.0, "sd {sd}");
         assert!(mean.abs() < 7.0, "mean {mean}");
+    }
+
+    #[test]
+    fn relative_accel_noise_is_drawn_only_when_configured() {
+        // Without the key the other fields' noise is what it was (same draws); with it the
+        // acceleration scatters around the truth (0 here: constant speeds) with its σ.
+        let mut a = sim("latency_ms = 0\ndistance_noise_m = 0.5");
+        let mut b = sim("latency_ms = 0\ndistance_noise_m = 0.5\nrelative_accel_noise_mps2 = 0");
+        let mut c = sim("latency_ms = 0\ndistance_noise_m = 0.5\nrelative_accel_noise_mps2 = 2");
+        let n = 4000;
+        let mut sum2 = 0.0;
+        for _ in 0..n {
+            let (x, y, z) = (
+                a.object(0.5).unwrap(),
+                b.object(0.5).unwrap(),
+                c.object(0.5).unwrap(),
+            );
+            assert_eq!(x, y);
+            assert_eq!(x.relative_accel_mps2, 0.0);
+            sum2 += f64::from(z.relative_accel_mps2).powi(2);
+        }
+        let sd = (sum2 / f64::from(n)).sqrt();
+        assert!((sd - 2.0).abs() < 0.12, "sd {sd}");
     }
 
     #[test]

@@ -149,7 +149,8 @@ pub fn run(scenario: &Scenario, cfg: &OfflineConfig) -> Result<OfflineRun> {
             }
         }
         let m = io.diagnostics.mode;
-        let crashed = m == restraint::EcuMode::Crash as u8 || m == restraint::EcuMode::PostCrash as u8;
+        let crashed =
+            m == restraint::EcuMode::Crash as u8 || m == restraint::EcuMode::PostCrash as u8;
         if crash_mode_ns.is_none() && crashed {
             crash_mode_ns = Some(now);
         }

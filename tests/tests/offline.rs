@@ -49,14 +49,19 @@ fn problems(s: &Scenario, r: &OfflineRun) -> Vec<String> {
         }
     };
     let pre = r.action("pretensioner_fire").is_some_and(|a| a.0 < 0.0)
-        && r.action("pretensioner_release").is_none_or(|rel| rel.0 >= 0.0);
+        && r.action("pretensioner_release")
+            .is_none_or(|rel| rel.0 >= 0.0);
     check("contact", e.contact, r.contact_s.is_some());
     check(
         "airbag fires",
         e.airbag_fires,
         r.action("airbag_fire").is_some(),
     );
-    check("pretensioner before contact", e.pretensioner_before_contact, pre);
+    check(
+        "pretensioner before contact",
+        e.pretensioner_before_contact,
+        pre,
+    );
     check(
         "pretensioner released",
         e.pretensioner_released,
@@ -220,7 +225,11 @@ fn the_campaigns_scenario_variants_meet_their_expectations_offline() {
         let r = run(&s, &cfg).expect("offline run");
         n += 1;
         table.push_str(&format!("{:<22} {}\n", case.name, table_row(&r)));
-        bad.extend(problems(&s, &r).into_iter().map(|p| format!("{}: {p}", case.name)));
+        bad.extend(
+            problems(&s, &r)
+                .into_iter()
+                .map(|p| format!("{}: {p}", case.name)),
+        );
     }
     eprintln!("{table}");
     assert!(n >= 15, "{n} variant cases");

@@ -39,6 +39,43 @@ struct Args {
     no_criterion: bool,
 }
 
+/// The most expensive call of `function` in one callgrind run of `bin args…` (arguments
+/// that name an existing file relative to `base` are made absolute).
+fn collected_max(
+    bin: &std::path::Path,
+    row: &cycle_benches::budgets::IcountBudget,
+    function: &str,
+    base: &std::path::Path,
+    tmp: &std::path::Path,
+) -> anyhow::Result<(f64, String)> {
+    let args: Vec<String> = row
+        .args
+        .iter()
+        .map(|a| {
+            let p = base.join(a);
+            if p.exists() {
+                p.display().to_string()
+            } else {
+                a.clone()
+            }
+        })
+        .collect();
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (totals, _) = icount::collected_totals(bin, &refs, function, tmp)?;
+    let max =
+        totals.iter().copied().max().ok_or_else(|| {
+            anyhow::anyhow!("{function} was never called by {} {args:?}", row.bin)
+        })?;
+    Ok((
+        max as f64,
+        format!(
+            "callgrind inside {}, max of {} call(s)",
+            function.rsplit("::").next().unwrap_or(function),
+            totals.len()
+        ),
+    ))
+}
+
 fn main() {
     match run() {
         Ok(true) => std::process::exit(0),
@@ -152,17 +189,21 @@ fn run() -> anyhow::Result<bool> {
             let built = cmd.status().context("cannot run cargo build")?.success();
             let bin_dir = gate::cargo_target_dir()?.join("release");
             let tmp = std::env::temp_dir();
+            let base = args.budgets.parent().unwrap_or(std::path::Path::new("."));
             for i in ic {
+                let bin = bin_dir.join(&i.bin);
                 let (measured, detail) = if built {
-                    match icount::instructions_per_iteration(
-                        &bin_dir.join(&i.bin),
-                        i.iterations,
-                        &tmp,
-                    ) {
-                        Ok(v) => (
-                            Some(v),
-                            format!("callgrind, N = {} vs {}", i.iterations[0], i.iterations[1]),
-                        ),
+                    let r = match &i.collect {
+                        Some(f) => collected_max(&bin, i, f, base, &tmp),
+                        None => {
+                            icount::instructions_per_iteration(&bin, i.iterations, &tmp).map(|v| {
+                                let n = i.iterations;
+                                (v, format!("callgrind, N = {} vs {}", n[0], n[1]))
+                            })
+                        }
+                    };
+                    match r {
+                        Ok((v, d)) => (Some(v), d),
                         Err(e) => (None, format!("{e:#}")),
                     }
                 } else {

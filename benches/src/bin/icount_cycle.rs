@@ -1,6 +1,6 @@
 //! Instruction-count workload: `icount_cycle N` runs N worst-case pre-crash cycles of the real
-//! ECU (`restraint::RestraintCycle::step` with a new object sample every cycle: full
-//! collision prediction at the ECU's step + LUT + state machine + command encode), set up by
+//! ECU (`restraint::RestraintCycle::step` with a new object sample every cycle: track filter +
+//! LUT + state machine + command encode), set up by
 //! `cycle_benches::ecu_cycle::WorstCasePreCrash` exactly as the `cycle/full_precrash_worst_case`
 //! criterion bench. Measured by the budget gate under callgrind at two N; exits 2 when the
 //! run did not stay on the worst-case path (then the count would measure something else).

@@ -5,14 +5,17 @@
 //!
 //! * `exact` (default; what the budget gate measures): the closed-form summary
 //!   `physics::predict_summary` — the per-cycle prediction.
-//! * `step`: the fixed-step integration at the ECU's `prediction_step_ms` into a 150 ms pulse
+//! * `step`: the fixed-step integration at the ECU's former 0.5 ms step into a 150 ms pulse
 //!   buffer — the per-cycle prediction before the closed form.
 //! * `diag`: `ExactCollision::solve_in_place` (a kept solution, as the ECU would hold it)
 //!   plus the 64 diagnostics points of the ego pulse.
 //! * `pulse-exact` / `pulse-step`: the 150 ms pulse at the default 0.1 ms step, closed form /
 //!   integrated (the table builder's pulse).
 
-use cycle_benches::{icount, workload::PredictionWorkload};
+use cycle_benches::{
+    icount,
+    workload::{PredictionWorkload, FORMER_ECU_STEP_S},
+};
 use physics::{
     defaults, predict_summary, simulate_collision, simulate_collision_exact, CollisionInput,
     DefaultPulseBuffer, ExactCollision,
@@ -23,7 +26,7 @@ fn main() {
     let n = icount::iterations_from_args();
     let mode = std::env::args().nth(2).unwrap_or_else(|| "exact".into());
     let w = PredictionWorkload::new();
-    let ecu_step_s = restraint::CycleConfig::default().prediction_step_ms * 1e-3;
+    let ecu_step_s = FORMER_ECU_STEP_S;
     let diag_step_s = defaults::PULSE_DURATION_S / ipc::PULSE_POINTS as f64;
     let mut buf = Box::new(DefaultPulseBuffer::new());
     let mut points = [0.0f32; ipc::PULSE_POINTS];

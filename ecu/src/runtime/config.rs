@@ -613,8 +613,26 @@ mod tests {
         let cfg = EcuConfig::load(&path).unwrap();
         assert_eq!(cfg.period_us, 1_000);
         assert_eq!(cfg.can.interface, "vcan0");
-        // `[cycle]` shows the core's defaults: the example must not drift from them.
+        // The file shows the defaults: the core's thresholds, its track filter included.
         assert_eq!(cfg.cycle.decision, restraint::CycleConfig::default());
+    }
+
+    #[test]
+    fn removed_prediction_step_is_rejected_and_track_keys_are_read() {
+        // The prediction is solved in closed form since issue 15: the old step key is an
+        // error that names it, not silently ignored.
+        let e = EcuConfig::from_toml_str("[cycle]\nprediction_step_ms = 0.5\n", &p())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("prediction_step_ms"), "{e}");
+        let text = "[cycle]\nconfirm_samples = 4\n[cycle.track]\ngate_chi2 = 11.34\n";
+        let cfg = EcuConfig::from_toml_str(text, &p()).unwrap();
+        assert_eq!(cfg.cycle.decision.track.gate_chi2, 11.34);
+        assert_eq!(cfg.cycle.decision.confirm_samples, 4);
+        let e = EcuConfig::from_toml_str("[cycle.track]\ngate_chi2 = 0.5\n", &p())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("track.gate_chi2"), "{e}");
     }
 
     #[test]

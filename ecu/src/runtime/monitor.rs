@@ -32,14 +32,31 @@ pub fn degraded_names(bits: u32) -> String {
     }
 }
 
+/// The track filter's estimate with its σ (`-` without a track).
+pub fn format_estimate(d: &EcuDiagnostics) -> String {
+    if !d.time_to_contact_s.is_finite() {
+        return "ttc - v - m -".to_owned();
+    }
+    format!(
+        "ttc {:.3}±{:.3} s v {:.1}±{:.1} m/s m {:.0}±{:.0} kg",
+        d.time_to_contact_s,
+        d.time_to_contact_sigma_s,
+        d.closing_speed_mps,
+        d.closing_speed_sigma_mps,
+        d.opponent_mass_kg,
+        d.opponent_mass_sigma_kg,
+    )
+}
+
 /// One status line for a diagnostics record.
 pub fn format_line(d: &EcuDiagnostics, rx_rate_hz: f64) -> String {
     let mode = EcuMode::from_u8(d.mode).map_or("?", EcuMode::name);
     format!(
-        "cycle {:>9} {:>7.0} Hz | mode {:<10} | Δv {:>5.1} m/s a_max {:>6.1} m/s² | belt {:>6.0} N pt {:>6.3}s bag st{} {:>6.3}s | wake {:>6.1} µs exec {:>6.1} µs overruns {} | obj#{} acc#{} | degraded {}",
+        "cycle {:>9} {:>7.0} Hz | mode {:<10} | {} | Δv {:>5.1} m/s a_max {:>6.1} m/s² | belt {:>6.0} N pt {:>6.3}s bag st{} {:>6.3}s | wake {:>6.1} µs exec {:>6.1} µs overruns {} | obj#{} acc#{} | degraded {}",
         d.cycle_count,
         rx_rate_hz,
         mode,
+        format_estimate(d),
         d.predicted_delta_v_mps,
         d.predicted_a_max_mps2,
         d.belt_force_limit_n,
@@ -127,6 +144,18 @@ mod tests {
         d.wake_latency_ns = 12_300;
         d.overrun_count = 4;
         let l = format_line(&d, 1000.0);
+        assert!(l.contains("ttc - v - m -"), "{l}");
+        d.time_to_contact_s = 0.25;
+        d.time_to_contact_sigma_s = 0.004;
+        d.closing_speed_mps = 25.0;
+        d.closing_speed_sigma_mps = 0.12;
+        d.opponent_mass_kg = 1512.0;
+        d.opponent_mass_sigma_kg = 212.0;
+        let l = format_line(&d, 1000.0);
+        assert!(
+            l.contains("ttc 0.250±0.004 s v 25.0±0.1 m/s m 1512±212 kg"),
+            "{l}"
+        );
         assert!(l.contains("pre-crash"), "{l}");
         assert!(l.contains("wake   12.3 µs"), "{l}");
         assert!(l.contains("overruns 4"), "{l}");

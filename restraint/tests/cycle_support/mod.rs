@@ -128,9 +128,28 @@ pub fn sync_time_us(now_ns: u64) -> u64 {
     SYNC_EPOCH_US + now_ns / 1_000
 }
 
+/// The default configuration with the track filter's two σ-dependent knobs neutral, for
+/// closed-form decision oracles: the contact instant is planned at the estimate itself
+/// (`contact_time_k = 0`) and the fused mass σ of equal reported σs is that σ
+/// (`mass_sigma_correlation = 1`), so the conservative mass is m + σ. The filter of
+/// noise-free samples on the motion model's own trajectory (constant closing acceleration)
+/// reproduces them exactly — every innovation is zero — so the estimate is the closed form.
+/// The knobs themselves are tested in `cycle_estimate.rs` and the filter's unit tests.
+pub fn oracle_config() -> CycleConfig {
+    let mut cfg = CycleConfig::default();
+    cfg.track.contact_time_k = 0.0;
+    cfg.track.mass_sigma_correlation = 1.0;
+    cfg
+}
+
 impl Bench {
     pub fn new(lut: Option<Diagram>) -> Self {
         Self::with_config(CycleConfig::default(), lut)
+    }
+
+    /// A bench with [`oracle_config`].
+    pub fn oracle(lut: Option<Diagram>) -> Self {
+        Self::with_config(oracle_config(), lut)
     }
 
     /// `lut` is leaked to `'static`: a bench lives for one test, and the cycle borrows its
@@ -201,7 +220,8 @@ impl Bench {
                 (true, true) => 0.05,
                 (true, false) => -0.05,
             };
-            self.io.push_accel(accel_batch(T0 + ms * MS, reading + dither));
+            self.io
+                .push_accel(accel_batch(T0 + ms * MS, reading + dither));
         }
         let info = CycleInfo {
             cycle: self.cycle,

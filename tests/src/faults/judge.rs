@@ -705,8 +705,16 @@ fn judge_variant(checks: &mut Checks, v: Variant, r: &Report) {
                     format!(
                         "{:+.1} % a_max + a_mean vs the reference restraint{}{}",
                         o.change_pct,
-                        if judged.bottomed_out { ", bottomed out" } else { "" },
-                        if emulated { " (commanded levels at planned times)" } else { "" }
+                        if judged.bottomed_out {
+                            ", bottomed out"
+                        } else {
+                            ""
+                        },
+                        if emulated {
+                            " (commanded levels at planned times)"
+                        } else {
+                            ""
+                        }
                     ),
                 )
             });

@@ -861,7 +861,10 @@ pub fn variant_scenario(src: &Path, dir: &Path, v: Variant) -> Result<PathBuf> {
         }
     }
     if matches!(v, Variant::AccelDead { .. } | Variant::AccelStuck { .. }) {
-        expect.insert("accel_fault_before_contact".into(), toml::Value::Boolean(true));
+        expect.insert(
+            "accel_fault_before_contact".into(),
+            toml::Value::Boolean(true),
+        );
         expect.remove("pretensioner_before_contact");
         if expect.get("airbag_fires") == Some(&toml::Value::Boolean(true)) {
             expect.insert("reference_fallback".into(), toml::Value::Boolean(true));
@@ -1137,14 +1140,12 @@ mod tests {
         let s = load(Variant::AccelDead {
             before_contact_s: 0.6,
         });
-        assert!(s.sensor.dropped(
-            sensor_feeds::scenario::DropoutTarget::Accel,
-            contact - 0.59
-        ));
-        assert!(!s.sensor.dropped(
-            sensor_feeds::scenario::DropoutTarget::Accel,
-            contact - 0.61
-        ));
+        assert!(s
+            .sensor
+            .dropped(sensor_feeds::scenario::DropoutTarget::Accel, contact - 0.59));
+        assert!(!s
+            .sensor
+            .dropped(sensor_feeds::scenario::DropoutTarget::Accel, contact - 0.61));
         assert_eq!(s.expect.accel_fault_before_contact, Some(true));
         assert_eq!(s.expect.reference_fallback, Some(true));
         let s = load(Variant::AccelStuck {
@@ -1164,7 +1165,9 @@ mod tests {
         )
         .unwrap();
         let s = sensor_feeds::Scenario::load(&p).unwrap();
-        assert!(s.sensor.dropped(sensor_feeds::scenario::DropoutTarget::Vehicle, 1.0));
+        assert!(s
+            .sensor
+            .dropped(sensor_feeds::scenario::DropoutTarget::Vehicle, 1.0));
         assert_eq!(s.expect.airbag_fires, Some(false));
         assert_eq!(s.expect.reference_fallback, Some(true));
     }

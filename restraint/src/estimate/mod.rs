@@ -1,25 +1,32 @@
-//! The estimate: what the newest object sample says about the coming collision, and what the
+//! The estimate: what the object track says about the coming collision, and what the
 //! restraint should do about it.
 //!
-//! Time to contact, closing speed at contact, conservative opponent mass and equivalent barrier
-//! speed ([`Situation`]); the two-mass collision prediction ([`physics::simulate_collision`])
-//! into a preallocated pulse buffer; the characteristic-diagram query ([`Lut`]). Everything is
-//! built in [`Estimator::new`]; [`Estimator::update`] allocates nothing.
+//! Per new object sample: the track filter ([`track`]: distance, closing speed and closing
+//! acceleration, latency-corrected, outliers gated, opponent mass fused) → time to contact,
+//! closing speed at contact and opponent mass with their σ at the cycle's time
+//! ([`Situation`]) → the characteristic-diagram query ([`Lut`]) → the plan. That is the
+//! decision's path, done in the sample's cycle.
 //!
-//! This is where a track filter belongs (the estimation work: a nalgebra Kalman filter over
-//! the object samples, smoothing distance, closing speed and acceleration before
-//! [`time_to_contact`]); the decision only consumes [`Situation`].
+//! The collision prediction in closed form ([`physics::ExactCollision`]: no step size) and
+//! its diagnostics pulse ([`pulse`]) are not on that path — no decision reads them; the
+//! diagnostics and the crash-phase work do — so they run in the following cycles that have
+//! time ([`Estimator::background`]: cycles without a new sample, outside CRASH): the pending
+//! prediction first (≈ 1 100 instructions), then the pulse a chunk per cycle. With object
+//! samples ≥ 5 ms apart the prediction of a sample is there 1 ms after it. Everything is
+//! built in [`Estimator::new`]; nothing here allocates.
+
+pub mod pulse;
+pub mod track;
 
 use diagram::{AirbagThresholds, DiagramView, Query};
-use physics::{
-    simulate_collision, CollisionInput, CollisionSummary, CombinedSpring, DefaultPulseBuffer,
-    MassClass,
-};
+use physics::{CollisionInput, CollisionSummary, CombinedSpring, ExactCollision, MassClass};
 
 use crate::config::{ms_to_ns, ConfigError, CycleConfig};
 use crate::counters::CycleCounters;
 use crate::inputs::InputMonitor;
 use crate::plan::RestraintPlan;
+use pulse::DiagnosticsPulse;
+use track::{TrackEstimate, TrackEvent, TrackFilter};
 
 /// Predicted contact of a constant-relative-acceleration approach.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -142,15 +149,27 @@ pub fn check_lut<'a>(
     }
 }
 
-/// The estimated situation from the newest object sample.
+/// The estimated situation: the track's contact estimate at the cycle's time.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Situation {
-    /// Predicted first contact, CLOCK_MONOTONIC ns.
+    /// The contact instant the decision plans with: estimate − k·σ
+    /// (`track.contact_time_k`), CLOCK_MONOTONIC ns.
     pub contact_ns: u64,
+    /// The estimated contact instant, CLOCK_MONOTONIC ns.
+    pub contact_estimate_ns: u64,
+    /// σ of the contact instant, s.
+    pub contact_sigma_s: f64,
     /// Closing speed at contact, m/s.
     pub closing_speed_mps: f64,
-    /// Conservative opponent mass m + k·σ, kg.
+    /// σ of the closing speed at contact, m/s.
+    pub closing_speed_sigma_mps: f64,
+    /// Conservative opponent mass m + k·σ (`conservative_mass_k`), kg: the prediction's and
+    /// the LUT's.
     pub opponent_mass_kg: f64,
+    /// Fused opponent mass estimate, kg.
+    pub opponent_mass_estimate_kg: f64,
+    /// σ of the fused opponent mass, kg.
+    pub opponent_mass_sigma_kg: f64,
     /// Ego equivalent barrier speed, km/h.
     pub ebs_kph: f64,
     /// Below the no-fire threshold.
@@ -158,26 +177,31 @@ pub struct Situation {
 }
 
 /// The spring of the opponent class of `opp_kg` (by mass; beyond the heaviest class the
-/// heaviest) among the six precomputed ones.
-fn spring_of(springs: &[Option<CombinedSpring>; 6], opp_kg: f64) -> Option<&CombinedSpring> {
+/// heaviest) among the six precomputed ones: its index.
+fn spring_index(opp_kg: f64) -> usize {
     let class = physics::class_for_mass_kg(opp_kg)
         .map(MassClass::number)
         .unwrap_or(6);
-    springs
-        .get(usize::from(class.saturating_sub(1)))
-        .and_then(Option::as_ref)
+    usize::from(class.saturating_sub(1))
 }
 
-/// State of the estimate: situation, prediction (springs, pulse buffer) and the LUT.
+/// State of the estimate: track, situation, prediction (springs, kept solution, diagnostics
+/// pulse) and the LUT.
+#[derive(Clone)]
 pub struct Estimator<'a> {
     ego_mass_kg: f64,
     conservative_mass_k: f64,
+    contact_time_k: f64,
     mass_misreport_kg: f64,
     no_fire_ebs_kph: f64,
-    prediction_step_ms: f64,
     exit_horizon_ns: u64,
     springs: [Option<CombinedSpring>; 6],
-    pulse: DefaultPulseBuffer,
+    track: TrackFilter,
+    solution: ExactCollision,
+    /// The prediction the newest situation asks for, not yet solved: (spring index,
+    /// conservative opponent kg, closing speed m/s).
+    pending: Option<(usize, f64, f64)>,
+    pulse: DiagnosticsPulse,
     lut: Option<Lut<'a>>,
     reference: RestraintPlan,
     /// Newest situation estimate.
@@ -187,8 +211,8 @@ pub struct Estimator<'a> {
 }
 
 impl<'a> Estimator<'a> {
-    /// Precomputes the six combined springs (ego class × opponent class) and the pulse
-    /// buffer; `lut` has passed [`check_lut`].
+    /// Precomputes the six combined springs (ego class × opponent class); `lut` has passed
+    /// [`check_lut`].
     pub fn new(
         cfg: &CycleConfig,
         lut: Option<Lut<'a>>,
@@ -210,12 +234,15 @@ impl<'a> Estimator<'a> {
         Ok(Self {
             ego_mass_kg: cfg.ego_mass_kg,
             conservative_mass_k: cfg.conservative_mass_k,
+            contact_time_k: cfg.track.contact_time_k,
             mass_misreport_kg: cfg.mass_misreport_kg,
             no_fire_ebs_kph: cfg.no_fire_ebs_kph,
-            prediction_step_ms: cfg.prediction_step_ms,
             exit_horizon_ns: horizon_ns.saturating_add(ms_to_ns(cfg.preset_exit_hysteresis_ms)),
             springs,
-            pulse: DefaultPulseBuffer::new(),
+            track: TrackFilter::new(&cfg.track, cfg.object_timeout_ms),
+            solution: ExactCollision::new(),
+            pending: None,
+            pulse: DiagnosticsPulse::new(),
             lut,
             reference,
             situation: None,
@@ -237,7 +264,9 @@ impl<'a> Estimator<'a> {
     /// mass; beyond the heaviest class the heaviest). `None` only if a class curve failed to
     /// combine at start-up.
     pub(crate) fn spring_for(&self, opp_kg: f64) -> Option<&CombinedSpring> {
-        spring_of(&self.springs, opp_kg)
+        self.springs
+            .get(spring_index(opp_kg))
+            .and_then(Option::as_ref)
     }
 
     /// The configured ego mass, kg.
@@ -245,14 +274,33 @@ impl<'a> Estimator<'a> {
         self.ego_mass_kg
     }
 
-    /// The predicted pulse of the newest prediction (ego acceleration, m/s²) and its step, s.
-    pub(crate) fn pulse(&self) -> (&[f64], f64) {
-        (self.pulse.ego_accel_mps2(), self.pulse.step_s())
+    /// The track filter.
+    pub fn track(&self) -> &TrackFilter {
+        &self.track
     }
 
-    /// Situation from the newest object sample; runs the prediction and the LUT lookup when
-    /// contact is within the exit horizon. Returns the plan when one was looked up.
-    /// Called only when a new sample (or a changed occupant) arrived.
+    /// The newest prediction's diagnostics pulse: ego acceleration, m/s², at
+    /// k · [`pulse::PULSE_DT_S`] after contact, and how many points are valid yet.
+    pub(crate) fn pulse(&self) -> (&[f32; crate::signals::PULSE_POINTS], usize) {
+        (self.pulse.points(), self.pulse.filled())
+    }
+
+    /// The work no decision waits for, in a cycle that has time: the pending prediction if
+    /// there is one, else the next chunk of its diagnostics pulse (nothing once complete).
+    #[inline(always)]
+    pub(crate) fn background(&mut self, counters: &mut CycleCounters) {
+        match self.pending.take() {
+            Some((spring, opp_kg, closing_mps)) => {
+                self.predict(spring, opp_kg, closing_mps, counters);
+            }
+            None => self.pulse.fill(&self.solution),
+        }
+    }
+
+    /// The situation from the track: a new object sample goes into the track filter first (a
+    /// refused sample changes nothing). Looks the LUT up and asks for a prediction
+    /// ([`Self::background`]) when contact is within the exit horizon. Returns the plan when
+    /// one was looked up. Called only when a new sample (or a changed occupant) arrived.
     #[inline(always)]
     pub(crate) fn update(
         &mut self,
@@ -260,61 +308,92 @@ impl<'a> Estimator<'a> {
         inputs: &InputMonitor,
         counters: &mut CycleCounters,
     ) -> Option<RestraintPlan> {
-        self.situation = None;
-        if !inputs.object_present || inputs.object_invalid {
+        if inputs.new_object {
+            let o = &inputs.object;
+            if !o.is_valid() {
+                self.track.end(); // the sensor reports no object: this track is over
+            }
+            if !inputs.object_present || inputs.object_invalid {
+                self.situation = None;
+                return None;
+            }
+            match self.track.update(o) {
+                TrackEvent::Updated => {}
+                TrackEvent::Started => {
+                    counters.track_starts = counters.track_starts.saturating_add(1);
+                }
+                TrackEvent::Outlier => {
+                    counters.track_outliers = counters.track_outliers.saturating_add(1);
+                }
+                TrackEvent::Refused(_) => {
+                    // Nothing new: the situation and plan of the last sample stand.
+                    counters.track_refused = counters.track_refused.saturating_add(1);
+                    return None;
+                }
+            }
+        } else if !inputs.object_present || inputs.object_invalid {
+            self.situation = None;
             return None;
         }
-        let o = inputs.object;
-        let c = time_to_contact(
-            f64::from(o.distance_m),
-            f64::from(o.closing_speed_mps),
-            f64::from(o.relative_accel_mps2),
-        )?;
-        let meas_ns = o.timestamp_ns.min(now);
-        let contact_ns = meas_ns.saturating_add((c.ttc_s * 1.0e9) as u64);
-        let m = f64::from(o.opponent_mass_kg);
-        let sigma = f64::from(o.opponent_mass_sigma_kg);
-        let opp_kg = m + self.conservative_mass_k * sigma;
-        let ebs_kph = equivalent_barrier_speed_kph(c.closing_speed_mps, self.ego_mass_kg, opp_kg);
-        let sit = Situation {
-            contact_ns,
-            closing_speed_mps: c.closing_speed_mps,
-            opponent_mass_kg: opp_kg,
-            ebs_kph,
-            low_speed: !(ebs_kph >= self.no_fire_ebs_kph),
+        let Some(e) = self.track.estimate_at(now) else {
+            self.situation = None; // no track, or it does not reach us
+            return None;
         };
+        let sit = self.situation_of(&e);
         self.situation = Some(sit);
         // Predict only what can become relevant before the next sample: contact within the
         // exit horizon (bounds the work to objects that matter).
-        if contact_ns.saturating_sub(now) > self.exit_horizon_ns || sit.low_speed {
+        if sit.contact_estimate_ns.saturating_sub(now) > self.exit_horizon_ns || sit.low_speed {
             return None;
         }
-        self.predict(&sit, counters);
+        // Opponent class by the conservative mass; beyond the classes, the heaviest.
+        let spring = spring_index(sit.opponent_mass_kg);
+        self.pending = Some((spring, sit.opponent_mass_kg, sit.closing_speed_mps));
         Some(self.lookup(&sit, inputs, counters))
     }
 
+    /// The situation of a track estimate.
+    fn situation_of(&self, e: &TrackEstimate) -> Situation {
+        let to_ns = |t_s: f64| (t_s * 1.0e9) as u64; // saturating, NaN → 0
+        let contact_estimate_ns = e.at_ns.saturating_add(to_ns(e.contact.ttc_s));
+        let early_ns = to_ns(self.contact_time_k * e.ttc_sigma_s);
+        let opp_kg = e.mass_kg + self.conservative_mass_k * e.mass_sigma_kg;
+        let v = e.contact.closing_speed_mps;
+        let ebs_kph = equivalent_barrier_speed_kph(v, self.ego_mass_kg, opp_kg);
+        Situation {
+            contact_ns: contact_estimate_ns.saturating_sub(early_ns),
+            contact_estimate_ns,
+            contact_sigma_s: e.ttc_sigma_s,
+            closing_speed_mps: v,
+            closing_speed_sigma_mps: e.closing_speed_sigma_mps,
+            opponent_mass_kg: opp_kg,
+            opponent_mass_estimate_kg: e.mass_kg,
+            opponent_mass_sigma_kg: e.mass_sigma_kg,
+            ebs_kph,
+            low_speed: !(ebs_kph >= self.no_fire_ebs_kph),
+        }
+    }
+
+    /// Solves the collision of the opponent `spring` (index of the six combined springs).
     #[inline(always)]
-    fn predict(&mut self, sit: &Situation, counters: &mut CycleCounters) {
-        counters.predictions = counters.predictions.saturating_add(1);
-        let Some(spring) = spring_of(&self.springs, sit.opponent_mass_kg) else {
+    fn predict(&mut self, spring: usize, opp_kg: f64, closing_mps: f64, c: &mut CycleCounters) {
+        c.predictions = c.predictions.saturating_add(1);
+        let Some(spring) = self.springs.get(spring).and_then(Option::as_ref) else {
             self.summary = None;
-            counters.prediction_errors = counters.prediction_errors.saturating_add(1);
+            self.pulse.clear();
+            c.prediction_errors = c.prediction_errors.saturating_add(1);
             return;
         };
-        let input = CollisionInput {
-            step_s: self.prediction_step_ms * 1e-3,
-            ..CollisionInput::with_defaults(
-                spring,
-                self.ego_mass_kg,
-                sit.opponent_mass_kg,
-                sit.closing_speed_mps,
-            )
-        };
-        match simulate_collision(&input, &mut self.pulse) {
-            Ok(s) => self.summary = Some(s),
+        let input = CollisionInput::with_defaults(spring, self.ego_mass_kg, opp_kg, closing_mps);
+        match self.solution.solve_in_place(&input) {
+            Ok(s) => {
+                self.summary = Some(*s);
+                self.pulse.restart();
+            }
             Err(_) => {
                 self.summary = None;
-                counters.prediction_errors = counters.prediction_errors.saturating_add(1);
+                self.pulse.clear();
+                c.prediction_errors = c.prediction_errors.saturating_add(1);
             }
         }
     }
@@ -325,7 +404,7 @@ impl<'a> Estimator<'a> {
     /// degraded input).
     ///
     /// **Robust planning mass**: the table is queried at the situation's conservative mass
-    /// raised to the reported mass + `mass_misreport_kg`, capped at the table's heaviest
+    /// raised to the track's fused mass estimate + `mass_misreport_kg`, capped at the table's heaviest
     /// opponent. The opponent's mass does not show in the ego pulse before the restraint is
     /// committed (`crash_match`), so the plan must already hold the heaviest opponent the
     /// sensing could be wrong about; where even the conservative mass is beyond the table, the
@@ -343,8 +422,10 @@ impl<'a> Estimator<'a> {
         if !(occ.buckled && occ.adult) {
             return self.reference;
         }
-        let heaviest = lut.view.axes()[1].last().map_or(f64::NAN, |m| f64::from(*m));
-        let robust = (f64::from(inputs.object.opponent_mass_kg) + self.mass_misreport_kg).min(heaviest);
+        let heaviest = lut.view.axes()[1]
+            .last()
+            .map_or(f64::NAN, |m| f64::from(*m));
+        let robust = (sit.opponent_mass_estimate_kg + self.mass_misreport_kg).min(heaviest);
         // NaN-safe: a NaN robust mass keeps the conservative one.
         let mass = if robust > sit.opponent_mass_kg {
             robust

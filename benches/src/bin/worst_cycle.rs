@@ -1,0 +1,259 @@
+//! `worst_cycle`: the searched worst case of one ECU cycle (see `cycle_benches::worst_case`).
+//!
+//! * `worst_cycle eval CASES.json` — prepares each case (a JSON case or list of cases) and
+//!   runs its measured cycle once, printing its path; what the search and the gate run under
+//!   callgrind, which counts only `measured_step`.
+//! * `worst_cycle search [--generations G] [--population P] [--seed S] [--secoc on|off|any]
+//!   [--crash-phase] [--start FILE]… [--budget N] [--out FILE]` — a seeded (μ + λ) evolution of cases,
+//!   one callgrind run per generation; starts from the `--start` cases (the committed seeds)
+//!   and the hand-picked case plus random ones; writes the best case found to `--out`; exits 1
+//!   if any evaluated case exceeded `--budget` instructions (printing it).
+
+use anyhow::Context;
+use clap::{Parser, Subcommand, ValueEnum};
+use cycle_benches::icount;
+use cycle_benches::worst_case::{self, CycleCase, MEASURED_FN};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::path::{Path, PathBuf};
+
+#[derive(Parser, Debug)]
+#[command(about = "Search for the ECU cycle with the most instructions")]
+struct Cli {
+    #[command(subcommand)]
+    command: Cmd,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Secoc {
+    /// Every case without SecOC (the budget conditions).
+    Off,
+    /// Every case with the SecOC sender set.
+    On,
+    /// Searched like any other field.
+    Any,
+}
+
+#[derive(Subcommand, Debug)]
+enum Cmd {
+    /// Run the measured cycle of each case once (a JSON case or list of cases).
+    Eval {
+        /// Case file.
+        cases: PathBuf,
+    },
+    /// Evolve cases towards the most instructions of the measured cycle.
+    Search {
+        /// Generations (one callgrind run each).
+        #[arg(long, default_value_t = 20)]
+        generations: u32,
+        /// Cases per generation.
+        #[arg(long, default_value_t = 32)]
+        population: usize,
+        /// Seed of the random cases and mutations.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// SecOC in the cases.
+        #[arg(long, value_enum, default_value_t = Secoc::Off)]
+        secoc: Secoc,
+        /// Count only measured cycles that start in CRASH or POST-CRASH (after the
+        /// confirmation: the cycles of the crash-phase work); others score 0.
+        #[arg(long)]
+        crash_phase: bool,
+        /// Cases to start from (e.g. the committed seed); missing files are skipped.
+        #[arg(long)]
+        start: Vec<PathBuf>,
+        /// Fail (exit 1) if a case exceeds this many instructions.
+        #[arg(long)]
+        budget: Option<u64>,
+        /// Where to write the best case found.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
+/// Instructions of each case's measured cycle (one callgrind run of `eval`) and its path.
+fn evaluate(cases: &[CycleCase], dir: &Path) -> anyhow::Result<Vec<(u64, String)>> {
+    let file = dir.join(format!("worst-cycle-cases.{}.json", std::process::id()));
+    std::fs::write(&file, serde_json::to_string(cases)?)?;
+    let exe = std::env::current_exe()?;
+    let file_arg = file.display().to_string();
+    let (totals, stdout) = icount::collected_totals(&exe, &["eval", &file_arg], MEASURED_FN, dir)?;
+    let _ = std::fs::remove_file(&file);
+    let paths: Vec<String> = stdout.lines().map(str::to_owned).collect();
+    anyhow::ensure!(
+        totals.len() == cases.len() && paths.len() == cases.len(),
+        "{} cases, {} counts, {} paths (is `{MEASURED_FN}` still the measured function?)",
+        cases.len(),
+        totals.len(),
+        paths.len()
+    );
+    Ok(totals.into_iter().zip(paths).collect())
+}
+
+fn force_secoc(mut c: CycleCase, s: Secoc) -> CycleCase {
+    match s {
+        Secoc::Off => c.secoc = false,
+        Secoc::On => c.secoc = true,
+        Secoc::Any => {}
+    }
+    c
+}
+
+/// Whether a path (the JSON line `eval` printed) starts in CRASH or POST-CRASH.
+fn starts_in_crash(path: &str) -> bool {
+    path.contains("\"phase_before\":\"crash\"") || path.contains("\"phase_before\":\"post-crash\"")
+}
+
+#[allow(clippy::too_many_arguments)]
+fn search(
+    generations: u32,
+    population: usize,
+    seed: u64,
+    secoc: Secoc,
+    crash_phase: bool,
+    start: &[PathBuf],
+    budget: Option<u64>,
+    out: Option<&Path>,
+) -> anyhow::Result<bool> {
+    let dir = std::env::temp_dir();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let population = population.max(4);
+    let survivors = (population / 4).max(1);
+    let mut starts = vec![("hand-picked".to_owned(), CycleCase::hand_picked())];
+    for p in start.iter().filter(|p| p.exists()) {
+        for c in worst_case::load_cases(p)? {
+            starts.push((p.display().to_string(), c));
+        }
+    }
+    let mut cases: Vec<CycleCase> = starts
+        .iter()
+        .map(|(_, c)| force_secoc(c.clone(), secoc))
+        .collect();
+    while cases.len() < population {
+        cases.push(force_secoc(worst_case::random_case(&mut rng), secoc));
+    }
+    let mut best: Option<(u64, CycleCase, String)> = None;
+    let mut start_counts: Vec<(String, u64)> = Vec::new();
+    let mut over = Vec::new();
+    let mut evaluated = 0usize;
+    for g in 0..generations {
+        let results = evaluate(&cases, &dir)?;
+        evaluated += cases.len();
+        if g == 0 {
+            for ((name, _), (n, _)) in starts.iter().zip(&results) {
+                start_counts.push((name.clone(), *n));
+            }
+        }
+        let mut scored: Vec<(u64, CycleCase, String)> = results
+            .into_iter()
+            .zip(cases)
+            .map(|((n, path), c)| {
+                let n = if crash_phase && !starts_in_crash(&path) {
+                    0
+                } else {
+                    n
+                };
+                (n, c, path)
+            })
+            .collect();
+        scored.sort_by_key(|s| std::cmp::Reverse(s.0));
+        for (n, c, _) in &scored {
+            if budget.is_some_and(|b| *n > b) {
+                over.push((*n, c.clone()));
+            }
+        }
+        let top = &scored[0];
+        if best.as_ref().is_none_or(|b| top.0 > b.0) {
+            best = Some(top.clone());
+        }
+        let median = scored[scored.len() / 2].0;
+        eprintln!(
+            "worst_cycle search: generation {}/{generations}: best {} instr (ever {}), median {median}, {evaluated} cases evaluated",
+            g + 1,
+            top.0,
+            best.as_ref().map_or(0, |b| b.0),
+        );
+        // Next generation: the survivors, mutated children of them, a few fresh cases.
+        let parents: Vec<CycleCase> = scored
+            .into_iter()
+            .take(survivors)
+            .map(|(_, c, _)| c)
+            .collect();
+        cases = parents.clone();
+        while cases.len() < population {
+            let child = if rng.gen_bool(0.1) {
+                worst_case::random_case(&mut rng)
+            } else {
+                let p = &parents[rng.gen_range(0..parents.len())];
+                worst_case::mutate(p, 0.3, &mut rng)
+            };
+            cases.push(force_secoc(child, secoc));
+        }
+    }
+    let (n, case, path) = best.context("no generation evaluated")?;
+    println!(
+        "searched {evaluated} cases in {generations} generations of {population} (seed {seed}, SecOC {secoc:?}{})",
+        if crash_phase { ", cycles after the confirmation only" } else { "" }
+    );
+    println!("worst case found: {n} instructions; path {path}");
+    for (name, c) in &start_counts {
+        println!("  start case {name}: {c} instructions");
+    }
+    println!("{}", serde_json::to_string_pretty(&case)?);
+    if let Some(out) = out {
+        std::fs::write(out, serde_json::to_string_pretty(&case)? + "\n")
+            .with_context(|| format!("cannot write {}", out.display()))?;
+        eprintln!("worst_cycle search: best case written to {}", out.display());
+    }
+    if let Some(b) = budget {
+        if let Some((n, c)) = over.iter().max_by_key(|(n, _)| *n) {
+            println!(
+                "FAIL: {} evaluated cases exceed the budget of {b} instructions; the worst ({n}):\n{}",
+                over.len(),
+                serde_json::to_string_pretty(c)?
+            );
+            return Ok(false);
+        }
+        println!("PASS: no evaluated case exceeds {b} instructions");
+    }
+    Ok(true)
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let r = match cli.command {
+        Cmd::Eval { cases } => worst_case::load_cases(&cases).and_then(|cases| {
+            for c in &cases {
+                println!("{}", serde_json::to_string(&worst_case::run(c)?)?);
+            }
+            Ok(true)
+        }),
+        Cmd::Search {
+            generations,
+            population,
+            seed,
+            secoc,
+            crash_phase,
+            start,
+            budget,
+            out,
+        } => search(
+            generations,
+            population,
+            seed,
+            secoc,
+            crash_phase,
+            &start,
+            budget,
+            out.as_deref(),
+        ),
+    };
+    match r {
+        Ok(true) => {}
+        Ok(false) => std::process::exit(1),
+        Err(e) => {
+            eprintln!("worst_cycle: error: {e:#}");
+            std::process::exit(2);
+        }
+    }
+}
