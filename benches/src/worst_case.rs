@@ -400,7 +400,8 @@ impl Feed<'_> {
     }
 
     /// The accelerometer batch of the millisecond starting at `t_ns`: the crash pulse after
-    /// contact, quiet before.
+    /// contact, before it a live sensor's quiet reading (±0.05 m/s² alternating: the ECU flags
+    /// bit-identical readings as a stuck sensor).
     fn accel(&mut self, t_ns: u64) -> CrashAccelSample {
         let c = self.case;
         let per_ms = ((c.accel_rate_hz / 1000.0).round() as u32).clamp(1, 8);
@@ -417,8 +418,10 @@ impl Feed<'_> {
             let t = first + k as u64 * u64::from(period);
             *s = if t >= self.contact_ns {
                 (-c.crash_decel_g * G) as f32
+            } else if (self.accel_sequence * u64::from(per_ms) + k as u64).is_multiple_of(2) {
+                0.05
             } else {
-                0.0
+                -0.05
             };
         }
         a
@@ -449,9 +452,8 @@ impl Feed<'_> {
             };
             io.push_object(o);
         }
-        if c.crash_decel_g > 0.0 && now + MS > self.contact_ns {
-            io.push_accel(self.accel(now));
-        }
+        // A live accelerometer every ms (a silent one is a fault the ECU degrades on).
+        io.push_accel(self.accel(now));
         Ok(())
     }
 
