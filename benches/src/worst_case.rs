@@ -315,6 +315,9 @@ pub struct PathSummary {
     pub track_events: u64,
     /// CAN frames it sent.
     pub frames_sent: u64,
+    /// A crash event was under way before or after it (accelerometer event in progress,
+    /// CRASH, POST-CRASH): a crash cycle, with its own budget.
+    pub crash_event: bool,
 }
 
 fn phase_name(p: Phase) -> &'static str {
@@ -585,6 +588,7 @@ pub fn measured_step(p: &mut Prepared) {
 pub fn run(case: &CycleCase) -> anyhow::Result<PathSummary> {
     let mut p = prepare(case)?;
     let before = (p.ecu.phase(), p.ecu.counters(), p.io.can_tx_total);
+    let event_before = p.ecu.crash_event();
     measured_step(&mut p);
     let c = p.ecu.counters();
     let track = |c: &restraint::CycleCounters| c.track_starts + c.track_outliers + c.track_refused;
@@ -595,6 +599,7 @@ pub fn run(case: &CycleCase) -> anyhow::Result<PathSummary> {
         lookups: c.lut_lookups - before.1.lut_lookups,
         track_events: track(&c) - track(&before.1),
         frames_sent: p.io.can_tx_total - before.2,
+        crash_event: event_before || p.ecu.crash_event(),
     })
 }
 

@@ -24,8 +24,63 @@ use crate::config::{ms_to_ns, CycleConfig};
 use crate::confirm::G_MPS2;
 use crate::signals::ACCEL_BATCH_CAPACITY;
 
-/// The plausible samples of one batch.
-pub type PlausibleBatch = heapless::Vec<AccelSample, ACCEL_BATCH_CAPACITY>;
+/// The plausible samples of one batch: the batch's timing once, each sample as its index in
+/// the batch and its reading (8 bytes instead of a 24-byte [`AccelSample`]: this runs for every
+/// sample of a drive, and the quiet ones need only their reading).
+#[derive(Debug, Clone, Default)]
+pub struct PlausibleBatch {
+    first_ns: u64,
+    period_ns: u64,
+    dt_s: f64,
+    /// (index in the batch, acceleration m/s², negative = deceleration).
+    readings: heapless::Vec<(u8, f32), ACCEL_BATCH_CAPACITY>,
+}
+
+impl PlausibleBatch {
+    /// An empty batch.
+    pub const fn new() -> Self {
+        Self {
+            first_ns: 0,
+            period_ns: 0,
+            dt_s: 0.0,
+            readings: heapless::Vec::new(),
+        }
+    }
+
+    /// Number of plausible samples.
+    pub fn len(&self) -> usize {
+        self.readings.len()
+    }
+
+    /// No plausible sample.
+    pub fn is_empty(&self) -> bool {
+        self.readings.is_empty()
+    }
+
+    /// Every sample's deceleration is below `decel_mps2` (true when empty).
+    pub fn all_below(&self, decel_mps2: f64) -> bool {
+        // decel = −a < d  ⇔  a > −d (the readings are finite: the monitor checked them).
+        self.readings
+            .iter()
+            .all(|&(_, a)| f64::from(a) > -decel_mps2)
+    }
+
+    /// The deceleration of the newest sample, m/s².
+    pub fn last_decel_mps2(&self) -> Option<f64> {
+        self.readings.last().map(|&(_, a)| -f64::from(a))
+    }
+
+    /// The samples, in time order.
+    pub fn iter(&self) -> impl Iterator<Item = AccelSample> + '_ {
+        self.readings.iter().map(|&(i, a)| AccelSample {
+            t_ns: self
+                .first_ns
+                .saturating_add(u64::from(i).saturating_mul(self.period_ns)),
+            dt_s: self.dt_s,
+            decel_mps2: -f64::from(a),
+        })
+    }
+}
 
 /// How long an implausible accelerometer sample keeps `ACCEL_INVALID` set, ms.
 pub const INVALID_HOLD_MS: f64 = 500.0;
@@ -116,7 +171,7 @@ impl AccelMonitor {
         samples: &[f32],
         out: &mut PlausibleBatch,
     ) {
-        out.clear();
+        out.readings.clear();
         let too_old = now.saturating_sub(first_ns) > self.timeout_ns;
         let in_future = first_ns > now.saturating_add(FUTURE_SLACK_NS);
         let backwards = self.next_from_ns.is_some_and(|t| first_ns < t);
@@ -127,46 +182,78 @@ impl AccelMonitor {
         }
         self.rx_ns = Some(now);
         let dt_s = f64::from(period_ns) * 1.0e-9;
-        let half = u64::from(period_ns / 2);
-        let mut t = first_ns;
-        for &a in samples.iter().take(ACCEL_BATCH_CAPACITY) {
-            let t_ns = t;
-            t = t.saturating_add(u64::from(period_ns));
-            self.next_from_ns = Some(t_ns.saturating_add(half));
+        let period = u64::from(period_ns);
+        (out.first_ns, out.period_ns, out.dt_s) = (first_ns, period, dt_s);
+        let out_of_range_mps2 = self.full_scale_mps2 * (1.0 + SATURATION_BAND);
+        let saturated_mps2 = self.full_scale_mps2 * (1.0 - SATURATION_BAND);
+        let samples = &samples[..samples.len().min(ACCEL_BATCH_CAPACITY)];
+        let time_of = |i: u8| first_ns.saturating_add(u64::from(i) * period);
+        if let Some(&last) = samples.last() {
+            // Where the next batch may start: the newest sample + half a period.
+            let last_ns = time_of(samples.len() as u8 - 1);
+            self.next_from_ns = Some(last_ns.saturating_add(period / 2));
+            // The common batch, checked in bulk: every reading within range and each differing
+            // from the one before (a live sensor's noise) — all plausible, nothing stuck.
+            let in_range = samples.iter().all(|&a| f64::from(a).abs() < saturated_mps2);
+            let changing = self.last_bits != samples.first().map(|a| a.to_bits())
+                && samples.windows(2).all(|w| w[0].to_bits() != w[1].to_bits());
+            if in_range && changing {
+                for (i, &a) in (0u8..).zip(samples) {
+                    // Cannot fail: at most ACCEL_BATCH_CAPACITY samples are read.
+                    let _ = out.readings.push((i, a));
+                }
+                self.last_bits = Some(last.to_bits());
+                self.same_since_ns = last_ns;
+                self.stuck = false;
+                return;
+            }
+        }
+        // Sample by sample: a reading out of range, saturated, or repeated (the state in
+        // locals, written back once).
+        let (mut last_bits, mut stuck) = (self.last_bits, self.stuck);
+        // The index of the newest change of reading in this batch (its time is computed once,
+        // after the loop, or where a repeated reading needs it).
+        let mut changed_at: Option<u8> = None;
+        let mut implausible = false;
+        for (i, &a) in (0u8..).zip(samples) {
             let v = f64::from(a);
             let magnitude = v.abs();
-            if !(magnitude <= self.full_scale_mps2 * (1.0 + SATURATION_BAND)) {
-                self.faults.out_of_range_samples =
-                    self.faults.out_of_range_samples.saturating_add(1);
-                self.implausible(now);
-                continue;
-            }
-            if magnitude >= self.full_scale_mps2 * (1.0 - SATURATION_BAND) {
-                self.faults.saturated_samples = self.faults.saturated_samples.saturating_add(1);
-                self.implausible(now);
+            // One comparison for a plausible reading; NaN fails it too.
+            if !(magnitude < saturated_mps2) {
+                if magnitude <= out_of_range_mps2 {
+                    self.faults.saturated_samples = self.faults.saturated_samples.saturating_add(1);
+                } else {
+                    self.faults.out_of_range_samples =
+                        self.faults.out_of_range_samples.saturating_add(1);
+                }
+                implausible = true;
                 continue;
             }
             let bits = a.to_bits();
-            if self.last_bits == Some(bits) {
-                if !self.stuck && t_ns.saturating_sub(self.same_since_ns) >= self.stuck_ns {
-                    self.stuck = true;
+            if last_bits == Some(bits) {
+                let same_since_ns = changed_at.map_or(self.same_since_ns, time_of);
+                if !stuck && time_of(i).saturating_sub(same_since_ns) >= self.stuck_ns {
+                    stuck = true;
                     self.faults.stuck_events = self.faults.stuck_events.saturating_add(1);
                 }
+                if stuck {
+                    implausible = true;
+                    continue;
+                }
             } else {
-                self.last_bits = Some(bits);
-                self.same_since_ns = t_ns;
-                self.stuck = false;
-            }
-            if self.stuck {
-                self.implausible(now);
-                continue;
+                last_bits = Some(bits);
+                changed_at = Some(i);
+                stuck = false;
             }
             // Cannot fail: at most ACCEL_BATCH_CAPACITY samples are read.
-            let _ = out.push(AccelSample {
-                t_ns,
-                dt_s,
-                decel_mps2: -v,
-            });
+            let _ = out.readings.push((i, a));
+        }
+        (self.last_bits, self.stuck) = (last_bits, stuck);
+        if let Some(i) = changed_at {
+            self.same_since_ns = time_of(i);
+        }
+        if implausible {
+            self.implausible(now);
         }
     }
 
@@ -203,7 +290,7 @@ mod tests {
     fn feed(m: &mut AccelMonitor, now: u64, v: [f32; 4]) -> Vec<AccelSample> {
         let mut out = PlausibleBatch::new();
         m.feed(now, now - 750_000, 250_000, &v, &mut out);
-        out.to_vec()
+        out.iter().collect()
     }
 
     #[test]

@@ -16,7 +16,7 @@
 //! The first confirmation latches ([`Confirmation`]); [`plan_for`] re-plans an adaptive crash
 //! from the table at the measured severity (and, as every lookup, the robust planning mass).
 
-use crate::accel::AccelSample;
+use crate::accel::{AccelSample, PlausibleBatch};
 use crate::config::{ms_to_ns, CycleConfig};
 use crate::confirm::{ConfirmParams, CrashDetector, G_MPS2};
 use crate::counters::CycleCounters;
@@ -97,18 +97,29 @@ impl CrashMonitor {
         }
     }
 
-    /// One plausible accelerometer sample for all three detectors. A quiet sample (below the
-    /// wake threshold, no event in progress) only updates their integrators' previous value:
-    /// the common case, every cycle of a drive.
-    pub(crate) fn on_sample(&mut self, s: &AccelSample, ctx: &FreezeContext<'_, '_>) {
-        if s.decel_mps2 < self.onset_params.wake_mps2
-            && !(self.matcher.awake() || self.generic.awake() || self.fallback.awake())
+    /// The plausible samples of one accelerometer batch, in time order, for all three
+    /// detectors. A quiet batch (every sample below the wake threshold, no event in progress)
+    /// only updates their integrators' previous value with its last sample: the common case,
+    /// every cycle of a drive, and what each detector would do sample by sample.
+    pub(crate) fn on_batch(&mut self, batch: &PlausibleBatch, ctx: &FreezeContext<'_, '_>) {
+        let wake = self.onset_params.wake_mps2;
+        if !(self.matcher.awake() || self.generic.awake() || self.fallback.awake())
+            && batch.all_below(wake)
         {
-            self.matcher.note_quiet(s.decel_mps2);
-            self.generic.note_quiet(s.decel_mps2);
-            self.fallback.note_quiet(s.decel_mps2);
+            if let Some(last) = batch.last_decel_mps2() {
+                self.matcher.note_quiet(last);
+                self.generic.note_quiet(last);
+                self.fallback.note_quiet(last);
+            }
             return;
         }
+        for s in batch.iter() {
+            self.on_sample(&s, ctx);
+        }
+    }
+
+    /// One plausible accelerometer sample for all three detectors.
+    fn on_sample(&mut self, s: &AccelSample, ctx: &FreezeContext<'_, '_>) {
         self.matcher.push(s, &mut |slot| {
             let Some(sit) = ctx.situation.filter(|_| ctx.armed) else {
                 return false;

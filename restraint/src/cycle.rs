@@ -126,6 +126,11 @@ impl<'lut> RestraintCycle<'lut> {
     pub fn crash_kind(&self) -> Option<crate::crash::ConfirmKind> {
         self.decision.crash_kind()
     }
+    /// A crash event is under way: the accelerometer shows one in progress, or the crash is
+    /// confirmed (CRASH, POST-CRASH). Its cycles run the crash detectors on every sample.
+    pub fn crash_event(&self) -> bool {
+        self.crash.awake() || matches!(self.phase(), Phase::Crash | Phase::PostCrash)
+    }
     /// Whether the airbag fire command has been sent.
     pub fn airbag_fired(&self) -> bool {
         self.decision.airbag_fired()
@@ -183,9 +188,7 @@ impl Activity for RestraintCycle<'_> {
         let mut plausible = crate::accel::PlausibleBatch::new();
         io.drain_accel(&mut |a| {
             inputs.on_accel(a, now, c, &mut plausible);
-            for s in &plausible {
-                crash.on_sample(s, &freeze);
-            }
+            crash.on_batch(&plausible, &freeze);
         });
         inputs.on_receive_errors(io.receive_errors(), now);
         let lut_present = self.estimate.lut().is_some();

@@ -4,7 +4,7 @@
 //!   runs its measured cycle once, printing its path; what the search and the gate run under
 //!   callgrind, which counts only `measured_step`.
 //! * `worst_cycle search [--generations G] [--population P] [--seed S] [--secoc on|off|any]
-//!   [--crash-phase] [--start FILE]… [--budget N] [--out FILE]` — a seeded (μ + λ) evolution of cases,
+//!   [--cycles all|no-crash|crash] [--start FILE]… [--budget N] [--out FILE]` — a seeded (μ + λ) evolution of cases,
 //!   one callgrind run per generation; starts from the `--start` cases (the committed seeds)
 //!   and the hand-picked case plus random ones; writes the best case found to `--out`; exits 1
 //!   if any evaluated case exceeded `--budget` instructions (printing it).
@@ -22,6 +22,30 @@ use std::path::{Path, PathBuf};
 struct Cli {
     #[command(subcommand)]
     command: Cmd,
+}
+
+/// Which measured cycles count (the others score 0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Cycles {
+    /// Every cycle.
+    All,
+    /// Cycles without a crash event (no accelerometer event in progress, not CRASH or
+    /// POST-CRASH): the driving and pre-crash path of issue 15's budget.
+    NoCrash,
+    /// Cycles of a crash event (the accelerometer's event in progress, CRASH, POST-CRASH):
+    /// every sample through the crash detectors.
+    Crash,
+}
+
+impl Cycles {
+    fn counts(self, path: &str) -> bool {
+        let event = path.contains("\"crash_event\":true");
+        match self {
+            Cycles::All => true,
+            Cycles::NoCrash => !event,
+            Cycles::Crash => event,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -55,10 +79,9 @@ enum Cmd {
         /// SecOC in the cases.
         #[arg(long, value_enum, default_value_t = Secoc::Off)]
         secoc: Secoc,
-        /// Count only measured cycles that start in CRASH or POST-CRASH (after the
-        /// confirmation: the cycles of the crash-phase work); others score 0.
-        #[arg(long)]
-        crash_phase: bool,
+        /// Which measured cycles count; the others score 0.
+        #[arg(long, value_enum, default_value_t = Cycles::All)]
+        cycles: Cycles,
         /// Cases to start from (e.g. the committed seed); missing files are skipped.
         #[arg(long)]
         start: Vec<PathBuf>,
@@ -99,18 +122,13 @@ fn force_secoc(mut c: CycleCase, s: Secoc) -> CycleCase {
     c
 }
 
-/// Whether a path (the JSON line `eval` printed) starts in CRASH or POST-CRASH.
-fn starts_in_crash(path: &str) -> bool {
-    path.contains("\"phase_before\":\"crash\"") || path.contains("\"phase_before\":\"post-crash\"")
-}
-
 #[allow(clippy::too_many_arguments)]
 fn search(
     generations: u32,
     population: usize,
     seed: u64,
     secoc: Secoc,
-    crash_phase: bool,
+    cycles: Cycles,
     start: &[PathBuf],
     budget: Option<u64>,
     out: Option<&Path>,
@@ -148,11 +166,7 @@ fn search(
             .into_iter()
             .zip(cases)
             .map(|((n, path), c)| {
-                let n = if crash_phase && !starts_in_crash(&path) {
-                    0
-                } else {
-                    n
-                };
+                let n = if !cycles.counts(&path) { 0 } else { n };
                 (n, c, path)
             })
             .collect();
@@ -192,8 +206,7 @@ fn search(
     }
     let (n, case, path) = best.context("no generation evaluated")?;
     println!(
-        "searched {evaluated} cases in {generations} generations of {population} (seed {seed}, SecOC {secoc:?}{})",
-        if crash_phase { ", cycles after the confirmation only" } else { "" }
+        "searched {evaluated} cases in {generations} generations of {population} (seed {seed}, SecOC {secoc:?}, cycles {cycles:?})"
     );
     println!("worst case found: {n} instructions; path {path}");
     for (name, c) in &start_counts {
@@ -233,7 +246,7 @@ fn main() {
             population,
             seed,
             secoc,
-            crash_phase,
+            cycles,
             start,
             budget,
             out,
@@ -242,7 +255,7 @@ fn main() {
             population,
             seed,
             secoc,
-            crash_phase,
+            cycles,
             &start,
             budget,
             out.as_deref(),
