@@ -101,7 +101,7 @@ pub struct CycleConfig {
     pub backup_confirm_g: f64,
     /// Accelerometer-only algorithm: velocity change since the onset [m/s] the crash must reach
     /// at 0, 4, 8, … 60 ms after the onset (linear between; *default* calibrated by
-    /// `lut study fallback --derive`, README "Accelerometer-only algorithm"). Reaching it fires
+    /// `lut study fallback --derive`, restraint/README.md, "Crash phase"). Reaching it fires
     /// the reference airbag; not reaching it within 60 ms is a no-fire.
     pub fallback_dv_mps: [f64; crate::fallback::KNOTS],
 

@@ -13,7 +13,7 @@
 //! has more Δv; a bump saturates at its small total Δv, a severe crash crosses the boundary
 //! within a few ms. The boundary is the velocity-time curve of a crash just above the no-fire
 //! line (calibrated by `lut study fallback` on barrier and car-to-car pulses of the model,
-//! README "Accelerometer-only algorithm"), so crashes below the no-fire line stay under it
+//! restraint/README.md, "Crash phase"), so crashes below the no-fire line stay under it
 //! and crashes above the must-fire line cross it in time.
 //!
 //! It sees what a conventional sensor sees: the opponent's mass does not show in the first
@@ -33,7 +33,7 @@ pub const WINDOW_MS: f64 = KNOT_SPACING_MS * (KNOTS - 1) as f64;
 
 /// Default boundary, m/s at 0, 4, … 60 ms after the onset: the upper envelope (+10 %) of the
 /// Δv(τ) curves of every no-fire crash of the calibration sweep as this algorithm measures
-/// them, from `lut study fallback --derive` (README "Accelerometer-only algorithm";
+/// them, from `lut study fallback --derive` (restraint/README.md, "Crash phase";
 /// `lut/tests/fallback.rs` checks that the sweep still derives exactly these numbers).
 pub const DEFAULT_DV_MPS: [f64; KNOTS] = [
     0.10, 0.25, 0.70, 1.25, 1.90, 2.55, 3.30, 4.10, 4.90, 5.55, 6.50, 7.05, 7.35, 7.35, 7.35, 7.35,
