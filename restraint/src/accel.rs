@@ -194,14 +194,21 @@ impl AccelMonitor {
             self.next_from_ns = Some(last_ns.saturating_add(period / 2));
             // The common batch, checked in bulk: every reading within range and each differing
             // from the one before (a live sensor's noise) — all plausible, nothing stuck.
-            let in_range = samples.iter().all(|&a| f64::from(a).abs() < saturated_mps2);
-            let changing = self.last_bits != samples.first().map(|a| a.to_bits())
-                && samples.windows(2).all(|w| w[0].to_bits() != w[1].to_bits());
-            if in_range && changing {
-                for (i, &a) in (0u8..).zip(samples) {
-                    // Cannot fail: at most ACCEL_BATCH_CAPACITY samples are read.
-                    let _ = out.readings.push((i, a));
+            // One pass; the first reading that breaks the rule sends the batch to the
+            // sample-by-sample path below.
+            let mut prev = self.last_bits;
+            let mut bulk = true;
+            for (i, &a) in (0u8..).zip(samples) {
+                let bits = Some(a.to_bits());
+                if !(f64::from(a).abs() < saturated_mps2) || bits == prev {
+                    bulk = false;
+                    break;
                 }
+                prev = bits;
+                // Cannot fail: at most ACCEL_BATCH_CAPACITY samples are read.
+                let _ = out.readings.push((i, a));
+            }
+            if bulk {
                 self.last_bits = Some(last.to_bits());
                 self.same_since_ns = last_ns;
                 self.stuck = false;
@@ -210,6 +217,7 @@ impl AccelMonitor {
         }
         // Sample by sample: a reading out of range, saturated, or repeated (the state in
         // locals, written back once).
+        out.readings.clear();
         let (mut last_bits, mut stuck) = (self.last_bits, self.stuck);
         // The index of the newest change of reading in this batch (its time is computed once,
         // after the loop, or where a repeated reading needs it).

