@@ -513,7 +513,10 @@ pub struct StudyScenario {
     pub outcome: Option<(Sampler, f64)>,
 }
 
-/// Loads every `*.toml` of `dir` with a true contact (sorted by file name).
+/// Loads every `*.toml` of `dir` with a true contact (sorted by file name), except those whose
+/// object list is deliberately misreported (`sensor.speed_bias_mps`, `sensor.mass_estimate_kg`:
+/// a bias of every sample that no estimator can see; the crash phase handles them, restraint
+/// README "Crash phase") or dead (no sample within the sensor's range: nothing to estimate).
 ///
 /// # Errors
 /// Unreadable directory or scenario, or a table that cannot serve the samplers.
@@ -528,7 +531,8 @@ pub fn load_scenarios(dir: &Path, table: &Diagram) -> Result<Vec<StudyScenario>>
     for f in files {
         let s = Scenario::load(&f).map_err(|e| anyhow!("{e}"))?;
         let truth = Truth::new(&s).map_err(|e| anyhow!("{}: {e}", f.display()))?;
-        if truth.contact_s.is_none() {
+        let misreported = s.sensor.speed_bias_mps != 0.0 || s.sensor.mass_estimate_kg.is_some();
+        if truth.contact_s.is_none() || misreported {
             continue;
         }
         let outcome = if s.occupant.belted && s.opponent.kind == OpponentKind::Vehicle {
