@@ -559,17 +559,31 @@ fn judge_reaction(
             )
         }),
     );
-    checks.check(
-        "recovers after the fault",
-        recovered_after_ms.is_some_and(|d| d <= recover_limit_ms + slack_ms),
-        rec.as_ref().map_or("never recovered".into(), |(t, m)| {
-            format!(
-                "{m} {:.0} ms after the fault ended (documented ≤ {recover_limit_ms:.0} ms + {slack_ms:.0} ms slack; at {:.0} ms)",
-                t - to_ms,
-                t
-            )
-        }),
-    );
+    // A crash confirmed after the fault began, before the recovery was due, latches the ECU
+    // (CrashDetected, Deployed: the specified post-crash state); it does not return to Normal,
+    // so there is no recovery to wait for.
+    let due_ms = to_ms + recover_limit_ms + slack_ms;
+    let latched = modes.iter().find(|(t, m)| {
+        *t >= from_ms - 5.0 && *t <= due_ms && (m == "CrashDetected" || m == "Deployed")
+    });
+    match latched {
+        Some((t, m)) if rec.is_none() => checks.check(
+            "recovers after the fault",
+            true,
+            format!("not expected: crash latched ({m} at {t:.0} ms, the fault began at {from_ms:.0} ms)"),
+        ),
+        _ => checks.check(
+            "recovers after the fault",
+            recovered_after_ms.is_some_and(|d| d <= recover_limit_ms + slack_ms),
+            rec.as_ref().map_or("never recovered".into(), |(t, m)| {
+                format!(
+                    "{m} {:.0} ms after the fault ended (documented ≤ {recover_limit_ms:.0} ms + {slack_ms:.0} ms slack; at {:.0} ms)",
+                    t - to_ms,
+                    t
+                )
+            }),
+        ),
+    }
     if let Some(reason) = reason {
         let n = rejected.get(reason).copied().unwrap_or(0);
         checks.check(
