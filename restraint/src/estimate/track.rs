@@ -498,7 +498,8 @@ impl TrackFilter {
         // 1 + α(gate/3 − 1).
         let r = &self.r_diag;
         let (gate, alpha) = (self.gate_chi2, self.alpha);
-        // max/min, not clamp: a NaN (never from finite inputs) becomes 1, not a panic.
+        // max/min, not clamp: a NaN (never from finite inputs) becomes 1, not NaN.
+        #[allow(clippy::manual_clamp)]
         let adapt = |l: f64, y: f64, p: f64, r: f64| {
             let seen = ((y * y - p) / r).max(0.0).min(l * gate / 3.0);
             ((1.0 - alpha) * l + alpha * seen).max(1.0).min(100.0)
