@@ -20,12 +20,9 @@ use bus::socket::BusSocket;
 use ipc::{AccelPublisher, CrashAccelSample, ObjectPublisher, ObjectState, ServiceNames, VALID};
 use vcan_rerun::{iface, repo_root, run_here_or_in_guest};
 
-const ECU: &str = env!("CARGO_BIN_EXE_ecu");
+use host::clock::monotonic_ns;
 
-fn monotonic_ns() -> u64 {
-    let t = nix::time::clock_gettime(nix::time::ClockId::CLOCK_MONOTONIC).unwrap();
-    t.tv_sec() as u64 * 1_000_000_000 + t.tv_nsec() as u64
-}
+const ECU: &str = env!("CARGO_BIN_EXE_ecu");
 
 #[test]
 fn ecu_process_on_vcan_sends_e2e_valid_commands() {

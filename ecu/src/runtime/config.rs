@@ -82,8 +82,17 @@ mod cycle_section {
             let key = String::deserialize(d)?;
             match FILE_KEYS.iter().position(|k| *k == key) {
                 Some(i) => Ok(Key::File(i, self.0)),
-                // Inside toml's key deserialisation: an unknown key gets the key's span.
-                None => self.0.deserialize(key.into_deserializer()).map(Key::Field),
+                // Inside toml's key deserialisation: an unknown key gets the key's span. The
+                // core's "expected one of" list does not know the file keys: they are added.
+                None => self
+                    .0
+                    .deserialize(key.as_str().into_deserializer())
+                    .map(Key::Field)
+                    .map_err(|e: D::Error| {
+                        serde::de::Error::custom(format_args!(
+                            "{e}, or one of the file keys `lut`, `reference`, `secoc_keys`"
+                        ))
+                    }),
             }
         }
     }
@@ -445,25 +454,25 @@ impl EcuConfig {
     }
 }
 
-/// `path:line` of `key` (last dotted component, inside its `[table]`), or `path`.
+/// `path:line` of the dotted `key` (from the span `toml_edit` keeps for it), or `path` when
+/// the file does not set it.
 fn origin_in_file(text: &str, path: &Path, key: &str) -> String {
-    let (table, leaf) = match key.rsplit_once('.') {
-        Some((t, l)) => (Some(t), l),
-        None => (None, key),
-    };
-    let mut current: Option<String> = None;
-    for (i, raw) in text.lines().enumerate() {
-        let line = raw.trim();
-        if let Some(t) = line.strip_prefix('[').and_then(|l| l.strip_suffix(']')) {
-            current = Some(t.trim().to_owned());
-            continue;
+    let line = toml_edit::ImDocument::parse(text).ok().and_then(|doc| {
+        let mut table: &dyn toml_edit::TableLike = doc.as_table();
+        let mut parts = key.split('.').peekable();
+        while let Some(part) = parts.next() {
+            let (k, item) = table.get_key_value(part)?;
+            if parts.peek().is_none() {
+                return k.span().or_else(|| item.span());
+            }
+            table = item.as_table_like()?;
         }
-        let key_part = line.split('=').next().map(str::trim);
-        if key_part == Some(leaf) && current.as_deref() == table {
-            return format!("{}:{}", path.display(), i + 1);
-        }
+        None
+    });
+    match line {
+        Some(span) => format!("{}:{}", path.display(), line_col(text, span.start).0),
+        None => path.display().to_string(),
     }
-    path.display().to_string()
 }
 
 /// `ecu` command line.
@@ -615,6 +624,19 @@ mod tests {
         assert_eq!(cfg.can.interface, "vcan0");
         // The file shows the defaults: the core's thresholds, its track filter included.
         assert_eq!(cfg.cycle.decision, restraint::CycleConfig::default());
+    }
+
+    #[test]
+    fn an_unknown_cycle_key_lists_the_file_keys_too() {
+        let e = EcuConfig::from_toml_str("[cycle]\nlut_file = \"x.lut\"\n", &p())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("lut_file"), "{e}");
+        assert!(
+            e.contains("`secoc_keys`") && e.contains("confirm_samples"),
+            "{e}"
+        );
+        assert!(e.contains(":2:"), "the key's line: {e}");
     }
 
     #[test]

@@ -1,13 +1,17 @@
-//! Scenario files: schema, loading and validation (schema documented in `scenarios/README.md`).
+//! Scenario files (schema documented in `scenarios/README.md`): the schema here, the semantic
+//! checks in [`validate`](self::validate), where an error is in the file in `location`.
 //!
 //! Every error names the file, the line (and column) and the field, because a bench engineer
-//! editing a scenario needs to know exactly where the mistake is:
-//! syntax/type/unknown-field errors come from `toml`'s span; semantic errors (a negative mass,
-//! a dropout window that ends before it starts) are located by searching the field's key inside
-//! its table in the source text.
+//! editing a scenario needs to know exactly where the mistake is: syntax, type and
+//! unknown-field errors carry `toml`'s span; semantic errors (a negative mass, a dropout window
+//! that ends before it starts) are located by the span of their key in the parsed document.
+
+mod location;
+mod validate;
+
+pub use location::ScenarioError;
 
 use serde::Deserialize;
-use std::fmt;
 use std::path::Path;
 
 /// A whole scenario file.
@@ -338,102 +342,6 @@ pub struct Expect {
     pub accel_fault_before_contact: Option<bool>,
 }
 
-/// A scenario-file error: where and what.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ScenarioError {
-    /// File name as given.
-    pub file: String,
-    /// 1-based line, when known.
-    pub line: Option<usize>,
-    /// 1-based column, when known.
-    pub column: Option<usize>,
-    /// Dotted field path (`ego.mass_kg`), when known.
-    pub field: Option<String>,
-    /// What is wrong.
-    pub message: String,
-}
-
-impl fmt::Display for ScenarioError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.file)?;
-        if let Some(l) = self.line {
-            write!(f, ":{l}")?;
-            if let Some(c) = self.column {
-                write!(f, ":{c}")?;
-            }
-        }
-        write!(f, ": ")?;
-        if let Some(field) = &self.field {
-            write!(f, "field `{field}`: ")?;
-        }
-        write!(f, "{}", self.message)
-    }
-}
-
-impl std::error::Error for ScenarioError {}
-
-/// 1-based (line, column) of byte offset `pos` in `text`.
-fn line_col(text: &str, pos: usize) -> (usize, usize) {
-    let pos = pos.min(text.len());
-    let before = &text[..pos];
-    let line = before.matches('\n').count() + 1;
-    let col = before.rfind('\n').map_or(pos, |nl| pos - nl - 1) + 1;
-    (line, col)
-}
-
-/// Dotted path of the key on `line` (1-based): the nearest `[table]` header above it plus the
-/// line's own `key =` (how a type error is turned into a field name).
-fn field_at_line(text: &str, line: usize) -> Option<String> {
-    let lines: Vec<&str> = text.lines().collect();
-    let this = lines.get(line.checked_sub(1)?)?.trim();
-    let key = this
-        .split_once('=')
-        .map(|(k, _)| k.trim().to_owned())
-        .filter(|k| !k.is_empty() && !k.starts_with('['));
-    let table = lines[..line - 1].iter().rev().find_map(|l| {
-        let t = l.trim();
-        t.strip_prefix('[')
-            .and_then(|r| r.strip_suffix(']'))
-            .map(|h| h.trim_matches(|c| c == '[' || c == ']').trim().to_owned())
-    });
-    match (table, key) {
-        (Some(t), Some(k)) => Some(format!("{t}.{k}")),
-        (None, Some(k)) => Some(k),
-        (Some(t), None) => Some(t),
-        (None, None) => None,
-    }
-}
-
-/// 1-based line of `field` (`table.key` or `key`) in `text`, for semantic errors.
-fn line_of_field(text: &str, field: &str) -> Option<usize> {
-    let (table, key) = match field.rsplit_once('.') {
-        Some((t, k)) => (Some(t), k),
-        None => (None, field),
-    };
-    let key = key.split('[').next().unwrap_or(key);
-    let mut in_table = table.is_none();
-    for (i, l) in text.lines().enumerate() {
-        let t = l.trim();
-        if t.starts_with('[') {
-            let h = t.trim_matches(|c| c == '[' || c == ']').trim();
-            in_table = Some(h) == table;
-            continue;
-        }
-        if in_table {
-            if let Some((k, _)) = t.split_once('=') {
-                if k.trim() == key {
-                    return Some(i + 1);
-                }
-            }
-        }
-    }
-    // The key is absent (a required value missing in a table): point at the table header.
-    let table = table?;
-    text.lines()
-        .position(|l| l.trim().trim_matches(|c| c == '[' || c == ']').trim() == table)
-        .map(|i| i + 1)
-}
-
 impl Scenario {
     /// Reads, parses and validates a scenario file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, ScenarioError> {
@@ -452,11 +360,11 @@ impl Scenario {
     /// Parses and validates scenario text; `file` names the source in errors.
     pub fn parse(file: &str, text: &str) -> Result<Self, ScenarioError> {
         let scenario: Scenario = toml::from_str(text).map_err(|e| {
-            let (line, column) = e.span().map(|s| line_col(text, s.start)).unzip();
+            let (line, column) = e.span().map(|s| location::line_col(text, s.start)).unzip();
             let message = e.message().to_owned();
             // Unknown/missing field errors name the key themselves; others (types, ranges
             // of integers) get the key of the offending line.
-            let field = line.and_then(|l| field_at_line(text, l));
+            let field = e.span().and_then(|s| location::field_at(text, s.start));
             ScenarioError {
                 file: file.to_owned(),
                 line,
@@ -469,259 +377,12 @@ impl Scenario {
             .validate()
             .map_err(|(field, message)| ScenarioError {
                 file: file.to_owned(),
-                line: line_of_field(text, &field),
+                line: location::line_of_field(text, &field),
                 column: None,
                 field: Some(field),
                 message,
             })?;
         Ok(scenario)
-    }
-
-    /// Semantic checks; `Err((field path, message))`.
-    pub fn validate(&self) -> Result<(), (String, String)> {
-        fn range(
-            field: &str,
-            v: f64,
-            lo: f64,
-            hi: f64,
-            unit: &str,
-        ) -> Result<(), (String, String)> {
-            if v.is_finite() && v >= lo && v <= hi {
-                Ok(())
-            } else {
-                Err((
-                    field.to_owned(),
-                    format!("{v} is outside {lo}..={hi} {unit}"),
-                ))
-            }
-        }
-        fn class(field: &str, c: Option<u8>) -> Result<(), (String, String)> {
-            match c {
-                Some(n) if !(1..=6).contains(&n) => Err((
-                    field.to_owned(),
-                    format!("class {n} does not exist (1..=6)"),
-                )),
-                _ => Ok(()),
-            }
-        }
-        fn braking(
-            prefix: &str,
-            b: &Option<Braking>,
-            duration_s: f64,
-        ) -> Result<(), (String, String)> {
-            if let Some(b) = b {
-                range(
-                    &format!("{prefix}.start_s"),
-                    b.start_s,
-                    0.0,
-                    duration_s,
-                    "s",
-                )?;
-                range(
-                    &format!("{prefix}.decel_mps2"),
-                    b.decel_mps2,
-                    0.1,
-                    15.0,
-                    "m/s²",
-                )?;
-                range(&format!("{prefix}.ramp_s"), b.ramp_s, 0.0, 2.0, "s")?;
-            }
-            Ok(())
-        }
-        if self.name.is_empty() || self.name.len() > ipc::SCENARIO_NAME_CAPACITY {
-            return Err((
-                "name".into(),
-                format!("must be 1..={} bytes", ipc::SCENARIO_NAME_CAPACITY),
-            ));
-        }
-        if !self
-            .name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
-        {
-            return Err((
-                "name".into(),
-                "use only letters, digits, '-' and '_' (it names the output folder)".into(),
-            ));
-        }
-        range("duration_s", self.duration_s, 0.1, 60.0, "s")?;
-        range("ego.mass_kg", self.ego.mass_kg, 500.0, 4000.0, "kg")?;
-        class("ego.class", self.ego.class)?;
-        range("ego.speed_kph", self.ego.speed_kph, 0.0, 200.0, "km/h")?;
-        braking("ego.braking", &self.ego.braking, self.duration_s)?;
-        let o = &self.opponent;
-        range(
-            "opponent.initial_distance_m",
-            o.initial_distance_m,
-            0.1,
-            1000.0,
-            "m",
-        )?;
-        match o.kind {
-            OpponentKind::Vehicle => {
-                let m = o.mass_kg.ok_or((
-                    "opponent.mass_kg".to_owned(),
-                    "required for kind = \"vehicle\"".to_owned(),
-                ))?;
-                range("opponent.mass_kg", m, 300.0, 10000.0, "kg")?;
-                class("opponent.class", o.class)?;
-                range("opponent.speed_kph", o.speed_kph, 0.0, 200.0, "km/h")?;
-                braking("opponent.braking", &o.braking, self.duration_s)?;
-                if let Some(te) = o.evade_s {
-                    range("opponent.evade_s", te, 0.0, self.duration_s, "s")?;
-                }
-            }
-            OpponentKind::Barrier => {
-                let bad = if o.mass_kg.is_some() {
-                    Some("mass_kg")
-                } else if o.class.is_some() {
-                    Some("class")
-                } else if o.speed_kph != 0.0 {
-                    Some("speed_kph")
-                } else if o.braking.is_some() {
-                    Some("braking")
-                } else if o.evade_s.is_some() {
-                    Some("evade_s")
-                } else {
-                    None
-                };
-                if let Some(k) = bad {
-                    return Err((
-                        format!("opponent.{k}"),
-                        "a rigid barrier is immovable and non-deforming: remove this key".into(),
-                    ));
-                }
-            }
-        }
-        let s = &self.sensor;
-        range(
-            "sensor.object_period_ms",
-            s.object_period_ms,
-            1.0,
-            1000.0,
-            "ms",
-        )?;
-        range("sensor.latency_ms", s.latency_ms, 0.0, 500.0, "ms")?;
-        range("sensor.range_m", s.range_m, 1.0, 1000.0, "m")?;
-        range(
-            "sensor.distance_noise_m",
-            s.distance_noise_m,
-            0.0,
-            10.0,
-            "m",
-        )?;
-        range(
-            "sensor.speed_noise_mps",
-            s.speed_noise_mps,
-            0.0,
-            10.0,
-            "m/s",
-        )?;
-        range(
-            "sensor.relative_accel_noise_mps2",
-            s.relative_accel_noise_mps2,
-            0.0,
-            50.0,
-            "m/s²",
-        )?;
-        range("sensor.mass_bias_kg", s.mass_bias_kg, -3000.0, 3000.0, "kg")?;
-        range("sensor.mass_noise_kg", s.mass_noise_kg, 0.0, 3000.0, "kg")?;
-        range(
-            "sensor.speed_bias_mps",
-            s.speed_bias_mps,
-            -30.0,
-            30.0,
-            "m/s",
-        )?;
-        range("sensor.mass_sigma_kg", s.mass_sigma_kg, 0.0, 3000.0, "kg")?;
-        if let Some(m) = s.mass_estimate_kg {
-            range("sensor.mass_estimate_kg", m, 100.0, 100000.0, "kg")?;
-        }
-        if o.kind == OpponentKind::Barrier && s.mass_estimate_kg.is_none() {
-            return Err((
-                "sensor.mass_estimate_kg".into(),
-                "required for a barrier opponent (what the object classifier reports for it)"
-                    .into(),
-            ));
-        }
-        range("sensor.confidence", s.confidence, 0.0, 1.0, "")?;
-        range(
-            "sensor.vehicle_period_ms",
-            s.vehicle_period_ms,
-            1.0,
-            1000.0,
-            "ms",
-        )?;
-        range(
-            "sensor.occupant_period_ms",
-            s.occupant_period_ms,
-            1.0,
-            5000.0,
-            "ms",
-        )?;
-        range(
-            "sensor.accel_rate_hz",
-            s.accel_rate_hz,
-            1000.0,
-            8000.0,
-            "Hz",
-        )?;
-        range(
-            "sensor.accel_noise_mps2",
-            s.accel_noise_mps2,
-            0.0,
-            50.0,
-            "m/s²",
-        )?;
-        range(
-            "sensor.accel_full_scale_g",
-            s.accel_full_scale_g,
-            10.0,
-            1000.0,
-            "g",
-        )?;
-        let windows = s
-            .dropouts
-            .iter()
-            .enumerate()
-            .map(|(i, d)| (format!("sensor.dropouts[{i}]"), d.start_s, d.end_s))
-            .chain(
-                s.freezes
-                    .iter()
-                    .enumerate()
-                    .map(|(i, d)| (format!("sensor.freezes[{i}]"), d.start_s, d.end_s)),
-            )
-            .chain(
-                s.accel_faults
-                    .iter()
-                    .enumerate()
-                    .map(|(i, d)| (format!("sensor.accel_faults[{i}]"), d.start_s, d.end_s)),
-            );
-        for (f, start_s, end_s) in windows {
-            if !(start_s.is_finite() && end_s.is_finite() && start_s >= 0.0 && end_s > start_s) {
-                return Err((
-                    f,
-                    format!("window {start_s}..{end_s} s must satisfy 0 <= start_s < end_s"),
-                ));
-            }
-        }
-        let occ = &self.occupant;
-        range("occupant.mass_kg", occ.mass_kg, 30.0, 150.0, "kg")?;
-        range(
-            "occupant.chest_to_wheel_mm",
-            occ.chest_to_wheel_mm,
-            150.0,
-            600.0,
-            "mm",
-        )?;
-        range(
-            "occupant.seat_track_mm",
-            occ.seat_track_mm,
-            0.0,
-            400.0,
-            "mm",
-        )?;
-        Ok(())
     }
 
     /// Ego stiffness class (explicit or by mass).
@@ -888,6 +549,36 @@ mass_kg = 75
         assert_eq!(e.field.as_deref(), Some("sensor.accel_faults[0]"), "{e}");
         let bad = text.replace("\"stuck\"", "\"sticky\"");
         assert!(Scenario::parse("x.toml", &bad).is_err());
+    }
+
+    #[test]
+    fn errors_in_an_array_of_tables_name_the_entry_and_its_line() {
+        // The same windows written as [[sensor.dropouts]] tables: the second one is wrong.
+        let text = format!(
+            "{OK}\n[[sensor.dropouts]]\nstart_s = 1.0\nend_s = 1.5\n\n[[sensor.dropouts]]\nstart_s = 2.0\nend_s = 1.9\n"
+        );
+        let second_header = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| l.trim() == "[[sensor.dropouts]]")
+            .nth(1)
+            .map(|(i, _)| i + 1);
+        let e = Scenario::parse("x.toml", &text).unwrap_err();
+        assert_eq!(e.field.as_deref(), Some("sensor.dropouts[1]"), "{e}");
+        assert_eq!(e.line, second_header, "{e}");
+        // A type error inside the first entry names the entry's key.
+        let bad = text.replacen("start_s = 1.0", "start_s = \"soon\"", 1);
+        let e = Scenario::parse("x.toml", &bad).unwrap_err();
+        assert_eq!(
+            e.field.as_deref(),
+            Some("sensor.dropouts[0].start_s"),
+            "{e}"
+        );
+        let line = bad
+            .lines()
+            .position(|l| l.contains("\"soon\""))
+            .map(|i| i + 1);
+        assert_eq!(e.line, line, "{e}");
     }
 
     #[test]

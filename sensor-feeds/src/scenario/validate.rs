@@ -1,0 +1,254 @@
+//! The semantic checks of a parsed scenario: ranges, classes, what a barrier may not have,
+//! windows that end after they start. Each error names its dotted field (`ego.mass_kg`,
+//! `sensor.dropouts[1]`); `location` turns it into a line.
+
+use super::{Braking, OpponentKind, Scenario};
+
+impl Scenario {
+    /// Semantic checks; `Err((field path, message))`.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        fn range(
+            field: &str,
+            v: f64,
+            lo: f64,
+            hi: f64,
+            unit: &str,
+        ) -> Result<(), (String, String)> {
+            if v.is_finite() && v >= lo && v <= hi {
+                Ok(())
+            } else {
+                Err((
+                    field.to_owned(),
+                    format!("{v} is outside {lo}..={hi} {unit}"),
+                ))
+            }
+        }
+        fn class(field: &str, c: Option<u8>) -> Result<(), (String, String)> {
+            match c {
+                Some(n) if !(1..=6).contains(&n) => Err((
+                    field.to_owned(),
+                    format!("class {n} does not exist (1..=6)"),
+                )),
+                _ => Ok(()),
+            }
+        }
+        fn braking(
+            prefix: &str,
+            b: &Option<Braking>,
+            duration_s: f64,
+        ) -> Result<(), (String, String)> {
+            if let Some(b) = b {
+                range(
+                    &format!("{prefix}.start_s"),
+                    b.start_s,
+                    0.0,
+                    duration_s,
+                    "s",
+                )?;
+                range(
+                    &format!("{prefix}.decel_mps2"),
+                    b.decel_mps2,
+                    0.1,
+                    15.0,
+                    "m/s²",
+                )?;
+                range(&format!("{prefix}.ramp_s"), b.ramp_s, 0.0, 2.0, "s")?;
+            }
+            Ok(())
+        }
+        if self.name.is_empty() || self.name.len() > ipc::SCENARIO_NAME_CAPACITY {
+            return Err((
+                "name".into(),
+                format!("must be 1..={} bytes", ipc::SCENARIO_NAME_CAPACITY),
+            ));
+        }
+        if !self
+            .name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+        {
+            return Err((
+                "name".into(),
+                "use only letters, digits, '-' and '_' (it names the output folder)".into(),
+            ));
+        }
+        range("duration_s", self.duration_s, 0.1, 60.0, "s")?;
+        range("ego.mass_kg", self.ego.mass_kg, 500.0, 4000.0, "kg")?;
+        class("ego.class", self.ego.class)?;
+        range("ego.speed_kph", self.ego.speed_kph, 0.0, 200.0, "km/h")?;
+        braking("ego.braking", &self.ego.braking, self.duration_s)?;
+        let o = &self.opponent;
+        range(
+            "opponent.initial_distance_m",
+            o.initial_distance_m,
+            0.1,
+            1000.0,
+            "m",
+        )?;
+        match o.kind {
+            OpponentKind::Vehicle => {
+                let m = o.mass_kg.ok_or((
+                    "opponent.mass_kg".to_owned(),
+                    "required for kind = \"vehicle\"".to_owned(),
+                ))?;
+                range("opponent.mass_kg", m, 300.0, 10000.0, "kg")?;
+                class("opponent.class", o.class)?;
+                range("opponent.speed_kph", o.speed_kph, 0.0, 200.0, "km/h")?;
+                braking("opponent.braking", &o.braking, self.duration_s)?;
+                if let Some(te) = o.evade_s {
+                    range("opponent.evade_s", te, 0.0, self.duration_s, "s")?;
+                }
+            }
+            OpponentKind::Barrier => {
+                let bad = if o.mass_kg.is_some() {
+                    Some("mass_kg")
+                } else if o.class.is_some() {
+                    Some("class")
+                } else if o.speed_kph != 0.0 {
+                    Some("speed_kph")
+                } else if o.braking.is_some() {
+                    Some("braking")
+                } else if o.evade_s.is_some() {
+                    Some("evade_s")
+                } else {
+                    None
+                };
+                if let Some(k) = bad {
+                    return Err((
+                        format!("opponent.{k}"),
+                        "a rigid barrier is immovable and non-deforming: remove this key".into(),
+                    ));
+                }
+            }
+        }
+        let s = &self.sensor;
+        range(
+            "sensor.object_period_ms",
+            s.object_period_ms,
+            1.0,
+            1000.0,
+            "ms",
+        )?;
+        range("sensor.latency_ms", s.latency_ms, 0.0, 500.0, "ms")?;
+        range("sensor.range_m", s.range_m, 1.0, 1000.0, "m")?;
+        range(
+            "sensor.distance_noise_m",
+            s.distance_noise_m,
+            0.0,
+            10.0,
+            "m",
+        )?;
+        range(
+            "sensor.speed_noise_mps",
+            s.speed_noise_mps,
+            0.0,
+            10.0,
+            "m/s",
+        )?;
+        range(
+            "sensor.relative_accel_noise_mps2",
+            s.relative_accel_noise_mps2,
+            0.0,
+            50.0,
+            "m/s²",
+        )?;
+        range("sensor.mass_bias_kg", s.mass_bias_kg, -3000.0, 3000.0, "kg")?;
+        range("sensor.mass_noise_kg", s.mass_noise_kg, 0.0, 3000.0, "kg")?;
+        range(
+            "sensor.speed_bias_mps",
+            s.speed_bias_mps,
+            -30.0,
+            30.0,
+            "m/s",
+        )?;
+        range("sensor.mass_sigma_kg", s.mass_sigma_kg, 0.0, 3000.0, "kg")?;
+        if let Some(m) = s.mass_estimate_kg {
+            range("sensor.mass_estimate_kg", m, 100.0, 100000.0, "kg")?;
+        }
+        if o.kind == OpponentKind::Barrier && s.mass_estimate_kg.is_none() {
+            return Err((
+                "sensor.mass_estimate_kg".into(),
+                "required for a barrier opponent (what the object classifier reports for it)"
+                    .into(),
+            ));
+        }
+        range("sensor.confidence", s.confidence, 0.0, 1.0, "")?;
+        range(
+            "sensor.vehicle_period_ms",
+            s.vehicle_period_ms,
+            1.0,
+            1000.0,
+            "ms",
+        )?;
+        range(
+            "sensor.occupant_period_ms",
+            s.occupant_period_ms,
+            1.0,
+            5000.0,
+            "ms",
+        )?;
+        range(
+            "sensor.accel_rate_hz",
+            s.accel_rate_hz,
+            1000.0,
+            8000.0,
+            "Hz",
+        )?;
+        range(
+            "sensor.accel_noise_mps2",
+            s.accel_noise_mps2,
+            0.0,
+            50.0,
+            "m/s²",
+        )?;
+        range(
+            "sensor.accel_full_scale_g",
+            s.accel_full_scale_g,
+            10.0,
+            1000.0,
+            "g",
+        )?;
+        let windows = s
+            .dropouts
+            .iter()
+            .enumerate()
+            .map(|(i, d)| (format!("sensor.dropouts[{i}]"), d.start_s, d.end_s))
+            .chain(
+                s.freezes
+                    .iter()
+                    .enumerate()
+                    .map(|(i, d)| (format!("sensor.freezes[{i}]"), d.start_s, d.end_s)),
+            )
+            .chain(
+                s.accel_faults
+                    .iter()
+                    .enumerate()
+                    .map(|(i, d)| (format!("sensor.accel_faults[{i}]"), d.start_s, d.end_s)),
+            );
+        for (f, start_s, end_s) in windows {
+            if !(start_s.is_finite() && end_s.is_finite() && start_s >= 0.0 && end_s > start_s) {
+                return Err((
+                    f,
+                    format!("window {start_s}..{end_s} s must satisfy 0 <= start_s < end_s"),
+                ));
+            }
+        }
+        let occ = &self.occupant;
+        range("occupant.mass_kg", occ.mass_kg, 30.0, 150.0, "kg")?;
+        range(
+            "occupant.chest_to_wheel_mm",
+            occ.chest_to_wheel_mm,
+            150.0,
+            600.0,
+            "mm",
+        )?;
+        range(
+            "occupant.seat_track_mm",
+            occ.seat_track_mm,
+            0.0,
+            400.0,
+            "mm",
+        )?;
+        Ok(())
+    }
+}
