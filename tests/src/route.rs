@@ -179,6 +179,34 @@ pub const STARVED_INPUT_FLAGS: [&str; 5] = [
 /// scenario does not inject (no dropout, freeze or accelerometer fault declared), or the airbag fired more than
 /// [`crate::FIRE_LATE_ALLOWANCE_MS`] after its plan. Under emulated timing such a run is run
 /// again ([`Allowances::time_limit_attempts`]); with real timers it is a failure like any other.
+/// The EcuStatus input flags a scenario's declared faults raise.
+fn injected_flags(scenario: &sensor_feeds::Scenario) -> Vec<&'static str> {
+    use sensor_feeds::scenario::DropoutTarget;
+    let s = &scenario.sensor;
+    let mut v = Vec::new();
+    for d in &s.dropouts {
+        v.extend_from_slice(match d.target {
+            DropoutTarget::Object => &["object_input"][..],
+            DropoutTarget::Vehicle => &["vehicle_input"],
+            DropoutTarget::Occupant => &["occupant_input"],
+            DropoutTarget::Accel => &["accel_sensor"],
+            DropoutTarget::All => &[
+                "object_input",
+                "vehicle_input",
+                "occupant_input",
+                "accel_sensor",
+            ],
+        });
+    }
+    if !s.freezes.is_empty() {
+        v.push("object_input");
+    }
+    if !s.accel_faults.is_empty() {
+        v.push("accel_sensor");
+    }
+    v
+}
+
 pub fn starved_run(
     scenario: &sensor_feeds::Scenario,
     r: &actuator_stubs::report::Report,
@@ -203,6 +231,25 @@ pub fn starved_run(
         }) {
             why.push(format!(
                 "inputs starved at {t:+.0} ms ({})",
+                flags.join("+")
+            ));
+        }
+    }
+    // Never Normal before the contact while an input the scenario does not inject was stale
+    // (e.g. the accelerometer's first batches late at start-up on a loaded emulator): the
+    // run never reached the state the scenario's faults are meant to disturb.
+    if first_normal.is_none_or(|t| t >= contact) {
+        let injected = injected_flags(scenario);
+        if let Some((t, flags)) = r.ecu_faults.iter().find(|(t, flags)| {
+            *t < contact
+                && flags.iter().any(|f| {
+                    f != "overrun"
+                        && STARVED_INPUT_FLAGS.contains(&f.as_str())
+                        && !injected.contains(&f.as_str())
+                })
+        }) {
+            why.push(format!(
+                "never Normal before contact; inputs starved at {t:+.0} ms ({})",
                 flags.join("+")
             ));
         }
@@ -288,5 +335,19 @@ mod tests {
             starved_run(&scenario("sensor-dropout"), &report(starved, FIRE_AT_7)),
             None
         );
+        // never Normal before contact: starved if an input it does not inject was stale (the
+        // accelerometer at start-up), not if only its own dropout was
+        let never_normal = |faults: &str| {
+            let mut r = report(faults, FIRE_AT_7);
+            r.ecu_modes.retain(|(_, m)| m != "Normal");
+            starved_run(&scenario("sensor-dropout"), &r)
+        };
+        let accel = r#"[[-1254.0, ["accel_sensor"]], [-810.0, ["object_input", "accel_sensor"]], [-768.0, ["object_input"]]]"#;
+        let why = never_normal(accel).expect("starved at start-up");
+        assert!(
+            why.contains("never Normal") && why.contains("accel_sensor"),
+            "{why}"
+        );
+        assert_eq!(never_normal(r#"[[-810.0, ["object_input"]]]"#), None);
     }
 }
