@@ -57,6 +57,27 @@ fn starved_inputs_at_fire(
     .then(|| flags.join("+"))
 }
 
+/// If a crash came (`contact`) and nothing fired while the ECU's only active faults at the
+/// contact were stale inputs, the crash accelerometer among them (see [`STARVED_INPUT_FLAGS`]):
+/// those faults. Without any acceleration sample no ECU can fire; where the emulator (or a
+/// restarted feed it slowed down) starved the accelerometer over the crash, the missing fire is
+/// a time limit there, a function failure with real timers.
+fn starved_without_fire(
+    fire: Option<&TimedAction>,
+    contact: bool,
+    ecu_faults: &[(f64, Vec<String>)],
+) -> Option<String> {
+    if fire.is_some() || !contact {
+        return None;
+    }
+    let (_, flags) = ecu_faults.iter().rev().find(|(t, _)| *t <= 0.0)?;
+    (flags.iter().any(|f| f == "accel_sensor")
+        && flags
+            .iter()
+            .all(|f| STARVED_INPUT_FLAGS.contains(&f.as_str())))
+    .then(|| flags.join("+"))
+}
+
 /// Scenario time [s] of a report time (ms rel. contact, or since start without contact).
 fn scenario_s(r: &Report, t_ms: f64) -> f64 {
     if r.contact_ns != 0 && r.start_ns != 0 {
@@ -191,7 +212,10 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
     let played = sensor_feeds::Scenario::load(&run.scenario).ok();
     let ecu = run.ecu_report.as_ref();
     let fire = r.action("airbag_fire");
-    let mut checks = Checks::new(starved_inputs_at_fire(fire, &r.ecu_faults));
+    let mut checks = Checks::new(
+        starved_inputs_at_fire(fire, &r.ecu_faults)
+            .or_else(|| starved_without_fire(fire, r.contact_ns != 0, &r.ecu_faults)),
+    );
 
     checks.check(
         "bench processes ran and stopped cleanly",
@@ -283,6 +307,19 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
         reaction.recovered_after_ms,
         fire,
     );
+    // The case's precondition: where the ECU was not in Normal when the fault began (a time
+    // limit: the emulator starved it before), its other checks measured nothing the case is
+    // about; they count as time limits too (run again where timing is emulated; with real
+    // timers the failed precondition fails the case anyway).
+    if checks
+        .list
+        .iter()
+        .any(|c| c.what == "ECU in Normal when the fault began" && !c.ok)
+    {
+        for c in checks.list.iter_mut().filter(|c| !c.ok) {
+            c.timing = true;
+        }
+    }
     let pass = checks.list.iter().all(|c| c.ok);
     CaseResult {
         name: case.name.to_owned(),
@@ -855,6 +892,34 @@ mod tests {
         assert_eq!(flood_frames_on_command_ids(&frames, 200), 6);
         // Fewer receptions than genuine frames: no attacker frame is assumed.
         assert_eq!(flood_frames_on_command_ids(&frames, 300), 0);
+    }
+
+    #[test]
+    fn a_missing_fire_with_the_accelerometer_starved_over_the_contact_is_a_time_limit_only() {
+        let faults = |at_contact: &[&str]| -> Vec<(f64, Vec<String>)> {
+            vec![
+                (-2600.0, vec!["accel_sensor".to_owned()]),
+                (
+                    -2285.0,
+                    at_contact.iter().map(|f| (*f).to_owned()).collect(),
+                ),
+                (142.0, vec!["occupant_input".to_owned()]),
+            ]
+        };
+        let all = faults(&["vehicle_input", "object_input", "accel_sensor", "overrun"]);
+        assert!(starved_without_fire(None, true, &all).is_some());
+        // The accelerometer alive: a missing fire is the ECU's own.
+        assert_eq!(
+            starved_without_fire(None, true, &faults(&["object_input"])),
+            None
+        );
+        // A corrupt input or a bad table is no starvation.
+        assert_eq!(
+            starved_without_fire(None, true, &faults(&["accel_sensor", "e2e"])),
+            None
+        );
+        // No crash, or a fire: nothing to excuse.
+        assert_eq!(starved_without_fire(None, false, &all), None);
     }
 
     #[test]
