@@ -212,23 +212,25 @@ pub fn starved_run(
     r: &actuator_stubs::report::Report,
 ) -> Option<String> {
     let mut why = Vec::new();
-    let injects = !scenario.sensor.dropouts.is_empty()
-        || !scenario.sensor.freezes.is_empty()
-        || !scenario.sensor.accel_faults.is_empty();
+    let injected = injected_flags(scenario);
+    // A stale input the scenario does not inject (overruns alone starve nothing).
+    let starving = |f: &String| {
+        f != "overrun"
+            && STARVED_INPUT_FLAGS.contains(&f.as_str())
+            && !injected.contains(&f.as_str())
+    };
     let first_normal = r
         .ecu_modes
         .iter()
         .find(|(_, m)| m == "Normal")
         .map(|(t, _)| *t);
     let contact = if r.contact_ns != 0 { 0.0 } else { f64::MAX };
-    if let (false, Some(from)) = (injects, first_normal) {
-        if let Some((t, flags)) = r.ecu_faults.iter().find(|(t, flags)| {
-            *t > from
-                && *t < contact
-                && flags
-                    .iter()
-                    .any(|f| f != "overrun" && STARVED_INPUT_FLAGS.contains(&f.as_str()))
-        }) {
+    if let (true, Some(from)) = (injected.is_empty(), first_normal) {
+        if let Some((t, flags)) = r
+            .ecu_faults
+            .iter()
+            .find(|(t, flags)| *t > from && *t < contact && flags.iter().any(starving))
+        {
             why.push(format!(
                 "inputs starved at {t:+.0} ms ({})",
                 flags.join("+")
@@ -239,15 +241,11 @@ pub fn starved_run(
     // (e.g. the accelerometer's first batches late at start-up on a loaded emulator): the
     // run never reached the state the scenario's faults are meant to disturb.
     if first_normal.is_none_or(|t| t >= contact) {
-        let injected = injected_flags(scenario);
-        if let Some((t, flags)) = r.ecu_faults.iter().find(|(t, flags)| {
-            *t < contact
-                && flags.iter().any(|f| {
-                    f != "overrun"
-                        && STARVED_INPUT_FLAGS.contains(&f.as_str())
-                        && !injected.contains(&f.as_str())
-                })
-        }) {
+        if let Some((t, flags)) = r
+            .ecu_faults
+            .iter()
+            .find(|(t, flags)| *t < contact && flags.iter().any(starving))
+        {
             why.push(format!(
                 "never Normal before contact; inputs starved at {t:+.0} ms ({})",
                 flags.join("+")

@@ -245,7 +245,6 @@ struct State {
 /// The track filter (see the module docs). Built once, allocation-free, `Copy`-sized.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrackFilter {
-    r: Matrix3<f64>,
     q: f64,
     gate_chi2: f64,
     max_outliers: u32,
@@ -257,6 +256,11 @@ pub struct TrackFilter {
     gap_ns: u64,
     rho: f64,
     state: Option<State>,
+}
+
+/// R: the specified variances `r_diag` scaled per channel by the learnt `lambda`.
+fn scaled_r(r_diag: &Vector3<f64>, lambda: &Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::from_diagonal(&r_diag.component_mul(lambda))
 }
 
 /// F(τ) x of the module docs.
@@ -405,9 +409,7 @@ impl TrackFilter {
             cfg.closing_speed_sigma_mps * cfg.closing_speed_sigma_mps,
             cfg.accel_sigma_mps2 * cfg.accel_sigma_mps2,
         );
-        let r = Matrix3::from_diagonal(&r_diag);
         Self {
-            r,
             q: cfg.jerk_density_m2ps5,
             gate_chi2: cfg.gate_chi2,
             max_outliers: cfg.max_outliers.max(1),
@@ -436,16 +438,6 @@ impl TrackFilter {
         self.lambda.x.max(self.lambda.y).max(self.lambda.z)
     }
 
-    /// The per-channel noise scales λ (distance, closing speed, closing acceleration).
-    pub fn noise_scales(&self) -> Vector3<f64> {
-        self.lambda
-    }
-
-    /// R scaled by the learnt λ.
-    fn r_scaled(&self) -> Matrix3<f64> {
-        Matrix3::from_diagonal(&self.r_diag.component_mul(&self.lambda))
-    }
-
     /// The state (d m, v m/s, a m/s²) and its covariance at the newest sample's time.
     pub fn state(&self) -> Option<(u64, Vector3<f64>, Matrix3<f64>)> {
         self.state.map(|s| (s.t_ns, s.x, s.p))
@@ -458,7 +450,7 @@ impl TrackFilter {
             object_id: o.object_id,
             t_ns: o.timestamp_ns,
             x: z,
-            p: self.r_scaled(),
+            p: scaled_r(&self.r_diag, &self.lambda),
             outliers_in_row: 0,
             mass,
         });
@@ -516,8 +508,8 @@ impl TrackFilter {
             p_pred *= lambda.sum() / self.lambda.sum();
             self.lambda = lambda;
         }
-        let r_scaled = Matrix3::from_diagonal(&self.r_diag.component_mul(&self.lambda));
-        let Some(s_inv) = symmetric_inverse(&(p_pred + r_scaled)) else {
+        let Some(s_inv) = symmetric_inverse(&(p_pred + scaled_r(&self.r_diag, &self.lambda)))
+        else {
             return self.start(o, z, m, sigma);
         };
         let d2 = quadratic_form(&s_inv, &y);

@@ -67,7 +67,7 @@ fn find(table: &dyn TableLike, offset: usize, path: &mut Vec<String>) {
         };
         if let Some(tables) = item.as_array_of_tables() {
             for (i, t) in tables.iter().enumerate() {
-                if contains(t.span(), offset) || span_of_entries(t, offset) {
+                if contains(t.span(), offset) || entries_contain(t, offset) {
                     path.push(format!("{name}[{i}]"));
                     find(t, offset, path);
                     return;
@@ -102,10 +102,6 @@ fn entries_contain(table: &dyn TableLike, offset: usize) -> bool {
                 .as_table_like()
                 .is_some_and(|t| entries_contain(t, offset))
     })
-}
-
-fn span_of_entries(table: &toml_edit::Table, offset: usize) -> bool {
-    entries_contain(table, offset)
 }
 
 /// 1-based line of `field` (`table.key`, `table.array[i].key` or `key`), for semantic errors;

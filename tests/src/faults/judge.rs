@@ -49,12 +49,18 @@ fn starved_inputs_at_fire(
     if fire.action.source != "reference" {
         return None;
     }
-    let (_, flags) = ecu_faults.iter().rev().find(|(tf, _)| *tf <= t)?;
+    only_starved_faults_at(ecu_faults, t).map(|flags| flags.join("+"))
+}
+
+/// The ECU's active faults at `t_ms` if there are some and all are stale inputs or overruns
+/// ([`STARVED_INPUT_FLAGS`]).
+fn only_starved_faults_at(ecu_faults: &[(f64, Vec<String>)], t_ms: f64) -> Option<&[String]> {
+    let (_, flags) = ecu_faults.iter().rev().find(|(tf, _)| *tf <= t_ms)?;
     (!flags.is_empty()
         && flags
             .iter()
             .all(|f| STARVED_INPUT_FLAGS.contains(&f.as_str())))
-    .then(|| flags.join("+"))
+    .then_some(flags.as_slice())
 }
 
 /// If a crash came (`contact`) and nothing fired while the ECU's only active faults at the
@@ -70,12 +76,11 @@ fn starved_without_fire(
     if fire.is_some() || !contact {
         return None;
     }
-    let (_, flags) = ecu_faults.iter().rev().find(|(t, _)| *t <= 0.0)?;
-    (flags.iter().any(|f| f == "accel_sensor")
-        && flags
-            .iter()
-            .all(|f| STARVED_INPUT_FLAGS.contains(&f.as_str())))
-    .then(|| flags.join("+"))
+    let flags = only_starved_faults_at(ecu_faults, 0.0)?;
+    flags
+        .iter()
+        .any(|f| f == "accel_sensor")
+        .then(|| flags.join("+"))
 }
 
 /// Scenario time [s] of a report time (ms rel. contact, or since start without contact).
