@@ -2,7 +2,7 @@
 
 use clap::Parser;
 use ecu::can_port::SocketCanPort;
-use ecu::runtime::{app, monitor, CanPort, Cli, Command, EcuConfig};
+use ecu::runtime::{app, monitor, CanPort, Cli, Command, EcuConfig, Layers};
 use physics::reference::ReferenceRestraint;
 use restraint::RestraintCycle;
 
@@ -78,7 +78,12 @@ fn load_reference(cfg: &EcuConfig) -> anyhow::Result<ReferenceRestraint> {
 }
 
 fn run(cli: &Cli) -> anyhow::Result<()> {
-    let cfg = EcuConfig::resolve(&cli.run)?;
+    let layers = Layers::new(cli.run.config.as_deref(), cli.run.clone())?;
+    let cfg = layers.extract()?;
+    if cli.run.show_config {
+        print!("{}", layers.show(&cfg));
+        return Ok(());
+    }
     let stop = host::install_stop_signals()?;
     let lut = load_lut(&cfg);
     let reference = load_reference(&cfg)?;

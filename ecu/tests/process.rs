@@ -60,6 +60,59 @@ fn bad_config_exits_with_file_and_line() {
     assert!(err.contains(&format!("{}:3:", path.display())), "{err}");
 }
 
+/// `ecu --show-config` with `env` set on the child only (no test changes its own environment).
+fn show_config(args: &[&str], env: &[(&str, &str)]) -> (bool, String, String) {
+    let out = Command::new(ECU)
+        .arg("--show-config")
+        .args(args)
+        .envs(env.iter().copied())
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn environment_overrides_the_file_and_flags_override_the_environment() {
+    let dir = tmpdir("layers");
+    let path = dir.join("ecu.toml");
+    std::fs::write(&path, "period_us = 2000\n[rt]\ncpu = 1\nmlockall = true\n").unwrap();
+    let env = [("ECU_PERIOD_US", "800"), ("ECU_RT__CPU", "0")];
+    let (ok, out, err) = show_config(
+        &["--config", path.to_str().unwrap(), "--period-us", "500"],
+        &env,
+    );
+    assert!(ok, "{err}");
+    let has = |line: &str| out.lines().any(|l| l == line);
+    assert!(has("period_us = 500  # command line"), "{out}");
+    assert!(has("cpu = 0  # environment variable ECU_RT__CPU"), "{out}");
+    assert!(
+        has(&format!("mlockall = true  # {}:4", path.display())),
+        "{out}"
+    );
+    assert!(has("interface = \"vcan0\"  # defaults"), "{out}");
+}
+
+#[test]
+fn a_bad_environment_variable_is_named_in_the_error() {
+    for (var, value, expect) in [
+        ("ECU_PERIOD_US", "fast", "invalid type"),
+        ("ECU_PERIOD_US", "5", "outside 50..=1000000"),
+        ("ECU_RT__MLOCK", "true", "unknown field"),
+        ("ECU_CYCLE__CONFIRM_DECEL_G", "0.1", "outside 1.5..=100"),
+    ] {
+        let (ok, _, err) = show_config(&[], &[(var, value)]);
+        assert!(!ok, "{var}={value} accepted");
+        assert!(
+            err.contains(&format!("environment variable {var}: invalid")) && err.contains(expect),
+            "{var}={value}: {err}"
+        );
+    }
+}
+
 #[test]
 fn missing_can_interface_is_an_error_unless_no_can() {
     let out = Command::new(ECU)

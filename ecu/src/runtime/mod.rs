@@ -1,6 +1,7 @@
 //! The real-time process shell (see the crate docs for the split).
 
 pub mod app;
+pub mod cli;
 mod com;
 pub mod config;
 mod deadline;
@@ -10,8 +11,9 @@ pub mod report;
 pub mod rt;
 mod run;
 
+pub use cli::{Cli, Command, MonitorArgs, RunArgs};
 pub use com::{CanPort, IceoryxIo};
-pub use config::{CanConfig, Cli, Command, EcuConfig, IpcConfig, MonitorArgs, RtConfig, RunArgs};
+pub use config::{CanConfig, EcuConfig, IpcConfig, Layers, RtConfig};
 pub use deadline::{DeadlineGrid, NextSlot};
 pub use histogram::{LatencyHistogram, Percentiles};
 pub use host::{Clock, MonotonicClock, SimClock};

@@ -5,7 +5,8 @@ use std::time::Duration;
 
 use ipc::{Degraded, DiagnosticsSubscriber, EcuDiagnostics, EcuMode, ServiceNames};
 
-use super::config::{EcuConfig, MonitorArgs};
+use super::cli::MonitorArgs;
+use super::config::Layers;
 
 /// Names of the set bits of a degraded-reason word.
 pub fn degraded_names(bits: u32) -> String {
@@ -75,13 +76,12 @@ pub fn format_line(d: &EcuDiagnostics, rx_rate_hz: f64) -> String {
 /// Runs the monitor until Ctrl-C (iceoryx2's node handles SIGINT/SIGTERM here) or
 /// `--count` refreshes.
 pub fn run(args: &MonitorArgs) -> anyhow::Result<()> {
-    let mut prefix = match &args.config {
-        Some(p) => EcuConfig::load(p)?.ipc.service_prefix,
-        None => ipc::DEFAULT_SERVICE_PREFIX.to_owned(),
-    };
-    if let Some(p) = &args.service_prefix {
-        prefix.clone_from(p);
-    }
+    // The same layers as the ECU (defaults ← file ← ECU_* ← flags): a monitor started beside
+    // an ECU with the same file and environment watches that ECU's services.
+    let prefix = Layers::new(args.config.as_deref(), args.clone())?
+        .extract()?
+        .ipc
+        .service_prefix;
     anyhow::ensure!(
         args.rate_hz.is_finite() && args.rate_hz > 0.0 && args.rate_hz <= 1_000.0,
         "--rate-hz must be in (0, 1000]"

@@ -1,9 +1,12 @@
-//! Configuration: a TOML file (`--config FILE`) overridden by CLI flags.
+//! The ECU's configuration: the schema (this file, one struct per table of `ecu/ecu.toml`), the
+//! strict check of a config file with `file:line:column` errors, range checks, and the layers
+//! it is merged from ([`Layers`]: defaults ← file ← `ECU_*` environment ← command line).
 
 use std::path::{Path, PathBuf};
 
-use clap::{Args, Parser, Subcommand};
 use serde::{Deserialize, Serialize};
+
+use super::cli::RunArgs;
 
 /// Shortest supported cycle period. Below this the loop is dominated by syscall cost.
 pub const MIN_PERIOD_US: u64 = 50;
@@ -53,115 +56,10 @@ pub struct CycleSection {
     pub decision: restraint::CycleConfig,
 }
 
-mod cycle_section {
-    //! Deserialises `[cycle]` without `#[serde(flatten)]` (which would lose toml's line
-    //! numbers and switch off `deny_unknown_fields`): a map access that hands the three file
-    //! keys to the shell and every other key, with its span, to the core's derived impl.
+mod cycle_section;
+mod layers;
 
-    use std::path::PathBuf;
-
-    use serde::de::value::MapAccessDeserializer;
-    use serde::de::{DeserializeSeed, Deserializer, IntoDeserializer, MapAccess, Visitor};
-    use serde::Deserialize;
-
-    use super::CycleSection;
-
-    /// A key of `[cycle]`: one of the core's fields, or a file key (with the unused seed).
-    enum Key<F, K> {
-        Field(F),
-        File(usize, K),
-    }
-
-    const FILE_KEYS: [&str; 3] = ["lut", "reference", "secoc_keys"];
-
-    struct KeySeed<K>(K);
-
-    impl<'de, K: DeserializeSeed<'de>> DeserializeSeed<'de> for KeySeed<K> {
-        type Value = Key<K::Value, K>;
-        fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
-            let key = String::deserialize(d)?;
-            match FILE_KEYS.iter().position(|k| *k == key) {
-                Some(i) => Ok(Key::File(i, self.0)),
-                // Inside toml's key deserialisation: an unknown key gets the key's span. The
-                // core's "expected one of" list does not know the file keys: they are added.
-                None => self
-                    .0
-                    .deserialize(key.as_str().into_deserializer())
-                    .map(Key::Field)
-                    .map_err(|e: D::Error| {
-                        serde::de::Error::custom(format_args!(
-                            "{e}, or one of the file keys `lut`, `reference`, `secoc_keys`"
-                        ))
-                    }),
-            }
-        }
-    }
-
-    struct Split<'f, A> {
-        inner: A,
-        files: &'f mut [Option<PathBuf>; 3],
-    }
-
-    impl<'de, A: MapAccess<'de>> MapAccess<'de> for Split<'_, A> {
-        type Error = A::Error;
-        fn next_key_seed<K: DeserializeSeed<'de>>(
-            &mut self,
-            seed: K,
-        ) -> Result<Option<K::Value>, A::Error> {
-            let mut seed = seed;
-            loop {
-                match self.inner.next_key_seed(KeySeed(seed))? {
-                    None => return Ok(None),
-                    Some(Key::Field(f)) => return Ok(Some(f)),
-                    Some(Key::File(i, s)) => {
-                        let path: PathBuf = self.inner.next_value()?;
-                        if let Some(slot) = self.files.get_mut(i) {
-                            *slot = Some(path);
-                        }
-                        seed = s;
-                    }
-                }
-            }
-        }
-        fn next_value_seed<V: DeserializeSeed<'de>>(
-            &mut self,
-            seed: V,
-        ) -> Result<V::Value, A::Error> {
-            self.inner.next_value_seed(seed)
-        }
-    }
-
-    struct SectionVisitor;
-
-    impl<'de> Visitor<'de> for SectionVisitor {
-        type Value = CycleSection;
-        fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-            f.write_str("the [cycle] table")
-        }
-        fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<CycleSection, A::Error> {
-            let mut files = [None, None, None];
-            let decision =
-                restraint::CycleConfig::deserialize(MapAccessDeserializer::new(Split {
-                    inner: map,
-                    files: &mut files,
-                }))?;
-            let [lut, reference, secoc_keys] = files;
-            let d = CycleSection::default();
-            Ok(CycleSection {
-                lut: lut.unwrap_or(d.lut),
-                reference: reference.unwrap_or(d.reference),
-                secoc_keys: secoc_keys.unwrap_or(d.secoc_keys),
-                decision,
-            })
-        }
-    }
-
-    impl<'de> Deserialize<'de> for CycleSection {
-        fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-            d.deserialize_map(SectionVisitor)
-        }
-    }
-}
+pub use layers::{Layers, ENV_PREFIX};
 
 impl Default for CycleSection {
     fn default() -> Self {
@@ -277,20 +175,21 @@ pub enum ConfigError {
         /// What is wrong.
         message: String,
     },
-    /// A value is out of range.
+    /// A value is out of range, or (from the environment) of the wrong type or unknown.
     #[error("{origin}: invalid `{key}`: {message}")]
     Invalid {
-        /// `file:line` of the key, or `command line`.
+        /// Where the value came from: `file:line`, `environment variable ECU_…`,
+        /// `command line` or `defaults`.
         origin: String,
         /// Dotted key, e.g. `rt.sched_fifo_priority`.
-        key: &'static str,
+        key: String,
         /// What is wrong.
         message: String,
     },
 }
 
 /// 1-based (line, column) of byte `offset` in `text`.
-fn line_col(text: &str, offset: usize) -> (usize, usize) {
+pub(super) fn line_col(text: &str, offset: usize) -> (usize, usize) {
     let before = text.get(..offset.min(text.len())).unwrap_or(text);
     let line = before.matches('\n').count() + 1;
     let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
@@ -309,7 +208,7 @@ impl EcuConfig {
                 message: e.message().trim().to_owned(),
             }
         })?;
-        cfg.validate(&|key: &str| origin_in_file(text, path, key))?;
+        cfg.validate(&|key: &str| layers::origin_in_file(text, path, key))?;
         Ok(cfg)
     }
 
@@ -322,11 +221,16 @@ impl EcuConfig {
         Self::from_toml_str(&text, path)
     }
 
+    /// Defaults ← `--config` file ← `ECU_*` environment ← flags, range-checked (see [`Layers`]).
+    pub fn resolve(a: &RunArgs) -> Result<Self, ConfigError> {
+        Layers::new(a.config.as_deref(), a.clone())?.extract()
+    }
+
     /// Range checks. `origin(key)` says where a key came from (for the message).
     pub fn validate(&self, origin: &dyn Fn(&str) -> String) -> Result<(), ConfigError> {
-        let invalid = |key: &'static str, message: String| ConfigError::Invalid {
+        let invalid = |key: &str, message: String| ConfigError::Invalid {
             origin: origin(key),
-            key,
+            key: key.to_owned(),
             message,
         };
         if !(MIN_PERIOD_US..=MAX_PERIOD_US).contains(&self.period_us) {
@@ -356,7 +260,7 @@ impl EcuConfig {
             ));
         }
         if let Err(e) = self.cycle.decision.validate() {
-            return Err(invalid("cycle", e.to_string()));
+            return Err(invalid(&format!("cycle.{}", e.key), e.to_string()));
         }
         if self.ipc.node_name.is_empty() {
             return Err(invalid("ipc.node_name", "must not be empty".into()));
@@ -369,239 +273,13 @@ impl EcuConfig {
         }
         Ok(())
     }
-
-    /// Applies CLI overrides (a flag given on the command line wins over the file).
-    pub fn apply_cli(&mut self, a: &RunArgs) {
-        if let Some(v) = a.period_us {
-            self.period_us = v;
-        }
-        if let Some(v) = a.cycles {
-            self.cycles = Some(v);
-        }
-        if let Some(v) = &a.report_json {
-            self.report_json = Some(v.clone());
-        }
-        if let Some(v) = a.sched_fifo {
-            self.rt.sched_fifo_priority = Some(v);
-        }
-        if a.mlockall {
-            self.rt.mlockall = true;
-        }
-        if a.no_mlockall {
-            self.rt.mlockall = false;
-        }
-        if let Some(v) = a.cpu {
-            self.rt.cpu = Some(v);
-        }
-        if a.pm_qos {
-            self.rt.pm_qos = true;
-        }
-        if a.no_pm_qos {
-            self.rt.pm_qos = false;
-        }
-        if let Some(v) = a.prefault_stack_kib {
-            self.rt.prefault_stack_kib = v;
-        }
-        if let Some(v) = &a.lut {
-            self.cycle.lut = v.clone();
-        }
-        if let Some(v) = &a.reference {
-            self.cycle.reference = v.clone();
-        }
-        if let Some(v) = &a.secoc_keys {
-            self.cycle.secoc_keys = v.clone();
-        }
-        if a.no_can {
-            self.can.enabled = false;
-        }
-        if let Some(v) = &a.can_interface {
-            self.can.interface = v.clone();
-        }
-        if let Some(v) = &a.service_prefix {
-            self.ipc.service_prefix = v.clone();
-        }
-        if let Some(v) = &a.node_name {
-            self.ipc.node_name = v.clone();
-        }
-    }
-
-    /// File (optional) + CLI, validated. CLI values are reported as `command line`.
-    pub fn resolve(a: &RunArgs) -> Result<Self, ConfigError> {
-        let (mut cfg, text) = match &a.config {
-            Some(path) => {
-                let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
-                    path: path.clone(),
-                    source,
-                })?;
-                (
-                    Self::from_toml_str(&text, path)?,
-                    Some((text, path.clone())),
-                )
-            }
-            None => (Self::default(), None),
-        };
-        cfg.apply_cli(a);
-        cfg.validate(&|key: &str| {
-            if a.overrides(key) {
-                "command line".to_owned()
-            } else if let Some((text, path)) = &text {
-                origin_in_file(text, path, key)
-            } else {
-                "defaults".to_owned()
-            }
-        })?;
-        Ok(cfg)
-    }
-}
-
-/// `path:line` of the dotted `key` (from the span `toml_edit` keeps for it), or `path` when
-/// the file does not set it.
-fn origin_in_file(text: &str, path: &Path, key: &str) -> String {
-    let line = toml_edit::ImDocument::parse(text).ok().and_then(|doc| {
-        let mut table: &dyn toml_edit::TableLike = doc.as_table();
-        let mut parts = key.split('.').peekable();
-        while let Some(part) = parts.next() {
-            let (k, item) = table.get_key_value(part)?;
-            if parts.peek().is_none() {
-                return k.span().or_else(|| item.span());
-            }
-            table = item.as_table_like()?;
-        }
-        None
-    });
-    match line {
-        Some(span) => format!("{}:{}", path.display(), line_col(text, span.start).0),
-        None => path.display().to_string(),
-    }
-}
-
-/// `ecu` command line.
-#[derive(Debug, Parser)]
-#[command(
-    name = "ecu",
-    version,
-    about = "Fixed-rate adaptive restraint ECU (real-time loop, iceoryx2 + CAN I/O)",
-    args_conflicts_with_subcommands = true
-)]
-pub struct Cli {
-    /// Subcommand (default: run the ECU).
-    #[command(subcommand)]
-    pub command: Option<Command>,
-    /// Options of the ECU run.
-    #[command(flatten)]
-    pub run: RunArgs,
-}
-
-/// Subcommands.
-#[derive(Debug, Subcommand)]
-pub enum Command {
-    /// Show the ECU diagnostics (mode, settings, timing) live; Ctrl-C to exit.
-    Monitor(MonitorArgs),
-}
-
-/// `ecu monitor` options.
-#[derive(Debug, Args, Clone)]
-pub struct MonitorArgs {
-    /// Config file (only `ipc.service_prefix` is used).
-    #[arg(long, value_name = "FILE")]
-    pub config: Option<PathBuf>,
-    /// iceoryx2 service-name prefix.
-    #[arg(long, value_name = "PREFIX")]
-    pub service_prefix: Option<String>,
-    /// Display refresh rate.
-    #[arg(long, default_value_t = 10.0, value_name = "HZ")]
-    pub rate_hz: f64,
-    /// Exit after this many refreshes (default: until Ctrl-C).
-    #[arg(long, value_name = "N")]
-    pub count: Option<u64>,
-    /// One line per refresh instead of an in-place refreshing line (for logs/pipes).
-    #[arg(long)]
-    pub lines: bool,
-}
-
-/// `ecu` run options; each overrides the config file.
-#[derive(Debug, Args, Clone, Default)]
-pub struct RunArgs {
-    /// TOML config file (see ecu/ecu.toml); flags override it.
-    #[arg(long, value_name = "FILE")]
-    pub config: Option<PathBuf>,
-    /// Cycle period in µs (default 1000 = 1 kHz).
-    #[arg(long, value_name = "US")]
-    pub period_us: Option<u64>,
-    /// Stop after N cycles and print the report (default: until SIGINT/SIGTERM).
-    #[arg(long, value_name = "N")]
-    pub cycles: Option<u64>,
-    /// Also write the timing report as JSON to FILE.
-    #[arg(long, value_name = "FILE")]
-    pub report_json: Option<PathBuf>,
-    /// Request SCHED_FIFO at this priority (1..=99); degrades with a message if denied.
-    #[arg(long, value_name = "PRIO")]
-    pub sched_fifo: Option<u8>,
-    /// Request mlockall(MCL_CURRENT|MCL_FUTURE).
-    #[arg(long, conflicts_with = "no_mlockall")]
-    pub mlockall: bool,
-    /// Do not lock memory (overrides the file).
-    #[arg(long)]
-    pub no_mlockall: bool,
-    /// Pin the process to this CPU.
-    #[arg(long, value_name = "CPU")]
-    pub cpu: Option<usize>,
-    /// Hold /dev/cpu_dma_latency at 0 while running.
-    #[arg(long, conflicts_with = "no_pm_qos")]
-    pub pm_qos: bool,
-    /// Do not touch PM-QoS (overrides the file).
-    #[arg(long)]
-    pub no_pm_qos: bool,
-    /// Stack to pre-fault before the loop, KiB.
-    #[arg(long, value_name = "KIB")]
-    pub prefault_stack_kib: Option<usize>,
-    /// Switch the CAN side off (e.g. no SocketCAN on this host); the report says so.
-    #[arg(long)]
-    pub no_can: bool,
-    /// SocketCAN interface (default vcan0).
-    #[arg(long, value_name = "IF")]
-    pub can_interface: Option<String>,
-    /// iceoryx2 service-name prefix.
-    #[arg(long, value_name = "PREFIX")]
-    pub service_prefix: Option<String>,
-    /// iceoryx2 node name.
-    #[arg(long, value_name = "NAME")]
-    pub node_name: Option<String>,
-    /// Do not print the start-up summary.
-    #[arg(long)]
-    pub quiet: bool,
-    /// Characteristic diagram (default data/default.lut). Missing or corrupt: the ECU says
-    /// why and runs DEGRADED on the reference restraint.
-    #[arg(long, value_name = "FILE")]
-    pub lut: Option<PathBuf>,
-    /// Reference-restraint file (default data/reference-restraint.toml; missing or corrupt:
-    /// the copy built into the binary).
-    #[arg(long, value_name = "FILE")]
-    pub reference: Option<PathBuf>,
-    /// SecOC key file (default data/secoc-keys.example.toml; missing or corrupt: the ECU
-    /// starts without authenticator frames and reports FaultConfig).
-    #[arg(long, value_name = "FILE")]
-    pub secoc_keys: Option<PathBuf>,
-}
-
-impl RunArgs {
-    /// Whether the CLI sets the config key `key`.
-    fn overrides(&self, key: &str) -> bool {
-        match key {
-            "period_us" => self.period_us.is_some(),
-            "rt.sched_fifo_priority" => self.sched_fifo.is_some(),
-            "rt.prefault_stack_kib" => self.prefault_stack_kib.is_some(),
-            "ipc.node_name" => self.node_name.is_some(),
-            "ipc.service_prefix" => self.service_prefix.is_some(),
-            "can.interface" => self.can_interface.is_some(),
-            _ => false,
-        }
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::runtime::cli::Cli;
+    use clap::Parser;
 
     fn p() -> PathBuf {
         PathBuf::from("ecu.toml")
@@ -760,6 +438,39 @@ mod tests {
     }
 
     #[test]
+    fn every_value_names_its_layer() {
+        let dir = std::env::temp_dir().join(format!("ecu-layers-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("c.toml");
+        std::fs::write(
+            &path,
+            "period_us = 2000\n\n[cycle.track]\ngate_chi2 = 20.0\n",
+        )
+        .unwrap();
+        let cli =
+            Cli::try_parse_from(["ecu", "--config", path.to_str().unwrap(), "--cpu", "1"]).unwrap();
+        let layers = Layers::new(cli.run.config.as_deref(), cli.run.clone()).unwrap();
+        let cfg = layers.extract().unwrap();
+        let file = path.display().to_string();
+        assert_eq!(layers.origin("period_us"), format!("{file}:1"));
+        assert_eq!(layers.origin("cycle.track.gate_chi2"), format!("{file}:4"));
+        assert_eq!(layers.origin("rt.cpu"), "command line");
+        assert_eq!(layers.origin("rt.mlockall"), "defaults");
+        let shown = layers.show(&cfg);
+        for line in [
+            format!("period_us = 2000  # {file}:1"),
+            format!("gate_chi2 = 20.0  # {file}:4"),
+            "cpu = 1  # command line".to_owned(),
+            "mlockall = false  # defaults".to_owned(),
+        ] {
+            assert!(shown.lines().any(|l| l == line), "{line} not in\n{shown}");
+        }
+        // What --show-config prints reads back as the same configuration.
+        assert_eq!(EcuConfig::from_toml_str(&shown, &p()).unwrap(), cfg);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
     fn missing_file_is_a_clear_error() {
         let e = EcuConfig::load(Path::new("/nonexistent/ecu.toml"))
             .unwrap_err()
@@ -768,14 +479,5 @@ mod tests {
             e.starts_with("/nonexistent/ecu.toml: cannot read config file"),
             "{e}"
         );
-    }
-
-    #[test]
-    fn monitor_subcommand_parses() {
-        let cli = Cli::try_parse_from(["ecu", "monitor", "--count", "3"]).unwrap();
-        assert!(matches!(
-            cli.command,
-            Some(Command::Monitor(MonitorArgs { count: Some(3), .. }))
-        ));
     }
 }

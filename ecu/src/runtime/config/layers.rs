@@ -1,0 +1,149 @@
+//! Where each setting comes from. Four layers, each overriding the one before:
+//!
+//! 1. the defaults (`EcuConfig::default()`, shown in `ecu/ecu.toml`),
+//! 2. the `--config` file,
+//! 3. `ECU_*` environment variables (`ECU_PERIOD_US=500`; `__` between table and key:
+//!    `ECU_RT__SCHED_FIFO_PRIORITY=80`, `ECU_CYCLE__LUT=my.lut`),
+//! 4. the command-line flags.
+//!
+//! figment merges them and keeps, for every value, the layer it came from: a range error, an
+//! environment variable of the wrong type and `ecu --show-config` all name that origin
+//! (`ecu.toml:12`, `environment variable ECU_RT__CPU`, `command line`, `defaults`). The file is
+//! first checked on its own ([`EcuConfig::from_toml_str`]) because only that check knows
+//! lines and columns; figment's own errors do not.
+
+use std::path::{Path, PathBuf};
+
+use figment::providers::{Env, Format, Serialized, Toml};
+use figment::{Figment, Provider, Source};
+
+use super::{line_col, ConfigError, EcuConfig};
+use crate::runtime::cli::COMMAND_LINE;
+
+/// Prefix of the environment layer's variables.
+pub const ENV_PREFIX: &str = "ECU_";
+/// Separates a table from its key in an environment variable's name (`ECU_RT__CPU`).
+const ENV_NESTING: &str = "__";
+
+/// The merged layers of one resolution (what [`EcuConfig::resolve`] extracts from).
+pub struct Layers {
+    figment: Figment,
+    /// The config file's path and text (for the line of a key).
+    file: Option<(PathBuf, String)>,
+}
+
+impl Layers {
+    /// Defaults ← `file` (read and checked strictly here) ← environment ← `command_line`.
+    pub fn new(file: Option<&Path>, command_line: impl Provider) -> Result<Self, ConfigError> {
+        let mut figment = Figment::from(Serialized::defaults(EcuConfig::default()));
+        let file = match file {
+            Some(path) => {
+                let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+                    path: path.to_owned(),
+                    source,
+                })?;
+                EcuConfig::from_toml_str(&text, path)?;
+                figment = figment.merge(Toml::file_exact(path));
+                Some((path.to_owned(), text))
+            }
+            None => None,
+        };
+        let figment = figment
+            .merge(Env::prefixed(ENV_PREFIX).split(ENV_NESTING))
+            .merge(command_line);
+        Ok(Self { figment, file })
+    }
+
+    /// The merged configuration, range-checked; errors name the layer of the value.
+    pub fn extract(&self) -> Result<EcuConfig, ConfigError> {
+        let cfg: EcuConfig = self.figment.extract().map_err(|e| {
+            // Only the environment can get here: the file passed its own check and the flags
+            // are typed by clap. The first error is the one to fix.
+            let e = e.into_iter().next().unwrap_or_else(|| "no value".into());
+            // The path ends in the offending key (an unknown field's name included).
+            let key = e.path.join(".");
+            ConfigError::Invalid {
+                origin: self.origin(&key),
+                key,
+                message: e.kind.to_string(),
+            }
+        })?;
+        cfg.validate(&|key| self.origin(key))?;
+        Ok(cfg)
+    }
+
+    /// Where the value of the dotted `key` came from.
+    pub fn origin(&self, key: &str) -> String {
+        let Some(metadata) = self.figment.find_metadata(key) else {
+            // A key no layer sets, e.g. an unknown one from the environment.
+            return env_origin(key);
+        };
+        match &metadata.source {
+            Some(Source::File(path)) => match &self.file {
+                Some((_, text)) => origin_in_file(text, path, key),
+                None => path.display().to_string(),
+            },
+            _ if metadata.name == COMMAND_LINE => COMMAND_LINE.to_owned(),
+            // figment names it "`ECU_` environment variable(s)".
+            _ if metadata.name.contains("environment variable") => env_origin(key),
+            _ => "defaults".to_owned(),
+        }
+    }
+
+    /// The effective configuration as TOML, every value followed by its origin
+    /// (`ecu --show-config`).
+    pub fn show(&self, cfg: &EcuConfig) -> String {
+        let text = match toml::to_string(cfg) {
+            Ok(t) => t,
+            Err(e) => return format!("# cannot print the configuration: {e}\n"),
+        };
+        let Ok(mut doc) = text.parse::<toml_edit::DocumentMut>() else {
+            return text;
+        };
+        self.annotate(doc.as_table_mut(), "");
+        doc.to_string()
+    }
+
+    fn annotate(&self, table: &mut toml_edit::Table, prefix: &str) {
+        for (key, item) in table.iter_mut() {
+            let dotted = format!("{prefix}{}", key.get());
+            match item {
+                toml_edit::Item::Table(t) => self.annotate(t, &format!("{dotted}.")),
+                toml_edit::Item::Value(v) => {
+                    v.decor_mut()
+                        .set_suffix(format!("  # {}", self.origin(&dotted)));
+                }
+                _ => {}
+            }
+        }
+    }
+}
+
+/// `environment variable ECU_RT__CPU` for `rt.cpu`.
+fn env_origin(key: &str) -> String {
+    format!(
+        "environment variable {ENV_PREFIX}{}",
+        key.to_ascii_uppercase().replace('.', ENV_NESTING)
+    )
+}
+
+/// `path:line` of the dotted `key` (from the span `toml_edit` keeps for it), or `path` when
+/// the file does not set it.
+pub(super) fn origin_in_file(text: &str, path: &Path, key: &str) -> String {
+    let line = toml_edit::ImDocument::parse(text).ok().and_then(|doc| {
+        let mut table: &dyn toml_edit::TableLike = doc.as_table();
+        let mut parts = key.split('.').peekable();
+        while let Some(part) = parts.next() {
+            let (k, item) = table.get_key_value(part)?;
+            if parts.peek().is_none() {
+                return k.span().or_else(|| item.span());
+            }
+            table = item.as_table_like()?;
+        }
+        None
+    });
+    match line {
+        Some(span) => format!("{}:{}", path.display(), line_col(text, span.start).0),
+        None => path.display().to_string(),
+    }
+}
