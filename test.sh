@@ -17,8 +17,12 @@ step "format and lints"
 cargo fmt --all --check
 cargo clippy --workspace --all-targets --release -- -D warnings
 
-step "build the bench processes"
-cargo build --workspace --release --bins
+step "build the bench processes and the tests"
+# One build with the test suite's feature set (dev-dependencies switch features on in shared
+# crates, e.g. bitflags/std): the bench binaries the end-to-end tests run, the tests
+# themselves, and the budget tools below all come from it, so nothing is compiled twice
+# (tests/src/lib.rs `harness::build_bench_bins` runs this same command: a no-op here).
+cargo build --workspace --release --features bus/socket --bins --tests --examples
 
 step "tests (unit, property, physics oracles, LUT build, real vcan + iceoryx2 end to end)"
 log=$(mktemp); trap 'rm -f "$log"' EXIT
@@ -31,16 +35,16 @@ mkdir -p target/robustness
 FUZZ_SECONDS=$FUZZ_SECONDS FUZZ_REPORT_JSON="$PWD/target/robustness/fuzz.json" tests/fuzz-smoke.sh
 
 step "deterministic budget: instructions per worst-case ECU cycle (valgrind)"
-cargo run --release -q -p cycle-benches --bin budget -- --no-criterion
+target/release/budget --no-criterion --prebuilt
 
 step "worst-case search: a short run from the committed seeds, no case above the budget"
 # Seconds; the long search that found the seeds is in benches/README.md ("Worst case, searched").
-cargo run --release -q -p cycle-benches --bin worst_cycle -- search --generations 3 \
-  --population 16 --cycles no-crash --start benches/worst-case/seed.json --budget 6000
-cargo run --release -q -p cycle-benches --bin worst_cycle -- search --generations 3 \
-  --population 16 --cycles no-crash --secoc on --start benches/worst-case/seed-secoc.json --budget 9500
-cargo run --release -q -p cycle-benches --bin worst_cycle -- search --generations 3 \
-  --population 16 --cycles crash --secoc on --start benches/worst-case/seed-crash-phase.json --budget 10500
+target/release/worst_cycle search --generations 3 --population 16 --cycles no-crash \
+  --start benches/worst-case/seed.json --budget 6000
+target/release/worst_cycle search --generations 3 --population 16 --cycles no-crash \
+  --secoc on --start benches/worst-case/seed-secoc.json --budget 9500
+target/release/worst_cycle search --generations 3 --population 16 --cycles crash \
+  --secoc on --start benches/worst-case/seed-crash-phase.json --budget 10500
 
 step "robustness report (fault campaign of the tests above + fuzz smoke)"
 target/release/fault-campaign report --campaign target/robustness/campaign.json \

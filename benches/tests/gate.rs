@@ -95,12 +95,12 @@ fn instruction_count_gate_fails_below_and_passes_above_the_measured_count() {
     // One lookup is hundreds of instructions (4-D multilinear interpolation of 16 corners):
     // 10 is far below, 100 000 far above.
     let low = budgets_file("icount-low", &icount_row(10.0));
-    let (code, text) = gate(&low, &["--no-criterion"]);
+    let (code, text) = gate(&low, &["--no-criterion", "--prebuilt"]);
     assert_eq!(code, 1, "{text}");
     assert!(verdict_line(&text, "icount_lut").contains("FAIL"), "{text}");
 
     let high = budgets_file("icount-high", &icount_row(100_000.0));
-    let (code, text) = gate(&high, &["--no-criterion"]);
+    let (code, text) = gate(&high, &["--no-criterion", "--prebuilt"]);
     assert_eq!(code, 0, "{text}");
     assert!(verdict_line(&text, "icount_lut").contains("PASS"), "{text}");
     for p in [low, high] {
@@ -123,14 +123,14 @@ fn collected_count_of_the_searched_worst_case_fails_below_and_passes_above() {
         )
     };
     let low = budgets_file("collect-low", &row(10.0));
-    let (code, text) = gate(&low, &["--no-criterion"]);
+    let (code, text) = gate(&low, &["--no-criterion", "--prebuilt"]);
     assert_eq!(code, 1, "{text}");
     assert!(
         verdict_line(&text, "worst_cycle").contains("FAIL"),
         "{text}"
     );
     let high = budgets_file("collect-high", &row(1e6));
-    let (code, text) = gate(&high, &["--no-criterion"]);
+    let (code, text) = gate(&high, &["--no-criterion", "--prebuilt"]);
     assert_eq!(code, 0, "{text}");
     let line = verdict_line(&text, "worst_cycle");
     assert!(
@@ -142,7 +142,7 @@ fn collected_count_of_the_searched_worst_case_fails_below_and_passes_above() {
         "collect-wrong",
         &row(1e6).replace("measured_step", "no_such_function"),
     );
-    let (code, text) = gate(&wrong, &["--no-criterion"]);
+    let (code, text) = gate(&wrong, &["--no-criterion", "--prebuilt"]);
     assert_eq!(code, 1, "{text}");
     assert!(
         verdict_line(&text, "worst_cycle").contains("MISSING"),
@@ -151,4 +151,18 @@ fn collected_count_of_the_searched_worst_case_fails_below_and_passes_above() {
     for p in [low, high, wrong] {
         let _ = std::fs::remove_file(p);
     }
+}
+
+#[test]
+fn a_prebuilt_binary_that_is_not_there_is_missing_not_passing() {
+    let row = "[[icount]]\nstage = \"absent\"\nbin = \"icount_no_such_bin\"\nbudget_instructions = 1e6\niterations = [1, 2]\n";
+    let p = budgets_file("prebuilt-absent", row);
+    let (code, text) = gate(&p, &["--no-criterion", "--prebuilt"]);
+    assert_eq!(code, 1, "{text}");
+    let line = verdict_line(&text, "icount_no_such_bin");
+    assert!(
+        line.contains("MISSING") && line.contains("--prebuilt: no"),
+        "{text}"
+    );
+    let _ = std::fs::remove_file(p);
 }

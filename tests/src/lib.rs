@@ -172,7 +172,10 @@ pub mod harness {
             .to_path_buf()
     }
 
-    /// Builds the bench binaries once per test process (a no-op when test.sh already did).
+    /// Builds the bench binaries once per test process with test.sh's build command, so under
+    /// test.sh (and after any `cargo test --workspace`, which resolves features the same way)
+    /// it is a no-op. A `-p` subset, or leaving out the tests, would resolve the shared crates'
+    /// features differently and rebuild them (≈ 1 min on 2 cores for a `-p` subset, measured).
     pub fn build_bench_bins() {
         static BUILT: OnceLock<()> = OnceLock::new();
         BUILT.get_or_init(|| {
@@ -181,13 +184,11 @@ pub mod harness {
                 .args([
                     "build",
                     "--release",
-                    "--bins",
-                    "-p",
-                    "ecu",
-                    "-p",
-                    "sensor-feeds",
+                    "--workspace",
+                    "--features",
+                    "bus/socket",
                 ])
-                .args(["-p", "actuator-stubs", "-p", "e2e-tests"])
+                .args(["--bins", "--tests", "--examples"])
                 .current_dir(super::repo_root())
                 .status()
                 .expect("cargo build");

@@ -1,5 +1,5 @@
 //! The budget gate: `cargo run --release -p cycle-benches --bin budget -- [--quick]
-//! [--only REGEX] [--budgets FILE] [--no-icount] [--no-criterion]`.
+//! [--only REGEX] [--budgets FILE] [--no-icount] [--no-criterion] [--prebuilt]`.
 //!
 //! Runs the budgeted criterion benches (`cargo bench`), reads the fresh `estimates.json`,
 //! measures instructions per iteration of the `icount_*` binaries under callgrind, prints one
@@ -37,6 +37,11 @@ struct Args {
     /// Skip the criterion rows.
     #[arg(long)]
     no_criterion: bool,
+    /// Measure the icount binaries already built beside this one instead of building them
+    /// (test.sh builds every binary once, with the test suite's feature set; a `cargo build -p
+    /// cycle-benches` here would resolve features anew and rebuild the chain below it).
+    #[arg(long)]
+    prebuilt: bool,
 }
 
 /// The most expensive call of `function` in one callgrind run of `bin args…` (arguments
@@ -181,13 +186,22 @@ fn run() -> anyhow::Result<bool> {
     if !args.no_icount {
         let ic: Vec<_> = budgets.icount.iter().filter(|i| selected(&i.bin)).collect();
         if !ic.is_empty() {
-            let mut cmd = Command::new(gate::cargo());
-            cmd.args(["build", "--release", "-p", "cycle-benches"]);
-            for i in &ic {
-                cmd.args(["--bin", &i.bin]);
-            }
-            let built = cmd.status().context("cannot run cargo build")?.success();
-            let bin_dir = gate::cargo_target_dir()?.join("release");
+            let (built, bin_dir) = if args.prebuilt {
+                let exe = std::env::current_exe().context("where is this binary?")?;
+                let dir = exe
+                    .parent()
+                    .context("binary without a folder")?
+                    .to_path_buf();
+                (ic.iter().all(|i| dir.join(&i.bin).is_file()), dir)
+            } else {
+                let mut cmd = Command::new(gate::cargo());
+                cmd.args(["build", "--release", "-p", "cycle-benches"]);
+                for i in &ic {
+                    cmd.args(["--bin", &i.bin]);
+                }
+                let built = cmd.status().context("cannot run cargo build")?.success();
+                (built, gate::cargo_target_dir()?.join("release"))
+            };
             let tmp = std::env::temp_dir();
             let base = args.budgets.parent().unwrap_or(std::path::Path::new("."));
             for i in ic {
@@ -206,6 +220,10 @@ fn run() -> anyhow::Result<bool> {
                         Ok((v, d)) => (Some(v), d),
                         Err(e) => (None, format!("{e:#}")),
                     }
+                } else if args.prebuilt {
+                    let missing =
+                        format!("--prebuilt: no {} (build the bins first)", bin.display());
+                    (None, missing)
                 } else {
                     (None, "cargo build of the icount binaries failed".to_owned())
                 };
