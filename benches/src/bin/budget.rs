@@ -130,10 +130,11 @@ fn run() -> anyhow::Result<bool> {
                 .collect();
             let filter = format!("^({})$", ids.join("|"));
             let mut cmd = Command::new(gate::cargo());
+            // `--workspace`, not `-p cycle-benches`: the same feature resolution as test.sh's
+            // build and `cargo test --workspace`, so the dependencies are not compiled again.
             cmd.args([
                 "bench",
-                "-p",
-                "cycle-benches",
+                "--workspace",
                 "--bench",
                 t,
                 "--",
