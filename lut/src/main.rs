@@ -60,8 +60,19 @@ enum Command {
     Slurm(cmd_slurm::SlurmCommand),
 }
 
-fn main() -> anyhow::Result<()> {
-    let cli = Cli::parse();
+/// Errors are printed as one readable chain (`lut: error: …: …`), never as a Debug dump with a
+/// backtrace (which `main() -> anyhow::Result` prints when RUST_BACKTRACE is set).
+fn main() -> std::process::ExitCode {
+    match run(Cli::parse()) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("lut: error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> anyhow::Result<()> {
     // Inside a Slurm job without cgroups every core of the node is visible: size rayon's
     // global pool (verify, studies) from the CPUs the job asked for.
     if let (Some(n), None) = (

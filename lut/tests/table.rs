@@ -123,12 +123,22 @@ fn ci_grid_end_to_end() {
     bad[last] ^= 0x40;
     let bad_path = tmp("bad.lut");
     std::fs::write(&bad_path, &bad).unwrap();
+    // RUST_BACKTRACE set (as on many developer machines): still one readable line, no dump.
     let out = Command::new(exe)
         .args(["verify", bad_path.to_str().unwrap()])
+        .env("RUST_BACKTRACE", "1")
         .output()
         .unwrap();
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("bad.lut"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("lut: error:") && err.contains("bad.lut"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("Stack backtrace") && !err.contains("Backtrace"),
+        "{err}"
+    );
 }
 
 #[test]
