@@ -15,8 +15,8 @@
 //! (ego Δv / (1 + e)) it does not fire the airbag (no-fire requirement; same limit as the
 //! ECU's default `no_fire_ebs_kph`).
 
+use crate::report::Judged;
 use physics::{OccupantInput, OccupantOutcome, RestraintHardware, RestraintSettings};
-use serde::{Deserialize, Serialize};
 
 /// Conventional no-fire limit on the ego's true equivalent barrier speed [km/h] (SPEC: below
 /// about 20 km/h restraints must not fire).
@@ -32,38 +32,6 @@ pub const NEVER_S: f64 = 100.0;
 /// receive times carry scheduling jitter of a few ms (more under an emulator), which moves
 /// the outcome by a few per cent even for identical settings.
 pub const NO_WORSE_TOLERANCE: f64 = 0.05;
-
-/// One restraint's occupant outcome and time history.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct Judged {
-    /// Settings used (SI; times relative to true contact).
-    pub load_limiter_kn: f64,
-    /// Airbag level [kN] (0 = not fired).
-    pub airbag_level_kn: f64,
-    /// Pretensioner time [ms after contact] (None = not fired).
-    pub pretensioner_ms: Option<f64>,
-    /// Airbag time [ms after contact] (None = not fired).
-    pub airbag_ms: Option<f64>,
-    /// Peak occupant deceleration [g].
-    pub a_max_g: f64,
-    /// Mean occupant deceleration over the restraint phase [g].
-    pub a_mean_g: f64,
-    /// Maximum forward excursion [mm].
-    pub excursion_mm: f64,
-    /// Available ride-down [mm].
-    pub available_mm: f64,
-    /// Struck through to the wheel/dash.
-    pub bottomed_out: bool,
-    /// Time history: t [ms after contact].
-    #[serde(skip)]
-    pub t_ms: Vec<f64>,
-    /// Time history: occupant deceleration [g].
-    #[serde(skip)]
-    pub decel_g: Vec<f64>,
-    /// Time history: excursion [mm].
-    #[serde(skip)]
-    pub excursion_trace_mm: Vec<f64>,
-}
 
 /// Simulates `set` against `pulse` for `occ`, with its time history.
 pub fn judge(

@@ -1,7 +1,7 @@
 //! Outcome picture: occupant deceleration and forward excursion over time, adaptive vs
 //! reference, with the compartment pulse and the available ride-down for context.
 
-use crate::outcome::Judged;
+use crate::report::Judged;
 use plotters::prelude::*;
 use std::path::Path;
 

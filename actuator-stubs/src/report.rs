@@ -2,7 +2,6 @@
 //! Times named `*_ms` are relative to the TRUE first contact (negative = before it).
 
 use crate::commands::Action;
-use crate::outcome::Judged;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -19,6 +18,38 @@ pub struct TrueCrash {
     pub a_mean_g: f64,
     /// Ego crush [mm].
     pub crush_mm: f64,
+}
+
+/// One restraint's occupant outcome and time history.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Judged {
+    /// Settings used (SI; times relative to true contact).
+    pub load_limiter_kn: f64,
+    /// Airbag level [kN] (0 = not fired).
+    pub airbag_level_kn: f64,
+    /// Pretensioner time [ms after contact] (None = not fired).
+    pub pretensioner_ms: Option<f64>,
+    /// Airbag time [ms after contact] (None = not fired).
+    pub airbag_ms: Option<f64>,
+    /// Peak occupant deceleration [g].
+    pub a_max_g: f64,
+    /// Mean occupant deceleration over the restraint phase [g].
+    pub a_mean_g: f64,
+    /// Maximum forward excursion [mm].
+    pub excursion_mm: f64,
+    /// Available ride-down [mm].
+    pub available_mm: f64,
+    /// Struck through to the wheel/dash.
+    pub bottomed_out: bool,
+    /// Time history: t [ms after contact].
+    #[serde(skip)]
+    pub t_ms: Vec<f64>,
+    /// Time history: occupant deceleration [g].
+    #[serde(skip)]
+    pub decel_g: Vec<f64>,
+    /// Time history: excursion [mm].
+    #[serde(skip)]
+    pub excursion_trace_mm: Vec<f64>,
 }
 
 /// An action with its time relative to the true contact.

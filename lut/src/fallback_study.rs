@@ -33,7 +33,7 @@ use physics::defaults::STANDARD_GRAVITY_MPS2 as G_MPS2;
 use physics::{OccupantInput, RestraintHardware, RestraintSettings};
 use rand_xoshiro::{rand_core::SeedableRng, Xoshiro256PlusPlus};
 use restraint::accel::AccelSample;
-use restraint::confirm::{ConfirmParams, CrashDetector, Onset, OnsetStep};
+use restraint::confirm::{CrashDetector, Onset, OnsetStep};
 use restraint::fallback::{FallbackAlgorithm, FallbackDecision, KNOTS, KNOT_SPACING_MS, WINDOW_MS};
 use restraint::CycleConfig;
 
@@ -245,7 +245,7 @@ impl Crash {
 
 /// Runs the ECU's detectors over `samples` (contact at `contact_ns`).
 pub fn measure(cfg: &CycleConfig, samples: &[AccelSample], contact_ns: u64) -> Measured {
-    let p = ConfirmParams::from_config(cfg);
+    let p = cfg.confirm_params();
     let mut onset = Onset::default();
     let mut generic = CrashDetector::default();
     let mut algo = FallbackAlgorithm::new(cfg.fallback_dv_mps);

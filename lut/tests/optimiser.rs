@@ -285,7 +285,7 @@ fn worst_lateness_of_the_earliest_plan_ms() -> f64 {
             let pred = PredictedPulse::solve(&spring, 1785.0, opponent_kg, 40.0 / 3.6, contact_ns)
                 .unwrap();
             let mut m = PulseMatch::new(MatchParams {
-                onset: restraint::confirm::ConfirmParams::from_config(&cfg),
+                onset: cfg.confirm_params(),
                 min_span_ns: (cfg.match_min_ms * 1e6) as u64,
                 window_ns: (cfg.match_window_ms * 1e6) as u64,
                 tolerance: cfg.match_tolerance,

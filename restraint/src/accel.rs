@@ -20,8 +20,7 @@
 //! Plausible samples come out in time order, as [`AccelSample`]s in a fixed-capacity batch
 //! ([`PlausibleBatch`]: no allocation, and the detectors are called without dynamic dispatch).
 
-use crate::config::{ms_to_ns, CycleConfig};
-use crate::confirm::G_MPS2;
+use crate::settings::ms_to_ns;
 use crate::signals::ACCEL_BATCH_CAPACITY;
 
 /// The plausible samples of one batch: the batch's timing once, each sample as its index in
@@ -138,13 +137,30 @@ pub struct AccelMonitor {
     pub faults: AccelFaultCounts,
 }
 
+/// The monitor's limits in its units (from the file's `accel_*` keys:
+/// [`crate::CycleConfig::accel_limits`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AccelLimits {
+    /// No batch for this long: the sensor is stale, ns.
+    pub timeout_ns: u64,
+    /// The same reading for this long: the sensor is stuck, ns.
+    pub stuck_ns: u64,
+    /// A reading at or beyond this magnitude is saturated, m/s².
+    pub full_scale_mps2: f64,
+}
+
 impl AccelMonitor {
-    /// Monitoring with the limits of a validated `cfg`.
-    pub fn new(cfg: &CycleConfig) -> Self {
+    /// Monitoring with the limits of a validated configuration.
+    pub fn new(limits: AccelLimits) -> Self {
+        let AccelLimits {
+            timeout_ns,
+            stuck_ns,
+            full_scale_mps2,
+        } = limits;
         Self {
-            timeout_ns: ms_to_ns(cfg.accel_timeout_ms),
-            stuck_ns: ms_to_ns(cfg.accel_stuck_ms),
-            full_scale_mps2: cfg.accel_full_scale_g * G_MPS2,
+            timeout_ns,
+            stuck_ns,
+            full_scale_mps2,
             hold_ns: ms_to_ns(INVALID_HOLD_MS),
             rx_ns: None,
             next_from_ns: None,
@@ -286,12 +302,13 @@ impl AccelMonitor {
 mod tests {
     extern crate std;
     use super::*;
+    use crate::settings::G_MPS2;
     use std::vec::Vec;
 
     const MS: u64 = 1_000_000;
 
     fn monitor() -> AccelMonitor {
-        AccelMonitor::new(&CycleConfig::default())
+        AccelMonitor::new(crate::CycleConfig::default().accel_limits())
     }
 
     /// Feeds one 4-sample 4 kHz batch ending at `now`; returns the samples passed on.

@@ -7,7 +7,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::estimate::track::TrackConfig;
+use crate::accel::AccelLimits;
+use crate::confirm::ConfirmParams;
+use crate::settings::{check_range as range, ms_to_ns, ConfigError, G_MPS2};
 
 /// Decision-logic configuration. Every key is optional (defaults below).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -185,13 +187,6 @@ pub const MAX_E2E_BURST: usize = 16;
 impl CycleConfig {
     /// Range checks; the error names the key.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        fn range(key: &'static str, value: f64, lo: f64, hi: f64) -> Result<(), ConfigError> {
-            if value.is_finite() && (lo..=hi).contains(&value) {
-                Ok(())
-            } else {
-                Err(ConfigError { key, value, lo, hi })
-            }
-        }
         range("ego_mass_kg", self.ego_mass_kg, 500.0, 5000.0)?;
         range("ego_class", f64::from(self.ego_class), 1.0, 6.0)?;
         range("conservative_mass_k", self.conservative_mass_k, 0.0, 5.0)?;
@@ -270,32 +265,113 @@ impl CycleConfig {
         range("e2e_max_lost", f64::from(self.e2e_max_lost), 0.0, 14.0)?;
         self.track.validate()
     }
-}
 
-/// A decision setting outside its range (the shell adds where it came from).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ConfigError {
-    /// Key inside `[cycle]`.
-    pub key: &'static str,
-    /// The value given.
-    pub value: f64,
-    /// Smallest allowed value.
-    pub lo: f64,
-    /// Largest allowed value.
-    pub hi: f64,
-}
+    /// The generic crash confirmation's thresholds (`confirm_*`) in the detector's units.
+    pub fn confirm_params(&self) -> ConfirmParams {
+        ConfirmParams {
+            wake_mps2: self.confirm_wake_g * G_MPS2,
+            decel_mps2: self.confirm_decel_g * G_MPS2,
+            samples: self.confirm_samples,
+            delta_v_mps: self.confirm_delta_v_mps,
+            reset_gap_ns: ms_to_ns(self.confirm_reset_gap_ms),
+        }
+    }
 
-impl core::fmt::Display for ConfigError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        let Self { key, value, lo, hi } = self;
-        write!(f, "cycle.{key} = {value} is outside {lo}..={hi}")
+    /// The accelerometer monitor's limits (`accel_*`) in its units.
+    pub fn accel_limits(&self) -> AccelLimits {
+        AccelLimits {
+            timeout_ns: ms_to_ns(self.accel_timeout_ms),
+            stuck_ns: ms_to_ns(self.accel_stuck_ms),
+            full_scale_mps2: self.accel_full_scale_g * G_MPS2,
+        }
     }
 }
 
-/// ms (config) → ns (cycle), saturating, NaN → 0.
-pub(crate) fn ms_to_ns(ms: f64) -> u64 {
-    // `as` from float saturates and maps NaN to 0: never panics.
-    (ms * 1.0e6) as u64
+/// Settings of the track filter (`[cycle.track]` in `ecu.toml`). Every key is optional.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TrackConfig {
+    /// Measurement noise of the distance, m, 1σ (*default* 0.1: twice the bench sensor's
+    /// 5 cm, so a somewhat worse sensor is not gated out).
+    pub distance_sigma_m: f64,
+    /// Measurement noise of the closing speed, m/s, 1σ (*default* 0.2: twice the bench
+    /// sensor's 0.1 m/s).
+    pub closing_speed_sigma_mps: f64,
+    /// Measurement noise of the tracker's relative acceleration, m/s², 1σ (*default* 1.0: a
+    /// tracker differentiates it from the speed, so it is the noisiest of the three).
+    pub accel_sigma_mps2: f64,
+    /// Spectral density of the relative jerk, m²/s⁵ (*default* 200: the closing acceleration
+    /// may change by √(q τ) ≈ 2 m/s² within one 20 ms object period — braking onsets reach
+    /// 16 m/s² within 150 ms).
+    pub jerk_density_m2ps5: f64,
+    /// Gate on the squared Mahalanobis distance of a sample (*default* 16.27: the χ² 99.9 %
+    /// quantile with 3 degrees of freedom — one good sample in a thousand is rejected).
+    pub gate_chi2: f64,
+    /// Outliers in a row after which the track restarts from the newest sample
+    /// (*default* 3: 60 ms of a 20 ms object list).
+    pub max_outliers: u32,
+    /// Weight α of a sample in the measurement-noise scale λ (*default* 0.2: about the
+    /// last five samples; 0 switches the adaptation off; see the module docs).
+    pub noise_adaptation: f64,
+    /// Share ρ of a mass sample's reported variance that is common to all samples
+    /// (systematic), 0..=1 (*default* 0.5; see the module docs).
+    pub mass_sigma_correlation: f64,
+    /// The decision plans with the contact instant estimate − k·σ (*default* 1.0): a
+    /// pretensioner planned before contact fires early rather than late, and PRE-CRASH is
+    /// entered early rather than late.
+    pub contact_time_k: f64,
+}
+
+impl Default for TrackConfig {
+    fn default() -> Self {
+        Self {
+            distance_sigma_m: 0.1,
+            closing_speed_sigma_mps: 0.2,
+            accel_sigma_mps2: 1.0,
+            jerk_density_m2ps5: 200.0,
+            gate_chi2: 16.27,
+            max_outliers: 3,
+            noise_adaptation: 0.2,
+            mass_sigma_correlation: 0.5,
+            contact_time_k: 1.0,
+        }
+    }
+}
+
+impl TrackConfig {
+    /// Range checks; the error names the key.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        range("track.distance_sigma_m", self.distance_sigma_m, 1e-3, 10.0)?;
+        range(
+            "track.closing_speed_sigma_mps",
+            self.closing_speed_sigma_mps,
+            1e-3,
+            10.0,
+        )?;
+        range("track.accel_sigma_mps2", self.accel_sigma_mps2, 1e-3, 100.0)?;
+        range(
+            "track.jerk_density_m2ps5",
+            self.jerk_density_m2ps5,
+            0.0,
+            1e6,
+        )?;
+        range("track.gate_chi2", self.gate_chi2, 1.0, 1e6)?;
+        range(
+            "track.max_outliers",
+            f64::from(self.max_outliers),
+            1.0,
+            100.0,
+        )?;
+        range("track.noise_adaptation", self.noise_adaptation, 0.0, 1.0)?;
+        range(
+            "track.mass_sigma_correlation",
+            self.mass_sigma_correlation,
+            0.0,
+            1.0,
+        )?;
+        range("track.contact_time_k", self.contact_time_k, 0.0, 5.0)?;
+        Ok(())
+    }
 }
 
 #[cfg(test)]

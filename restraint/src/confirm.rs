@@ -3,12 +3,9 @@
 //! NaN-safe; fed with the plausible samples of [`crate::accel::AccelMonitor`].
 
 use crate::accel::AccelSample;
-use crate::config::{ms_to_ns, CycleConfig};
 
-/// Standard gravity, m/s² (same constant as the physics crate).
-pub const G_MPS2: f64 = physics::defaults::STANDARD_GRAVITY_MPS2;
-
-/// Crash-confirmation settings in the detector's units.
+/// Crash-confirmation settings in the detector's units (from the file's `confirm_*` keys:
+/// [`crate::CycleConfig::confirm_params`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ConfirmParams {
     /// Wake threshold, m/s² (deceleration magnitude).
@@ -21,19 +18,6 @@ pub struct ConfirmParams {
     pub delta_v_mps: f64,
     /// Reset after this long below the wake threshold, ns.
     pub reset_gap_ns: u64,
-}
-
-impl ConfirmParams {
-    /// The generic confirmation's thresholds of a validated `cfg` (`confirm_*`).
-    pub fn from_config(cfg: &CycleConfig) -> Self {
-        Self {
-            wake_mps2: cfg.confirm_wake_g * G_MPS2,
-            decel_mps2: cfg.confirm_decel_g * G_MPS2,
-            samples: cfg.confirm_samples,
-            delta_v_mps: cfg.confirm_delta_v_mps,
-            reset_gap_ns: ms_to_ns(cfg.confirm_reset_gap_ms),
-        }
-    }
 }
 
 /// An event in the accelerometer signal: awake from the first sample at or above the wake
@@ -189,6 +173,7 @@ impl CrashDetector {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::settings::G_MPS2;
 
     fn params() -> ConfirmParams {
         ConfirmParams {

@@ -17,14 +17,15 @@
 //! from the table at the measured severity (and, as every lookup, the robust planning mass).
 
 use crate::accel::{AccelSample, PlausibleBatch};
-use crate::config::{ms_to_ns, CycleConfig};
-use crate::confirm::{ConfirmParams, CrashDetector, G_MPS2};
+use crate::config::CycleConfig;
+use crate::confirm::{ConfirmParams, CrashDetector};
 use crate::counters::CycleCounters;
 use crate::crash_match::{MatchParams, MatchState, PulseMatch, SeverityEstimate};
 use crate::estimate::{equivalent_barrier_speed_kph, Estimator, Situation};
 use crate::fallback::{FallbackAlgorithm, FallbackDecision};
 use crate::inputs::InputMonitor;
 use crate::plan::RestraintPlan;
+use crate::settings::{ms_to_ns, G_MPS2};
 
 /// Which path confirmed the crash.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -78,7 +79,7 @@ pub struct CrashMonitor {
 impl CrashMonitor {
     /// The detectors with the thresholds of a validated `cfg`.
     pub fn new(cfg: &CycleConfig) -> Self {
-        let onset_params = ConfirmParams::from_config(cfg);
+        let onset_params = cfg.confirm_params();
         Self {
             onset_params,
             generic: CrashDetector::default(),

@@ -346,7 +346,7 @@ impl PulseMatch {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::confirm::G_MPS2;
+    use crate::settings::G_MPS2;
     use physics::MassClass;
 
     const MS: u64 = 1_000_000;

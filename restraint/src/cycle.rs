@@ -9,7 +9,7 @@ use bus::secoc::SecOcTx;
 use bus::{EnumCount, RejectReason, VariantArray};
 use physics::CollisionSummary;
 
-use crate::config::{ConfigError, CycleConfig};
+use crate::config::CycleConfig;
 use crate::contract::{Activity, CycleInfo, CycleIo, StartupError};
 use crate::counters::CycleCounters;
 use crate::crash::{plan_for, CrashMonitor, FreezeContext};
@@ -18,6 +18,7 @@ use crate::estimate::{check_lut, Estimator, Lut, LutMismatch, Situation};
 use crate::inputs::InputMonitor;
 use crate::outputs::{publish_diagnostics, Outputs};
 use crate::plan::{ReferenceSettings, RestraintPlan};
+use crate::settings::ConfigError;
 use crate::signals::Degraded;
 
 /// What [`RestraintCycle::new`] found (for start-up messages).

@@ -26,11 +26,12 @@
 //! facts, the crash detectors' evidence and whether the inputs are degraded; outputs are the
 //! phase, the active plan and the pretensioner/airbag commands ([`Decision`]'s accessors).
 
-use crate::config::{ms_to_ns, CycleConfig};
+use crate::config::CycleConfig;
 use crate::crash::{ConfirmKind, Confirmation};
 use crate::estimate::Situation;
 use crate::fallback::{FallbackDecision, WINDOW_MS};
 use crate::plan::RestraintPlan;
+use crate::settings::ms_to_ns;
 use crate::signals::EcuMode;
 
 /// Decision phase (what the state machine is doing).

@@ -21,8 +21,8 @@
 //! speed and structure; a light opponent's crash ends early and stays under the boundary.
 
 use crate::accel::AccelSample;
-use crate::config::ConfigError;
 use crate::confirm::{ConfirmParams, Onset, OnsetStep};
+use crate::settings::ConfigError;
 
 /// Number of threshold knots (0, 4, … 60 ms).
 pub const KNOTS: usize = 16;
@@ -155,7 +155,7 @@ impl FallbackAlgorithm {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::confirm::G_MPS2;
+    use crate::settings::G_MPS2;
 
     fn params() -> ConfirmParams {
         ConfirmParams {

@@ -14,9 +14,10 @@ use bus::{E2eChecker, Messages, RawFrame, RejectReason, CAN_EFF_FLAG};
 use heapless::Deque;
 
 use crate::accel::{AccelMonitor, PlausibleBatch, INVALID_HOLD_MS};
-use crate::config::{ms_to_ns, CycleConfig, MAX_E2E_BURST};
+use crate::config::{CycleConfig, MAX_E2E_BURST};
 use crate::contract::ReceiveErrors;
 use crate::counters::CycleCounters;
+use crate::settings::ms_to_ns;
 use crate::signals::{CrashAccelSample, Degraded, ObjectState};
 /// Closing speed above ego speed + this is implausible (opponent > 250 km/h), m/s.
 const MAX_OPPONENT_SPEED_MPS: f32 = 70.0;
@@ -156,7 +157,7 @@ impl InputMonitor {
             occupant_rx_ns: None,
             occupant_changed: false,
             last_accel_sequence: 0,
-            accel: AccelMonitor::new(cfg),
+            accel: AccelMonitor::new(cfg.accel_limits()),
             rx_errors: ReceiveErrors::default(),
             object_rx_error_until_ns: None,
             accel_rx_error_until_ns: None,

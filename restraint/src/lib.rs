@@ -10,6 +10,8 @@
 //!
 //! | module | job |
 //! |---|---|
+//! | [`config`] | every setting (`[cycle]`, `[cycle.track]`) with its default, range check and conversion into the modules' parameters |
+//! | [`settings`] | what the settings share: the range error, ms → ns, g → m/s² (a leaf: no module imports `config` to check or convert) |
 //! | [`inputs`] | input monitoring: E2E, freshness, plausibility, degraded reasons |
 //! | [`accel`] | crash-accelerometer plausibility: stale, stuck, saturated, out of range, time |
 //! | [`confirm`] | generic crash confirmation from the compartment accelerometer |
@@ -49,21 +51,23 @@ pub mod fallback;
 pub mod inputs;
 pub mod outputs;
 pub mod plan;
+pub mod settings;
 pub mod signals;
 pub mod sim;
 
-pub use config::{ConfigError, CycleConfig, MAX_E2E_BURST};
-pub use confirm::{ConfirmParams, CrashDetector, G_MPS2};
+pub use config::{CycleConfig, TrackConfig, MAX_E2E_BURST};
+pub use confirm::{ConfirmParams, CrashDetector};
 pub use contract::{Activity, CycleInfo, CycleIo, IoError, ReceiveErrors, StartupError};
 pub use counters::CycleCounters;
 pub use cycle::{RestraintCycle, StartupNotes};
 pub use decision::{Phase, Pretensioner};
-pub use estimate::track::{Refused, TrackConfig, TrackEstimate, TrackEvent, TrackFilter};
+pub use estimate::track::{Refused, TrackEstimate, TrackEvent, TrackFilter};
 pub use estimate::{
     equivalent_barrier_speed_kph, time_to_contact, Contact, Lut, LutMismatch, Situation,
 };
 pub use inputs::{input_can_ids, Occupant};
 pub use plan::{PlanSource, ReferenceSettings, RestraintPlan};
+pub use settings::{ConfigError, G_MPS2};
 pub use signals::{
     CrashAccelSample, Degraded, EcuDiagnostics, EcuMode, ObjectState, ACCEL_BATCH_CAPACITY,
     PULSE_POINTS, VALID,

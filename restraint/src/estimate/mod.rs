@@ -21,10 +21,12 @@ pub mod track;
 use diagram::{AirbagThresholds, DiagramView, Query};
 use physics::{CollisionInput, CollisionSummary, CombinedSpring, ExactCollision, MassClass};
 
-use crate::config::{ms_to_ns, ConfigError, CycleConfig};
+use crate::config::CycleConfig;
 use crate::counters::CycleCounters;
 use crate::inputs::InputMonitor;
 use crate::plan::RestraintPlan;
+use crate::settings::ms_to_ns;
+use crate::settings::ConfigError;
 use pulse::DiagnosticsPulse;
 use track::{TrackEstimate, TrackEvent, TrackFilter};
 

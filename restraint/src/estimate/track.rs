@@ -59,116 +59,17 @@
 //! ([`super::time_to_contact`]), each with its σ from the first-order propagation of P:
 //! with t the time to contact and v_c the closing speed at contact,
 //! ∂t/∂(d, v, a) = (1, −t, −t²/2)/v_c and ∂v_c/∂(d, v, a) = (a, v, d)/v_c.
-//!
-//! **Why one file of ≈ 580 lines** (over the core's ~500): a quarter of it is this derivation
-//! and the settings' documentation; the rest is one algorithm whose steps (predict, gate,
-//! update, noise adaptation, mass fusion) share the state's invariants and are checked against
-//! each other when read — split, each part would need the others open beside it.
 
 use nalgebra::{Matrix3, Vector3};
-use serde::{Deserialize, Serialize};
 
 use super::{time_to_contact, Contact};
-use crate::config::{ms_to_ns, ConfigError};
+use crate::config::TrackConfig;
+use crate::settings::ms_to_ns;
 use crate::signals::ObjectState;
 
 /// Smallest mass σ a sample is weighted with, kg (a reported σ of 0 would otherwise outweigh
 /// every other sample forever).
 const MIN_MASS_SIGMA_KG: f64 = 1.0;
-
-/// Settings of the track filter (`[cycle.track]` in `ecu.toml`). Every key is optional.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct TrackConfig {
-    /// Measurement noise of the distance, m, 1σ (*default* 0.1: twice the bench sensor's
-    /// 5 cm, so a somewhat worse sensor is not gated out).
-    pub distance_sigma_m: f64,
-    /// Measurement noise of the closing speed, m/s, 1σ (*default* 0.2: twice the bench
-    /// sensor's 0.1 m/s).
-    pub closing_speed_sigma_mps: f64,
-    /// Measurement noise of the tracker's relative acceleration, m/s², 1σ (*default* 1.0: a
-    /// tracker differentiates it from the speed, so it is the noisiest of the three).
-    pub accel_sigma_mps2: f64,
-    /// Spectral density of the relative jerk, m²/s⁵ (*default* 200: the closing acceleration
-    /// may change by √(q τ) ≈ 2 m/s² within one 20 ms object period — braking onsets reach
-    /// 16 m/s² within 150 ms).
-    pub jerk_density_m2ps5: f64,
-    /// Gate on the squared Mahalanobis distance of a sample (*default* 16.27: the χ² 99.9 %
-    /// quantile with 3 degrees of freedom — one good sample in a thousand is rejected).
-    pub gate_chi2: f64,
-    /// Outliers in a row after which the track restarts from the newest sample
-    /// (*default* 3: 60 ms of a 20 ms object list).
-    pub max_outliers: u32,
-    /// Weight α of a sample in the measurement-noise scale λ (*default* 0.2: about the
-    /// last five samples; 0 switches the adaptation off; see the module docs).
-    pub noise_adaptation: f64,
-    /// Share ρ of a mass sample's reported variance that is common to all samples
-    /// (systematic), 0..=1 (*default* 0.5; see the module docs).
-    pub mass_sigma_correlation: f64,
-    /// The decision plans with the contact instant estimate − k·σ (*default* 1.0): a
-    /// pretensioner planned before contact fires early rather than late, and PRE-CRASH is
-    /// entered early rather than late.
-    pub contact_time_k: f64,
-}
-
-impl Default for TrackConfig {
-    fn default() -> Self {
-        Self {
-            distance_sigma_m: 0.1,
-            closing_speed_sigma_mps: 0.2,
-            accel_sigma_mps2: 1.0,
-            jerk_density_m2ps5: 200.0,
-            gate_chi2: 16.27,
-            max_outliers: 3,
-            noise_adaptation: 0.2,
-            mass_sigma_correlation: 0.5,
-            contact_time_k: 1.0,
-        }
-    }
-}
-
-impl TrackConfig {
-    /// Range checks; the error names the key.
-    pub fn validate(&self) -> Result<(), ConfigError> {
-        fn range(key: &'static str, value: f64, lo: f64, hi: f64) -> Result<(), ConfigError> {
-            if value.is_finite() && (lo..=hi).contains(&value) {
-                Ok(())
-            } else {
-                Err(ConfigError { key, value, lo, hi })
-            }
-        }
-        range("track.distance_sigma_m", self.distance_sigma_m, 1e-3, 10.0)?;
-        range(
-            "track.closing_speed_sigma_mps",
-            self.closing_speed_sigma_mps,
-            1e-3,
-            10.0,
-        )?;
-        range("track.accel_sigma_mps2", self.accel_sigma_mps2, 1e-3, 100.0)?;
-        range(
-            "track.jerk_density_m2ps5",
-            self.jerk_density_m2ps5,
-            0.0,
-            1e6,
-        )?;
-        range("track.gate_chi2", self.gate_chi2, 1.0, 1e6)?;
-        range(
-            "track.max_outliers",
-            f64::from(self.max_outliers),
-            1.0,
-            100.0,
-        )?;
-        range("track.noise_adaptation", self.noise_adaptation, 0.0, 1.0)?;
-        range(
-            "track.mass_sigma_correlation",
-            self.mass_sigma_correlation,
-            0.0,
-            1.0,
-        )?;
-        range("track.contact_time_k", self.contact_time_k, 0.0, 5.0)?;
-        Ok(())
-    }
-}
 
 /// Why a sample was not taken.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
