@@ -22,6 +22,33 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
+/// How an EcuStatus fault flag showed for a failure that began at `from_ms`, given the ECU's
+/// flag changes `(ms, set flags)` on the same time axis. A flag set long before — e.g. the
+/// accelerometer reported faulty at start-up, before its first batch — is not a detection of
+/// this failure: only a rise after it counts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FaultSeen {
+    /// Raised at this time; the flag was clear when the failure began.
+    Raised(f64),
+    /// Already set when the failure began (by the change at this time): nothing to see.
+    AlreadySet(f64),
+    /// Not raised after the failure began.
+    Never,
+}
+
+/// See [`FaultSeen`].
+pub fn fault_seen(changes: &[(f64, Vec<String>)], flag: &str, from_ms: f64) -> FaultSeen {
+    let has = |f: &[String]| f.iter().any(|n| n == flag);
+    let at_failure = changes.iter().take_while(|(t, _)| *t <= from_ms).last();
+    if let Some((t, _)) = at_failure.filter(|(_, f)| has(f)) {
+        return FaultSeen::AlreadySet(*t);
+    }
+    changes
+        .iter()
+        .find(|(t, f)| *t > from_ms && has(f))
+        .map_or(FaultSeen::Never, |(t, _)| FaultSeen::Raised(*t))
+}
+
 /// What one run needs.
 #[derive(Clone, Debug)]
 pub struct RunConfig {

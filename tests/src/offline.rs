@@ -96,14 +96,6 @@ impl OfflineRun {
             )
         })
     }
-
-    /// First instant a fault flag named `flag` was set [ms rel. contact].
-    pub fn fault_first_ms(&self, flag: &str) -> Option<f64> {
-        self.faults
-            .iter()
-            .find(|(_, f)| f.iter().any(|n| n == flag))
-            .map(|(t, _)| *t)
-    }
 }
 
 /// Runs `scenario` through the core with `cfg`.

@@ -73,10 +73,18 @@ fn problems(s: &Scenario, r: &OfflineRun) -> Vec<String> {
         e.reference_fallback,
         r.modules.first_reference_cmd_ns.is_some(),
     );
+    // Raised after the sensor failed (not the start-up report) and before the contact.
+    let accel_failed_ms = match (s.sensor.accel_fails_at_s(), r.contact_s) {
+        (Some(f), Some(c)) => (f - c) * 1e3,
+        _ => f64::NEG_INFINITY,
+    };
     check(
         "accelerometer fault before contact",
         e.accel_fault_before_contact,
-        r.fault_first_ms("accel_sensor").is_some_and(|t| t < 0.0),
+        matches!(
+            e2e_tests::fault_seen(&r.faults, "accel_sensor", accel_failed_ms),
+            e2e_tests::FaultSeen::Raised(t) if t < 0.0
+        ),
     );
     if let Some(ev) = &r.evaluated {
         if !ev.outcome.adaptive_no_worse {

@@ -279,6 +279,18 @@ impl SensorModel {
         })
     }
 
+    /// When the crash accelerometer first fails [s after start]: the earliest dropout that
+    /// silences it or faulty-reading window (`None`: it never fails).
+    pub fn accel_fails_at_s(&self) -> Option<f64> {
+        let silenced = self
+            .dropouts
+            .iter()
+            .filter(|d| matches!(d.target, DropoutTarget::Accel | DropoutTarget::All))
+            .map(|d| d.start_s);
+        let faulty = self.accel_faults.iter().map(|f| f.start_s);
+        silenced.chain(faulty).reduce(f64::min)
+    }
+
     /// The accelerometer fault at scenario time `t_s`, if any (the first window that holds).
     pub fn accel_fault(&self, t_s: f64) -> Option<AccelFaultKind> {
         self.accel_faults

@@ -3,7 +3,7 @@
 
 use super::{Case, CaseResult, Check, Fault, Variant, DELAY_MS};
 use crate::route::STARVED_INPUT_FLAGS;
-use crate::{RunResult, FIRE_LATE_ALLOWANCE_MS};
+use crate::{fault_seen, FaultSeen, RunResult, FIRE_LATE_ALLOWANCE_MS};
 use actuator_stubs::report::{Report, TimedAction};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -18,13 +18,21 @@ const E2E_BURST_MS: f64 = 30.0;
 const OBJECT_PERIOD_MS: f64 = 20.0;
 /// OccupantClassification period (DBC).
 const OCCUPANT_PERIOD_MS: f64 = 100.0;
+/// Scheduling slack on a documented detection time (one object period of a loaded host).
+const DETECTION_SLACK_MS: f64 = 20.0;
+
+const ACCEL_HEALTHY_CHECK: &str = "accelerometer healthy on the bus when it failed";
+const ACCEL_DETECTION_TIME_CHECK: &str =
+    "accelerometer fault on the bus within the documented time";
 
 /// Checks that are time limits (see [`Check::timing`]).
-const TIMING_CHECKS: [&str; 4] = [
+const TIMING_CHECKS: [&str; 6] = [
     "fire command on time",
     "ECU in Normal when the fault began",
     "fault detected: ECU degrades to the reference restraint",
     "recovers after the fault",
+    ACCEL_HEALTHY_CHECK,
+    ACCEL_DETECTION_TIME_CHECK,
 ];
 
 const FIRES_CHECK: &str = "airbag fires exactly when the scenario requires";
@@ -735,12 +743,15 @@ fn judge_fault(
     }
 }
 
-/// When the ECU first reported the crash accelerometer faulty [ms rel. contact].
-fn accel_fault_first_ms(r: &Report) -> Option<f64> {
-    r.ecu_faults
-        .iter()
-        .find(|(_, f)| f.iter().any(|n| n == "accel_sensor"))
-        .map(|(t, _)| *t)
+/// Documented bound on "sensor failed → fault bit on the bus": the monitor's limit (no batch
+/// for `accel_timeout_ms`, the same reading for `accel_stuck_ms`) plus one EcuStatus period.
+fn accel_fault_bound_ms(v: Variant) -> f64 {
+    let cfg = restraint::CycleConfig::default();
+    let limit = match v {
+        Variant::AccelStuck { .. } => cfg.accel_stuck_ms,
+        _ => cfg.accel_timeout_ms,
+    };
+    limit + bus::EcuStatus::MESSAGE_CYCLE_TIME_MS as f64
 }
 
 /// Issue 14's checks of a scenario variant: a misreported crash is no worse than the reference
@@ -780,15 +791,47 @@ fn judge_variant(checks: &mut Checks, v: Variant, r: &Report) {
                 verdict.map_or("no outcome (no contact?)".into(), |(_, d)| d),
             );
         }
-        Variant::AccelDead { .. } | Variant::AccelStuck { .. } => {
-            let t = accel_fault_first_ms(r);
+        Variant::AccelDead { before_contact_s } | Variant::AccelStuck { before_contact_s } => {
+            let from_ms = -before_contact_s * 1e3;
+            let seen = fault_seen(&r.ecu_faults, "accel_sensor", from_ms);
+            // A precondition, like "ECU in Normal when the fault began": a fault bit still set
+            // (an emulated start-up that starved the sensor) hides the detection.
+            checks.check(
+                ACCEL_HEALTHY_CHECK,
+                !matches!(seen, FaultSeen::AlreadySet(_)),
+                match seen {
+                    FaultSeen::AlreadySet(t) => format!(
+                        "FaultAccelSensor set since {t:+.0} ms, the sensor failed at {from_ms:+.0} ms"
+                    ),
+                    _ => "fault bit clear".into(),
+                },
+            );
+            if let FaultSeen::AlreadySet(_) = seen {
+                return;
+            }
             checks.check(
                 "accelerometer fault on the bus before the crash",
-                t.is_some_and(|t| t < 0.0),
-                t.map_or("never reported".into(), |t| {
-                    format!("FaultAccelSensor at {t:+.0} ms rel. contact")
-                }),
+                matches!(seen, FaultSeen::Raised(t) if t < 0.0),
+                match seen {
+                    FaultSeen::Raised(t) => format!(
+                        "FaultAccelSensor at {t:+.0} ms rel. contact, the sensor failed at \
+                         {from_ms:+.0} ms"
+                    ),
+                    _ => format!("never reported after the sensor failed at {from_ms:+.0} ms"),
+                },
             );
+            if let FaultSeen::Raised(t) = seen {
+                let bound_ms = accel_fault_bound_ms(v) + DETECTION_SLACK_MS;
+                checks.check(
+                    ACCEL_DETECTION_TIME_CHECK,
+                    t - from_ms <= bound_ms,
+                    format!(
+                        "{:.0} ms (monitor limit + one EcuStatus period + {DETECTION_SLACK_MS:.0} ms: \
+                         {bound_ms:.0} ms)",
+                        t - from_ms
+                    ),
+                );
+            }
         }
         Variant::AsIs | Variant::Dropout { .. } | Variant::Frozen { .. } => {}
     }
@@ -837,8 +880,17 @@ fn describe_reaction(
         s.push_str("reference restraint from start; ");
     }
     if let (Fault::Variant(v), Some(r)) = (&case.fault, report) {
-        if let Some(t) = accel_fault_first_ms(r) {
-            let _ = write!(s, "accelerometer fault on the bus at {t:+.0} ms; ");
+        if let Variant::AccelDead { before_contact_s } | Variant::AccelStuck { before_contact_s } =
+            v
+        {
+            let from_ms = -before_contact_s * 1e3;
+            if let FaultSeen::Raised(t) = fault_seen(&r.ecu_faults, "accel_sensor", from_ms) {
+                let _ = write!(
+                    s,
+                    "accelerometer fault on the bus {:.0} ms after the sensor failed; ",
+                    t - from_ms
+                );
+            }
         }
         if let (Variant::MassMisreport { .. } | Variant::SpeedBias { .. }, Some(o)) =
             (v, r.outcome.as_ref())
@@ -925,6 +977,47 @@ mod tests {
         );
         // No crash, or a fire: nothing to excuse.
         assert_eq!(starved_without_fire(None, false, &all), None);
+    }
+
+    #[test]
+    fn an_accelerometer_fault_counts_only_when_it_rises_after_the_sensor_failed() {
+        let f = |names: &[&str]| names.iter().map(|n| (*n).to_owned()).collect::<Vec<_>>();
+        // The accel-dead case of a clean-clone run: the start-up report (no samples yet) long
+        // before the failure at −600 ms, then the detection 52 ms after it.
+        let run = vec![
+            (
+                -3760.4,
+                f(&["vehicle_input", "object_input", "accel_sensor"]),
+            ),
+            (-3685.1, f(&["vehicle_input", "object_input", "overrun"])),
+            (-3669.5, f(&["overrun"])),
+            (-548.4, f(&["accel_sensor", "overrun"])),
+            (29.7, f(&["object_input", "accel_sensor", "overrun"])),
+        ];
+        assert_eq!(
+            fault_seen(&run, "accel_sensor", -600.0),
+            FaultSeen::Raised(-548.4)
+        );
+        // Without the detection the start-up report must not stand in for it.
+        let undetected: Vec<_> = run.iter().take(3).cloned().collect();
+        assert_eq!(
+            fault_seen(&undetected, "accel_sensor", -600.0),
+            FaultSeen::Never
+        );
+        // Still set from start-up when the sensor failed: nothing can be seen.
+        let starved = vec![
+            (-3760.4, f(&["accel_sensor"])),
+            (29.7, f(&["accel_sensor"])),
+        ];
+        assert_eq!(
+            fault_seen(&starved, "accel_sensor", -600.0),
+            FaultSeen::AlreadySet(-3760.4)
+        );
+        assert!(
+            accel_fault_bound_ms(Variant::AccelDead {
+                before_contact_s: 0.6
+            }) > 52.0
+        );
     }
 
     #[test]
