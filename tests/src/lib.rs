@@ -49,6 +49,18 @@ pub fn fault_seen(changes: &[(f64, Vec<String>)], flag: &str, from_ms: f64) -> F
         .map_or(FaultSeen::Never, |(t, _)| FaultSeen::Raised(*t))
 }
 
+/// When the ECU fell back to the reference restraint after it had been Normal, given its
+/// EcuStatus mode changes `(ms, mode)`. Every run starts in ReferenceFallback (no input is
+/// fresh yet): that start is not a fallback, so "the ECU fell back" needs a Normal before it.
+pub fn fell_back_after_normal(modes: &[(f64, String)]) -> Option<f64> {
+    let normal = modes.iter().position(|(_, m)| m == "Normal")?;
+    modes
+        .iter()
+        .skip(normal + 1)
+        .find(|(_, m)| m == "ReferenceFallback")
+        .map(|(t, _)| *t)
+}
+
 /// What one run needs.
 #[derive(Clone, Debug)]
 pub struct RunConfig {

@@ -980,6 +980,31 @@ mod tests {
     }
 
     #[test]
+    fn the_start_up_reference_fallback_is_not_a_fallback() {
+        let m = |v: &[(f64, &str)]| {
+            v.iter()
+                .map(|(t, m)| (*t, (*m).to_owned()))
+                .collect::<Vec<_>>()
+        };
+        // sensor-dropout offline: start → Normal → the dropout → crash.
+        let dropout = m(&[
+            (-1691.0, "ReferenceFallback"),
+            (-1671.0, "Normal"),
+            (-810.0, "ReferenceFallback"),
+            (7.0, "CrashDetected"),
+        ]);
+        assert_eq!(crate::fell_back_after_normal(&dropout), Some(-810.0));
+        let clean = m(&[
+            (-2000.0, "ReferenceFallback"),
+            (-1980.0, "Normal"),
+            (2.0, "Deployed"),
+        ]);
+        assert_eq!(crate::fell_back_after_normal(&clean), None);
+        let never_normal = m(&[(-2000.0, "ReferenceFallback"), (5.0, "CrashDetected")]);
+        assert_eq!(crate::fell_back_after_normal(&never_normal), None);
+    }
+
+    #[test]
     fn an_accelerometer_fault_counts_only_when_it_rises_after_the_sensor_failed() {
         let f = |names: &[&str]| names.iter().map(|n| (*n).to_owned()).collect::<Vec<_>>();
         // The accel-dead case of a clean-clone run: the start-up report (no samples yet) long
