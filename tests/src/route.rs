@@ -156,7 +156,7 @@ impl Allowances {
         }
         if self.starved_fire_is_timing {
             v.push(
-                "a reference fire caused only by starved inputs (stale-input/overrun flags), a missing fire with the accelerometer starved over the contact, and every check of a case whose ECU was not Normal when the fault began count as time limits"
+                "a reference fire caused only by starved inputs (stale-input/overrun flags), a missing fire with the accelerometer starved over the contact (the e2e flag that a bus fault or the flood sets by design aside), and every check of a case whose ECU was not Normal when the fault began count as time limits"
                     .to_owned(),
             );
         }

@@ -72,23 +72,36 @@ fn only_starved_faults_at(ecu_faults: &[(f64, Vec<String>)], t_ms: f64) -> Optio
 }
 
 /// If a crash came (`contact`) and nothing fired while the ECU's only active faults at the
-/// contact were stale inputs, the crash accelerometer among them (see [`STARVED_INPUT_FLAGS`]):
-/// those faults. Without any acceleration sample no ECU can fire; where the emulator (or a
-/// restarted feed it slowed down) starved the accelerometer over the crash, the missing fire is
-/// a time limit there, a function failure with real timers.
+/// contact were stale inputs, the crash accelerometer among them (see [`STARVED_INPUT_FLAGS`]),
+/// besides those the case's own fault sets (`own`, see [`own_flags`]): those faults. Without any
+/// acceleration sample no ECU can fire; where the emulator (or a restarted feed it slowed down)
+/// starved the accelerometer over the crash, the missing fire is a time limit there, a
+/// function failure with real timers.
 fn starved_without_fire(
     fire: Option<&TimedAction>,
     contact: bool,
     ecu_faults: &[(f64, Vec<String>)],
+    own: &[&str],
 ) -> Option<String> {
     if fire.is_some() || !contact {
         return None;
     }
-    let flags = only_starved_faults_at(ecu_faults, 0.0)?;
-    flags
-        .iter()
-        .any(|f| f == "accel_sensor")
-        .then(|| flags.join("+"))
+    let (_, flags) = ecu_faults.iter().rev().find(|(t, _)| *t <= 0.0)?;
+    let starved = flags.iter().any(|f| f == "accel_sensor")
+        && flags
+            .iter()
+            .all(|f| STARVED_INPUT_FLAGS.contains(&f.as_str()) || own.contains(&f.as_str()));
+    starved.then(|| flags.join("+"))
+}
+
+/// The EcuStatus fault flags a case's fault sets by design: the bus faults and the flood put
+/// frames that fail E2E on EgoVehicleState's id (`e2e`). They are the fault's effect, not a
+/// sign that the ECU went wrong, so they do not hide a starved accelerometer.
+fn own_flags(fault: &Fault) -> &'static [&'static str] {
+    match fault {
+        Fault::Bus { .. } | Fault::Flood => &["e2e"],
+        _ => &[],
+    }
 }
 
 /// Scenario time [s] of a report time (ms rel. contact, or since start without contact).
@@ -225,10 +238,14 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
     let played = sensor_feeds::Scenario::load(&run.scenario).ok();
     let ecu = run.ecu_report.as_ref();
     let fire = r.action("airbag_fire");
-    let mut checks = Checks::new(
-        starved_inputs_at_fire(fire, &r.ecu_faults)
-            .or_else(|| starved_without_fire(fire, r.contact_ns != 0, &r.ecu_faults)),
-    );
+    let mut checks = Checks::new(starved_inputs_at_fire(fire, &r.ecu_faults).or_else(|| {
+        starved_without_fire(
+            fire,
+            r.contact_ns != 0,
+            &r.ecu_faults,
+            own_flags(&case.fault),
+        )
+    }));
 
     checks.check(
         "bench processes ran and stopped cleanly",
@@ -964,19 +981,46 @@ mod tests {
             ]
         };
         let all = faults(&["vehicle_input", "object_input", "accel_sensor", "overrun"]);
-        assert!(starved_without_fire(None, true, &all).is_some());
+        assert!(starved_without_fire(None, true, &all, &[]).is_some());
         // The accelerometer alive: a missing fire is the ECU's own.
         assert_eq!(
-            starved_without_fire(None, true, &faults(&["object_input"])),
+            starved_without_fire(None, true, &faults(&["object_input"]), &[]),
             None
         );
-        // A corrupt input or a bad table is no starvation.
+        // A corrupt input or a bad table is no starvation...
+        let e2e = faults(&["accel_sensor", "e2e"]);
+        assert_eq!(starved_without_fire(None, true, &e2e, &[]), None);
+        // ...unless the case's own fault sets it: the cangen flood of a clean-clone run, whose
+        // feeds the loaded emulator starved for 2 s (no accelerometer, no objects) while the
+        // flood's frames kept EgoVehicleState in its E2E hold.
+        let flood = vec![
+            (
+                -2128.7,
+                vec!["accel_sensor".to_owned(), "overrun".to_owned()],
+            ),
+            (
+                -1736.5,
+                ["object_input", "accel_sensor", "e2e", "overrun"]
+                    .map(str::to_owned)
+                    .to_vec(),
+            ),
+            (
+                -53.0,
+                ["object_input", "accel_sensor", "e2e", "overrun"]
+                    .map(str::to_owned)
+                    .to_vec(),
+            ),
+        ];
         assert_eq!(
-            starved_without_fire(None, true, &faults(&["accel_sensor", "e2e"])),
+            starved_without_fire(None, true, &flood, own_flags(&Fault::Flood)).as_deref(),
+            Some("object_input+accel_sensor+e2e+overrun")
+        );
+        assert_eq!(
+            starved_without_fire(None, true, &flood, own_flags(&Fault::None)),
             None
         );
         // No crash, or a fire: nothing to excuse.
-        assert_eq!(starved_without_fire(None, false, &all), None);
+        assert_eq!(starved_without_fire(None, false, &all, &[]), None);
     }
 
     #[test]
