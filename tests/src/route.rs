@@ -150,7 +150,7 @@ impl Allowances {
         let mut v = Vec::new();
         if self.time_limit_attempts > 1 {
             v.push(format!(
-                "a fault case that misses only time limits (genuine commands lost only because they came after the freshness window count as one), or a scenario run whose inputs were starved or whose fire came late, runs again (≤ {} runs): emulated timing follows the host's load",
+                "a fault case that misses only time limits (genuine commands lost only because they came after the freshness window or the pairing timeout count as one), or a scenario run whose inputs were starved or whose fire came late, runs again (≤ {} runs): emulated timing follows the host's load",
                 self.time_limit_attempts
             ));
         }

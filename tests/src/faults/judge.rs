@@ -454,6 +454,24 @@ fn judge_commands(
             .map(|k| r.secoc_rejected.get(*k).copied().unwrap_or(0))
             .sum::<u64>()
     };
+    // A held command whose authenticator came after the pairing timeout shows as a dropped
+    // command plus an authenticator with no pending command (seen once in the TCG guest's
+    // baseline: the emulator stalled the stubs between the two frames sent back to back).
+    // Without frames from an attacker on the SecOC ids that pair can have no other cause.
+    let paired_late = if matches!(
+        case.fault,
+        Fault::ForgedFire { .. } | Fault::ReplayedFire { .. } | Fault::Flood
+    ) {
+        0
+    } else {
+        let alone = r
+            .secoc_rejected
+            .get("no_pending_command")
+            .copied()
+            .unwrap_or(0);
+        r.secoc_commands_dropped.min(alone)
+    };
+    let late = late + paired_late;
     let lost = sent.saturating_sub(authenticated);
     let attack = matches!(
         case.fault,

@@ -40,19 +40,21 @@ use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
 /// The crash scenario most cases disturb (the demo's case), run with [`CRASH_LEAD_S`] more
-/// approach: contact at ≈ 3.69 s instead of 1.69 s.
+/// approach: contact at ≈ 4.19 s instead of 1.69 s.
 pub const CRASH_SCENARIO: &str = "taurus-48-48-abs";
 /// Extra steady approach of the crash scenario in the campaign (see [`lengthened_scenario`]).
-pub const CRASH_LEAD_S: f64 = 2.0;
+pub const CRASH_LEAD_S: f64 = 2.5;
 /// The scenario in which nothing may fire (a 15 + 15 km/h bump).
 pub const QUIET_SCENARIO: &str = "low-speed-no-fire";
 
-/// Fault window of the pre-crash faults, scenario seconds: late enough that every injector has
-/// started (a process start in the QEMU TCG guest: ≈ 0.2 s), early enough that the documented
-/// recovery (E2E hold 500 ms; a restarted feed is back ≈ 1.2 s after its restart in the TCG
-/// guest, measured) completes before the pre-crash phase (≈ 3.4 s with [`CRASH_LEAD_S`]).
-const FAULT_FROM_S: f64 = 1.0;
-const FAULT_TO_S: f64 = 1.3;
+/// Fault window of the pre-crash faults, scenario seconds: late enough that the ECU is Normal
+/// when it begins (in the QEMU TCG guest a loaded emulator brought it there only ≈ 1.0 s after
+/// the start: with the window at 1.0 s, 4 of 27 cases of one clean-clone run missed that
+/// precondition and ran again, one of them twice), early enough that the documented recovery
+/// (E2E hold 500 ms; a restarted feed is back ≈ 1.2 s after its restart in the TCG guest,
+/// measured) completes before the pre-crash phase (≈ 3.9 s with [`CRASH_LEAD_S`]).
+const FAULT_FROM_S: f64 = 1.5;
+const FAULT_TO_S: f64 = 1.8;
 /// Delay of the `delay` mirror's copies, ms.
 const DELAY_MS: f64 = 200.0;
 
@@ -181,13 +183,13 @@ pub fn cases() -> Vec<Case> {
                 kill_s: from_s,
                 restart_s: to_s,
             },
-            what: "sensor-feeds SIGKILLed at 1.0 s, restarted at 1.3 s",
+            what: "sensor-feeds SIGKILLed at 1.5 s, restarted at 1.8 s",
         },
         Case {
             name: "stale-objects",
             scenario: CRASH_SCENARIO,
             fault: Fault::StaleObjects { from_s, to_s },
-            what: "object list stuck 1.0–1.3 s (last sample repeated, old timestamp)",
+            what: "object list stuck 1.5–1.8 s (last sample repeated, old timestamp)",
         },
         Case {
             name: "can-crc",
@@ -197,7 +199,7 @@ pub fn cases() -> Vec<Case> {
                 from_s,
                 to_s,
             },
-            what: "a corrupted-CRC copy after every EgoVehicleState, 1.0–1.3 s",
+            what: "a corrupted-CRC copy after every EgoVehicleState, 1.5–1.8 s",
         },
         Case {
             name: "can-counter",
@@ -207,7 +209,7 @@ pub fn cases() -> Vec<Case> {
                 from_s,
                 to_s,
             },
-            what: "a copy with the alive counter +5 (valid CRC) after every EgoVehicleState, 1.0–1.3 s",
+            what: "a copy with the alive counter +5 (valid CRC) after every EgoVehicleState, 1.5–1.8 s",
         },
         Case {
             name: "can-replay",
@@ -217,7 +219,7 @@ pub fn cases() -> Vec<Case> {
                 from_s,
                 to_s,
             },
-            what: "every EgoVehicleState replayed at once, 1.0–1.3 s",
+            what: "every EgoVehicleState replayed at once, 1.5–1.8 s",
         },
         Case {
             name: "can-delay",
@@ -227,13 +229,13 @@ pub fn cases() -> Vec<Case> {
                 from_s,
                 to_s,
             },
-            what: "every EgoVehicleState of 1.0–1.3 s sent again 200 ms late",
+            what: "every EgoVehicleState of 1.5–1.8 s sent again 200 ms late",
         },
         Case {
             name: "cangen-flood",
             scenario: CRASH_SCENARIO,
             fault: Fault::Flood,
-            what: "cangen at full rate (random ids, lengths, data) for the whole scenario",
+            what: "cangen at full rate on idle CPU time (random ids, lengths, data) for the whole scenario",
         },
         Case {
             name: "lut-corrupt",
@@ -671,11 +673,13 @@ impl Disturbance for CaseDisturbance<'_> {
                 }])
             }
             Fault::Flood => {
-                // Full rate, but at the lowest CPU priority: the flood stands for another node
-                // on the bus, not for a process that takes the ECU's CPU (on a one-CPU guest
-                // an un-niced busy loop would starve every bench process).
-                let child = Command::new("nice")
-                    .args(["-n", "19", "cangen", can.as_str()])
+                // Full rate, but only on CPU time nobody else wants (SCHED_IDLE): the flood
+                // stands for another node on the bus, with a CPU of its own, not for a process
+                // that takes the bench's CPU. At nice 19 it still starved the feeds of a loaded
+                // TCG guest for seconds (no accelerometer over the crash, so nothing could
+                // fire: 4 of 5 runs in one campaign).
+                let child = Command::new("chrt")
+                    .args(["--idle", "0", "cangen", can.as_str()])
                     .args(["-g", "0", "-I", "r", "-L", "r", "-D", "r"])
                     .stdout(Stdio::piped())
                     .stderr(Stdio::null())
@@ -1170,6 +1174,21 @@ mod tests {
             .dropped(sensor_feeds::scenario::DropoutTarget::Vehicle, 1.0));
         assert_eq!(s.expect.airbag_fires, Some(false));
         assert_eq!(s.expect.reference_fallback, Some(true));
+    }
+
+    #[test]
+    fn the_case_descriptions_name_the_fault_window() {
+        let window = format!("{FAULT_FROM_S:.1}–{FAULT_TO_S:.1} s");
+        let killed = format!("at {FAULT_FROM_S:.1} s, restarted at {FAULT_TO_S:.1} s");
+        for c in cases().into_iter().filter(|c| c.scenario == CRASH_SCENARIO) {
+            match c.fault {
+                Fault::StaleObjects { .. } | Fault::Bus { .. } => {
+                    assert!(c.what.contains(&window), "{}: {}", c.name, c.what);
+                }
+                Fault::FeedsKilled { .. } => assert!(c.what.contains(&killed), "{}", c.what),
+                _ => {}
+            }
+        }
     }
 
     #[test]

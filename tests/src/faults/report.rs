@@ -101,7 +101,7 @@ pub fn report_text(c: &Campaign, fuzz: Option<&[FuzzTarget]>) -> String {
     let _ = writeln!(s, "denied by attack   {denied}   (genuine frames displaced by attacker frames; resent next cycle)");
     let _ = writeln!(
         s,
-        "arrived late       {late}   (genuine commands refused as stale: delivered after the freshness window; counted as lost)"
+        "arrived late       {late}   (genuine commands refused as stale: delivered after the freshness window or the pairing timeout; counted as lost)"
     );
     let _ = writeln!(
         s,
