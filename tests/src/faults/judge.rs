@@ -57,17 +57,21 @@ fn starved_inputs_at_fire(
     if fire.action.source != "reference" {
         return None;
     }
-    only_starved_faults_at(ecu_faults, t).map(|flags| flags.join("+"))
+    only_starved_faults_at(ecu_faults, t, &[]).map(|flags| flags.join("+"))
 }
 
 /// The ECU's active faults at `t_ms` if there are some and all are stale inputs or overruns
-/// ([`STARVED_INPUT_FLAGS`]).
-fn only_starved_faults_at(ecu_faults: &[(f64, Vec<String>)], t_ms: f64) -> Option<&[String]> {
+/// ([`STARVED_INPUT_FLAGS`]) or flags in `own` (what the case's fault sets by design).
+fn only_starved_faults_at<'a>(
+    ecu_faults: &'a [(f64, Vec<String>)],
+    t_ms: f64,
+    own: &[&str],
+) -> Option<&'a [String]> {
     let (_, flags) = ecu_faults.iter().rev().find(|(tf, _)| *tf <= t_ms)?;
     (!flags.is_empty()
         && flags
             .iter()
-            .all(|f| STARVED_INPUT_FLAGS.contains(&f.as_str())))
+            .all(|f| STARVED_INPUT_FLAGS.contains(&f.as_str()) || own.contains(&f.as_str())))
     .then_some(flags.as_slice())
 }
 
@@ -86,12 +90,11 @@ fn starved_without_fire(
     if fire.is_some() || !contact {
         return None;
     }
-    let (_, flags) = ecu_faults.iter().rev().find(|(t, _)| *t <= 0.0)?;
-    let starved = flags.iter().any(|f| f == "accel_sensor")
-        && flags
-            .iter()
-            .all(|f| STARVED_INPUT_FLAGS.contains(&f.as_str()) || own.contains(&f.as_str()));
-    starved.then(|| flags.join("+"))
+    let flags = only_starved_faults_at(ecu_faults, 0.0, own)?;
+    flags
+        .iter()
+        .any(|f| f == "accel_sensor")
+        .then(|| flags.join("+"))
 }
 
 /// The EcuStatus fault flags a case's fault sets by design: the bus faults and the flood put
@@ -458,10 +461,11 @@ fn judge_commands(
     // command plus an authenticator with no pending command (seen once in the TCG guest's
     // baseline: the emulator stalled the stubs between the two frames sent back to back).
     // Without frames from an attacker on the SecOC ids that pair can have no other cause.
-    let paired_late = if matches!(
+    let attack = matches!(
         case.fault,
         Fault::ForgedFire { .. } | Fault::ReplayedFire { .. } | Fault::Flood
-    ) {
+    );
+    let paired_late = if attack {
         0
     } else {
         let alone = r
@@ -473,10 +477,6 @@ fn judge_commands(
     };
     let late = late + paired_late;
     let lost = sent.saturating_sub(authenticated);
-    let attack = matches!(
-        case.fault,
-        Fault::ForgedFire { .. } | Fault::ReplayedFire { .. } | Fault::Flood
-    );
     checks.check(
         "ECU sent authenticated commands",
         sent > 0,
@@ -778,6 +778,17 @@ fn judge_fault(
     }
 }
 
+/// For a dead or stuck accelerometer variant: when the sensor failed (ms rel. contact) and
+/// how its fault flag showed after that.
+fn accel_failure_seen(v: Variant, r: &Report) -> Option<(f64, FaultSeen)> {
+    let (Variant::AccelDead { before_contact_s } | Variant::AccelStuck { before_contact_s }) = v
+    else {
+        return None;
+    };
+    let from_ms = -before_contact_s * 1e3;
+    Some((from_ms, fault_seen(&r.ecu_faults, "accel_sensor", from_ms)))
+}
+
 /// Documented bound on "sensor failed → fault bit on the bus": the monitor's limit (no batch
 /// for `accel_timeout_ms`, the same reading for `accel_stuck_ms`) plus one EcuStatus period.
 fn accel_fault_bound_ms(v: Variant) -> f64 {
@@ -826,9 +837,10 @@ fn judge_variant(checks: &mut Checks, v: Variant, r: &Report) {
                 verdict.map_or("no outcome (no contact?)".into(), |(_, d)| d),
             );
         }
-        Variant::AccelDead { before_contact_s } | Variant::AccelStuck { before_contact_s } => {
-            let from_ms = -before_contact_s * 1e3;
-            let seen = fault_seen(&r.ecu_faults, "accel_sensor", from_ms);
+        Variant::AccelDead { .. } | Variant::AccelStuck { .. } => {
+            let Some((from_ms, seen)) = accel_failure_seen(v, r) else {
+                return;
+            };
             // A precondition, like "ECU in Normal when the fault began": a fault bit still set
             // (an emulated start-up that starved the sensor) hides the detection.
             checks.check(
@@ -915,17 +927,12 @@ fn describe_reaction(
         s.push_str("reference restraint from start; ");
     }
     if let (Fault::Variant(v), Some(r)) = (&case.fault, report) {
-        if let Variant::AccelDead { before_contact_s } | Variant::AccelStuck { before_contact_s } =
-            v
-        {
-            let from_ms = -before_contact_s * 1e3;
-            if let FaultSeen::Raised(t) = fault_seen(&r.ecu_faults, "accel_sensor", from_ms) {
-                let _ = write!(
-                    s,
-                    "accelerometer fault on the bus {:.0} ms after the sensor failed; ",
-                    t - from_ms
-                );
-            }
+        if let Some((from_ms, FaultSeen::Raised(t))) = accel_failure_seen(*v, r) {
+            let _ = write!(
+                s,
+                "accelerometer fault on the bus {:.0} ms after the sensor failed; ",
+                t - from_ms
+            );
         }
         if let (Variant::MassMisreport { .. } | Variant::SpeedBias { .. }, Some(o)) =
             (v, r.outcome.as_ref())
