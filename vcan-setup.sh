@@ -12,7 +12,11 @@
 #   qemu-kvm  no SocketCAN here; QEMU with KVM runs Debian's kernel: real kernel, real timers.
 #   qemu-tcg  no SocketCAN and no KVM that can run a stock kernel (no VT-x/AMD-V, or a PVM
 #             /dev/kvm): QEMU software emulation. Kernel, vcan, iceoryx2 and the programs are
-#             real; timing is EMULATED and depends on the host's load — for function only.
+#             real; time is VIRTUAL (QEMU icount: one guest instruction = 1 ns on one emulated
+#             CPU, idle time skipped), so the host's load slows the run but cannot starve the
+#             guest. Timing is EMULATED — a 1-GIPS machine's, for function only, not a real-time
+#             figure. VCAN_GUEST_ICOUNT=0: the guest clock follows the host's instead (2 CPUs,
+#             faster, and then timing depends on the host's load).
 # No route is ever skipped silently: if none works the script says why and how to fix it (exit 4).
 #
 # The guest sees the host's / read-only (virtio-9p), so host-built binaries run unchanged; the
@@ -20,14 +24,15 @@
 # shared read-write at the same paths; /tmp, /run and /dev/shm are fresh tmpfs. The command
 # starts in the working directory with the caller's exported environment plus VCAN, VCAN_ROUTE,
 # VCAN_GUEST=1, VCAN_GUEST_KERNEL, VCAN_HOST_LOADAVG (the host's 1-min load at the start) and
-# VCAN_GUEST_SCHED (QEMU's scheduling);
+# VCAN_GUEST_SCHED (QEMU's scheduling) and VCAN_GUEST_CLOCK (virtual: TCG icount; host: real or host time);
 # its stdout and stderr come back separately, its exit status is ours.
 # Nothing is installed into /boot or /lib/modules: the kernel and busybox .debs (and QEMU's, when
 # qemu-system-x86 cannot be installed) are unpacked once into the cache (≈ 150 MB).
 #
 # Environment: VCAN (interface, default vcan0); VCAN_NO_INSTALL=1 (never apt-get);
 #   VCAN_GUEST_CACHE (default /var/tmp/vcan-guest), VCAN_GUEST_ACCEL (auto|kvm|tcg, default auto),
-#   VCAN_GUEST_FLAVOUR (rt|std, default rt), VCAN_GUEST_CPUS (2), VCAN_GUEST_MEM (MiB, 1024),
+#   VCAN_GUEST_FLAVOUR (rt|std, default rt), VCAN_GUEST_CPUS (2; 1 under icount), VCAN_GUEST_MEM
+#   (MiB, 1024), VCAN_GUEST_ICOUNT (1 = TCG in virtual time, the default; 0 = host time),
 #   VCAN_GUEST_TIMEOUT (s for the whole run, 3600), VCAN_GUEST_BOOT_TIMEOUT (s until the command
 #   runs under KVM, 60; a KVM guest that misses it falls back to TCG), VCAN_GUEST_RW,
 #   VCAN_GUEST_RT_PRIO (QEMU's SCHED_RR priority where permitted, default 5; 0 = normal),
@@ -38,13 +43,14 @@ IFACE=${VCAN:-vcan0}
 MODE=setup
 CACHE=${VCAN_GUEST_CACHE:-/var/tmp/vcan-guest}
 FLAVOUR=${VCAN_GUEST_FLAVOUR:-rt}
-CPUS=${VCAN_GUEST_CPUS:-2}
+CPUS=${VCAN_GUEST_CPUS:-}
+ICOUNT=${VCAN_GUEST_ICOUNT:-1}
 MEM=${VCAN_GUEST_MEM:-1024}
 TIMEOUT=${VCAN_GUEST_TIMEOUT:-3600}
 # Bump when the guest's init below changes: the cached initramfs is rebuilt.
-INIT_REV=3
+INIT_REV=4
 
-usage() { sed -n '2,30p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d' | sed 's/^# \{0,1\}//'; }
 
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -143,8 +149,11 @@ choose_accel() {
 route_name() { echo "qemu-$ACCEL"; }
 route_words() {
   if [ "$ACCEL" = kvm ]; then echo "QEMU/KVM guest, Debian kernel $KVER: real timers"
-  else echo "QEMU guest under software emulation (TCG), Debian kernel $KVER: timing EMULATED ($ACCEL_WHY)"; fi
+  elif virtual_time; then echo "QEMU guest under software emulation (TCG) in virtual time (icount), Debian kernel $KVER: timing EMULATED ($ACCEL_WHY)"
+  else echo "QEMU guest under software emulation (TCG), Debian kernel $KVER: timing EMULATED and following the host's load ($ACCEL_WHY; VCAN_GUEST_ICOUNT=0)"; fi
 }
+# True when the guest runs in virtual time: TCG with icount (the default under TCG).
+virtual_time() { [ "$ACCEL" = tcg ] && [ "$ICOUNT" != 0 ]; }
 
 # deb_of PKG — the package's .deb in the cache (downloaded once); prints its path.
 deb_of() {
@@ -266,7 +275,12 @@ mount -o bind /ctl $R/run/vcan-guest
 i=0
 for d in $SHARES; do
   mkdir -p "$R$d" 2>/dev/null
-  mount -t 9p -o "$O,rw,cache=mmap" "rw$i" "$R$d" || echo "mount of $d failed"
+  # cache=loose: writes go to the guest's page cache and reach the host in the background (and
+  # at the sync below), so a process writing its log or plots never waits for the host; in
+  # virtual time such a wait would pass as idle time (candump falling behind, a 20 s exit
+  # timeout running out while a report was being written). Only this guest writes these files
+  # while it runs.
+  mount -t 9p -o "$O,rw,cache=loose" "rw$i" "$R$d" || echo "mount of $d failed"
   i=$((i + 1))
 done
 hostname vcan-guest
@@ -329,16 +343,21 @@ shares() {
 }
 
 # QEMU's threads run at SCHED_RR (priority VCAN_GUEST_RT_PRIO, default 5; 0 = off) where that is
-# permitted, as the device under test on a bench would: the emulated CPUs then run whenever
-# they are runnable instead of queueing behind the host's other work. Measured under TCG with
-# two niced cargo builds beside it (load ≈ 6.5): cyclictest in the guest max 50.6 ms at normal
-# priority, 13.9 ms at nice -10, 9.4 ms at SCHED_RR 5 (a quiet host: 9.6 ms), and the demo's
-# ECU went from 575 to 91 overruns. The kernel's RT throttling keeps 5 % of each CPU for the
-# rest. Sets QEMU_SCHED (the command prefix) and QEMU_SCHED_WORDS.
+# permitted and the guest's clock follows the host's (KVM; TCG with VCAN_GUEST_ICOUNT=0), as the
+# device under test on a bench would: the emulated CPUs then run whenever they are runnable
+# instead of queueing behind the host's other work. Measured under TCG with two niced cargo
+# builds beside it (load ≈ 6.5): cyclictest in the guest max 50.6 ms at normal priority, 13.9 ms
+# at nice -10, 9.4 ms at SCHED_RR 5 (a quiet host: 9.6 ms), and the demo's ECU went from 575 to
+# 91 overruns. The kernel's RT throttling keeps 5 % of each CPU for the rest.
+# In virtual time (TCG icount) QEMU stays at normal priority: its one thread is busy whenever it
+# runs (idle time is skipped, not slept), so at SCHED_RR it would take a host CPU from everyone,
+# and the guest's timing no longer depends on the host's scheduling anyway.
+# Sets QEMU_SCHED (the command prefix) and QEMU_SCHED_WORDS.
 qemu_sched() {
   local prio=${VCAN_GUEST_RT_PRIO:-5}
   QEMU_SCHED=(); QEMU_SCHED_WORDS="normal priority"
-  if [ "$prio" = 0 ]; then QEMU_SCHED_WORDS="normal priority (VCAN_GUEST_RT_PRIO=0)"
+  if virtual_time; then QEMU_SCHED_WORDS="virtual time (icount, 1 instruction = 1 ns), normal priority"
+  elif [ "$prio" = 0 ]; then QEMU_SCHED_WORDS="normal priority (VCAN_GUEST_RT_PRIO=0)"
   elif chrt -r "$prio" true 2>/dev/null; then QEMU_SCHED=(chrt -r "$prio"); QEMU_SCHED_WORDS="SCHED_RR $prio"
   else say "note: QEMU runs at normal priority (SCHED_RR not permitted): the guest's timing then follows the host's load"
   fi
@@ -347,7 +366,7 @@ qemu_sched() {
 # run_guest CMD ARGS… — CMD inside the guest with IFACE up; exit status propagated.
 run_guest() {
   shares
-  local opid epid t0 t1 acc fs i
+  local opid epid t0 t1 acc cpus fs i
   # global: the EXIT trap reads them after this function returned
   qpid=
   run=$(mktemp -d "${TMPDIR:-/tmp}/vcan-guest.XXXXXX")
@@ -363,8 +382,9 @@ run_guest() {
   # the host's load when the guest starts and QEMU's scheduling: emulated timing depends on
   # them, so reports name them
   qemu_sched
-  printf 'export VCAN=%q VCAN_ROUTE=%q VCAN_GUEST=1 VCAN_GUEST_KERNEL=%q VCAN_HOST_LOADAVG=%q VCAN_GUEST_SCHED=%q\n' \
-    "$IFACE" "$(route_name)" "$KVER" "$(cut -d' ' -f1 /proc/loadavg)" "$QEMU_SCHED_WORDS" >> "$run/env"
+  printf 'export VCAN=%q VCAN_ROUTE=%q VCAN_GUEST=1 VCAN_GUEST_KERNEL=%q VCAN_HOST_LOADAVG=%q VCAN_GUEST_SCHED=%q VCAN_GUEST_CLOCK=%q\n' \
+    "$IFACE" "$(route_name)" "$KVER" "$(cut -d' ' -f1 /proc/loadavg)" "$QEMU_SCHED_WORDS" \
+    "$(if virtual_time; then echo virtual; else echo host; fi)" >> "$run/env"
   {
     echo 'source /run/vcan-guest/env'
     echo '[ -z "${TMPDIR:-}" ] || [ -d "$TMPDIR" ] || unset TMPDIR'
@@ -374,7 +394,15 @@ run_guest() {
     printf 'exec'; printf ' %q' "$@"; echo
   } > "$run/stage2"
 
-  if [ "$ACCEL" = kvm ]; then acc=(-accel kvm -cpu host); else acc=(-accel tcg -cpu max); fi
+  # TCG in virtual time: QEMU's icount makes the guest's clock count executed instructions
+  # (shift=0: 1 ns each) and skip idle time (sleep=off), so the host's load slows the run but
+  # never starves the guest: with host time, a loaded CI host left the accelerometer stale for
+  # seconds, and a fault campaign failed 4 of 26 cases three runs in a row (112–737 overruns per
+  # case); in virtual time the same campaign passes every case at the first run with 0
+  # overruns. icount runs one emulated CPU (single-threaded TCG; two CPUs hang at SMP bring-up).
+  if [ "$ACCEL" = kvm ]; then acc=(-accel kvm -cpu host); cpus=${CPUS:-2}
+  elif virtual_time; then acc=(-accel tcg,thread=single -cpu max -icount shift=0,sleep=off); cpus=${CPUS:-1}
+  else acc=(-accel tcg -cpu max); cpus=${CPUS:-2}; fi
   # passthrough keeps the host's owners and modes (root); without root QEMU cannot chown
   if [ "$(id -u)" -eq 0 ]; then fs=security_model=passthrough,multidevs=remap; else fs=security_model=none,multidevs=remap; fi
   local rw=()
@@ -388,7 +416,7 @@ run_guest() {
   local boot_timeout=${VCAN_GUEST_BOOT_TIMEOUT:-60}
   [ "$ACCEL" = tcg ] && boot_timeout=${VCAN_GUEST_BOOT_TIMEOUT_TCG:-240}
   t0=$(date +%s.%N)
-  "${QEMU_SCHED[@]}" "${QEMU[@]}" "${acc[@]}" -m "$MEM" -smp "$CPUS" \
+  "${QEMU_SCHED[@]}" "${QEMU[@]}" "${acc[@]}" -m "$MEM" -smp "$cpus" \
     -nodefaults -no-user-config -display none -no-reboot -nic none \
     -kernel "$K/vmlinuz" -initrd "$K/initrd.gz" \
     -append "console=ttyS0 loglevel=4 panic=-1 no_timer_check ${VCAN_GUEST_APPEND:-}" \

@@ -8,8 +8,12 @@ pub struct CycleCounters {
     pub objects_rx: u64,
     /// Object states rejected as invalid (NaN, out of range, implausible).
     pub objects_invalid: u64,
-    /// Cycles with stale object data.
+    /// Cycles with stale object data (including the wait for the first object at start-up).
     pub object_stale_cycles: u64,
+    /// Cycles with stale object data after objects had arrived: dropouts only. A bench that
+    /// asks "did the ECU notice the object list die?" compares this one — the start-up wait
+    /// depends on how fast the feeds come up, not on the fault.
+    pub object_lost_cycles: u64,
     /// Accelerometer batches received.
     pub accel_batches_rx: u64,
     /// Accelerometer samples received.

@@ -197,6 +197,9 @@ impl Activity for RestraintCycle<'_> {
         let c = &mut self.counters;
         if self.reasons.contains(Degraded::OBJECT_STALE) {
             c.object_stale_cycles = c.object_stale_cycles.saturating_add(1);
+            if self.inputs.objects_seen() {
+                c.object_lost_cycles = c.object_lost_cycles.saturating_add(1);
+            }
         }
         if self.reasons.contains(Degraded::ACCEL_STALE) {
             self.inputs.accel.note_stale_cycle();
@@ -282,6 +285,7 @@ impl Activity for RestraintCycle<'_> {
             ("objects_rx", c.objects_rx),
             ("objects_invalid", c.objects_invalid),
             ("object_stale_cycles", c.object_stale_cycles),
+            ("object_lost_cycles", c.object_lost_cycles),
             ("accel_batches_rx", c.accel_batches_rx),
             ("accel_samples_rx", c.accel_samples_rx),
             ("accel_bad_time_batches", a.bad_time_batches),

@@ -179,6 +179,11 @@ impl InputMonitor {
         rx.is_none_or(|t| now.saturating_sub(t) > limit)
     }
 
+    /// An object sample (or a fresh "no track") has arrived at least once.
+    pub(crate) fn objects_seen(&self) -> bool {
+        self.object_rx_ns.is_some()
+    }
+
     /// The ego vehicle frame is missing or older than its timeout.
     pub(crate) fn vehicle_stale(&self, now: u64) -> bool {
         Self::stale(self.vehicle_rx_ns, now, self.vehicle_timeout_ns)

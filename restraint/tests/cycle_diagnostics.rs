@@ -4,7 +4,7 @@
 mod cycle_support;
 
 use cycle_support::{Bench, MS, T0};
-use restraint::{EcuDiagnostics, PULSE_POINTS};
+use restraint::{Activity as _, EcuDiagnostics, PULSE_POINTS};
 
 /// A record whose every field differs from anything the cycle writes in these runs.
 fn garbage() -> EcuDiagnostics {
@@ -80,4 +80,45 @@ fn every_field_is_written_with_and_without_a_prediction() {
             assert!(clean.last().is_some_and(|d| d.pulse_points > 0));
         }
     }
+}
+
+fn counter(b: &cycle_support::Bench, name: &str) -> u64 {
+    let mut v = None;
+    b.ecu.report_counters(&mut |n, x| {
+        if n == name {
+            v = Some(x);
+        }
+    });
+    v.unwrap_or_else(|| panic!("no counter {name}"))
+}
+
+/// The wait for the first object is counted as stale but not as lost: a bench asking "did the
+/// ECU notice the object list die?" must not see how fast the feeds came up. The oracle is the
+/// default object timeout (100 ms): a 400 ms silence after fresh objects is ≈ 300 lost cycles.
+#[test]
+fn object_lost_cycles_count_dropouts_not_the_start_up_wait() {
+    let mut b = Bench::new(Some(cycle_support::test_lut()));
+    b.run_ms(300);
+    let startup_stale = counter(&b, "object_stale_cycles");
+    assert!((299..=300).contains(&startup_stale), "{startup_stale}");
+    assert_eq!(counter(&b, "object_lost_cycles"), 0);
+    let contact = b.now + 5_000 * MS;
+    let mut last_object = 0;
+    for _ in 0..20 {
+        last_object = b.now;
+        b.push_approach(contact, 15.0, 1500.0, 100.0);
+        b.run_ms(10);
+    }
+    assert_eq!(counter(&b, "object_stale_cycles"), startup_stale);
+    assert_eq!(counter(&b, "object_lost_cycles"), 0);
+    b.run_ms(400);
+    // Steps at last_object + k ms, k = 0 … (now − last_object)/ms − 1; stale once k > 100.
+    let silent_steps = (b.now - last_object) / MS;
+    let expected = silent_steps - 101;
+    let lost = counter(&b, "object_lost_cycles");
+    assert!(
+        lost.abs_diff(expected) <= 1,
+        "{lost} lost cycles, {expected} expected"
+    );
+    assert_eq!(counter(&b, "object_stale_cycles"), startup_stale + lost);
 }

@@ -260,6 +260,55 @@ pub mod harness {
             }
         })
     }
+    /// How many guests may run side by side: where the route is the QEMU TCG guest in virtual
+    /// time (`vcan-setup.sh`'s default there; `VCAN_GUEST_ICOUNT=0` turns it off) one per host
+    /// CPU (at most 4), because a guest's clock counts its own instructions and another guest
+    /// beside it slows the run, not the guest's timing. Everywhere else 1: real timers on the
+    /// host or under KVM would measure each other, and a TCG guest on host time is starved by
+    /// anything beside it.
+    pub fn parallel_guests() -> usize {
+        let virtual_time = vcan_route() == super::Route::QemuTcg
+            && std::env::var("VCAN_GUEST_ICOUNT").map_or(true, |v| v != "0");
+        if !virtual_time {
+            return 1;
+        }
+        std::thread::available_parallelism().map_or(1, |n| n.get().clamp(1, 4))
+    }
+
+    /// `items` dealt round-robin into `n` non-empty groups (fewer when there are fewer items).
+    pub fn deal<T: Clone>(items: &[T], n: usize) -> Vec<Vec<T>> {
+        let n = n.clamp(1, items.len().max(1));
+        let mut groups = vec![Vec::new(); n];
+        for (i, x) in items.iter().enumerate() {
+            groups[i % n].push(x.clone());
+        }
+        groups.retain(|g| !g.is_empty());
+        groups
+    }
+
+    /// Runs `vcan-setup.sh --run -- ARGS…` once per argument list, all at once (one guest each),
+    /// in the repository root; returns their outputs in the same order.
+    pub fn run_in_guests(runs: Vec<Vec<std::ffi::OsString>>) -> Vec<std::process::Output> {
+        let script = super::repo_root().join("vcan-setup.sh");
+        let handles: Vec<_> = runs
+            .into_iter()
+            .map(|args| {
+                let script = script.clone();
+                std::thread::spawn(move || {
+                    Command::new(&script)
+                        .args(["--run", "--"])
+                        .args(&args)
+                        .current_dir(super::repo_root())
+                        .output()
+                        .expect("vcan-setup.sh --run")
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("guest thread"))
+            .collect()
+    }
 }
 
 /// The repository root (this crate lives in `<root>/tests`).

@@ -4,10 +4,13 @@
 //!
 //! On the host kernel and in a QEMU/KVM guest the timers are real: no allowance. Under QEMU's
 //! software emulation (TCG) the kernel, vcan, iceoryx2 and the processes are real but time is
-//! not: the guest's clock runs at host speed while its CPUs run 5–50× slower and stall when the
-//! host is busy, so a time limit measures the emulator and the host's load. Verdicts there
-//! separate the logic (what was commanded, for when: never relaxed) from delivery times
-//! (allowed for, and named).
+//! not. By default `vcan-setup.sh` runs TCG in virtual time (icount: the guest's clock counts
+//! executed instructions, 1 ns each, on one emulated CPU, and skips idle time), so the host's
+//! load slows the run but no longer starves the guest; every bench process then shares that one
+//! 1-GIPS CPU, which is still not a real ECU's timing. With `VCAN_GUEST_ICOUNT=0` the guest's
+//! clock runs at host speed while its CPUs run 5–50× slower and stall when the host is busy.
+//! Verdicts there separate the logic (what was commanded, for when: never relaxed) from delivery
+//! times (allowed for, and named).
 
 use serde::{Deserialize, Serialize};
 
@@ -78,16 +81,33 @@ impl Route {
             .and_then(|s| s.split_whitespace().next()?.parse().ok())
     }
 
-    /// What the run's timing depended on besides the route: the host's load when it started
-    /// and, in the guest, QEMU's scheduling (`$VCAN_GUEST_SCHED`), e.g. "host load 0.52 at the
-    /// start, QEMU at SCHED_RR 5"; empty when unknown.
+    /// True in a guest that runs in virtual time (`$VCAN_GUEST_CLOCK` = `virtual`: TCG with
+    /// icount), where the host's load slows the run but cannot starve the guest.
+    pub fn virtual_time() -> bool {
+        std::env::var("VCAN_GUEST_CLOCK").is_ok_and(|c| c == "virtual")
+    }
+
+    /// What the run's timing depended on besides the route: the guest's clock, the host's load
+    /// when it started and, in a guest on host time, QEMU's scheduling (`$VCAN_GUEST_SCHED`),
+    /// e.g. "host load 0.52 at the start, QEMU at SCHED_RR 5"; empty when unknown.
     pub fn conditions() -> String {
         let mut v = Vec::new();
-        if let Some(l) = Self::host_load() {
-            v.push(format!("host load {l:.2} at the start"));
+        let virtual_time = Self::virtual_time();
+        if virtual_time {
+            v.push(
+                "virtual time: QEMU icount, 1 instruction = 1 ns on one emulated CPU".to_owned(),
+            );
         }
-        if let Ok(sched) = std::env::var("VCAN_GUEST_SCHED") {
-            v.push(format!("QEMU at {sched}"));
+        if let Some(l) = Self::host_load() {
+            v.push(if virtual_time {
+                format!("host load {l:.2} at the start (it slows the run, not the guest's clock)")
+            } else {
+                format!("host load {l:.2} at the start")
+            });
+        }
+        match std::env::var("VCAN_GUEST_SCHED") {
+            Ok(sched) if !virtual_time => v.push(format!("QEMU at {sched}")),
+            _ => {}
         }
         v.join(", ")
     }
@@ -150,7 +170,7 @@ impl Allowances {
         let mut v = Vec::new();
         if self.time_limit_attempts > 1 {
             v.push(format!(
-                "a fault case that misses only time limits (genuine commands lost only because they came after the freshness window or the pairing timeout count as one), or a scenario run whose inputs were starved or whose fire came late, runs again (≤ {} runs): emulated timing follows the host's load",
+                "a fault case that misses only time limits (genuine commands lost only because they came after the freshness window or the pairing timeout count as one), or a scenario run whose inputs were starved or whose fire came late, runs again (≤ {} runs): emulated timing is not a bench's (on host time it follows the host's load; in virtual time every bench process shares one emulated 1-GIPS CPU)",
                 self.time_limit_attempts
             ));
         }

@@ -1,6 +1,7 @@
 //! End to end, real processes, real vcan: the whole scenario library through `hil-bench`
-//! (candump + actuator-stubs + ecu + sensor-feeds) in ONE `vcan-setup.sh --run` — on the host if
-//! its kernel has vcan, else inside one boot of the QEMU guest; with no route the tests FAIL.
+//! (candump + actuator-stubs + ecu + sensor-feeds) through `vcan-setup.sh --run` — on the host if
+//! its kernel has vcan, else inside the QEMU guest (one boot; one per host CPU side by side where
+//! the guests run in virtual time); with no route the tests FAIL.
 //! The run happens once (first test to get here); every test then checks the reports.
 //!
 //! Time limits are the same on every route; where the route's timing is emulated (QEMU TCG)
@@ -47,31 +48,46 @@ fn bench_run() -> &'static Path {
         harness::build_bench_bins();
         harness::vcan_route();
         let bins = harness::bin_dir();
-        let script = root().join("vcan-setup.sh");
         let out = bins.join("e2e-bench-out");
         let _ = std::fs::remove_dir_all(&out);
-        let mut cmd = Command::new(&script);
-        cmd.args(["--run", "--"])
-            .arg(bins.join("hil-bench"))
-            .arg("--out")
-            .arg(&out)
-            .arg("--repo")
-            .arg(root());
-        for s in library() {
-            cmd.arg("--scenario").arg(s);
+        // One guest per group of scenarios, side by side where the guests run in virtual time
+        // (harness::parallel_guests); each scenario writes OUT/<name>/.
+        let groups = harness::deal(&library(), harness::parallel_guests());
+        let runs = groups
+            .iter()
+            .map(|group| {
+                let mut args: Vec<std::ffi::OsString> = vec![
+                    bins.join("hil-bench").into(),
+                    "--out".into(),
+                    out.clone().into(),
+                    "--repo".into(),
+                    root().into(),
+                ];
+                for s in group {
+                    args.push("--scenario".into());
+                    args.push(s.into());
+                }
+                args
+            })
+            .collect();
+        let outputs = harness::run_in_guests(runs);
+        for (k, o) in outputs.iter().enumerate() {
+            let stdout = String::from_utf8_lossy(&o.stdout);
+            let stderr = String::from_utf8_lossy(&o.stderr);
+            eprintln!(
+                "--- hil-bench, guest {} of {} (all summaries) ---\n{stdout}\n--- stderr ---\n{stderr}",
+                k + 1,
+                outputs.len()
+            );
         }
-        let o = cmd
-            .current_dir(root())
-            .output()
-            .expect("vcan-setup.sh --run hil-bench");
-        let stdout = String::from_utf8_lossy(&o.stdout);
-        let stderr = String::from_utf8_lossy(&o.stderr);
-        eprintln!("--- hil-bench (all summaries) ---\n{stdout}\n--- stderr ---\n{stderr}");
-        assert!(
-            o.status.success(),
-            "hil-bench failed ({}); see the output above",
-            o.status
-        );
+        for (k, o) in outputs.iter().enumerate() {
+            assert!(
+                o.status.success(),
+                "hil-bench in guest {} failed ({}); see the output above",
+                k + 1,
+                o.status
+            );
+        }
         out
     })
 }

@@ -1,11 +1,15 @@
 //! The fault-injection campaign (tests/src/faults/) end to end: real ecu, sensor-feeds,
 //! actuator-stubs, candump, cansend, cangen and bus-inject on vcan — on the host if its kernel
-//! has vcan, else inside ONE boot of the QEMU guest; with no route the tests FAIL (never skipped).
-//! The campaign runs once (first test to get here) and writes `target/robustness/campaign.json`,
+//! has vcan, else inside the QEMU guest (one boot; where guests run in virtual time, one per host
+//! CPU side by side, each on a share of the cases with its own baseline); with no route the tests
+//! FAIL (never skipped). The campaign runs once (first test to get here) and writes
+//! `target/robustness/campaign.json` (the guests' parts merged),
 //! which `test.sh` prints as the robustness report together with the fuzzing figures.
 
-use e2e_tests::faults::{cases, report_text, Campaign, Fault};
-use e2e_tests::harness::{bin_dir, build_bench_bins};
+use e2e_tests::faults::{cases, merge_campaigns, report_text, Campaign, Fault};
+use e2e_tests::harness::{bin_dir, build_bench_bins, deal, parallel_guests, run_in_guests};
+use e2e_tests::timeline::draw_timeline;
+use std::ffi::OsString;
 use std::path::PathBuf;
 use std::process::Command;
 use std::sync::{Mutex, OnceLock};
@@ -35,31 +39,62 @@ fn campaign() -> &'static Campaign {
             .unwrap_or_else(std::sync::PoisonError::into_inner);
         build_bench_bins();
         e2e_tests::harness::vcan_route();
-        let script = root().join("vcan-setup.sh");
         let out = bin_dir().join("robustness");
         let _ = std::fs::remove_dir_all(&out);
-        let o = Command::new(&script)
-            .args(["--run", "--"])
-            .arg(bin_dir().join("fault-campaign"))
-            .arg("run")
-            .arg("--out")
-            .arg(&out)
-            .arg("--repo")
-            .arg(root())
-            .current_dir(root())
-            .output()
-            .expect("vcan-setup.sh --run fault-campaign");
-        eprintln!(
-            "--- fault-campaign ---\n{}\n--- stderr ---\n{}",
-            String::from_utf8_lossy(&o.stdout),
-            String::from_utf8_lossy(&o.stderr)
-        );
-        let path = out.join("campaign.json");
-        let text = std::fs::read_to_string(&path).unwrap_or_else(|e| {
-            panic!("{}: {e} (fault-campaign exit {})", path.display(), o.status)
-        });
+        // The fault cases dealt over guests side by side where they run in virtual time
+        // (harness::parallel_guests); every guest runs its own baseline first, which its cases
+        // are judged against, and the parts are merged into one campaign.
+        let faults: Vec<&str> = cases()
+            .iter()
+            .filter(|k| k.fault != Fault::None)
+            .map(|k| k.name)
+            .collect();
+        let groups = deal(&faults, parallel_guests());
+        let dirs: Vec<PathBuf> = (0..groups.len())
+            .map(|k| out.join(format!("guest-{}", k + 1)))
+            .collect();
+        let runs = groups
+            .iter()
+            .zip(&dirs)
+            .map(|(group, dir)| {
+                let mut args: Vec<OsString> = vec![
+                    bin_dir().join("fault-campaign").into(),
+                    "run".into(),
+                    "--out".into(),
+                    dir.into(),
+                    "--repo".into(),
+                    root().into(),
+                ];
+                for name in group {
+                    args.push("--case".into());
+                    args.push(name.into());
+                }
+                args
+            })
+            .collect();
+        let outputs = run_in_guests(runs);
+        let mut parts = Vec::new();
+        for ((o, dir), k) in outputs.iter().zip(&dirs).zip(1..) {
+            eprintln!(
+                "--- fault-campaign, guest {k} of {} ---\n{}\n--- stderr ---\n{}",
+                dirs.len(),
+                String::from_utf8_lossy(&o.stdout),
+                String::from_utf8_lossy(&o.stderr)
+            );
+            let path = dir.join("campaign.json");
+            let text = std::fs::read_to_string(&path).unwrap_or_else(|e| {
+                panic!("{}: {e} (fault-campaign exit {})", path.display(), o.status)
+            });
+            let part: Campaign =
+                serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            parts.push(part);
+        }
+        let merged = merge_campaigns(parts);
+        let text = serde_json::to_string_pretty(&merged).expect("campaign json");
+        std::fs::write(out.join("campaign.json"), &text).expect("campaign.json");
+        draw_timeline(&merged, &out.join("campaign.png")).expect("campaign timeline");
         keep("campaign.json", text.as_bytes());
-        serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        merged
     })
 }
 

@@ -590,6 +590,32 @@ pub fn run_campaign(cfg: &CampaignConfig, only: &[String]) -> Result<Campaign> {
     Ok(out)
 }
 
+/// The campaigns of guests that ran side by side (each on a share of the cases, each with its
+/// own baseline, which its cases are judged against) as one: every case once, in the order of
+/// [`cases`]; the baseline shown is the first guest's, or the first that failed. Route,
+/// allowances and conditions are the first guest's (the guests differ only in their cases).
+pub fn merge_campaigns(parts: Vec<Campaign>) -> Campaign {
+    let mut parts = parts.into_iter();
+    let Some(mut merged) = parts.next() else {
+        return Campaign::default();
+    };
+    for part in parts {
+        for case in part.cases {
+            let is_baseline = cases()
+                .iter()
+                .any(|k| k.name == case.name && k.fault == Fault::None);
+            match merged.cases.iter_mut().find(|c| c.name == case.name) {
+                Some(kept) if is_baseline && kept.pass && !case.pass => *kept = case,
+                Some(_) => {}
+                None => merged.cases.push(case),
+            }
+        }
+    }
+    let order = |name: &str| cases().iter().position(|k| k.name == name);
+    merged.cases.sort_by_key(|c| order(&c.name));
+    merged
+}
+
 fn scenario_path(cfg: &CampaignConfig, stem: &str) -> PathBuf {
     cfg.repo.join("scenarios").join(format!("{stem}.toml"))
 }
@@ -1060,6 +1086,35 @@ fn run_case(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn merged_guests_give_every_case_once_in_campaign_order_and_keep_a_failed_baseline() {
+        let case = |name: &str, pass: bool| CaseResult {
+            name: name.to_owned(),
+            pass,
+            ..CaseResult::default()
+        };
+        let names: Vec<&str> = cases().iter().map(|k| k.name).collect();
+        let (base, rest) = names.split_first().expect("cases");
+        // two guests, each with its own baseline and every other case
+        let part = |k: usize, baseline_pass: bool| Campaign {
+            conditions: format!("guest {k}"),
+            cases: std::iter::once(case(base, baseline_pass))
+                .chain(rest.iter().skip(k).step_by(2).map(|n| case(n, true)))
+                .collect(),
+            ..Campaign::default()
+        };
+        let m = merge_campaigns(vec![part(0, true), part(1, true)]);
+        let got: Vec<&str> = m.cases.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(got, names);
+        assert_eq!(m.conditions, "guest 0");
+        assert!(m.cases.iter().all(|c| c.pass));
+        // the second guest's baseline failed: the merged campaign shows the failure
+        let m = merge_campaigns(vec![part(0, true), part(1, false)]);
+        assert_eq!(m.cases.len(), names.len());
+        assert!(!m.cases[0].pass, "the failed baseline is kept");
+        assert!(merge_campaigns(Vec::new()).cases.is_empty());
+    }
 
     fn tmp(name: &str) -> PathBuf {
         let d = std::env::temp_dir().join(format!("faults-test-{}-{name}", std::process::id()));
