@@ -134,6 +134,29 @@ fn every_scenario_meets_its_declared_expectations() {
             e.pretensioner_released,
             r.pretensioner_released,
         );
+        // As offline (tests/offline.rs), on the EcuStatus frames the stubs received: a fallback
+        // after the ECU had been Normal (every run starts in ReferenceFallback), and an
+        // accelerometer fault raised after the sensor failed (not the start-up report) and
+        // before the contact. Times are ms relative to the contact.
+        check(
+            "reference fallback",
+            e.reference_fallback,
+            e2e_tests::fell_back_after_normal(&r.ecu_modes).is_some(),
+        );
+        let contact_s =
+            (r.contact_ns != 0).then(|| r.contact_ns.saturating_sub(r.start_ns) as f64 * 1e-9);
+        let accel_failed_ms = match (s.sensor.accel_fails_at_s(), contact_s) {
+            (Some(f), Some(c)) => (f - c) * 1e3,
+            _ => f64::NEG_INFINITY,
+        };
+        check(
+            "accelerometer fault before contact",
+            e.accel_fault_before_contact,
+            matches!(
+                e2e_tests::fault_seen(&r.ecu_faults, "accel_sensor", accel_failed_ms),
+                e2e_tests::FaultSeen::Raised(t) if t < 0.0
+            ),
+        );
         if !r.e2e_rejected.is_empty() {
             failures.push(format!(
                 "{}: E2E rejections on a clean bus: {:?}",
