@@ -407,7 +407,9 @@ run_guest() {
   # case); in virtual time the same campaign passes every case at the first run with 0
   # overruns. icount runs one emulated CPU (single-threaded TCG; two CPUs hang at SMP bring-up).
   if [ "$ACCEL" = kvm ]; then acc=(-accel kvm -cpu host); cpus=${CPUS:-2}
-  elif virtual_time; then acc=(-accel tcg,thread=single -cpu max -icount shift=0,sleep=off); cpus=${CPUS:-1}
+  elif virtual_time; then
+    acc=(-accel tcg,thread=single -cpu max -icount shift=0,sleep=off); cpus=1
+    [ "${CPUS:-1}" = 1 ] || say "note: VCAN_GUEST_CPUS=$CPUS ignored: virtual time runs one emulated CPU (VCAN_GUEST_ICOUNT=0 for more)"
   else acc=(-accel tcg -cpu max); cpus=${CPUS:-2}; fi
   # passthrough keeps the host's owners and modes (root); without root QEMU cannot chown
   if [ "$(id -u)" -eq 0 ]; then fs=security_model=passthrough,multidevs=remap; else fs=security_model=none,multidevs=remap; fi
