@@ -94,6 +94,11 @@ fn environment_overrides_the_file_and_flags_override_the_environment() {
         "{out}"
     );
     assert!(has("interface = \"vcan0\"  # defaults"), "{out}");
+    // optional settings that are not set are listed as comments, not left out (TOML has no
+    // null); a set one is not
+    assert!(has("# cycles = (not set)"), "{out}");
+    assert!(has("# sched_fifo_priority = (not set)"), "{out}");
+    assert!(!out.contains("# cpu = (not set)"), "{out}");
 }
 
 #[test]

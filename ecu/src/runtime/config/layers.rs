@@ -101,7 +101,27 @@ impl Layers {
             return text;
         };
         self.annotate(doc.as_table_mut(), "");
-        doc.to_string()
+        let mut out = doc.to_string();
+        // TOML has no null: an optional setting that is not set would simply be missing, so
+        // the user would not learn it exists. serde_json keeps it (as null); each one becomes a
+        // comment line at the top of its table.
+        if let Ok(json) = serde_json::to_value(cfg) {
+            let mut unset = Vec::new();
+            unset_keys(&json, "", &mut unset);
+            for (table, key) in unset.iter().rev() {
+                let line = format!("# {key} = (not set)\n");
+                match table.as_str() {
+                    "" => out.insert_str(0, &line),
+                    t => {
+                        let header = format!("[{t}]\n");
+                        if let Some(i) = out.find(&header) {
+                            out.insert_str(i + header.len(), &line);
+                        }
+                    }
+                }
+            }
+        }
+        out
     }
 
     fn annotate(&self, table: &mut toml_edit::Table, prefix: &str) {
@@ -115,6 +135,25 @@ impl Layers {
                 }
                 _ => {}
             }
+        }
+    }
+}
+
+/// The optional settings that are not set, as (table, key): the nulls of the JSON form.
+fn unset_keys(v: &serde_json::Value, table: &str, out: &mut Vec<(String, String)>) {
+    let Some(map) = v.as_object() else { return };
+    for (key, value) in map {
+        match value {
+            serde_json::Value::Null => out.push((table.to_owned(), key.clone())),
+            serde_json::Value::Object(_) => {
+                let inner = if table.is_empty() {
+                    key.clone()
+                } else {
+                    format!("{table}.{key}")
+                };
+                unset_keys(value, &inner, out);
+            }
+            _ => {}
         }
     }
 }
