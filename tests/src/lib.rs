@@ -260,6 +260,7 @@ pub mod harness {
             }
         })
     }
+
     /// How many guests may run side by side: where the route is the QEMU TCG guest in virtual
     /// time (`vcan-setup.sh`'s default there; `VCAN_GUEST_ICOUNT=0` turns it off) one per host
     /// CPU (at most 4), because a guest's clock counts its own instructions and another guest
