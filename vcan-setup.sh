@@ -31,7 +31,7 @@
 #
 # Environment: VCAN (interface, default vcan0); VCAN_NO_INSTALL=1 (never apt-get);
 #   VCAN_GUEST_CACHE (default /var/tmp/vcan-guest), VCAN_GUEST_ACCEL (auto|kvm|tcg, default auto),
-#   VCAN_GUEST_FLAVOUR (rt|std, default rt), VCAN_GUEST_CPUS (2; 1 under icount), VCAN_GUEST_MEM
+#   VCAN_GUEST_FLAVOUR (rt|std, default rt), VCAN_GUEST_CPUS (2; always 1 in virtual time), VCAN_GUEST_MEM
 #   (MiB, 1024), VCAN_GUEST_ICOUNT (1 = TCG in virtual time, the default; 0 = host time),
 #   VCAN_GUEST_TIMEOUT (s for the whole run, 3600), VCAN_GUEST_BOOT_TIMEOUT (s until the command
 #   runs under KVM, 60; a KVM guest that misses it falls back to TCG), VCAN_GUEST_RW,
@@ -278,8 +278,8 @@ for d in $SHARES; do
   # cache=loose: writes go to the guest's page cache and reach the host in the background (and
   # at the sync below), so a process writing its log or plots never waits for the host; in
   # virtual time such a wait would pass as idle time (candump falling behind, a 20 s exit
-  # timeout running out while a report was being written). Only this guest writes these files
-  # while it runs.
+  # timeout running out while a report was being written). Safe as the bench uses it: nobody
+  # else writes the files a guest writes while it runs (guests side by side write apart).
   mount -t 9p -o "$O,rw,cache=loose" "rw$i" "$R$d" || echo "mount of $d failed"
   i=$((i + 1))
 done
