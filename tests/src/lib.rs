@@ -49,6 +49,25 @@ pub fn fault_seen(changes: &[(f64, Vec<String>)], flag: &str, from_ms: f64) -> F
         .map_or(FaultSeen::Never, |(t, _)| FaultSeen::Raised(*t))
 }
 
+/// A scenario's `accel_fault_before_contact` as the ECU showed it: FaultAccelSensor rose after
+/// the sensor failed (not the start-up report, see [`fault_seen`]) and before the contact.
+/// `faults` are the EcuStatus flag changes in ms relative to the contact, which came at
+/// `contact_s` scenario seconds (None: no contact, so nothing before it).
+pub fn accel_fault_before_contact(
+    scenario: &sensor_feeds::Scenario,
+    faults: &[(f64, Vec<String>)],
+    contact_s: Option<f64>,
+) -> bool {
+    let failed_ms = match (scenario.sensor.accel_fails_at_s(), contact_s) {
+        (Some(f), Some(c)) => (f - c) * 1e3,
+        _ => f64::NEG_INFINITY,
+    };
+    matches!(
+        fault_seen(faults, "accel_sensor", failed_ms),
+        FaultSeen::Raised(t) if t < 0.0
+    )
+}
+
 /// When the ECU fell back to the reference restraint after it had been Normal, given its
 /// EcuStatus mode changes `(ms, mode)`. Every run starts in ReferenceFallback (no input is
 /// fresh yet): that start is not a fallback, so "the ECU fell back" needs a Normal before it.
@@ -288,8 +307,12 @@ pub mod harness {
     }
 
     /// Runs `vcan-setup.sh --run -- ARGS…` once per argument list, all at once (one guest each),
-    /// in the repository root; returns their outputs in the same order.
-    pub fn run_in_guests(runs: Vec<Vec<std::ffi::OsString>>) -> Vec<std::process::Output> {
+    /// in the repository root; prints each guest's stdout and stderr under a `--- WHAT, guest k
+    /// of n ---` header and returns their outputs in the same order.
+    pub fn run_in_guests(
+        what: &str,
+        runs: Vec<Vec<std::ffi::OsString>>,
+    ) -> Vec<std::process::Output> {
         let script = super::repo_root().join("vcan-setup.sh");
         let handles: Vec<_> = runs
             .into_iter()
@@ -305,10 +328,20 @@ pub mod harness {
                 })
             })
             .collect();
-        handles
+        let outputs: Vec<std::process::Output> = handles
             .into_iter()
             .map(|h| h.join().expect("guest thread"))
-            .collect()
+            .collect();
+        for (k, o) in outputs.iter().enumerate() {
+            eprintln!(
+                "--- {what}, guest {} of {} ---\n{}\n--- stderr ---\n{}",
+                k + 1,
+                outputs.len(),
+                String::from_utf8_lossy(&o.stdout),
+                String::from_utf8_lossy(&o.stderr)
+            );
+        }
+        outputs
     }
 }
 

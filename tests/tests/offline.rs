@@ -76,17 +76,10 @@ fn problems(s: &Scenario, r: &OfflineRun) -> Vec<String> {
         e2e_tests::fell_back_after_normal(&r.modes).is_some(),
     );
     // Raised after the sensor failed (not the start-up report) and before the contact.
-    let accel_failed_ms = match (s.sensor.accel_fails_at_s(), r.contact_s) {
-        (Some(f), Some(c)) => (f - c) * 1e3,
-        _ => f64::NEG_INFINITY,
-    };
     check(
         "accelerometer fault before contact",
         e.accel_fault_before_contact,
-        matches!(
-            e2e_tests::fault_seen(&r.faults, "accel_sensor", accel_failed_ms),
-            e2e_tests::FaultSeen::Raised(t) if t < 0.0
-        ),
+        e2e_tests::accel_fault_before_contact(s, &r.faults, r.contact_s),
     );
     if let Some(ev) = &r.evaluated {
         if !ev.outcome.adaptive_no_worse {

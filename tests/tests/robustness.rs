@@ -72,15 +72,9 @@ fn campaign() -> &'static Campaign {
                 args
             })
             .collect();
-        let outputs = run_in_guests(runs);
+        let outputs = run_in_guests("fault-campaign", runs);
         let mut parts = Vec::new();
-        for ((o, dir), k) in outputs.iter().zip(&dirs).zip(1..) {
-            eprintln!(
-                "--- fault-campaign, guest {k} of {} ---\n{}\n--- stderr ---\n{}",
-                dirs.len(),
-                String::from_utf8_lossy(&o.stdout),
-                String::from_utf8_lossy(&o.stderr)
-            );
+        for (o, dir) in outputs.iter().zip(&dirs) {
             let path = dir.join("campaign.json");
             let text = std::fs::read_to_string(&path).unwrap_or_else(|e| {
                 panic!("{}: {e} (fault-campaign exit {})", path.display(), o.status)

@@ -48,11 +48,12 @@ pub const CRASH_LEAD_S: f64 = 2.5;
 pub const QUIET_SCENARIO: &str = "low-speed-no-fire";
 
 /// Fault window of the pre-crash faults, scenario seconds: late enough that the ECU is Normal
-/// when it begins (in the QEMU TCG guest a loaded emulator brought it there only ≈ 1.0 s after
-/// the start: with the window at 1.0 s, 4 of 27 cases of one clean-clone run missed that
-/// precondition and ran again, one of them twice), early enough that the documented recovery
-/// (E2E hold 500 ms; a restarted feed is back ≈ 1.2 s after its restart in the TCG guest,
-/// measured) completes before the pre-crash phase (≈ 3.9 s with [`CRASH_LEAD_S`]).
+/// when it begins (a TCG guest on host time, `VCAN_GUEST_ICOUNT=0`, brought it there only
+/// ≈ 1.0 s after the start under load: with the window at 1.0 s, 4 of 27 cases of one
+/// clean-clone run missed that precondition; in virtual time it is Normal after ≈ 20 ms), early
+/// enough that the documented recovery (E2E hold 500 ms; a restarted feed is back ≈ 1.2 s after
+/// its restart on host time, 41 ms in virtual time, measured) completes before the pre-crash
+/// phase (≈ 3.9 s with [`CRASH_LEAD_S`]).
 const FAULT_FROM_S: f64 = 1.5;
 const FAULT_TO_S: f64 = 1.8;
 /// Delay of the `delay` mirror's copies, ms.
@@ -595,13 +596,14 @@ pub fn run_campaign(cfg: &CampaignConfig, only: &[String]) -> Result<Campaign> {
 /// [`cases`]; the baseline shown is the first guest's, or the first that failed. Route,
 /// allowances and conditions are the first guest's (the guests differ only in their cases).
 pub fn merge_campaigns(parts: Vec<Campaign>) -> Campaign {
+    let all = cases();
     let mut parts = parts.into_iter();
     let Some(mut merged) = parts.next() else {
         return Campaign::default();
     };
     for part in parts {
         for case in part.cases {
-            let is_baseline = cases()
+            let is_baseline = all
                 .iter()
                 .any(|k| k.name == case.name && k.fault == Fault::None);
             match merged.cases.iter_mut().find(|c| c.name == case.name) {
@@ -611,7 +613,7 @@ pub fn merge_campaigns(parts: Vec<Campaign>) -> Campaign {
             }
         }
     }
-    let order = |name: &str| cases().iter().position(|k| k.name == name);
+    let order = |name: &str| all.iter().position(|k| k.name == name);
     merged.cases.sort_by_key(|c| order(&c.name));
     merged
 }
@@ -757,9 +759,9 @@ impl Disturbance for CaseDisturbance<'_> {
         feeds.wait()?;
         ctx.sleep_until_s(restart_s);
         // Same time base: the restarted feeds resume at the current scenario time. They are
-        // back once they announce the epoch (≈ 1.2 s after the restart in the QEMU TCG guest:
-        // iceoryx2 set-up and the true-crash pre-computation, emulated); recovery is measured
-        // from then.
+        // back once they announce the epoch (iceoryx2 set-up and the true-crash
+        // pre-computation: 41 ms after the restart in the TCG guest in virtual time, ≈ 1.2 s on
+        // host time); recovery is measured from then.
         let mut again = ctx
             .feeds_command()
             .stdout(Stdio::piped())
@@ -919,9 +921,9 @@ fn toml_f64(t: &toml::Table, key: &str) -> Option<f64> {
 
 /// The scenario with `extra_s` more of steady approach before everything happens: longer
 /// duration, braking `extra_s` later, the opponent further away by `extra_s` × closing speed —
-/// the same crash at `extra_s` later. In the QEMU TCG guest a restarted feed is back ≈ 1.2 s
-/// after its restart (measured; emulated CPUs), so it needs this head room to be back before
-/// the pre-crash phase.
+/// the same crash at `extra_s` later. In a TCG guest on host time a restarted feed is back
+/// ≈ 1.2 s after its restart (measured; emulated CPUs; 41 ms in virtual time), so it needs
+/// this head room to be back before the pre-crash phase on either clock.
 pub fn lengthened_scenario(src: &Path, dir: &Path, extra_s: f64) -> Result<PathBuf> {
     let text =
         std::fs::read_to_string(src).with_context(|| format!("reading {}", src.display()))?;
