@@ -24,7 +24,9 @@ done
 [ -f "$scenario" ] || { echo "demo: no scenario file $scenario (see scenarios/)" >&2; exit 2; }
 
 echo "demo: setting up the host (packages, cantools venv)…" >&2
-export PATH="$(tests/setup-host.sh | tail -n1):$PATH"
+# (A plain assignment, not `export PATH="$(…)"`: only so does a failed set-up stop the script.)
+venv_bin=$(tests/setup-host.sh --disk-gb 1 | tail -n1)
+export PATH="$venv_bin:$PATH"
 target=${CARGO_TARGET_DIR:-target}
 echo "demo: building the bench (release)…" >&2
 cargo build --release --workspace --bins

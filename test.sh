@@ -8,7 +8,9 @@
 # for a test to fail on them.
 set -euo pipefail
 cd "$(dirname "$0")"
-export PATH="$(tests/setup-host.sh | tail -n1):$PATH"
+# (A plain assignment, not `export PATH="$(…)"`: only so does a failed set-up stop the script.)
+venv_bin=$(tests/setup-host.sh --disk-gb 4 | tail -n1)
+export PATH="$venv_bin:$PATH"
 export CARGO_TERM_COLOR=${CARGO_TERM_COLOR:-never}
 
 step() { printf '\n=== %s ===\n' "$*"; }
