@@ -47,6 +47,7 @@ CPUS=${VCAN_GUEST_CPUS:-}
 ICOUNT=${VCAN_GUEST_ICOUNT:-1}
 MEM=${VCAN_GUEST_MEM:-1024}
 TIMEOUT=${VCAN_GUEST_TIMEOUT:-3600}
+TICK_US=${VCAN_GUEST_TICK_US:-1000}
 # Bump when the guest's init below changes: the cached initramfs is rebuilt.
 INIT_REV=4
 
@@ -396,7 +397,7 @@ run_guest() {
     # of guest time and a bench process's 20 s exit timeout ran out once. A 1 kHz ticker at
     # normal priority (cyclictest, SCHED_OTHER) bounds each such wait to 1 ms (fc-list 0.55 s)
     # for well under 1 % of the emulated CPU; anything at real-time priority preempts it.
-    if virtual_time; then echo 'cyclictest -q -i 1000 -p 0 -t 1 </dev/null >/dev/null 2>&1 &'; fi
+    if virtual_time && [ "$TICK_US" != 0 ]; then echo "cyclictest -q -i $TICK_US -p 0 -t 1 </dev/null >/dev/null 2>&1 &"; fi
     printf 'exec'; printf ' %q' "$@"; echo
   } > "$run/stage2"
 
