@@ -21,7 +21,7 @@ use std::path::Path;
 use crc::{Crc, CRC_32_ISCSI};
 use serde::{Deserialize, Serialize};
 
-use crate::owned::{Axes, Diagram, DiagramData, Header};
+use crate::data::{Axes, DiagramData, Header};
 use crate::{Cell, Problem};
 
 /// File magic number.
@@ -141,7 +141,7 @@ pub enum FileProblem {
     Invalid(#[from] Problem),
 }
 
-fn err(file: &str, problem: impl Into<FileProblem>) -> LoadError {
+pub(crate) fn err(file: &str, problem: impl Into<FileProblem>) -> LoadError {
     LoadError {
         file: file.to_owned(),
         problem: problem.into(),
@@ -265,7 +265,7 @@ fn read_u32(b: &[u8], at: usize) -> u32 {
 }
 
 /// Decode the envelope and payload without validating the content.
-fn decode_unvalidated(bytes: &[u8]) -> Result<DiagramData, FileProblem> {
+pub(crate) fn decode_unvalidated(bytes: &[u8]) -> Result<DiagramData, FileProblem> {
     let payload = unframe(&MAGIC, DIAGRAM_FILE_KIND, FORMAT_VERSION, bytes)?;
     let (data, rest) = postcard::take_from_bytes::<DiagramData>(payload)
         .map_err(|e| FileProblem::Decode(e.to_string()))?;
@@ -306,10 +306,52 @@ struct JsonIn {
     cells: Vec<Cell>,
 }
 
+/// The JSON export of `data` (pretty-printed), carrying the binary encoding's CRC-32C and the
+/// LUT id so that an import reproduces the identical table.
+pub(crate) fn json_string(data: &DiagramData, crc32c: u32, lut_id: u16) -> String {
+    let out = JsonOut {
+        format: JSON_FORMAT_NAME,
+        format_version: FORMAT_VERSION,
+        crc32c,
+        lut_id,
+        header: &data.header,
+        axes: &data.axes,
+        cells: &data.cells,
+    };
+    // Only plain data with finite floats and string map keys: cannot fail.
+    serde_json::to_string_pretty(&out).unwrap_or_default()
+}
+
+/// A JSON export's data, not validated, with the CRC-32C and LUT id it carries (if any);
+/// format name and version checked.
+pub(crate) fn decode_json(
+    text: &str,
+) -> Result<(DiagramData, Option<u32>, Option<u16>), FileProblem> {
+    let j: JsonIn = serde_json::from_str(text).map_err(|e| FileProblem::Json(e.to_string()))?;
+    if j.format != JSON_FORMAT_NAME {
+        return Err(FileProblem::JsonFormat {
+            found: j.format,
+            expected: JSON_FORMAT_NAME,
+        });
+    }
+    if j.format_version != FORMAT_VERSION {
+        return Err(FileProblem::UnsupportedVersion {
+            found: j.format_version,
+            supported: FORMAT_VERSION,
+        });
+    }
+    let data = DiagramData {
+        header: j.header,
+        axes: j.axes,
+        cells: j.cells,
+    };
+    Ok((data, j.crc32c, j.lut_id))
+}
+
 impl DiagramData {
     /// Encode into the binary file format WITHOUT validating the content.
     /// For tools and tests that need to produce a (possibly broken) file;
-    /// use [`Diagram::to_bytes`] for real tables.
+    /// use [`crate::Diagram::to_bytes`] for real tables.
     pub fn to_bytes_unvalidated(&self) -> Vec<u8> {
         encode_with_version(self, FORMAT_VERSION)
     }
@@ -319,134 +361,6 @@ impl DiagramData {
     /// version handling.
     pub fn to_bytes_with_version(&self, version: u16) -> Vec<u8> {
         encode_with_version(self, version)
-    }
-}
-
-impl Diagram {
-    /// Encode into the binary file format.
-    pub fn to_bytes(&self) -> Vec<u8> {
-        self.data().to_bytes_unvalidated()
-    }
-
-    /// Decode and validate a binary file's bytes. `file` names the file in errors.
-    pub fn from_bytes(file: &str, bytes: &[u8]) -> Result<Self, LoadError> {
-        let data = decode_unvalidated(bytes).map_err(|p| err(file, p))?;
-        Diagram::new(data).map_err(|p| err(file, p))
-    }
-
-    /// Load and validate a binary file (allocates; start-up only).
-    pub fn load(path: impl AsRef<Path>) -> Result<Self, LoadError> {
-        let path = path.as_ref();
-        let name = path.display().to_string();
-        let bytes = fs::read(path).map_err(|e| err(&name, e))?;
-        Self::from_bytes(&name, &bytes)
-    }
-
-    /// Load a binary or JSON file, told apart by the magic number (JSON
-    /// starts with `{` after optional whitespace).
-    pub fn load_any(path: impl AsRef<Path>) -> Result<Self, LoadError> {
-        let path = path.as_ref();
-        let name = path.display().to_string();
-        let bytes = fs::read(path).map_err(|e| err(&name, e))?;
-        let first = bytes.iter().copied().find(|b| !b.is_ascii_whitespace());
-        if first == Some(b'{') {
-            let text = std::str::from_utf8(&bytes)
-                .map_err(|e| err(&name, FileProblem::Json(e.to_string())))?;
-            Self::from_json_str(&name, text)
-        } else {
-            Self::from_bytes(&name, &bytes)
-        }
-    }
-
-    /// Write the binary file atomically (temporary file + rename), so a
-    /// crashed build never leaves a half-written table behind.
-    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), LoadError> {
-        write_atomically(path.as_ref(), &self.to_bytes())
-    }
-
-    /// JSON export (pretty-printed). Carries the binary encoding's CRC-32C
-    /// and the LUT id so that an import reproduces the identical table.
-    pub fn to_json_string(&self) -> String {
-        let out = JsonOut {
-            format: JSON_FORMAT_NAME,
-            format_version: FORMAT_VERSION,
-            crc32c: self.checksum(),
-            lut_id: self.lut_id(),
-            header: &self.data().header,
-            axes: &self.data().axes,
-            cells: &self.data().cells,
-        };
-        // Only plain data with finite floats and string map keys: cannot fail.
-        serde_json::to_string_pretty(&out).unwrap_or_default()
-    }
-
-    /// JSON import with the same validation as the binary loader; if the
-    /// JSON carries `crc32c` / `lut_id` they must match the content.
-    pub fn from_json_str(file: &str, text: &str) -> Result<Self, LoadError> {
-        let j: JsonIn =
-            serde_json::from_str(text).map_err(|e| err(file, FileProblem::Json(e.to_string())))?;
-        if j.format != JSON_FORMAT_NAME {
-            return Err(err(
-                file,
-                FileProblem::JsonFormat {
-                    found: j.format,
-                    expected: JSON_FORMAT_NAME,
-                },
-            ));
-        }
-        if j.format_version != FORMAT_VERSION {
-            return Err(err(
-                file,
-                FileProblem::UnsupportedVersion {
-                    found: j.format_version,
-                    supported: FORMAT_VERSION,
-                },
-            ));
-        }
-        let d = Diagram::new(DiagramData {
-            header: j.header,
-            axes: j.axes,
-            cells: j.cells,
-        })
-        .map_err(|p| err(file, p))?;
-        if let Some(stored) = j.crc32c {
-            if stored != d.checksum() {
-                return Err(err(
-                    file,
-                    FileProblem::ChecksumMismatch {
-                        stored,
-                        computed: d.checksum(),
-                    },
-                ));
-            }
-        }
-        if let Some(stored) = j.lut_id {
-            if stored != d.lut_id() {
-                return Err(err(
-                    file,
-                    FileProblem::LutIdMismatch {
-                        stored,
-                        computed: d.lut_id(),
-                    },
-                ));
-            }
-        }
-        Ok(d)
-    }
-
-    /// Load a JSON export.
-    pub fn load_json(path: impl AsRef<Path>) -> Result<Self, LoadError> {
-        let path = path.as_ref();
-        let name = path.display().to_string();
-        let text = fs::read_to_string(path).map_err(|e| err(&name, e))?;
-        Self::from_json_str(&name, &text)
-    }
-
-    /// Write the JSON export atomically.
-    pub fn save_json(&self, path: impl AsRef<Path>) -> Result<(), LoadError> {
-        let mut text = self.to_json_string();
-        text.push('\n');
-        write_atomically(path.as_ref(), text.as_bytes())
     }
 }
 

@@ -24,6 +24,8 @@ mod validate;
 mod view;
 
 #[cfg(feature = "std")]
+mod data;
+#[cfg(feature = "std")]
 mod file;
 #[cfg(feature = "std")]
 mod owned;
@@ -32,15 +34,17 @@ pub use validate::{limits, Problem};
 pub use view::{DiagramView, Lookup};
 
 #[cfg(feature = "std")]
+pub use data::{
+    Axes, BuildInfo, DiagramData, EgoVehicle, GridPoint, Header, NAN_FALLBACK_OCCUPANT_KG,
+    NAN_FALLBACK_SEAT_MM,
+};
+#[cfg(feature = "std")]
 pub use file::{
     frame, unframe, write_atomically, FileProblem, LoadError, FORMAT_VERSION, JSON_FORMAT_NAME,
     MAGIC, PREAMBLE_LEN,
 };
 #[cfg(feature = "std")]
-pub use owned::{
-    lut_id_of, Axes, BuildInfo, Diagram, DiagramData, EgoVehicle, GridPoint, Header,
-    NAN_FALLBACK_OCCUPANT_KG, NAN_FALLBACK_SEAT_MM,
-};
+pub use owned::{lut_id_of, Diagram};
 
 /// Number of axes of the characteristic diagram.
 pub const AXIS_COUNT: usize = 4;
