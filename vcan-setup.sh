@@ -3,7 +3,9 @@
 # a real Debian kernel (PREEMPT_RT flavour) with vcan up.
 #
 #   ./vcan-setup.sh [--iface NAME]                  set up (idempotent): host vcan, else prepare the guest; name the route
-#   ./vcan-setup.sh [--iface NAME] --check          print the route; exit 0 host, 3 guest, 4 none (reason on stderr)
+#   ./vcan-setup.sh [--iface NAME] --check          print the route and its clock ("qemu-tcg virtual",
+#                                                   "qemu-kvm host", "host host"); exit 0 host, 3 guest,
+#                                                   4 none (reason on stderr)
 #   ./vcan-setup.sh [--iface NAME] --run -- CMD…    run CMD where vcan is: on the host, else inside the guest
 #   ./vcan-setup.sh [--iface NAME] --guest -- CMD…  always inside the guest (tests of the guest route)
 #
@@ -155,6 +157,9 @@ route_words() {
 }
 # True when the guest runs in virtual time: TCG with icount (the default under TCG).
 virtual_time() { [ "$ACCEL" = tcg ] && [ "$ICOUNT" != 0 ]; }
+# The guest's clock in one word (VCAN_GUEST_CLOCK, and the second word of --check): the only
+# place that decides it; the test harness reads it from --check.
+clock_name() { if virtual_time; then echo virtual; else echo host; fi; }
 
 # deb_of PKG — the package's .deb in the cache (downloaded once); prints its path.
 deb_of() {
@@ -385,7 +390,7 @@ run_guest() {
   qemu_sched
   printf 'export VCAN=%q VCAN_ROUTE=%q VCAN_GUEST=1 VCAN_GUEST_KERNEL=%q VCAN_HOST_LOADAVG=%q VCAN_GUEST_SCHED=%q VCAN_GUEST_CLOCK=%q\n' \
     "$IFACE" "$(route_name)" "$KVER" "$(cut -d' ' -f1 /proc/loadavg)" "$QEMU_SCHED_WORDS" \
-    "$(if virtual_time; then echo virtual; else echo host; fi)" >> "$run/env"
+    "$(clock_name)" >> "$run/env"
   {
     echo 'source /run/vcan-guest/env'
     echo '[ -z "${TMPDIR:-}" ] || [ -d "$TMPDIR" ] || unset TMPDIR'
@@ -488,11 +493,11 @@ guest() {
 
 case "$MODE" in
   check)
-    if host_vcan nocreate || host_vcan create; then echo host; exit 0; fi
+    if host_vcan nocreate || host_vcan create; then echo "host host"; exit 0; fi
     say "$(kernel_reason)"
     choose_accel
     prepare_guest
-    echo "$(route_name)"
+    echo "$(route_name) $(clock_name)"
     say "route=$(route_name): $(route_words)"
     exit 3 ;;
   setup)

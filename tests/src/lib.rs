@@ -254,22 +254,25 @@ pub mod harness {
         });
     }
 
-    /// The route these tests reach vcan by (`vcan-setup.sh --check`), checked once: the host
-    /// kernel, or a QEMU guest (KVM or TCG). With none the test PANICS with the script's reason:
-    /// these tests are never skipped.
-    pub fn vcan_route() -> super::Route {
-        static ROUTE: OnceLock<super::Route> = OnceLock::new();
-        *ROUTE.get_or_init(|| {
+    /// The route these tests reach vcan by and whether its guest keeps virtual time, as
+    /// `vcan-setup.sh --check` prints them ("qemu-tcg virtual"), checked once. With no route the
+    /// test PANICS with the script's reason: these tests are never skipped.
+    fn vcan_check() -> (super::Route, bool) {
+        static CHECK: OnceLock<(super::Route, bool)> = OnceLock::new();
+        *CHECK.get_or_init(|| {
             let o = Command::new(super::repo_root().join("vcan-setup.sh"))
                 .arg("--check")
                 .stderr(std::process::Stdio::piped())
                 .output()
                 .expect("vcan-setup.sh --check");
             let printed = String::from_utf8_lossy(&o.stdout);
-            match (o.status.code(), super::Route::parse(&printed)) {
+            let mut words = printed.split_whitespace();
+            let route = words.next().and_then(super::Route::parse);
+            let virtual_time = words.next() == Some("virtual");
+            match (o.status.code(), route) {
                 (Some(0 | 3), Some(r)) => {
                     eprintln!("e2e: vcan route {}: {}", r.name(), r.describe());
-                    r
+                    (r, virtual_time)
                 }
                 (code, _) => panic!(
                     "no vcan route (vcan-setup.sh --check → {code:?}, printed {printed:?}):\n{}\n\
@@ -280,16 +283,18 @@ pub mod harness {
         })
     }
 
-    /// How many guests may run side by side: where the route is the QEMU TCG guest in virtual
-    /// time (`vcan-setup.sh`'s default there; `VCAN_GUEST_ICOUNT=0` turns it off) one per host
-    /// CPU (at most 4), because a guest's clock counts its own instructions and another guest
-    /// beside it slows the run, not the guest's timing. Everywhere else 1: real timers on the
-    /// host or under KVM would measure each other, and a TCG guest on host time is starved by
-    /// anything beside it.
+    /// The route these tests reach vcan by (the host kernel, or a QEMU guest under KVM or TCG).
+    pub fn vcan_route() -> super::Route {
+        vcan_check().0
+    }
+
+    /// How many guests may run side by side: where the guests keep virtual time (TCG's icount,
+    /// `vcan-setup.sh` decides and `--check` says so) one per host CPU (at most 4), because a
+    /// guest's clock counts its own instructions and another guest beside it slows the run, not
+    /// the guest's timing. Everywhere else 1: real timers on the host or under KVM would measure
+    /// each other, and a TCG guest on host time is starved by anything beside it.
     pub fn parallel_guests() -> usize {
-        let virtual_time = vcan_route() == super::Route::QemuTcg
-            && std::env::var("VCAN_GUEST_ICOUNT").map_or(true, |v| v != "0");
-        if !virtual_time {
+        if !vcan_check().1 {
             return 1;
         }
         std::thread::available_parallelism().map_or(1, |n| n.get().clamp(1, 4))

@@ -37,7 +37,7 @@ impl Route {
             .unwrap_or_default()
     }
 
-    /// `host`, `qemu-kvm`, `qemu-tcg` (what `vcan-setup.sh --check` prints).
+    /// `host`, `qemu-kvm`, `qemu-tcg` (the first word `vcan-setup.sh --check` prints).
     pub fn parse(s: &str) -> Option<Self> {
         match s.trim() {
             "host" => Some(Self::Host),
