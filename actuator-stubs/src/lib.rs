@@ -18,3 +18,8 @@ pub mod plot;
 pub mod report;
 pub mod rx;
 pub mod status;
+
+/// The start of the line the stubs print on stderr once their CAN socket is open and they
+/// receive: an orchestrator (the e2e harness, `hil-bench`) starts the ECU only after it, so the
+/// ECU's first commands are not sent before anyone listens.
+pub const READY_PREFIX: &str = "actuator-stubs: listening on";

@@ -166,8 +166,10 @@ fn run(cli: &Cli) -> Result<()> {
     let started = monotonic_ns();
     let deadline = started + (cli.timeout_s * 1e9) as u64;
     eprintln!(
-        "actuator-stubs: listening on {} for {}",
-        cli.can, scenario.name
+        "{} {} for {}",
+        actuator_stubs::READY_PREFIX,
+        cli.can,
+        scenario.name
     );
     let mut done = false;
     let stop_reason = loop {

@@ -5,19 +5,48 @@
 
 use std::path::PathBuf;
 use std::process::{Command, Output, Stdio};
+use std::sync::{Condvar, Mutex, OnceLock, PoisonError};
 
 fn script() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../vcan-setup.sh")
 }
 
-/// One guest at a time: QEMU runs at SCHED_RR, and guests booting side by side on two CPUs
-/// take turns in 100 ms slices (6 parallel boots took ≈ 180 s, one after the other ≈ 50 s).
-static GUEST: std::sync::Mutex<()> = std::sync::Mutex::new(());
+/// Guests (and set-up runs) at once. Where the guest keeps virtual time (`--check` prints
+/// "qemu-tcg virtual") two, one per host CPU here: its clock counts its own instructions, so a
+/// guest beside it slows the run, not its timing. Otherwise one: QEMU runs at SCHED_RR on host
+/// time and under KVM, and guests booting side by side on two CPUs took turns in 100 ms slices
+/// (6 parallel boots took ≈ 180 s, one after the other ≈ 50 s).
+fn guest_slot() -> GuestSlot {
+    static LIMIT: OnceLock<usize> = OnceLock::new();
+    let limit = *LIMIT.get_or_init(|| {
+        let printed = text(&run(&["--check"]).stdout);
+        if printed.split_whitespace().nth(1) == Some("virtual") {
+            2
+        } else {
+            1
+        }
+    });
+    let (busy, freed) = &SLOTS;
+    let mut n = busy.lock().unwrap_or_else(PoisonError::into_inner);
+    while *n >= limit {
+        n = freed.wait(n).unwrap_or_else(PoisonError::into_inner);
+    }
+    *n += 1;
+    GuestSlot
+}
 
-fn one_at_a_time() -> std::sync::MutexGuard<'static, ()> {
-    GUEST
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner)
+/// Guests running now, and the signal that one finished.
+static SLOTS: (Mutex<usize>, Condvar) = (Mutex::new(0), Condvar::new());
+
+/// A place among the guests at once; given back when dropped (also when the test panics).
+struct GuestSlot;
+
+impl Drop for GuestSlot {
+    fn drop(&mut self) {
+        let (busy, freed) = &SLOTS;
+        *busy.lock().unwrap_or_else(PoisonError::into_inner) -= 1;
+        freed.notify_one();
+    }
 }
 
 fn run(args: &[&str]) -> Output {
@@ -46,7 +75,7 @@ fn route_named(stderr: &str) -> Option<String> {
 
 #[test]
 fn setup_twice_is_harmless_and_names_the_route() {
-    let _guest = one_at_a_time();
+    let _guest = guest_slot();
     let a = run(&[]);
     let b = run(&[]);
     for o in [&a, &b] {
@@ -75,7 +104,7 @@ fn setup_twice_is_harmless_and_names_the_route() {
 
 #[test]
 fn check_prints_the_route_and_its_exit_code() {
-    let _guest = one_at_a_time();
+    let _guest = guest_slot();
     let o = run(&["--check"]);
     let printed = text(&o.stdout);
     // The route and the clock its runs keep: real or host time, or virtual time (TCG's icount,
@@ -95,7 +124,7 @@ fn check_prints_the_route_and_its_exit_code() {
 
 #[test]
 fn run_mode_propagates_exit_code_streams_env_and_iface() {
-    let _guest = one_at_a_time();
+    let _guest = guest_slot();
     let o = Command::new(script())
         .args(["--iface", "vcan7", "--run", "--", "sh", "-c"])
         .arg("ip -d link show \"$VCAN\" | grep -q 'vcan' && echo \"iface=$VCAN bench=$BENCH_PROBE arg=$0 pwd=$(pwd) route=$VCAN_ROUTE\"; echo oops >&2; exit 42")
@@ -122,7 +151,7 @@ fn run_mode_propagates_exit_code_streams_env_and_iface() {
 
 #[test]
 fn guest_mode_runs_a_real_kernel_with_vcan_and_shares_the_working_directory() {
-    let _guest = one_at_a_time();
+    let _guest = guest_slot();
     // A directory under /tmp: the guest's own /tmp is a fresh tmpfs, so this proves the share.
     let dir = std::env::temp_dir().join(format!("vcan-setup-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -192,7 +221,7 @@ fn guest_mode_runs_a_real_kernel_with_vcan_and_shares_the_working_directory() {
 
 #[test]
 fn a_kvm_that_cannot_boot_the_guest_falls_back_to_tcg() {
-    let _guest = one_at_a_time();
+    let _guest = guest_slot();
     // Forced KVM: where /dev/kvm runs a stock kernel the guest boots under KVM; where it does
     // not (no /dev/kvm, a PVM /dev/kvm as on this project's CI VMs) the script must say so and
     // run the command under TCG instead — never fail or skip.
@@ -215,7 +244,7 @@ fn a_kvm_that_cannot_boot_the_guest_falls_back_to_tcg() {
 
 #[test]
 fn no_route_fails_loudly_with_the_reason_and_the_fix() {
-    let _guest = one_at_a_time();
+    let _guest = guest_slot();
     // A guest that cannot be prepared (its cache cannot be created): exit 4, said why.
     let o = Command::new(script())
         .args(["--guest", "--", "true"])

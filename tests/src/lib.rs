@@ -386,9 +386,6 @@ pub(crate) fn terminate(
     Ok(st)
 }
 
-/// The line the stubs print once their CAN socket is open and they receive.
-const STUBS_READY: &str = "actuator-stubs: listening on";
-
 /// Forwards a child's piped stderr to ours line by line (and to `log` if given); if `ready`
 /// is given, the returned receiver gets a message when a line starting with it was seen.
 fn forward_stderr(
@@ -546,7 +543,8 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     // The ECU starts only once the stubs listen on the bus: its first commands would otherwise
     // go out before the receiver's socket exists (under load, or in an emulated guest where a
     // process takes up to a second to start, that was several cycles of commands).
-    let (stubs_stderr, stubs_ready) = forward_stderr(&mut stubs, None, Some(STUBS_READY));
+    let (stubs_stderr, stubs_ready) =
+        forward_stderr(&mut stubs, None, Some(actuator_stubs::READY_PREFIX));
     if let Err(e) = wait_ready(stubs_ready, &mut stubs, "actuator-stubs") {
         let _ = terminate(&mut stubs, "actuator-stubs", Duration::from_secs(2));
         let _ = terminate(&mut candump, "candump", Duration::from_secs(2));
@@ -574,11 +572,15 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     )?;
     // The ECU's start-up messages (LUT/keys accepted or rejected) go to the console as before
     // and into ecu-stderr.txt, where the fault campaign reads them.
-    let (ecu_stderr, _) = forward_stderr(&mut ecu, Some(dir.join("ecu-stderr.txt")), None);
-    // Let the ECU and the stubs come up (nodes, services, CAN sockets) before the scenario.
-    std::thread::sleep(Duration::from_millis(400));
-    if let Ok(Some(st)) = ecu.try_wait() {
-        problems.push(format!("ecu exited early: {st}"));
+    // The scenario starts once the ECU receives (its ports open, its loop running): the feeds'
+    // first samples are not lost, and no fixed wait (400 ms of each run before) is spent.
+    let (ecu_stderr, ecu_ready) = forward_stderr(
+        &mut ecu,
+        Some(dir.join("ecu-stderr.txt")),
+        Some(ecu::runtime::app::READY_LINE),
+    );
+    if let Err(e) = wait_ready(ecu_ready, &mut ecu, "ecu") {
+        problems.push(format!("{e:#}"));
     }
     // The feeds fix scenario t = 0 when they are ready and print it ("epoch_ns N").
     let mut feeds = spawn(

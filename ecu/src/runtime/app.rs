@@ -57,6 +57,9 @@ pub struct RunOutcome {
 }
 
 /// Runs the ECU process body with `activity` until `stop` or `cfg.cycles`.
+/// The line the ECU prints on stderr when its ports are open and its cycle loop starts.
+pub const READY_LINE: &str = "ecu: cycle loop running";
+
 pub fn run_ecu(
     cfg: &EcuConfig,
     activity: &mut dyn Activity,
@@ -113,6 +116,9 @@ pub fn run_ecu(
         }
     }
 
+    // Ports open, RT settings applied: from here on the ECU receives. Printed also with
+    // --quiet, for whoever starts the feeds only then (the e2e harness waits for it).
+    eprintln!("{READY_LINE}");
     let loop_cfg = LoopConfig {
         period_ns: cfg.period_us.saturating_mul(1_000),
         max_cycles: cfg.cycles,
