@@ -56,10 +56,10 @@ pub struct RunOutcome {
     pub stats: LoopStats,
 }
 
-/// Runs the ECU process body with `activity` until `stop` or `cfg.cycles`.
 /// The line the ECU prints on stderr when its ports are open and its cycle loop starts.
 pub const READY_LINE: &str = "ecu: cycle loop running";
 
+/// Runs the ECU process body with `activity` until `stop` or `cfg.cycles`.
 pub fn run_ecu(
     cfg: &EcuConfig,
     activity: &mut dyn Activity,
