@@ -61,6 +61,8 @@ pub struct ReceiveErrors {
     pub objects: u64,
     /// On the crash-accelerometer port.
     pub accel: u64,
+    /// On the safing-accelerometer port (the independent second channel).
+    pub safing: u64,
 }
 
 /// Why an activity refused to start.
@@ -85,6 +87,9 @@ pub trait CycleIo {
     fn drain_objects(&mut self, f: &mut dyn FnMut(&ObjectState)) -> usize;
     /// Hands every accelerometer batch received since the last call to `f`.
     fn drain_accel(&mut self, f: &mut dyn FnMut(&CrashAccelSample)) -> usize;
+    /// Hands every batch of the independent safing accelerometer received since the last
+    /// call to `f` (same record as the crash accelerometer, its own sensor and port).
+    fn drain_safing(&mut self, f: &mut dyn FnMut(&CrashAccelSample)) -> usize;
     /// Hands every CAN frame received since the last call to `f` (none when CAN is off).
     fn drain_can(&mut self, f: &mut dyn FnMut(&RawFrame)) -> usize;
     /// Queues one CAN frame for sending.

@@ -31,6 +31,8 @@ pub struct SimIo {
     pub objects: Deque<ObjectState, SIM_QUEUE>,
     /// Accelerometer batches delivered on the next drain.
     pub accel: Deque<CrashAccelSample, SIM_QUEUE>,
+    /// Safing-accelerometer batches delivered on the next drain.
+    pub safing: Deque<CrashAccelSample, SIM_QUEUE>,
     /// CAN frames delivered on the next drain.
     pub can_rx: Deque<RawFrame, SIM_QUEUE>,
     /// The newest frames sent (a ring that overwrites its oldest entry).
@@ -61,6 +63,7 @@ impl SimIo {
         Self {
             objects: Deque::new(),
             accel: Deque::new(),
+            safing: Deque::new(),
             can_rx: Deque::new(),
             can_tx: HistoryBuf::new(),
             can_tx_total: 0,
@@ -71,6 +74,7 @@ impl SimIo {
             receive_errors: ReceiveErrors {
                 objects: 0,
                 accel: 0,
+                safing: 0,
             },
         }
     }
@@ -83,6 +87,11 @@ impl SimIo {
     /// Queues an accelerometer batch for the next cycle.
     pub fn push_accel(&mut self, a: CrashAccelSample) {
         push_dropping_oldest(&mut self.accel, a, &mut self.dropped);
+    }
+
+    /// Queues a safing-accelerometer batch for the next cycle.
+    pub fn push_safing(&mut self, a: CrashAccelSample) {
+        push_dropping_oldest(&mut self.safing, a, &mut self.dropped);
     }
 
     /// Queues a received CAN frame for the next cycle.
@@ -112,6 +121,15 @@ impl CycleIo for SimIo {
     fn drain_accel(&mut self, f: &mut dyn FnMut(&CrashAccelSample)) -> usize {
         let mut n = 0;
         while let Some(a) = self.accel.pop_front() {
+            f(&a);
+            n += 1;
+        }
+        n
+    }
+
+    fn drain_safing(&mut self, f: &mut dyn FnMut(&CrashAccelSample)) -> usize {
+        let mut n = 0;
+        while let Some(a) = self.safing.pop_front() {
             f(&a);
             n += 1;
         }

@@ -222,6 +222,12 @@ impl CycleIo for IceoryxIo {
         self.accel.drain(f)
     }
 
+    fn drain_safing(&mut self, _f: &mut dyn FnMut(&CrashAccelSample)) -> usize {
+        // Placeholder until the safing subscriber lands (issue 20): no safing data, so the
+        // safing function never agrees and nothing can fire.
+        0
+    }
+
     fn drain_can(&mut self, f: &mut dyn FnMut(&RawFrame)) -> usize {
         let Some(can) = self.can.as_mut() else {
             return 0;
@@ -271,6 +277,7 @@ impl CycleIo for IceoryxIo {
         ReceiveErrors {
             objects: self.objects.counters().errors,
             accel: self.accel.counters().errors,
+            safing: 0,
         }
     }
 }
