@@ -1,11 +1,14 @@
 //! Scenario player library: scenario files ([`scenario`]), the true world ([`truth`]: closed-form
-//! pre-crash kinematics + the true collision physics after contact) and the sensor model
-//! ([`sensors`]: noise, bias, latency, range, dropouts). The `sensor-feeds` binary plays it in
-//! real time; `actuator-stubs` and the e2e tests use the same library to know the truth.
+//! pre-crash kinematics + the true collision physics after contact), the sensor model
+//! ([`sensors`]: noise, bias, latency, range, dropouts; the crash and the safing
+//! accelerometer) and what the acceleration sensors see besides a crash ([`events`]:
+//! `[[accel_event]]`). The `sensor-feeds` binary plays it in real time; `actuator-stubs` and
+//! the e2e tests use the same library to know the truth.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod events;
 pub mod player;
 pub mod scenario;
 pub mod sensors;

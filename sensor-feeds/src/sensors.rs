@@ -1,8 +1,15 @@
 //! The sensor model: what the ECU's sensors report about the true world (noise, bias, latency,
 //! range), as bench payloads and CAN frames. Pure and seeded (ChaCha8), so a run is reproducible
 //! and testable without a clock.
+//!
+//! Two acceleration sensors measure the same true compartment acceleration independently: the
+//! crash accelerometer (`accel_*` keys; its noise comes from the scenario's main stream, shared
+//! with the object list, as it always has) and the safing accelerometer (`safing_*` keys; its
+//! own stream [`SAFING_STREAM`], so adding it changed no other draw). Both see the scenario's
+//! `[[accel_event]]` entries that reach them ([`crate::events`]).
 
-use crate::scenario::{BrakeStateName, Scenario};
+use crate::events::AccelEvents;
+use crate::scenario::{AccelSensor, BrakeStateName, Scenario};
 use crate::truth::Truth;
 use bus::codec::{
     EgoVehicleStateBrakeState, OccupantClassificationBeltBuckle,
@@ -16,15 +23,21 @@ use rand_chacha::ChaCha8Rng;
 /// Tracker id of the opponent (one tracked object).
 pub const OPPONENT_OBJECT_ID: u32 = 7;
 
+/// ChaCha8 stream of the safing accelerometer's noise (same key — the scenario's `seed` — as
+/// the main stream 0, which the object list and the crash accelerometer draw from).
+pub const SAFING_STREAM: u64 = 1;
+
 /// Seeded sensor model over a solved [`Truth`].
 pub struct SensorModelSim {
     truth: Truth,
     rng: ChaCha8Rng,
+    safing_rng: ChaCha8Rng,
+    events: AccelEvents,
     object_sequence: u64,
 }
 
 /// A standard normal draw (Box–Muller; two uniforms per draw keeps the stream simple).
-fn gauss(rng: &mut ChaCha8Rng) -> f64 {
+pub(crate) fn gauss(rng: &mut ChaCha8Rng) -> f64 {
     let u1: f64 = rng.gen_range(f64::MIN_POSITIVE..1.0);
     let u2: f64 = rng.gen::<f64>();
     (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
@@ -34,11 +47,20 @@ impl SensorModelSim {
     /// Model over `truth`, seeded with the scenario's seed.
     pub fn new(truth: Truth) -> Self {
         let seed = truth.scenario().seed;
+        let mut safing_rng = ChaCha8Rng::seed_from_u64(seed);
+        safing_rng.set_stream(SAFING_STREAM);
         SensorModelSim {
+            events: AccelEvents::new(truth.scenario()),
             truth,
             rng: ChaCha8Rng::seed_from_u64(seed),
+            safing_rng,
             object_sequence: 0,
         }
+    }
+
+    /// The scenario's acceleration events.
+    pub fn events(&self) -> &AccelEvents {
+        &self.events
     }
 
     /// The true world.
@@ -92,14 +114,45 @@ impl SensorModelSim {
         (t >= 0.0).then_some(t)
     }
 
-    /// Compartment accelerometer reading at `t_s` [m/s²]: braking deceleration before contact,
-    /// the TRUE crash pulse after it, plus sensor noise, clipped to the measuring range.
+    /// Compartment (crash) accelerometer reading at `t_s` [m/s²]: braking deceleration before
+    /// contact, the TRUE crash pulse after it, the additive `[[accel_event]]`s it sees, plus
+    /// sensor noise, clipped to the measuring range.
     pub fn accel_mps2(&mut self, t_s: f64) -> f64 {
+        self.reading_mps2(AccelSensor::Crash, t_s)
+    }
+
+    /// Safing accelerometer reading at `t_s` [m/s²]: the same true acceleration and mechanical
+    /// events as the crash accelerometer, its own events, noise (own stream) and range.
+    pub fn safing_mps2(&mut self, t_s: f64) -> f64 {
+        self.reading_mps2(AccelSensor::Safing, t_s)
+    }
+
+    /// `sensor`'s reading at `t_s` [m/s²] (one noise draw from its stream per call).
+    pub fn reading_mps2(&mut self, sensor: AccelSensor, t_s: f64) -> f64 {
         let w = self.truth.state(t_s);
-        let s = &self.truth.scenario().sensor;
-        let full_scale = s.accel_full_scale_g * physics::defaults::STANDARD_GRAVITY_MPS2;
-        let noise = s.accel_noise_mps2 * gauss(&mut self.rng);
-        (w.ego_accel_mps2 + noise).clamp(-full_scale, full_scale)
+        let (_, noise_sd, full_scale_g) = self.truth.scenario().sensor.accel_params(sensor);
+        let rng = match sensor {
+            AccelSensor::Crash => &mut self.rng,
+            AccelSensor::Safing => &mut self.safing_rng,
+        };
+        let full_scale = full_scale_g * physics::defaults::STANDARD_GRAVITY_MPS2;
+        let noise = noise_sd * gauss(rng);
+        let mut a = w.ego_accel_mps2;
+        // Only when an event is active: otherwise the sum is the one it always was, bit for bit.
+        if let Some(e) = self.events.added_mps2(sensor, t_s) {
+            a += e;
+        }
+        (a + noise).clamp(-full_scale, full_scale)
+    }
+
+    /// The reading a spike `[[accel_event]]` forces on `sensor`'s sample at `t_s` (samples
+    /// `dt_s` apart), clipped to the sensor's measuring range; `None`: no spike there.
+    pub fn spike_mps2(&self, sensor: AccelSensor, t_s: f64, dt_s: f64) -> Option<f64> {
+        let (_, _, full_scale_g) = self.truth.scenario().sensor.accel_params(sensor);
+        let full_scale = full_scale_g * physics::defaults::STANDARD_GRAVITY_MPS2;
+        self.events
+            .spike_mps2(sensor, t_s, dt_s)
+            .map(|v| v.clamp(-full_scale, full_scale))
     }
 
     /// The `EgoVehicleState` frame content at `t_s` (E2E bytes are filled by the protector).

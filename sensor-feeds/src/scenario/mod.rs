@@ -40,6 +40,10 @@ pub struct Scenario {
     /// What the scenario is meant to show (the e2e tests assert it).
     #[serde(default)]
     pub expect: Expect,
+    /// What the acceleration sensors see besides a crash (`[[accel_event]]`): misuse events
+    /// the whole car feels and single-sensor faults ([`AccelEvent`]).
+    #[serde(default, rename = "accel_event")]
+    pub accel_events: Vec<AccelEvent>,
 }
 
 fn default_seed() -> u64 {
@@ -141,6 +145,8 @@ pub enum DropoutTarget {
     Occupant,
     /// The crash accelerometer.
     Accel,
+    /// The safing accelerometer (the independent second acceleration channel).
+    Safing,
     /// Everything.
     All,
 }
@@ -180,7 +186,28 @@ pub enum AccelFaultKind {
     Saturated,
 }
 
-/// A time window in which the crash accelerometer is faulty but keeps publishing.
+/// One of the ECU's two acceleration sensors.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum AccelSensor {
+    /// The crash accelerometer (the main algorithm's sensor).
+    #[default]
+    Crash,
+    /// The safing accelerometer (the safing function's independent sensor).
+    Safing,
+}
+
+impl AccelSensor {
+    /// The name used in scenario files (`crash`, `safing`).
+    pub fn name(self) -> &'static str {
+        match self {
+            AccelSensor::Crash => "crash",
+            AccelSensor::Safing => "safing",
+        }
+    }
+}
+
+/// A time window in which one acceleration sensor is faulty but keeps publishing.
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct AccelFault {
@@ -190,6 +217,89 @@ pub struct AccelFault {
     pub end_s: f64,
     /// What it reports meanwhile.
     pub kind: AccelFaultKind,
+    /// The faulty sensor (default: the crash accelerometer).
+    #[serde(default)]
+    pub sensor: AccelSensor,
+}
+
+/// What an [`AccelEvent`] does to the acceleration readings.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum AccelEventKind {
+    /// A half-sine deceleration pulse `peak_g · sin(π (t − start_s) / duration)` for
+    /// `t ∈ [start_s, start_s + duration_ms]`, added to the true deceleration (pothole, kerb
+    /// strike, door slam, hammer blow).
+    HalfSine,
+    /// One sample — the first at or after `start_s` — reads `peak_g` instead of its value.
+    Spike,
+    /// Band-limited random deceleration (road excitation, 5–40 Hz) with `rms_g` over
+    /// `[start_s, end_s)`.
+    RoughRoad,
+    /// The reading shifted by `peak_g` over `[start_s, end_s)` (a biased sensor, or with
+    /// `sensor = "all"` a sustained body acceleration).
+    Offset,
+}
+
+impl AccelEventKind {
+    /// The name used in scenario files.
+    pub fn name(self) -> &'static str {
+        match self {
+            AccelEventKind::HalfSine => "half_sine",
+            AccelEventKind::Spike => "spike",
+            AccelEventKind::RoughRoad => "rough_road",
+            AccelEventKind::Offset => "offset",
+        }
+    }
+}
+
+/// Which acceleration sensors an [`AccelEvent`] reaches.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum EventSensor {
+    /// Mechanical: the whole car feels it, every acceleration sensor sees it (each with its
+    /// own noise, range and rate).
+    #[default]
+    All,
+    /// A fault of the crash accelerometer alone.
+    Crash,
+    /// A fault of the safing accelerometer alone.
+    Safing,
+}
+
+impl EventSensor {
+    /// True if `sensor` sees events of this reach.
+    pub fn reaches(self, sensor: AccelSensor) -> bool {
+        match self {
+            EventSensor::All => true,
+            EventSensor::Crash => sensor == AccelSensor::Crash,
+            EventSensor::Safing => sensor == AccelSensor::Safing,
+        }
+    }
+}
+
+/// One `[[accel_event]]`: what the acceleration sensors see besides a crash. Which keys a kind
+/// needs (and which it rejects) is checked by validation: `peak_g` for `half_sine`, `spike`
+/// and `offset`; `duration_ms` for `half_sine` only; `rms_g` for `rough_road` only; `end_s` for
+/// `rough_road` and `offset`. Signs as the crash: `peak_g > 0` is a deceleration.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AccelEvent {
+    /// What happens.
+    pub kind: AccelEventKind,
+    /// Onset [s after scenario start].
+    pub start_s: f64,
+    /// Peak deceleration of a half-sine, the reading of a spike, the shift of an offset [g]
+    /// (+ = deceleration).
+    pub peak_g: Option<f64>,
+    /// Length of a half-sine [ms].
+    pub duration_ms: Option<f64>,
+    /// Root mean square of a rough road over its window [g].
+    pub rms_g: Option<f64>,
+    /// End of a rough road or offset [s after scenario start] (exclusive).
+    pub end_s: Option<f64>,
+    /// Which sensors see it (default: all — a mechanical event).
+    #[serde(default)]
+    pub sensor: EventSensor,
 }
 
 /// Sensor model; every field has a documented default.
@@ -234,6 +344,13 @@ pub struct SensorModel {
     /// Measuring range of the crash accelerometer [g]: readings are clipped to ±this, and a
     /// saturated sensor reads −this.
     pub accel_full_scale_g: f64,
+    /// Safing accelerometer sample rate [Hz] (≥ 1000, ≤ 8000: one batch per ms).
+    pub safing_rate_hz: f64,
+    /// Gaussian noise of the safing accelerometer [m/s², 1σ] (its own random stream).
+    pub safing_noise_mps2: f64,
+    /// Measuring range of the safing accelerometer [g]: readings are clipped to ±this, and a
+    /// saturated safing sensor reads −this.
+    pub safing_full_scale_g: f64,
     /// Feed dropouts.
     pub dropouts: Vec<Dropout>,
     /// Stuck object-list windows (stale data: the last sample repeated).
@@ -262,6 +379,9 @@ impl Default for SensorModel {
             accel_rate_hz: 4000.0,
             accel_noise_mps2: 0.5,
             accel_full_scale_g: 200.0,
+            safing_rate_hz: 2000.0,
+            safing_noise_mps2: 1.0,
+            safing_full_scale_g: 50.0,
             dropouts: Vec::new(),
             freezes: Vec::new(),
             accel_faults: Vec::new(),
@@ -280,23 +400,71 @@ impl SensorModel {
     }
 
     /// When the crash accelerometer first fails [s after start]: the earliest dropout that
-    /// silences it or faulty-reading window (`None`: it never fails).
+    /// silences it or faulty-reading window (`None`: it never fails). `[[accel_event]]`
+    /// entries are not counted: a spike or an offset is a reading, not a sensor that stopped
+    /// being plausible.
     pub fn accel_fails_at_s(&self) -> Option<f64> {
+        self.fails_at_s(AccelSensor::Crash)
+    }
+
+    /// When the safing accelerometer first fails [s after start] (as
+    /// [`Self::accel_fails_at_s`] for the crash accelerometer).
+    pub fn safing_fails_at_s(&self) -> Option<f64> {
+        self.fails_at_s(AccelSensor::Safing)
+    }
+
+    /// When `sensor` first fails: its earliest dropout or faulty-reading window.
+    pub fn fails_at_s(&self, sensor: AccelSensor) -> Option<f64> {
+        let target = Self::dropout_target(sensor);
         let silenced = self
             .dropouts
             .iter()
-            .filter(|d| matches!(d.target, DropoutTarget::Accel | DropoutTarget::All))
+            .filter(|d| d.target == target || d.target == DropoutTarget::All)
             .map(|d| d.start_s);
-        let faulty = self.accel_faults.iter().map(|f| f.start_s);
+        let faulty = self
+            .accel_faults
+            .iter()
+            .filter(|f| f.sensor == sensor)
+            .map(|f| f.start_s);
         silenced.chain(faulty).reduce(f64::min)
     }
 
-    /// The accelerometer fault at scenario time `t_s`, if any (the first window that holds).
+    /// The dropout target that silences `sensor`.
+    pub fn dropout_target(sensor: AccelSensor) -> DropoutTarget {
+        match sensor {
+            AccelSensor::Crash => DropoutTarget::Accel,
+            AccelSensor::Safing => DropoutTarget::Safing,
+        }
+    }
+
+    /// The crash accelerometer's fault at scenario time `t_s`, if any (the first window that
+    /// holds).
     pub fn accel_fault(&self, t_s: f64) -> Option<AccelFaultKind> {
+        self.sensor_fault(AccelSensor::Crash, t_s)
+    }
+
+    /// `sensor`'s fault at scenario time `t_s`, if any (the first of its windows that holds).
+    pub fn sensor_fault(&self, sensor: AccelSensor, t_s: f64) -> Option<AccelFaultKind> {
         self.accel_faults
             .iter()
-            .find(|f| t_s >= f.start_s && t_s < f.end_s)
+            .find(|f| f.sensor == sensor && t_s >= f.start_s && t_s < f.end_s)
             .map(|f| f.kind)
+    }
+
+    /// Sample rate [Hz], noise [m/s², 1σ] and measuring range [g] of `sensor`.
+    pub fn accel_params(&self, sensor: AccelSensor) -> (f64, f64, f64) {
+        match sensor {
+            AccelSensor::Crash => (
+                self.accel_rate_hz,
+                self.accel_noise_mps2,
+                self.accel_full_scale_g,
+            ),
+            AccelSensor::Safing => (
+                self.safing_rate_hz,
+                self.safing_noise_mps2,
+                self.safing_full_scale_g,
+            ),
+        }
     }
 
     /// True if the object list is stuck at scenario time `t_s`.
@@ -608,5 +776,313 @@ mass_kg = 75
         let e = Scenario::parse("x.toml", &bad).unwrap_err();
         assert_eq!(e.field.as_deref(), Some("sensor.dropouts[0]"), "{e}");
         assert!(e.line.is_some(), "{e}");
+    }
+
+    #[test]
+    fn safing_sensor_defaults_and_ranges() {
+        let s = Scenario::parse("t.toml", OK).expect("valid");
+        assert_eq!(s.sensor.safing_rate_hz, 2000.0);
+        assert_eq!(s.sensor.safing_noise_mps2, 1.0);
+        assert_eq!(s.sensor.safing_full_scale_g, 50.0);
+        assert_eq!(
+            s.sensor.accel_params(AccelSensor::Safing),
+            (2000.0, 1.0, 50.0)
+        );
+        assert_eq!(
+            s.sensor.accel_params(AccelSensor::Crash),
+            (4000.0, 0.5, 200.0)
+        );
+        assert!(s.accel_events.is_empty());
+        // OK ends on line 16: [sensor] is line 17, the key line 18.
+        for (key, bad, msg) in [
+            ("safing_rate_hz", "500", "500 is outside 1000..=8000 Hz"),
+            ("safing_rate_hz", "9000", "9000 is outside 1000..=8000 Hz"),
+            ("safing_noise_mps2", "-1", "-1 is outside 0..=50 m/s²"),
+            ("safing_full_scale_g", "5", "5 is outside 10..=1000 g"),
+        ] {
+            let text = format!("{OK}[sensor]\n{key} = {bad}\n");
+            let e = Scenario::parse("x.toml", &text).unwrap_err();
+            assert_eq!(
+                e.to_string(),
+                format!("x.toml:18: field `sensor.{key}`: {msg}"),
+                "{key}"
+            );
+        }
+    }
+
+    #[test]
+    fn accel_faults_name_their_sensor() {
+        let text = format!(
+            "{OK}[sensor]\naccel_faults = [{{ start_s = 0.5, end_s = 0.7, kind = \"stuck\" }}, \
+             {{ start_s = 0.6, end_s = 0.8, kind = \"saturated\", sensor = \"safing\" }}]\n\
+             dropouts = [{{ start_s = 0.2, end_s = 0.3, target = \"safing\" }}]\n"
+        );
+        let s = Scenario::parse("x.toml", &text).expect("valid");
+        assert_eq!(s.sensor.accel_faults[0].sensor, AccelSensor::Crash);
+        assert_eq!(s.sensor.accel_fault(0.65), Some(AccelFaultKind::Stuck));
+        assert_eq!(s.sensor.accel_fault(0.75), None, "the safing window");
+        assert_eq!(
+            s.sensor.sensor_fault(AccelSensor::Safing, 0.75),
+            Some(AccelFaultKind::Saturated)
+        );
+        assert_eq!(s.sensor.sensor_fault(AccelSensor::Safing, 0.55), None);
+        assert_eq!(s.sensor.accel_fails_at_s(), Some(0.5));
+        assert_eq!(s.sensor.safing_fails_at_s(), Some(0.2));
+        assert!(s.sensor.dropped(DropoutTarget::Safing, 0.25));
+        assert!(!s.sensor.dropped(DropoutTarget::Accel, 0.25));
+        let all = text.replace("target = \"safing\"", "target = \"all\"");
+        let s = Scenario::parse("x.toml", &all).expect("valid");
+        assert!(s.sensor.dropped(DropoutTarget::Safing, 0.25));
+        assert!(s.sensor.dropped(DropoutTarget::Accel, 0.25));
+        assert_eq!(s.sensor.accel_fails_at_s(), Some(0.2));
+        let bad = text.replace("sensor = \"safing\"", "sensor = \"all\"");
+        let e = Scenario::parse("x.toml", &bad).unwrap_err();
+        assert_eq!(e.line, Some(18), "{e}");
+        assert!(e.message.contains("unknown variant `all`"), "{e}");
+    }
+
+    /// `OK` + `extra`, and the 1-based line of the first line of `extra` containing `needle`.
+    fn with(extra: &str, needle: &str) -> (String, Option<usize>) {
+        let text = format!("{OK}{extra}");
+        let line = text.lines().position(|l| l.contains(needle)).map(|i| i + 1);
+        (text, line)
+    }
+
+    const EVENTS: &str = "
+[[accel_event]]
+kind = \"half_sine\"
+start_s = 1.80
+peak_g = 7.5
+duration_ms = 4.0
+
+[[accel_event]]
+kind = \"spike\"
+start_s = 0.5
+peak_g = 40
+sensor = \"crash\"
+
+[[accel_event]]
+kind = \"rough_road\"
+start_s = 0.2
+rms_g = 2.0
+end_s = 2.5
+
+[[accel_event]]
+kind = \"offset\"
+start_s = 1.0
+peak_g = -6
+end_s = 2.0
+sensor = \"safing\"
+";
+
+    #[test]
+    fn accel_events_parse_with_their_documented_defaults() {
+        let s = Scenario::parse("x.toml", &format!("{OK}{EVENTS}")).expect("valid");
+        let e = &s.accel_events;
+        assert_eq!(e.len(), 4);
+        assert_eq!(e[0].kind, AccelEventKind::HalfSine);
+        assert_eq!(e[0].sensor, EventSensor::All, "default: all");
+        assert_eq!((e[0].peak_g, e[0].duration_ms), (Some(7.5), Some(4.0)));
+        assert_eq!((e[0].rms_g, e[0].end_s), (None, None));
+        assert_eq!(e[1].kind, AccelEventKind::Spike);
+        assert_eq!(e[1].sensor, EventSensor::Crash);
+        assert_eq!(e[2].kind, AccelEventKind::RoughRoad);
+        assert_eq!((e[2].rms_g, e[2].end_s), (Some(2.0), Some(2.5)));
+        assert_eq!(e[3].kind, AccelEventKind::Offset);
+        assert_eq!(e[3].sensor, EventSensor::Safing);
+        assert!(EventSensor::All.reaches(AccelSensor::Safing));
+        assert!(!EventSensor::Crash.reaches(AccelSensor::Safing));
+        // The same as inline tables; 0 g is allowed for every kind.
+        let inline = "accel_event = [{ kind = \"spike\", start_s = 0.5, peak_g = 0 }]\n";
+        let s = Scenario::parse("x.toml", &format!("{inline}{OK}")).expect("valid");
+        assert_eq!(s.accel_events[0].peak_g, Some(0.0));
+    }
+
+    #[test]
+    fn accel_event_keys_are_checked_per_kind_with_their_line() {
+        // (what to change in EVENTS, the line it points at, the error after the location)
+        let cases: &[(&str, &str, &str, &str)] = &[
+            // A required key that is missing points at its entry's header.
+            (
+                "peak_g = 7.5\nduration_ms = 4.0\n",
+                "peak_g = 7.5\n",
+                "[[accel_event]]",
+                "field `accel_event[0].duration_ms`: required for kind = \"half_sine\"",
+            ),
+            (
+                "rms_g = 2.0\n",
+                "peak_g = 2.0\n",
+                "peak_g = 2.0",
+                "field `accel_event[2].peak_g`: not used by kind = \"rough_road\": remove this key",
+            ),
+            (
+                "peak_g = 40\n",
+                "peak_g = 40\nduration_ms = 3\n",
+                "duration_ms = 3",
+                "field `accel_event[1].duration_ms`: not used by kind = \"spike\": remove this key",
+            ),
+            (
+                "peak_g = 40\n",
+                "peak_g = 40\nend_s = 3\n",
+                "end_s = 3",
+                "field `accel_event[1].end_s`: not used by kind = \"spike\": remove this key",
+            ),
+            (
+                "peak_g = 7.5\n",
+                "peak_g = 7.5\nrms_g = 1\n",
+                "rms_g = 1",
+                "field `accel_event[0].rms_g`: not used by kind = \"half_sine\": remove this key",
+            ),
+            (
+                "end_s = 2.0\n",
+                "\n",
+                "kind = \"offset\"",
+                "field `accel_event[3].end_s`: required for kind = \"offset\"",
+            ),
+            (
+                "rms_g = 2.0\n",
+                "\n",
+                "kind = \"rough_road\"",
+                "field `accel_event[2].rms_g`: required for kind = \"rough_road\"",
+            ),
+            (
+                "start_s = 1.80\n",
+                "start_s = 3.5\n",
+                "start_s = 3.5",
+                "field `accel_event[0].start_s`: 3.5 is outside 0..=3 s (the run)",
+            ),
+            (
+                "start_s = 0.5\n",
+                "start_s = -0.1\n",
+                "start_s = -0.1",
+                "field `accel_event[1].start_s`: -0.1 is outside 0..=3 s (the run)",
+            ),
+            (
+                "end_s = 2.5\n",
+                "end_s = 0.2\n",
+                "end_s = 0.2",
+                "field `accel_event[2].end_s`: 0.2 s must be after start_s = 0.2 s",
+            ),
+            (
+                "peak_g = 7.5\n",
+                "peak_g = 250\n",
+                "peak_g = 250",
+                "field `accel_event[0].peak_g`: 250 is outside -200..=200 g",
+            ),
+            (
+                "duration_ms = 4.0\n",
+                "duration_ms = 0.05\n",
+                "duration_ms = 0.05",
+                "field `accel_event[0].duration_ms`: 0.05 is outside 0.1..=200 ms",
+            ),
+            (
+                "duration_ms = 4.0\n",
+                "duration_ms = 201\n",
+                "duration_ms = 201",
+                "field `accel_event[0].duration_ms`: 201 is outside 0.1..=200 ms",
+            ),
+            (
+                "rms_g = 2.0\n",
+                "rms_g = 25\n",
+                "rms_g = 25",
+                "field `accel_event[2].rms_g`: 25 is outside 0..=20 g",
+            ),
+            (
+                "rms_g = 2.0\n",
+                "rms_g = -1\n",
+                "rms_g = -1",
+                "field `accel_event[2].rms_g`: -1 is outside 0..=20 g",
+            ),
+        ];
+        for (from, to, needle, want) in cases {
+            assert!(EVENTS.contains(from), "{from}");
+            let events = EVENTS.replacen(from, to, 1);
+            let (text, _) = with(&events, "");
+            // The line: of the changed key, or of the entry's header for a missing key.
+            let entry = want
+                .split("accel_event[")
+                .nth(1)
+                .and_then(|x| x.split(']').next())
+                .and_then(|x| x.parse::<usize>().ok())
+                .expect("entry");
+            let line = if *needle == "[[accel_event]]" || want.contains("required") {
+                text.lines()
+                    .enumerate()
+                    .filter(|(_, l)| l.trim() == "[[accel_event]]")
+                    .nth(entry)
+                    .map(|(i, _)| i + 1)
+            } else {
+                text.lines().position(|l| l.contains(needle)).map(|i| i + 1)
+            };
+            let e = Scenario::parse("x.toml", &text).unwrap_err();
+            let line = line.expect("line");
+            assert_eq!(
+                e.to_string(),
+                format!("x.toml:{line}: {want}"),
+                "{from} -> {to}"
+            );
+        }
+    }
+
+    #[test]
+    fn accel_event_syntax_errors_name_file_line_column_and_field() {
+        // Unknown key, unknown kind, unknown sensor, wrong type: toml's own errors, with the
+        // column, located in the entry.
+        let cases = [
+            (
+                "duration_ms = 4.0\n",
+                "duration_ms = 4.0\nwidth_ms = 2\n",
+                "width_ms = 2",
+                1,
+                "accel_event[0].width_ms",
+                "unknown field `width_ms`",
+            ),
+            (
+                "kind = \"spike\"",
+                "kind = \"spikes\"",
+                "\"spikes\"",
+                8,
+                "accel_event[1].kind",
+                "unknown variant `spikes`",
+            ),
+            (
+                "sensor = \"safing\"",
+                "sensor = \"both\"",
+                "\"both\"",
+                10,
+                "accel_event[3].sensor",
+                "unknown variant `both`",
+            ),
+            (
+                "peak_g = 40\n",
+                "peak_g = \"forty\"\n",
+                "\"forty\"",
+                10,
+                "accel_event[1].peak_g",
+                "invalid type",
+            ),
+        ];
+        for (from, to, needle, column, field, msg) in cases {
+            let (text, line) = with(&EVENTS.replacen(from, to, 1), needle);
+            let e = Scenario::parse("x.toml", &text).unwrap_err();
+            assert_eq!((e.line, e.column), (line, Some(column)), "{e}");
+            assert_eq!(e.field.as_deref(), Some(field), "{e}");
+            assert!(e.message.contains(msg), "{e}");
+            assert!(
+                e.to_string().starts_with(&format!(
+                    "x.toml:{}:{column}: field `{field}`: ",
+                    line.unwrap()
+                )),
+                "{e}"
+            );
+        }
+        // A misspelt table name is an unknown top-level key.
+        let e = Scenario::parse(
+            "x.toml",
+            &format!("{OK}[[accel_events]]\nkind = \"spike\"\n"),
+        )
+        .unwrap_err();
+        assert_eq!(e.field.as_deref(), Some("accel_events[0]"), "{e}");
+        assert!(e.message.contains("unknown field `accel_events`"), "{e}");
     }
 }

@@ -2,7 +2,15 @@
 //! windows that end after they start. Each error names its dotted field (`ego.mass_kg`,
 //! `sensor.dropouts[1]`); `location` turns it into a line.
 
-use super::{Braking, OpponentKind, Scenario};
+use super::{AccelEvent, AccelEventKind, Braking, OpponentKind, Scenario};
+
+/// Range of `peak_g` [g] (+ = deceleration; 0 is allowed for every kind: a no-op half-sine or
+/// offset, a spike that reads 0).
+pub const EVENT_PEAK_G: (f64, f64) = (-200.0, 200.0);
+/// Range of a half-sine's `duration_ms` [ms].
+pub const EVENT_DURATION_MS: (f64, f64) = (0.1, 200.0);
+/// Range of a rough road's `rms_g` [g].
+pub const EVENT_RMS_G: (f64, f64) = (0.0, 20.0);
 
 impl Scenario {
     /// Semantic checks; `Err((field path, message))`.
@@ -208,6 +216,27 @@ impl Scenario {
             1000.0,
             "g",
         )?;
+        range(
+            "sensor.safing_rate_hz",
+            s.safing_rate_hz,
+            1000.0,
+            8000.0,
+            "Hz",
+        )?;
+        range(
+            "sensor.safing_noise_mps2",
+            s.safing_noise_mps2,
+            0.0,
+            50.0,
+            "m/s²",
+        )?;
+        range(
+            "sensor.safing_full_scale_g",
+            s.safing_full_scale_g,
+            10.0,
+            1000.0,
+            "g",
+        )?;
         let windows = s
             .dropouts
             .iter()
@@ -249,6 +278,69 @@ impl Scenario {
             400.0,
             "mm",
         )?;
+        for (i, e) in self.accel_events.iter().enumerate() {
+            validate_event(i, e, self.duration_s)?;
+        }
         Ok(())
     }
+}
+
+/// The checks of `accel_event[i]`: onset within the run, the kind's keys present and no
+/// other kind's, ranges, `end_s` after `start_s`.
+fn validate_event(i: usize, e: &AccelEvent, duration_s: f64) -> Result<(), (String, String)> {
+    let field = |key: &str| format!("accel_event[{i}].{key}");
+    let in_range = |key: &str, v: f64, (lo, hi): (f64, f64), unit: &str| {
+        if v.is_finite() && v >= lo && v <= hi {
+            Ok(())
+        } else {
+            Err((field(key), format!("{v} is outside {lo}..={hi} {unit}")))
+        }
+    };
+    in_range("start_s", e.start_s, (0.0, duration_s), "s (the run)")?;
+    let kind = e.kind.name();
+    // Which keys the kind needs: peak_g, duration_ms, rms_g, end_s.
+    let needs = match e.kind {
+        AccelEventKind::HalfSine => [true, true, false, false],
+        AccelEventKind::Spike => [true, false, false, false],
+        AccelEventKind::RoughRoad => [false, false, true, true],
+        AccelEventKind::Offset => [true, false, false, true],
+    };
+    let keys = [
+        ("peak_g", e.peak_g),
+        ("duration_ms", e.duration_ms),
+        ("rms_g", e.rms_g),
+        ("end_s", e.end_s),
+    ];
+    for ((key, value), needed) in keys.into_iter().zip(needs) {
+        match (value, needed) {
+            (None, true) => {
+                return Err((field(key), format!("required for kind = \"{kind}\"")));
+            }
+            (Some(_), false) => {
+                return Err((
+                    field(key),
+                    format!("not used by kind = \"{kind}\": remove this key"),
+                ));
+            }
+            _ => {}
+        }
+    }
+    if let Some(v) = e.peak_g {
+        in_range("peak_g", v, EVENT_PEAK_G, "g")?;
+    }
+    if let Some(v) = e.duration_ms {
+        in_range("duration_ms", v, EVENT_DURATION_MS, "ms")?;
+    }
+    if let Some(v) = e.rms_g {
+        in_range("rms_g", v, EVENT_RMS_G, "g")?;
+    }
+    if let Some(end) = e.end_s {
+        if !(end.is_finite() && end > e.start_s) {
+            return Err((
+                field("end_s"),
+                format!("{end} s must be after start_s = {} s", e.start_s),
+            ));
+        }
+    }
+    Ok(())
 }

@@ -1,0 +1,342 @@
+//! What the acceleration sensors see besides a crash: the scenario's `[[accel_event]]` entries
+//! (misuse events the whole car feels, single-sensor faults) as signals of scenario time.
+//!
+//! Every signal is a closed-form or precomputed function of time, never of a sensor's sample
+//! grid, so two sensors with different rates see the same mechanical event (`sensor = "all"`)
+//! at their own instants, and a restarted feed sees the same signal again. Signs as the
+//! readings: the values returned here are accelerations [m/s², negative = deceleration];
+//! a file's `peak_g > 0` is a deceleration.
+//!
+//! | kind | signal |
+//! |---|---|
+//! | `half_sine` | `−peak_g·g·sin(π (t − start_s) / duration)` for `t ∈ [start_s, start_s + duration]`, added |
+//! | `spike` | the first sample at or after `start_s` reads `−peak_g·g` (replaces the reading) |
+//! | `rough_road` | band-limited random signal with `rms_g` over `[start_s, end_s)`, added ([`ROUGH_ROAD_BAND_HZ`]) |
+//! | `offset` | `−peak_g·g` over `[start_s, end_s)`, added |
+
+use crate::scenario::{AccelEvent, AccelEventKind, AccelSensor, EventSensor, Scenario};
+use physics::defaults::STANDARD_GRAVITY_MPS2 as G;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+/// Pass band of a rough road's signal [Hz]: body vertical/pitch and longitudinal excitation of
+/// a car on a rough surface lies between the body mode (~1–2 Hz, mostly vertical) and the
+/// wheel-hop mode (~10–15 Hz) and its harmonics; 5–40 Hz is the part a compartment
+/// accelerometer's longitudinal channel sees. Realised as white Gaussian noise through a
+/// 2nd-order Butterworth high-pass at 5 Hz and a 2nd-order Butterworth low-pass at 40 Hz (−3 dB
+/// at both edges, 40 dB/decade skirts).
+pub const ROUGH_ROAD_BAND_HZ: (f64, f64) = (5.0, 40.0);
+
+/// Grid on which a rough road's signal is generated [Hz]; sensors read it by linear
+/// interpolation (the band ends at 40 Hz: the interpolation error is < 1 % of the amplitude).
+pub const ROUGH_ROAD_GRID_HZ: f64 = 2000.0;
+
+/// Filter warm-up before `start_s` [s], so the signal starts stationary (the high-pass's
+/// poles decay in ≈ 45 ms).
+const ROUGH_ROAD_WARMUP_S: f64 = 0.5;
+
+/// ChaCha8 stream of rough road `accel_event[i]`: `ROUGH_ROAD_STREAM_BASE + i` (stream 0 is the
+/// object list and crash accelerometer, [`crate::sensors::SAFING_STREAM`] the safing sensor).
+pub const ROUGH_ROAD_STREAM_BASE: u64 = 0x100;
+
+/// Tolerance of sample instants against event edges [s] (the feed grid's own `1e-9` is for
+/// ms ticks; sample instants are `k / rate`).
+const EDGE_S: f64 = 1e-12;
+
+/// One prepared event.
+#[derive(Clone, Debug)]
+enum Signal {
+    HalfSine {
+        start_s: f64,
+        duration_s: f64,
+        peak_mps2: f64,
+    },
+    Spike {
+        start_s: f64,
+        value_mps2: f64,
+    },
+    RoughRoad {
+        start_s: f64,
+        end_s: f64,
+        /// Acceleration [m/s²] at `start_s + j / ROUGH_ROAD_GRID_HZ`.
+        track: Vec<f64>,
+    },
+    Offset {
+        start_s: f64,
+        end_s: f64,
+        shift_mps2: f64,
+    },
+}
+
+#[derive(Clone, Debug)]
+struct Event {
+    reach: EventSensor,
+    signal: Signal,
+}
+
+/// The scenario's acceleration events, ready to be read at any instant.
+#[derive(Clone, Debug, Default)]
+pub struct AccelEvents {
+    events: Vec<Event>,
+}
+
+impl AccelEvents {
+    /// Prepares `scenario`'s `[[accel_event]]` entries (validated: every kind has its keys).
+    /// Rough roads are generated here, from the scenario's seed on their own streams, up to
+    /// the end of the run at most.
+    pub fn new(scenario: &Scenario) -> Self {
+        let events = scenario
+            .accel_events
+            .iter()
+            .enumerate()
+            .map(|(i, e)| Event {
+                reach: e.sensor,
+                signal: prepare(scenario, i, e),
+            })
+            .collect();
+        AccelEvents { events }
+    }
+
+    /// True if the scenario has no events.
+    pub fn is_empty(&self) -> bool {
+        self.events.is_empty()
+    }
+
+    /// The sum of the additive events (half-sine, rough road, offset) `sensor` sees at `t_s`
+    /// [m/s², negative = deceleration]; `None` when none is active (the reading is then the
+    /// sensor's alone, bit for bit).
+    pub fn added_mps2(&self, sensor: AccelSensor, t_s: f64) -> Option<f64> {
+        let mut sum = None;
+        for e in self.events.iter().filter(|e| e.reach.reaches(sensor)) {
+            let v = match &e.signal {
+                Signal::HalfSine {
+                    start_s,
+                    duration_s,
+                    peak_mps2,
+                } => {
+                    let x = t_s - start_s;
+                    (x >= -EDGE_S && x <= duration_s + EDGE_S).then(|| {
+                        let phase = (x / duration_s).clamp(0.0, 1.0);
+                        peak_mps2 * (std::f64::consts::PI * phase).sin()
+                    })
+                }
+                Signal::RoughRoad {
+                    start_s,
+                    end_s,
+                    track,
+                } => (t_s >= start_s - EDGE_S && t_s < end_s - EDGE_S)
+                    .then(|| interpolate(track, (t_s - start_s) * ROUGH_ROAD_GRID_HZ)),
+                Signal::Offset {
+                    start_s,
+                    end_s,
+                    shift_mps2,
+                } => (t_s >= start_s - EDGE_S && t_s < end_s - EDGE_S).then_some(*shift_mps2),
+                Signal::Spike { .. } => None,
+            };
+            if let Some(v) = v {
+                sum = Some(sum.unwrap_or(0.0) + v);
+            }
+        }
+        sum
+    }
+
+    /// The reading of a spike that replaces `sensor`'s sample at `t_s`, whose samples are
+    /// `dt_s` apart: the sample is the first at or after the spike's `start_s`, i.e. `t_s` lies
+    /// in `[start_s, start_s + dt_s)` (exactly one sample of a grid does). The last spike
+    /// wins when two hit the same sample.
+    pub fn spike_mps2(&self, sensor: AccelSensor, t_s: f64, dt_s: f64) -> Option<f64> {
+        self.events
+            .iter()
+            .rev()
+            .filter(|e| e.reach.reaches(sensor))
+            .find_map(|e| match e.signal {
+                Signal::Spike {
+                    start_s,
+                    value_mps2,
+                } if t_s >= start_s - EDGE_S && t_s < start_s + dt_s - EDGE_S => Some(value_mps2),
+                _ => None,
+            })
+    }
+}
+
+fn prepare(scenario: &Scenario, index: usize, e: &AccelEvent) -> Signal {
+    let peak_mps2 = -e.peak_g.unwrap_or(0.0) * G;
+    let end_s = e.end_s.unwrap_or(e.start_s);
+    match e.kind {
+        AccelEventKind::HalfSine => Signal::HalfSine {
+            start_s: e.start_s,
+            duration_s: e.duration_ms.unwrap_or(1.0) * 1e-3,
+            peak_mps2,
+        },
+        AccelEventKind::Spike => Signal::Spike {
+            start_s: e.start_s,
+            value_mps2: peak_mps2,
+        },
+        AccelEventKind::Offset => Signal::Offset {
+            start_s: e.start_s,
+            end_s,
+            shift_mps2: peak_mps2,
+        },
+        AccelEventKind::RoughRoad => {
+            let mut rng = ChaCha8Rng::seed_from_u64(scenario.seed);
+            rng.set_stream(ROUGH_ROAD_STREAM_BASE + index as u64);
+            // Nothing is sampled after the run: generate up to its end (+ 2 grid points).
+            let last_s = end_s.min(scenario.duration_s.max(e.start_s));
+            let track = rough_road(&mut rng, last_s - e.start_s, -e.rms_g.unwrap_or(0.0) * G);
+            Signal::RoughRoad {
+                start_s: e.start_s,
+                end_s,
+                track,
+            }
+        }
+    }
+}
+
+/// Linear interpolation of `track` at fractional index `x ≥ 0` (the last point beyond it).
+fn interpolate(track: &[f64], x: f64) -> f64 {
+    let i = x.max(0.0).floor() as usize;
+    match (track.get(i), track.get(i + 1)) {
+        (Some(a), Some(b)) => a + (b - a) * (x - i as f64),
+        (Some(a), None) => *a,
+        _ => track.last().copied().unwrap_or(0.0),
+    }
+}
+
+/// A rough road's track over `length_s` on the [`ROUGH_ROAD_GRID_HZ`] grid: white Gaussian
+/// noise through the band-pass (after a warm-up), scaled so the rms of the track's points
+/// inside the window is exactly `|rms_mps2|` (the sign of `rms_mps2` only says the convention;
+/// the signal is symmetric).
+fn rough_road(rng: &mut ChaCha8Rng, length_s: f64, rms_mps2: f64) -> Vec<f64> {
+    let n = (length_s.max(0.0) * ROUGH_ROAD_GRID_HZ).ceil() as usize + 2;
+    let warmup = (ROUGH_ROAD_WARMUP_S * ROUGH_ROAD_GRID_HZ) as usize;
+    let mut filter = BandPass::new(ROUGH_ROAD_BAND_HZ, ROUGH_ROAD_GRID_HZ);
+    for _ in 0..warmup {
+        filter.step(crate::sensors::gauss(rng));
+    }
+    let mut track: Vec<f64> = (0..n)
+        .map(|_| filter.step(crate::sensors::gauss(rng)))
+        .collect();
+    // The rms over the window's own points (j / grid < length).
+    let inside = ((length_s.max(0.0) * ROUGH_ROAD_GRID_HZ).ceil() as usize).clamp(1, n);
+    let ms = track[..inside].iter().map(|v| v * v).sum::<f64>() / inside as f64;
+    let gain = if ms > 0.0 {
+        rms_mps2.abs() / ms.sqrt()
+    } else {
+        0.0
+    };
+    track.iter_mut().for_each(|v| *v *= gain);
+    track
+}
+
+/// The rough road's band-pass: a 2nd-order Butterworth high-pass at `f_lo` cascaded with a
+/// 2nd-order Butterworth low-pass at `f_hi` (RBJ cookbook biquads, bilinear transform
+/// prewarped at each corner): −3 dB at both edges, 40 dB/decade skirts, ≈ 0 dB between.
+struct BandPass {
+    high: Biquad,
+    low: Biquad,
+}
+
+impl BandPass {
+    fn new((lo_hz, hi_hz): (f64, f64), fs_hz: f64) -> Self {
+        BandPass {
+            high: Biquad::butterworth(lo_hz, fs_hz, true),
+            low: Biquad::butterworth(hi_hz, fs_hz, false),
+        }
+    }
+
+    fn step(&mut self, x: f64) -> f64 {
+        self.low.step(self.high.step(x))
+    }
+}
+
+/// One 2nd-order section, direct form I, normalised (a0 = 1).
+struct Biquad {
+    b: [f64; 3],
+    a: [f64; 2],
+    x: [f64; 2],
+    y: [f64; 2],
+}
+
+impl Biquad {
+    /// Butterworth (Q = 1/√2) high-pass (`high`) or low-pass at `f_hz`.
+    fn butterworth(f_hz: f64, fs_hz: f64, high: bool) -> Self {
+        let w0 = 2.0 * std::f64::consts::PI * f_hz / fs_hz;
+        let (sin, cos) = w0.sin_cos();
+        let alpha = sin / (2.0 * std::f64::consts::FRAC_1_SQRT_2);
+        let a0 = 1.0 + alpha;
+        let (b0, b1) = if high {
+            ((1.0 + cos) / 2.0, -(1.0 + cos))
+        } else {
+            ((1.0 - cos) / 2.0, 1.0 - cos)
+        };
+        Biquad {
+            b: [b0 / a0, b1 / a0, b0 / a0],
+            a: [-2.0 * cos / a0, (1.0 - alpha) / a0],
+            x: [0.0; 2],
+            y: [0.0; 2],
+        }
+    }
+
+    fn step(&mut self, x: f64) -> f64 {
+        let y = self.b[0] * x + self.b[1] * self.x[0] + self.b[2] * self.x[1]
+            - self.a[0] * self.y[0]
+            - self.a[1] * self.y[1];
+        self.x = [x, self.x[0]];
+        self.y = [y, self.y[0]];
+        y
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Gain of the band-pass at `f` Hz, measured on a long sine.
+    fn gain_at(f: f64) -> f64 {
+        let mut bp = BandPass::new(ROUGH_ROAD_BAND_HZ, ROUGH_ROAD_GRID_HZ);
+        let n = (20.0 * ROUGH_ROAD_GRID_HZ) as usize;
+        let mut peak: f64 = 0.0;
+        for j in 0..n {
+            let y = bp.step((2.0 * std::f64::consts::PI * f * j as f64 / ROUGH_ROAD_GRID_HZ).sin());
+            if j > n / 2 {
+                peak = peak.max(y.abs());
+            }
+        }
+        peak
+    }
+
+    #[test]
+    fn the_band_pass_is_minus_3_db_at_its_edges_and_flat_between() {
+        let (lo, hi) = ROUGH_ROAD_BAND_HZ;
+        let centre = (lo * hi).sqrt();
+        // Between: each section's own roll-off, 1/√(1 + (5/14.1)⁴) · 1/√(1 + (14.1/40)⁴).
+        assert!(
+            (gain_at(centre) - 0.984).abs() < 0.005,
+            "{}",
+            gain_at(centre)
+        );
+        for f in [lo, hi] {
+            let g = gain_at(f);
+            assert!(
+                (g - std::f64::consts::FRAC_1_SQRT_2).abs() < 0.01,
+                "{f} Hz: {g}"
+            );
+        }
+        // 40 dB/decade: a decade out, 1 %.
+        assert!(gain_at(0.5) < 0.011 && gain_at(400.0) < 0.011);
+    }
+
+    #[test]
+    fn a_track_has_its_rms_and_is_reproducible() {
+        let make = || {
+            let mut rng = ChaCha8Rng::seed_from_u64(3);
+            rng.set_stream(ROUGH_ROAD_STREAM_BASE);
+            rough_road(&mut rng, 2.0, -2.0 * G)
+        };
+        let t = make();
+        assert_eq!(t, make());
+        let inside = &t[..4000];
+        let rms = (inside.iter().map(|v| v * v).sum::<f64>() / 4000.0).sqrt();
+        assert!((rms - 2.0 * G).abs() < 1e-9, "{rms}");
+    }
+}
