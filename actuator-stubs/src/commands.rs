@@ -72,7 +72,7 @@ pub enum Decoded {
         mode: u8,
         /// The frame's fault flags (why the ECU degraded): bit k = the k-th `Fault…` signal of
         /// the DBC ([`crate::status::ecu_fault_signals`]).
-        faults: u8,
+        faults: u16,
     },
     /// Any other accepted frame (authenticators, foreign frames).
     Other,
@@ -159,7 +159,7 @@ pub struct Modules {
     /// ECU mode changes seen on EcuStatus: (t_ns, mode).
     pub ecu_modes: Vec<(u64, u8)>,
     /// ECU fault-flag changes seen on EcuStatus: (t_ns, flags as in [`Decoded::Status`]).
-    pub ecu_faults: Vec<(u64, u8)>,
+    pub ecu_faults: Vec<(u64, u16)>,
     /// First command (belt or airbag) whose source is the reference restraint [ns].
     pub first_reference_cmd_ns: Option<u64>,
     /// First airbag command with `Arm = Armed` [ns].
@@ -403,6 +403,7 @@ mod tests {
                 false,
                 false,
                 true,
+                false,
                 false,
                 3,
                 0x2ec7,

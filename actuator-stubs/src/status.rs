@@ -13,7 +13,7 @@ pub fn ecu_fault_signals() -> impl Iterator<Item = (usize, String)> {
 }
 
 /// The names of the fault flags set in `bits` (bit k = the k-th of [`ecu_fault_signals`]).
-pub fn ecu_fault_names(bits: u8) -> Vec<String> {
+pub fn ecu_fault_names(bits: u16) -> Vec<String> {
     ecu_fault_signals()
         .enumerate()
         .filter(|(k, _)| bits & (1 << k) != 0)

@@ -149,7 +149,7 @@ pub fn precrash(
         let [e, o] = can_inputs(tx)?;
         io.push_can(if k.is_multiple_of(2) { e } else { o });
         io.push_object(object(*now_ns));
-        io.push_accel(quiet_accel(*now_ns));
+        io.push_both_accel(quiet_accel(*now_ns));
         ecu.step(&info(*now_ns), io);
         *now_ns += MS;
     }
@@ -234,7 +234,7 @@ impl WorstCasePreCrash {
     pub fn step(&mut self) {
         self.k += 1;
         self.io.push_object(object(self.now_ns));
-        self.io.push_accel(quiet_accel(self.now_ns));
+        self.io.push_both_accel(quiet_accel(self.now_ns));
         if self.k.is_multiple_of(CAN_EVERY) {
             if let Some(f) = self.can.next() {
                 self.io.push_can(f);
@@ -316,7 +316,7 @@ impl DecisionOnly {
         self.k += 1;
         if self.k.is_multiple_of(CAN_EVERY) {
             self.io.push_object(object(self.now_ns));
-            self.io.push_accel(quiet_accel(self.now_ns));
+            self.io.push_both_accel(quiet_accel(self.now_ns));
             if let Some(f) = self.can.next() {
                 self.io.push_can(f);
             }
@@ -328,7 +328,7 @@ impl DecisionOnly {
     /// One measured cycle without new object or CAN inputs (the accelerometer's batch, as
     /// every cycle).
     pub fn step(&mut self) {
-        self.io.push_accel(quiet_accel(self.now_ns));
+        self.io.push_both_accel(quiet_accel(self.now_ns));
         self.ecu
             .step(std::hint::black_box(&info(self.now_ns)), &mut self.io);
         self.now_ns += MS;
@@ -356,11 +356,11 @@ pub fn crash_confirmation_setup() -> anyhow::Result<(RestraintCycle<'static>, Si
     let mut tx = bus::E2eProtector::new();
     let mut ecu = precrash(&mut now_ns, &mut io, &mut tx).context("crash confirmation")?;
     for _ in 0..2 {
-        io.push_accel(accel(now_ns));
+        io.push_both_accel(accel(now_ns));
         ecu.step(&info(now_ns), &mut io);
         now_ns += MS;
     }
-    io.push_accel(accel(now_ns));
+    io.push_both_accel(accel(now_ns));
     Ok((ecu, io, now_ns))
 }
 
@@ -409,7 +409,7 @@ impl CrashPhase {
                     io.push_can(f);
                 }
             }
-            io.push_accel(quiet_accel(now_ns));
+            io.push_both_accel(quiet_accel(now_ns));
             ecu.step(&info(now_ns), &mut io);
             now_ns += MS;
         }
@@ -449,7 +449,7 @@ impl CrashPhase {
                 *s += self.crash.state_at(tau_s).ego_accel_mps2 as f32;
             }
         }
-        self.io.push_accel(a);
+        self.io.push_both_accel(a);
         if (self.now_ns / MS).is_multiple_of(CAN_EVERY) {
             if let Some(f) = self.can.next() {
                 self.io.push_can(f);

@@ -203,6 +203,7 @@ impl CommandEncoder {
             false,
             c.overruns > 0,
             false,
+            false,
             c.overruns,
             7,
         )?);

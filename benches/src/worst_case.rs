@@ -456,7 +456,7 @@ impl Feed<'_> {
             io.push_object(o);
         }
         // A live accelerometer every ms (a silent one is a fault the ECU degrades on).
-        io.push_accel(self.accel(now));
+        io.push_both_accel(self.accel(now));
         Ok(())
     }
 
@@ -500,7 +500,7 @@ impl Feed<'_> {
             io.push_can(f);
         }
         for _ in 0..c.accel_batches {
-            io.push_accel(self.accel(now));
+            io.push_both_accel(self.accel(now));
         }
         Ok(())
     }

@@ -390,7 +390,7 @@ impl Harness {
 
     fn push_accel(&mut self, a: restraint::CrashAccelSample) {
         self.fed.note(self.cycle.config(), &a);
-        self.io.push_accel(a);
+        self.io.push_both_accel(a);
     }
 }
 

@@ -248,7 +248,7 @@ pub fn measure(cfg: &CycleConfig, samples: &[AccelSample], contact_ns: u64) -> M
     let p = cfg.confirm_params();
     let mut onset = Onset::default();
     let mut generic = CrashDetector::default();
-    let mut algo = FallbackAlgorithm::new(cfg.fallback_dv_mps);
+    let mut algo = FallbackAlgorithm::new(cfg.fallback_dv_mps, cfg.fallback_floor());
     let mut curve = Vec::new();
     let mut first_event = true;
     let rel = |t: u64| (t as f64 - contact_ns as f64) * 1e-6;
@@ -272,7 +272,7 @@ pub fn measure(cfg: &CycleConfig, samples: &[AccelSample], contact_ns: u64) -> M
         onset_ms: generic.onset_ns().map(rel),
         confirm_ms: generic.confirmed_at_ns().map(rel),
         decision_ms: match algo.decision() {
-            FallbackDecision::Fire(t) => Some(rel(t)),
+            FallbackDecision::Fire { at_ns, .. } => Some(rel(at_ns)),
             _ => None,
         },
         dv_curve: curve,

@@ -257,41 +257,55 @@ fn infeasible_situation_is_reported_not_hidden() {
     );
 }
 
-/// The latest the ECU can execute the table's earliest airbag plan (+3 ms, SPEC), ms: its
-/// prediction-matched confirmation (the core's own matcher, `restraint::crash_match`) on the
-/// pulses of the table's slowest closing speed (40 km/h) against its lightest and heaviest
-/// opponent, sampled like the bench's accelerometer at 4 kHz and at the slowest rate a
-/// scenario may have (1 kHz), + up to one cycle until the batch is read + one more until the
-/// cycle runs (the feeds and the ECU are two unsynchronised 1 kHz loops), − 3 ms.
+/// How late the ECU executes the shipped table's airbag plans, ms: its prediction-matched
+/// confirmation (the core's own matcher, `restraint::crash_match`, with the severity floor
+/// `match_min_dv_mps` of issue 20) on the pulses of closing speeds from the table's slowest
+/// (40 km/h) up, against its lightest and heaviest opponent, sampled like the bench's
+/// accelerometer at 4 kHz and at the slowest rate a scenario may have (1 kHz), + up to one
+/// cycle until the batch is read + one more until the cycle runs (the feeds and the ECU are two
+/// unsynchronised 1 kHz loops), − the airbag time the shipped table plans for that crash (at
+/// the robust planning mass, 75 kg, 300 mm). Before issue 20 this compared with the earliest
+/// time the optimiser allows (+3 ms) at 40 km/h; the floor delays a 40 km/h confirmation to
+/// ≈ 7.6 ms after contact, so the requirement is now what it always meant: no plan the table
+/// holds is executed later than its tolerance.
 fn worst_lateness_of_the_earliest_plan_ms() -> f64 {
     use lut::fallback_study::{CaseSpec, Crash, Family, SensorSpec};
-    use restraint::crash_match::{MatchParams, MatchState, PredictedPulse, PulseMatch};
+    use restraint::crash_match::{MatchState, PredictedPulse, PulseMatch};
     let cfg = restraint::CycleConfig::default();
+    let table = diagram::Diagram::load("../data/default.lut").expect("shipped table");
     let mut worst = f64::NEG_INFINITY;
-    for opponent_kg in [800.0, 3000.0] {
+    for (closing_kph, opponent_kg) in [40.0, 60.0, 80.0, 108.0]
+        .into_iter()
+        .flat_map(|v| [(v, 800.0), (v, 3000.0)])
+    {
         let crash = Crash::new(CaseSpec {
             family: Family::Car { opponent_kg },
-            closing_kph: 40.0,
+            closing_kph,
         })
         .unwrap();
         let ego = physics::MassClass::new(4).unwrap().curve();
         let opp = physics::class_for_mass_kg(opponent_kg).unwrap().curve();
         let spring = physics::CombinedSpring::series(ego, Some(opp)).unwrap();
+        let planned_ms = f64::from(
+            table
+                .lookup(&diagram::Query {
+                    closing_speed_kph: closing_kph as f32,
+                    opponent_mass_kg: (opponent_kg + cfg.mass_misreport_kg).min(3000.0) as f32,
+                    occupant_mass_kg: 75.0,
+                    seat_distance_mm: 300.0,
+                })
+                .values
+                .airbag_time_ms,
+        );
         for rate_hz in [1000.0, 4000.0] {
             let (samples, contact_ns) = crash.samples(&SensorSpec {
                 rate_hz,
                 ..SensorSpec::bench(7)
             });
-            let pred = PredictedPulse::solve(&spring, 1785.0, opponent_kg, 40.0 / 3.6, contact_ns)
-                .unwrap();
-            let mut m = PulseMatch::new(MatchParams {
-                onset: cfg.confirm_params(),
-                min_span_ns: (cfg.match_min_ms * 1e6) as u64,
-                window_ns: (cfg.match_window_ms * 1e6) as u64,
-                tolerance: cfg.match_tolerance,
-                ratio_min: cfg.match_ratio_min,
-                ratio_max: cfg.match_ratio_max,
-            });
+            let pred =
+                PredictedPulse::solve(&spring, 1785.0, opponent_kg, closing_kph / 3.6, contact_ns)
+                    .unwrap();
+            let mut m = PulseMatch::new(cfg.match_params());
             let confirm_ms = samples
                 .iter()
                 .find_map(|s| {
@@ -306,9 +320,14 @@ fn worst_lateness_of_the_earliest_plan_ms() -> f64 {
                         _ => None,
                     }
                 })
-                .unwrap_or_else(|| panic!("{opponent_kg} kg at {rate_hz} Hz: not matched"));
-            eprintln!("40 km/h vs {opponent_kg} kg at {rate_hz} Hz: matched {confirm_ms:.2} ms after contact");
-            worst = worst.max(confirm_ms + 2.0 - 3.0);
+                .unwrap_or_else(|| {
+                    panic!("{closing_kph} km/h, {opponent_kg} kg at {rate_hz} Hz: not matched")
+                });
+            eprintln!(
+                "{closing_kph} km/h vs {opponent_kg} kg at {rate_hz} Hz: matched \
+                 {confirm_ms:.2} ms after contact, table plans the airbag at +{planned_ms:.1} ms"
+            );
+            worst = worst.max(confirm_ms + 2.0 - planned_ms);
         }
     }
     worst

@@ -9,6 +9,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::accel::AccelLimits;
 use crate::confirm::ConfirmParams;
+use crate::fallback::FireFloor;
+use crate::safing::SafingParams;
 use crate::settings::{check_range as range, ms_to_ns, ConfigError, G_MPS2};
 
 /// Decision-logic configuration. Every key is optional (defaults below).
@@ -106,6 +108,50 @@ pub struct CycleConfig {
     /// `lut study fallback --derive`, restraint/README.md, "Crash phase"). Reaching it fires
     /// the reference airbag; not reaching it within 60 ms is a no-fire.
     pub fallback_dv_mps: [f64; crate::fallback::KNOTS],
+    /// Accelerometer-only algorithm, airbag: a must-fire also needs at least this velocity
+    /// change since the onset, m/s, and the generic confirmation's persistence
+    /// (`confirm_decel_g` for `confirm_samples`) at the deciding sample (*default* 1.0 ≈
+    /// 3.6 km/h). Why: the boundary's first knots are low so that a severe crash is recognised
+    /// in its first ms; a door slam (40 g × 2 ms ≈ 0.5 m/s), a hammer blow on the housing or a
+    /// pothole (≤ 15 g × 10 ms ≈ 0.95 m/s) crosses them but never carries 1 m/s, while every
+    /// crash above the must-fire line has it long before its required fire time
+    /// (`misuse-matrix`, README "No single fault may fire").
+    pub fallback_min_dv_mps: f64,
+    /// The pyrotechnic pretensioner on the conventional path (no adaptive plan): its own
+    /// velocity-time boundary, m/s at 0, 4, … 60 ms after the onset (*default* 0.6 × the
+    /// airbag's: the pretensioner is meant for crashes below the airbag's no-fire line too).
+    /// An event that does not reach it fires no pretensioner (a bump that the generic
+    /// thresholds confirm is not a crash that needs one).
+    pub pretensioner_dv_mps: [f64; crate::fallback::KNOTS],
+    /// The pretensioner's severity floor, m/s (*default* 0.8), with the same persistence rule
+    /// as `fallback_min_dv_mps`.
+    pub pretensioner_min_dv_mps: f64,
+    /// Prediction-matched confirmation: besides the onset ramp fitting the prediction, the
+    /// velocity change since the onset must reach this, m/s, with the deceleration staying
+    /// above the wake threshold until then (*default* 0.3). Why: a kerb strike or pothole at
+    /// the predicted contact of a collision that does not happen (a near miss, a ghost
+    /// object) can ramp up like the predicted crash for 2 ms (7.4 g in 4 ms ≈ 0.15 m/s);
+    /// a crash of the table's range reaches 0.3 m/s 4–6 ms after contact, within the
+    /// table's fire-delay tolerance of a +3 ms airbag.
+    pub match_min_dv_mps: f64,
+
+    /// Safing channel (`safing`): its events begin at this deceleration, g (*default* 1.5).
+    pub safing_wake_g: f64,
+    /// Safing channel: Δv since its onset that closes it, m/s (*default* 0.2: below every
+    /// main path's floor, so a real crash is never waiting for it).
+    pub safing_dv_mps: f64,
+    /// Safing channel: stays closed this long after its event ended, ms (*default* 20).
+    pub safing_hold_ms: f64,
+    /// A crash-phase fire that is due waits at most this long for the safing agreement,
+    /// then it is dropped, ms (*default* 30).
+    pub safing_wait_ms: f64,
+    /// With the safing sensor faulty, a vehicle deceleration (`EgoLongAccel`) at least this
+    /// stands in for it, g (*default* 2.0: above braking, ≤ 1.2 g).
+    pub safing_substitute_g: f64,
+    /// Safing sensor measuring range, g (*default* 50): readings at it are saturated, beyond
+    /// it impossible (`SAFING_INVALID`). Its timeout and stuck time are the crash
+    /// accelerometer's (`accel_timeout_ms`, `accel_stuck_ms`).
+    pub safing_full_scale_g: f64,
 
     /// Crash accelerometer: no batch for this long → `ACCEL_STALE`, ms (*default* 50: batches
     /// come every ms, so 50 missed ones are a dead sensor; with one 20 ms `EcuStatus` period the
@@ -166,6 +212,16 @@ impl Default for CycleConfig {
             mass_misreport_kg: 1200.0,
             backup_confirm_g: 4.0,
             fallback_dv_mps: crate::fallback::DEFAULT_DV_MPS,
+            fallback_min_dv_mps: 1.0,
+            pretensioner_dv_mps: crate::fallback::DEFAULT_PRETENSIONER_DV_MPS,
+            pretensioner_min_dv_mps: 0.8,
+            match_min_dv_mps: 0.3,
+            safing_wake_g: 1.5,
+            safing_dv_mps: 0.2,
+            safing_hold_ms: 20.0,
+            safing_wait_ms: 30.0,
+            safing_substitute_g: 2.0,
+            safing_full_scale_g: 50.0,
             accel_timeout_ms: 50.0,
             accel_stuck_ms: 20.0,
             accel_full_scale_g: 200.0,
@@ -237,7 +293,27 @@ impl CycleConfig {
         )?;
         range("mass_misreport_kg", self.mass_misreport_kg, 0.0, 10_000.0)?;
         range("backup_confirm_g", self.backup_confirm_g, 1.5, 15.0)?;
-        crate::fallback::validate_thresholds(&self.fallback_dv_mps)?;
+        crate::fallback::validate_thresholds("fallback_dv_mps", &self.fallback_dv_mps)?;
+        range("fallback_min_dv_mps", self.fallback_min_dv_mps, 0.0, 20.0)?;
+        crate::fallback::validate_thresholds("pretensioner_dv_mps", &self.pretensioner_dv_mps)?;
+        range(
+            "pretensioner_min_dv_mps",
+            self.pretensioner_min_dv_mps,
+            0.0,
+            20.0,
+        )?;
+        range("match_min_dv_mps", self.match_min_dv_mps, 0.0, 5.0)?;
+        range("safing_wake_g", self.safing_wake_g, 0.1, 50.0)?;
+        range("safing_dv_mps", self.safing_dv_mps, 0.01, 5.0)?;
+        range("safing_hold_ms", self.safing_hold_ms, 0.0, 1_000.0)?;
+        range("safing_wait_ms", self.safing_wait_ms, 0.0, 1_000.0)?;
+        range("safing_substitute_g", self.safing_substitute_g, 1.5, 15.0)?;
+        range(
+            "safing_full_scale_g",
+            self.safing_full_scale_g,
+            10.0,
+            1_000.0,
+        )?;
         range("accel_timeout_ms", self.accel_timeout_ms, 2.0, 1_000.0)?;
         range("accel_stuck_ms", self.accel_stuck_ms, 1.0, 10_000.0)?;
         range("accel_full_scale_g", self.accel_full_scale_g, 10.0, 1_000.0)?;
@@ -274,6 +350,58 @@ impl CycleConfig {
             samples: self.confirm_samples,
             delta_v_mps: self.confirm_delta_v_mps,
             reset_gap_ns: ms_to_ns(self.confirm_reset_gap_ms),
+        }
+    }
+
+    /// The prediction-matched confirmation's settings (`match_*`) in its units.
+    pub fn match_params(&self) -> crate::crash_match::MatchParams {
+        crate::crash_match::MatchParams {
+            onset: self.confirm_params(),
+            min_span_ns: ms_to_ns(self.match_min_ms),
+            window_ns: ms_to_ns(self.match_window_ms),
+            tolerance: self.match_tolerance,
+            ratio_min: self.match_ratio_min,
+            ratio_max: self.match_ratio_max,
+            min_dv_mps: self.match_min_dv_mps,
+        }
+    }
+
+    /// The airbag's floor on the conventional path (`fallback_min_dv_mps` + persistence).
+    pub fn fallback_floor(&self) -> FireFloor {
+        FireFloor {
+            min_dv_mps: self.fallback_min_dv_mps,
+            decel_mps2: self.confirm_decel_g * G_MPS2,
+            samples: self.confirm_samples,
+        }
+    }
+
+    /// The pyrotechnic pretensioner's floor on the conventional path.
+    pub fn pretensioner_floor(&self) -> FireFloor {
+        FireFloor {
+            min_dv_mps: self.pretensioner_min_dv_mps,
+            ..self.fallback_floor()
+        }
+    }
+
+    /// The safing function's settings (`safing_*`) in its units.
+    pub fn safing_params(&self) -> SafingParams {
+        SafingParams {
+            onset: ConfirmParams {
+                wake_mps2: self.safing_wake_g * G_MPS2,
+                ..self.confirm_params()
+            },
+            dv_mps: self.safing_dv_mps,
+            hold_ns: ms_to_ns(self.safing_hold_ms),
+            substitute_mps2: self.safing_substitute_g * G_MPS2,
+        }
+    }
+
+    /// The safing sensor's monitor limits (the crash accelerometer's timeout and stuck time,
+    /// its own range).
+    pub fn safing_limits(&self) -> AccelLimits {
+        AccelLimits {
+            full_scale_mps2: self.safing_full_scale_g * G_MPS2,
+            ..self.accel_limits()
         }
     }
 

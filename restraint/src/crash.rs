@@ -20,7 +20,7 @@ use crate::accel::{AccelSample, PlausibleBatch};
 use crate::config::CycleConfig;
 use crate::confirm::{ConfirmParams, CrashDetector};
 use crate::counters::CycleCounters;
-use crate::crash_match::{MatchParams, MatchState, PulseMatch, SeverityEstimate};
+use crate::crash_match::{MatchState, PulseMatch, SeverityEstimate};
 use crate::estimate::{equivalent_barrier_speed_kph, Estimator, Situation};
 use crate::fallback::{FallbackAlgorithm, FallbackDecision};
 use crate::inputs::InputMonitor;
@@ -71,6 +71,8 @@ pub struct CrashMonitor {
     generic: CrashDetector,
     matcher: PulseMatch,
     fallback: FallbackAlgorithm,
+    /// The pyrotechnic pretensioner's own boundary on the conventional path.
+    pretensioner: FallbackAlgorithm,
     window_ns: u64,
     backup_decel_mps2: f64,
     confirmation: Option<Confirmation>,
@@ -83,15 +85,9 @@ impl CrashMonitor {
         Self {
             onset_params,
             generic: CrashDetector::default(),
-            matcher: PulseMatch::new(MatchParams {
-                onset: onset_params,
-                min_span_ns: ms_to_ns(cfg.match_min_ms),
-                window_ns: ms_to_ns(cfg.match_window_ms),
-                tolerance: cfg.match_tolerance,
-                ratio_min: cfg.match_ratio_min,
-                ratio_max: cfg.match_ratio_max,
-            }),
-            fallback: FallbackAlgorithm::new(cfg.fallback_dv_mps),
+            matcher: PulseMatch::new(cfg.match_params()),
+            fallback: FallbackAlgorithm::new(cfg.fallback_dv_mps, cfg.fallback_floor()),
+            pretensioner: FallbackAlgorithm::new(cfg.pretensioner_dv_mps, cfg.pretensioner_floor()),
             window_ns: ms_to_ns(cfg.match_window_ms),
             backup_decel_mps2: cfg.backup_confirm_g * G_MPS2,
             confirmation: None,
@@ -104,13 +100,17 @@ impl CrashMonitor {
     /// every cycle of a drive, and what each detector would do sample by sample.
     pub(crate) fn on_batch(&mut self, batch: &PlausibleBatch, ctx: &FreezeContext<'_, '_>) {
         let wake = self.onset_params.wake_mps2;
-        if !(self.matcher.awake() || self.generic.awake() || self.fallback.awake())
+        if !(self.matcher.awake()
+            || self.generic.awake()
+            || self.fallback.awake()
+            || self.pretensioner.awake())
             && batch.all_below(wake)
         {
             if let Some(last) = batch.last_decel_mps2() {
                 self.matcher.note_quiet(last);
                 self.generic.note_quiet(last);
                 self.fallback.note_quiet(last);
+                self.pretensioner.note_quiet(last);
             }
             return;
         }
@@ -138,6 +138,7 @@ impl CrashMonitor {
         });
         self.generic.push(&self.onset_params, s);
         self.fallback.push(&self.onset_params, s);
+        self.pretensioner.push(&self.onset_params, s);
         if self.confirmation.is_some() {
             return;
         }
@@ -195,6 +196,27 @@ impl CrashMonitor {
     /// The accelerometer-only algorithm's decision on the current event.
     pub fn fallback(&self) -> FallbackDecision {
         self.fallback.decision()
+    }
+
+    /// The pretensioner's accelerometer-only decision on the current event.
+    pub fn pretensioner(&self) -> FallbackDecision {
+        self.pretensioner.decision()
+    }
+
+    /// An accelerometer event is in progress on any detector (the conventional algorithms
+    /// track every event, also after a confirmation).
+    pub fn event_in_progress(&self) -> bool {
+        self.fallback.awake() || self.matcher.awake()
+    }
+
+    /// Forgets a confirmation whose event ended without any fire (a bump the generic
+    /// thresholds confirmed, a crash the safing channel never agreed with): the detectors
+    /// start afresh, so the next event is judged on its own (issue 20: a decision belongs to
+    /// its event). Call only when no event is in progress.
+    pub fn rearm(&mut self) {
+        self.generic = CrashDetector::default();
+        self.matcher = PulseMatch::new(*self.matcher.params());
+        self.confirmation = None;
     }
 
     /// The prediction-matched confirmation's state.

@@ -58,6 +58,9 @@ pub struct MatchParams {
     pub ratio_min: f64,
     /// Highest ratio still re-estimated.
     pub ratio_max: f64,
+    /// Δv since the onset a matched pulse must reach before it confirms, m/s (the severity
+    /// floor: a kerb strike at the predicted contact ramps like the crash for 2 ms).
+    pub min_dv_mps: f64,
 }
 
 /// The prediction frozen at the wake-up.
@@ -225,6 +228,8 @@ pub struct PulseMatch {
     frozen: bool,
     fit: LineFit,
     state: MatchState,
+    /// The ramp matched; waiting for the severity floor (state stays `Fitting`).
+    matched: Option<SeverityEstimate>,
 }
 
 impl PulseMatch {
@@ -237,7 +242,13 @@ impl PulseMatch {
             frozen: false,
             fit: LineFit::default(),
             state: MatchState::Idle,
+            matched: None,
         }
+    }
+
+    /// Its settings.
+    pub fn params(&self) -> &MatchParams {
+        &self.params
     }
 
     /// The current state.
@@ -272,10 +283,12 @@ impl PulseMatch {
             OnsetStep::Reset => {
                 self.state = MatchState::Idle;
                 self.frozen = false;
+                self.matched = None;
                 return;
             }
             OnsetStep::Woke => {
                 self.fit = LineFit::default();
+                self.matched = None;
                 self.frozen = freeze(&mut self.prediction);
                 self.state = if self.frozen {
                     MatchState::Fitting
@@ -296,6 +309,10 @@ impl PulseMatch {
             self.state = MatchState::Mismatch(Mismatch::Shape);
             return;
         }
+        if let Some(e) = self.matched {
+            self.state = self.hold_for_floor(e, wake_ns, s.t_ns);
+            return;
+        }
         let x_ms = s.t_ns.saturating_sub(wake_ns) as f64 * 1e-6;
         // Time since the (predicted-slope) contact: the ramp ends at the first knee.
         let tau_ms = x_ms + self.params.onset.wake_mps2 / p.slope_mps2_per_ms;
@@ -306,7 +323,29 @@ impl PulseMatch {
         let span_ns = (self.fit.x_last * 1e6) as u64;
         let enough = span_ns >= self.params.min_span_ns && self.fit.n >= 3.0;
         if enough || !in_ramp {
-            self.state = self.decide(p, wake_ns, s.t_ns);
+            self.state = match self.decide(p, wake_ns, s.t_ns) {
+                MatchState::Confirmed(e) => {
+                    self.matched = Some(e);
+                    self.hold_for_floor(e, wake_ns, s.t_ns)
+                }
+                other => other,
+            };
+        }
+    }
+
+    /// A matched ramp confirms once the velocity change since the onset reaches the floor
+    /// (the deceleration staying above the wake threshold meanwhile, checked by the caller);
+    /// an event that has not reached it within the match window is not this crash.
+    fn hold_for_floor(&self, e: SeverityEstimate, wake_ns: u64, t_ns: u64) -> MatchState {
+        if self.onset.delta_v_mps() >= self.params.min_dv_mps {
+            MatchState::Confirmed(SeverityEstimate {
+                confirm_ns: t_ns,
+                ..e
+            })
+        } else if t_ns.saturating_sub(wake_ns) > self.params.window_ns {
+            MatchState::Mismatch(Mismatch::Severity)
+        } else {
+            MatchState::Fitting
         }
     }
 
@@ -366,6 +405,7 @@ mod tests {
             tolerance: 0.12,
             ratio_min: 0.5,
             ratio_max: 2.5,
+            min_dv_mps: 0.0,
         }
     }
 

@@ -18,6 +18,7 @@ use crate::estimate::{check_lut, Estimator, Lut, LutMismatch, Situation};
 use crate::inputs::InputMonitor;
 use crate::outputs::{publish_diagnostics, Outputs};
 use crate::plan::{ReferenceSettings, RestraintPlan};
+use crate::safing::Safing;
 use crate::settings::ConfigError;
 use crate::signals::Degraded;
 
@@ -38,6 +39,7 @@ pub struct RestraintCycle<'lut> {
     estimate: Estimator<'lut>,
     decision: Decision,
     crash: CrashMonitor,
+    safing: Safing,
     outputs: Outputs,
     reasons: Degraded,
     counters: CycleCounters,
@@ -73,6 +75,7 @@ impl<'lut> RestraintCycle<'lut> {
             estimate,
             decision: Decision::new(&cfg, reference),
             crash: CrashMonitor::new(&cfg),
+            safing: Safing::new(cfg.safing_params()),
             outputs: Outputs::new(lut_id),
             reasons: Degraded::empty(),
             counters: CycleCounters::default(),
@@ -131,6 +134,14 @@ impl<'lut> RestraintCycle<'lut> {
     /// confirmed (CRASH, POST-CRASH). Its cycles run the crash detectors on every sample.
     pub fn crash_event(&self) -> bool {
         self.crash.awake() || matches!(self.phase(), Phase::Crash | Phase::PostCrash)
+    }
+    /// Crash-phase fires the safing function vetoed (`fires_vetoed_by_safing`).
+    pub fn vetoed_fires(&self) -> u64 {
+        self.decision.vetoed_fires()
+    }
+    /// The safing function's state.
+    pub fn safing(&self) -> &Safing {
+        &self.safing
     }
     /// Whether the airbag fire command has been sent.
     pub fn airbag_fired(&self) -> bool {
@@ -191,6 +202,13 @@ impl Activity for RestraintCycle<'_> {
             inputs.on_accel(a, now, c, &mut plausible);
             crash.on_batch(&plausible, &freeze);
         });
+        // The independent safing channel: its own monitor, its own function.
+        let safing = &mut self.safing;
+        let mut safing_batch = crate::accel::PlausibleBatch::new();
+        io.drain_safing(&mut |a| {
+            inputs.on_safing(a, now, &mut safing_batch);
+            safing.on_batch(&safing_batch);
+        });
         inputs.on_receive_errors(io.receive_errors(), now);
         let lut_present = self.estimate.lut().is_some();
         self.reasons = self.inputs.reasons(now, io.can_enabled(), lut_present);
@@ -228,7 +246,14 @@ impl Activity for RestraintCycle<'_> {
         }
         let accel_faulty = self
             .reasons
-            .intersects(Degraded::ACCEL_STALE | Degraded::ACCEL_INVALID);
+            .intersects(Degraded::ACCEL_STALE | Degraded::ACCEL_INVALID)
+            || self.inputs.accel_port_error(now);
+        let safing_faulty = self
+            .reasons
+            .intersects(Degraded::SAFING_STALE | Degraded::SAFING_INVALID);
+        let safing = self
+            .safing
+            .agrees(now, safing_faulty, self.inputs.vehicle_decel(now));
         self.crash.end_cycle(
             now,
             accel_faulty,
@@ -250,9 +275,15 @@ impl Activity for RestraintCycle<'_> {
             object_present: self.inputs.object_present,
             confirmation: self.crash.confirmation(),
             fallback: self.crash.fallback(),
+            pretensioner_fallback: self.crash.pretensioner(),
+            safing,
+            event_in_progress: self.crash.event_in_progress(),
             replan: &mut replan,
         };
         self.decision.step(now, &mut x);
+        if self.decision.take_abandoned() {
+            self.crash.rearm();
+        }
         // Prediction and diagnostics pulse in the cycles that have time (estimate docs): not
         // in a crash, nor while the accelerometer shows one in progress.
         if !estimated
@@ -293,6 +324,23 @@ impl Activity for RestraintCycle<'_> {
             ("accel_saturated_samples", a.saturated_samples),
             ("accel_stuck_events", a.stuck_events),
             ("accel_stale_cycles", a.stale_cycles),
+            (
+                "safing_bad_time_batches",
+                self.inputs.safing.faults.bad_time_batches,
+            ),
+            (
+                "safing_out_of_range_samples",
+                self.inputs.safing.faults.out_of_range_samples,
+            ),
+            (
+                "safing_saturated_samples",
+                self.inputs.safing.faults.saturated_samples,
+            ),
+            (
+                "safing_stuck_events",
+                self.inputs.safing.faults.stuck_events,
+            ),
+            ("fires_vetoed_by_safing", self.decision.vetoed_fires()),
             ("can_frames_rx", c.can_frames_rx),
             ("can_accepted", e2e.accepted),
             ("can_lost_frames", e2e.lost_frames),

@@ -89,17 +89,24 @@ pub(crate) struct DecisionInputs<'d> {
     pub confirmation: Option<Confirmation>,
     /// The accelerometer-only algorithm's decision on the current event.
     pub fallback: FallbackDecision,
+    /// The pretensioner's accelerometer-only decision on the current event.
+    pub pretensioner_fallback: FallbackDecision,
+    /// The safing function agrees in this cycle (`safing`).
+    pub safing: bool,
+    /// An accelerometer event is still in progress.
+    pub event_in_progress: bool,
     /// The table's plan for an adaptive crash at a closing speed (m/s): `None` when that
     /// severity is below the no-fire line (`crash::plan_for`).
     pub replan: &'d mut dyn FnMut(f64) -> Option<RestraintPlan>,
 }
 
-/// How the airbag of the crash plan is decided.
+/// How a restraint of the crash plan (airbag, pyrotechnic pretensioner) is decided.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum AirbagGate {
     /// Decided at the confirmation (scheduled or not fired).
     Decided,
-    /// Waiting for the accelerometer-only algorithm (reference airbag, conventional path).
+    /// Waiting for the accelerometer-only algorithm of the confirmed event (conventional
+    /// path): its must-fire schedules the restraint, its no-fire or the window's end drops it.
     Fallback,
 }
 
@@ -121,6 +128,19 @@ pub struct Decision {
     armed: bool,
     contact_ns: Option<u64>,
     gate: AirbagGate,
+    /// The pyrotechnic pretensioner's gate in the crash phase.
+    pt_gate: AirbagGate,
+    /// A due crash-phase fire waits this long for the safing agreement, ns.
+    safing_wait_ns: u64,
+    /// Something fired in the crash phase (it then ends in POST-CRASH).
+    crash_fired: bool,
+    /// The phase the crash phase was entered from (returned to when the event ends with
+    /// nothing fired).
+    before_crash: Phase,
+    /// The crash phase ended without a fire: the cycle re-arms the detectors.
+    abandoned: bool,
+    /// Crash-phase fires dropped because the safing function did not agree in time.
+    vetoed: u64,
     /// How the crash was confirmed (latched with the crash plan).
     crash_kind: Option<ConfirmKind>,
 }
@@ -152,8 +172,25 @@ impl Decision {
             armed: false,
             contact_ns: None,
             gate: AirbagGate::Decided,
+            pt_gate: AirbagGate::Decided,
+            safing_wait_ns: ms_to_ns(cfg.safing_wait_ms),
+            crash_fired: false,
+            before_crash: Phase::Monitoring,
+            abandoned: false,
+            vetoed: 0,
             crash_kind: None,
         }
+    }
+
+    /// Crash-phase fires the safing function vetoed (not agreeing within `safing_wait_ms`).
+    pub fn vetoed_fires(&self) -> u64 {
+        self.vetoed
+    }
+
+    /// True once after a crash phase ended with nothing fired (the event is over): the
+    /// caller re-arms the crash detectors ([`crate::crash::CrashMonitor::rearm`]).
+    pub fn take_abandoned(&mut self) -> bool {
+        core::mem::take(&mut self.abandoned)
     }
 
     /// How the crash was confirmed (`None` before a crash).
@@ -233,13 +270,24 @@ impl Decision {
     fn enter_crash(&mut self, c: Confirmation, x: &mut DecisionInputs<'_>) {
         let (plan, gate) = self.crash_plan_for(&c, x);
         let (confirm_ns, contact) = (c.at_ns, c.contact_ns);
+        self.before_crash = self.phase;
         self.crash_plan = plan;
         self.crash_kind = Some(c.kind);
         self.gate = gate;
+        self.crash_fired = false;
         self.contact_ns = Some(contact);
         self.armed = true;
+        // The conventional path's pretensioner has its own boundary (like the airbag); the
+        // adaptive and backup paths fire it as planned. Either way only with safing.
+        self.pt_gate = AirbagGate::Decided;
         if self.pretensioner != Pretensioner::Fired {
-            self.pretensioner_at_ns = Some(at(contact, plan.pretensioner_time_ms).max(confirm_ns));
+            if gate == AirbagGate::Fallback {
+                self.pt_gate = AirbagGate::Fallback;
+                self.pretensioner_at_ns = None;
+            } else {
+                self.pretensioner_at_ns =
+                    Some(at(contact, plan.pretensioner_time_ms).max(confirm_ns));
+            }
         }
         self.airbag_fire_at_ns = (gate == AirbagGate::Decided && plan.airbag_fires())
             .then(|| at(contact, plan.airbag_time_ms).max(confirm_ns));
@@ -247,24 +295,61 @@ impl Decision {
     }
 
     /// The conventional path: the reference airbag when the accelerometer-only algorithm says
-    /// must-fire; no airbag when it says no-fire or its window has passed.
+    /// must-fire for the confirmed event (and only for it); no airbag when it says no-fire,
+    /// or its window has passed.
     fn gate_airbag(&mut self, now: u64, fallback: FallbackDecision) {
         if self.gate != AirbagGate::Fallback {
             return;
         }
         let contact = self.contact_ns.unwrap_or(now);
         let window_over = now > at(contact, (WINDOW_MS + 1.0) as f32);
-        match fallback {
-            FallbackDecision::Fire(t) if self.crash_plan.airbag_fires() => {
+        match (fallback.fire_of(contact), fallback) {
+            (Some(t), _) if self.crash_plan.airbag_fires() => {
                 self.airbag_fire_at_ns = Some(at(contact, self.crash_plan.airbag_time_ms).max(t));
                 self.gate = AirbagGate::Decided;
             }
-            FallbackDecision::Pending if !window_over => {}
+            (None, FallbackDecision::Pending) if !window_over => {}
             _ => {
                 self.crash_plan = self.crash_plan.without_airbag();
                 self.gate = AirbagGate::Decided;
             }
         }
+    }
+
+    /// The conventional path's pyrotechnic pretensioner: at max(decision, contact + t_pt)
+    /// when its own boundary says must-fire for the confirmed event; none otherwise.
+    fn gate_pretensioner(&mut self, now: u64, decision: FallbackDecision) {
+        if self.pt_gate != AirbagGate::Fallback {
+            return;
+        }
+        let contact = self.contact_ns.unwrap_or(now);
+        let window_over = now > at(contact, (WINDOW_MS + 1.0) as f32);
+        match (decision.fire_of(contact), decision) {
+            (Some(t), _) => {
+                self.pretensioner_at_ns =
+                    Some(at(contact, self.crash_plan.pretensioner_time_ms).max(t));
+                self.pt_gate = AirbagGate::Decided;
+            }
+            (None, FallbackDecision::Pending) if !window_over => {}
+            _ => self.pt_gate = AirbagGate::Decided,
+        }
+    }
+
+    /// A scheduled fire at `t`: whether it goes out now (`Some(true)`), is dropped
+    /// (`Some(false)`: the safing function did not agree within the wait), or waits (`None`).
+    /// Pre-crash (reversible pretensioner) fires need no safing.
+    fn release(&mut self, t: u64, now: u64, due_slack_ns: u64, safing: bool) -> Option<bool> {
+        if now.saturating_add(due_slack_ns) < t {
+            return None;
+        }
+        if !matches!(self.phase, Phase::Crash | Phase::PostCrash) || safing {
+            return Some(true);
+        }
+        if now > t.saturating_add(self.safing_wait_ns) {
+            self.vetoed = self.vetoed.saturating_add(1);
+            return Some(false);
+        }
+        None
     }
 
     /// One step of the state machine at `now`, then the scheduled fires that are due.
@@ -276,6 +361,7 @@ impl Decision {
         }
         if self.phase == Phase::Crash {
             self.gate_airbag(now, x.fallback);
+            self.gate_pretensioner(now, x.pretensioner_fallback);
         }
         match self.phase {
             Phase::Monitoring => {
@@ -343,16 +429,23 @@ impl Decision {
         }
         // Scheduled fires (pre-crash pretensioner, crash fires), each in the cycle nearest its
         // time (a crash fire is never scheduled before its confirmation, which is past).
-        let due = |t: u64| now.saturating_add(x.half_period_ns) >= t;
+        // A crash-phase fire also needs the safing function (module `safing`).
+        let in_crash = self.phase == Phase::Crash;
         if let Some(t) = self.pretensioner_at_ns {
-            if due(t) {
-                self.pretensioner = Pretensioner::Fired;
+            if let Some(go) = self.release(t, now, x.half_period_ns, x.safing) {
+                if go {
+                    self.pretensioner = Pretensioner::Fired;
+                    self.crash_fired |= in_crash;
+                }
                 self.pretensioner_at_ns = None;
             }
         }
         if let Some(t) = self.airbag_fire_at_ns {
-            if due(t) {
-                self.airbag_fired = true;
+            if let Some(go) = self.release(t, now, x.half_period_ns, x.safing) {
+                if go {
+                    self.airbag_fired = true;
+                    self.crash_fired |= in_crash;
+                }
                 self.airbag_fire_at_ns = None;
             }
         }
@@ -360,8 +453,22 @@ impl Decision {
             && self.pretensioner_at_ns.is_none()
             && self.airbag_fire_at_ns.is_none()
             && self.gate == AirbagGate::Decided
+            && self.pt_gate == AirbagGate::Decided
         {
-            self.phase = Phase::PostCrash;
+            if self.crash_fired || self.airbag_fired {
+                self.phase = Phase::PostCrash;
+            } else if !x.event_in_progress {
+                // The event ended and nothing fired: it was not a crash that needed a
+                // restraint (or the safing channel never agreed). Its decisions end with it.
+                self.phase = self.before_crash;
+                self.crash_plan = self.reference;
+                self.gate = AirbagGate::Decided;
+                self.crash_kind = None;
+                self.abandoned = true;
+                if self.phase == Phase::Monitoring {
+                    self.armed = false;
+                }
+            }
         }
     }
 

@@ -39,11 +39,17 @@ pub const DEFAULT_DV_MPS: [f64; KNOTS] = [
     0.10, 0.25, 0.70, 1.25, 1.90, 2.55, 3.30, 4.10, 4.90, 5.55, 6.50, 7.05, 7.35, 7.35, 7.35, 7.35,
 ];
 
+/// Default boundary of the pyrotechnic pretensioner on the conventional path: 0.6 × the
+/// airbag's [`DEFAULT_DV_MPS`] (restraint/README.md, "No-fire lines").
+pub const DEFAULT_PRETENSIONER_DV_MPS: [f64; KNOTS] = [
+    0.06, 0.15, 0.42, 0.75, 1.14, 1.53, 1.98, 2.46, 2.94, 3.33, 3.90, 4.23, 4.41, 4.41, 4.41, 4.41,
+];
+
 /// The threshold must be finite, positive at τ = 0 (a decision needs some Δv) and
 /// non-decreasing (Δv only grows during a crash).
-pub fn validate_thresholds(t: &[f64; KNOTS]) -> Result<(), ConfigError> {
+pub fn validate_thresholds(key: &'static str, t: &[f64; KNOTS]) -> Result<(), ConfigError> {
     let bad = |i: usize, lo: f64| ConfigError {
-        key: "fallback_dv_mps",
+        key,
         value: t.get(i).copied().unwrap_or(f64::NAN),
         lo,
         hi: 50.0,
@@ -69,54 +75,96 @@ pub fn threshold_mps(t: &[f64; KNOTS], tau_ms: f64) -> f64 {
     }
 }
 
-/// The algorithm's decision about the current event.
+/// The algorithm's decision about the current event. Every decision belongs to one event
+/// (one onset) and ends with it: a new event starts [`FallbackDecision::Pending`] again, so a
+/// must-fire of an event that is over can never open a restraint for a later one.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FallbackDecision {
     /// No event, or inside the window and under the boundary.
     Pending,
-    /// Must-fire: the boundary was reached at this sample time, ns.
-    Fire(u64),
+    /// Must-fire: the boundary was reached at `at_ns` by the event that began at `onset_ns`.
+    Fire {
+        /// Sample time of the decision, ns.
+        at_ns: u64,
+        /// Onset of the event it belongs to, ns.
+        onset_ns: u64,
+    },
     /// No-fire: the window passed, or the event ended, under the boundary (at this sample
     /// time, ns). A new event starts pending again.
     NoFire(u64),
 }
 
-/// State of the accelerometer-only algorithm (one event at a time; a decision latches until
-/// the event is over, a fire latches for good).
+impl FallbackDecision {
+    /// The must-fire of the event that began at `onset_ns` (and of no other), if decided.
+    pub fn fire_of(self, onset_ns: u64) -> Option<u64> {
+        match self {
+            Self::Fire { at_ns, onset_ns: o } if o == onset_ns => Some(at_ns),
+            _ => None,
+        }
+    }
+}
+
+/// What, besides the boundary, a must-fire needs at the sample that decides it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FireFloor {
+    /// Δv since the onset at least this, m/s: the severity floor. A short high-g event (door
+    /// slam, hammer blow, a spike) can cross the boundary's first knots, which are low so
+    /// that a severe crash is recognised in its first ms; it never carries this much Δv.
+    pub min_dv_mps: f64,
+    /// Deceleration at least this for `samples` consecutive samples ending at the deciding
+    /// sample, m/s² (the generic confirmation's persistence: a single-sample spike's Δv
+    /// cannot decide, however large it is).
+    pub decel_mps2: f64,
+    /// See `decel_mps2`.
+    pub samples: u32,
+}
+
+/// State of the accelerometer-only algorithm (one event at a time; the decision belongs to
+/// the event and is forgotten when the next one begins).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FallbackAlgorithm {
     thresholds: [f64; KNOTS],
+    floor: FireFloor,
     onset: Onset,
+    run: u32,
     decision: FallbackDecision,
 }
 
 impl FallbackAlgorithm {
-    /// The algorithm with a validated boundary.
-    pub fn new(thresholds: [f64; KNOTS]) -> Self {
+    /// The algorithm with a validated boundary and floor.
+    pub fn new(thresholds: [f64; KNOTS], floor: FireFloor) -> Self {
         Self {
             thresholds,
+            floor,
             onset: Onset::default(),
+            run: 0,
             decision: FallbackDecision::Pending,
         }
     }
 
     /// Feeds one plausible sample (`p`: the wake threshold and quiet gap of the onset).
     pub fn push(&mut self, p: &ConfirmParams, s: &AccelSample) {
-        if matches!(self.decision, FallbackDecision::Fire(_)) {
-            return;
-        }
         match self.onset.push(p, s) {
             OnsetStep::Quiet => return,
             OnsetStep::Reset => {
-                // An event that ended under the boundary was a no-fire.
+                // An event that ended under the boundary was a no-fire; a fired event is over.
                 if self.decision == FallbackDecision::Pending {
                     self.decision = FallbackDecision::NoFire(s.t_ns);
                 }
+                self.run = 0;
                 return;
             }
-            OnsetStep::Woke => self.decision = FallbackDecision::Pending,
+            OnsetStep::Woke => {
+                self.decision = FallbackDecision::Pending;
+                self.run = 0;
+            }
             OnsetStep::Awake => {}
         }
+        self.run = if s.decel_mps2 >= self.floor.decel_mps2 {
+            self.run.saturating_add(1)
+        } else {
+            0
+        };
         if self.decision != FallbackDecision::Pending {
             return;
         }
@@ -124,10 +172,17 @@ impl FallbackAlgorithm {
             return;
         };
         let tau_ms = s.t_ns.saturating_sub(onset) as f64 * 1e-6;
+        let dv = self.onset.delta_v_mps();
         if tau_ms > WINDOW_MS {
             self.decision = FallbackDecision::NoFire(s.t_ns);
-        } else if self.onset.delta_v_mps() >= threshold_mps(&self.thresholds, tau_ms) {
-            self.decision = FallbackDecision::Fire(s.t_ns);
+        } else if dv >= threshold_mps(&self.thresholds, tau_ms)
+            && dv >= self.floor.min_dv_mps
+            && self.run >= self.floor.samples
+        {
+            self.decision = FallbackDecision::Fire {
+                at_ns: s.t_ns,
+                onset_ns: onset,
+            };
         }
     }
 
@@ -136,14 +191,14 @@ impl FallbackAlgorithm {
         self.decision
     }
 
-    /// Onset of the event in progress (or of the fired event).
+    /// Onset of the event in progress.
     pub fn onset_ns(&self) -> Option<u64> {
         self.onset.onset_ns()
     }
 
-    /// An event is in progress and not yet fired.
+    /// An event is in progress.
     pub fn awake(&self) -> bool {
-        !matches!(self.decision, FallbackDecision::Fire(_)) && self.onset.awake()
+        self.onset.awake()
     }
 
     /// See [`Onset::note_quiet`](crate::confirm::Onset::note_quiet).
@@ -164,6 +219,21 @@ mod tests {
             samples: 3,
             delta_v_mps: 0.5,
             reset_gap_ns: 10_000_000,
+        }
+    }
+
+    /// No floor beyond the boundary: one sample of persistence at 0 g, no Δv floor.
+    const NO_FLOOR: FireFloor = FireFloor {
+        min_dv_mps: 0.0,
+        decel_mps2: 0.0,
+        samples: 1,
+    };
+
+    fn floor() -> FireFloor {
+        FireFloor {
+            min_dv_mps: 1.0,
+            decel_mps2: 4.0 * G_MPS2,
+            samples: 3,
         }
     }
 
@@ -190,16 +260,20 @@ mod tests {
         assert_eq!(threshold_mps(&t, 60.0), t[15]);
         assert_eq!(threshold_mps(&t, 1e9), t[15]);
         assert_eq!(threshold_mps(&t, f64::NAN), t[0]);
-        validate_thresholds(&t).expect("default boundary is valid");
+        validate_thresholds("fallback_dv_mps", &t).expect("default boundary is valid");
         let mut bad = t;
         bad[3] = bad[2] - 0.1;
         assert_eq!(
-            validate_thresholds(&bad).unwrap_err().key,
+            validate_thresholds("fallback_dv_mps", &bad)
+                .unwrap_err()
+                .key,
             "fallback_dv_mps"
         );
         bad = t;
         bad[0] = 0.0;
-        assert!(validate_thresholds(&bad).is_err());
+        assert!(validate_thresholds("fallback_dv_mps", &bad).is_err());
+        validate_thresholds("pretensioner_dv_mps", &DEFAULT_PRETENSIONER_DV_MPS)
+            .expect("default pretensioner boundary is valid");
     }
 
     #[test]
@@ -208,15 +282,18 @@ mod tests {
         // fire at the first n with n·a·1e-3 ≥ T(n − 1). Boundary 0.1 + 0.1·τ/4 m/s (linear).
         let lin: [f64; KNOTS] = core::array::from_fn(|i| 0.1 + 0.1 * i as f64);
         // Δv after n samples of a from rest (trapezoidal): (n − ½)·a·1 ms, at τ = n − 1 ms.
-        let mut f = FallbackAlgorithm::new(lin);
+        let mut f = FallbackAlgorithm::new(lin, NO_FLOOR);
         run(&mut f, 5.0, 80); // a = 49.03 m/s²: (n − ½)·0.04903 ≥ 0.075 + 0.025 n → n ≥ 4.14
         assert_eq!(
             f.decision(),
-            FallbackDecision::Fire(1_000_000_000 + 4_000_000)
+            FallbackDecision::Fire {
+                at_ns: 1_000_000_000 + 4_000_000,
+                onset_ns: 1_000_000_000
+            }
         );
         // 2 g: (n − ½)·0.0196 ≥ 0.075 + 0.025 n never holds (slope 0.0196 < 0.025): no fire,
         // closed at the first sample after the 60 ms window.
-        let mut f = FallbackAlgorithm::new(lin);
+        let mut f = FallbackAlgorithm::new(lin, NO_FLOOR);
         run(&mut f, 2.0, 80);
         assert_eq!(
             f.decision(),
@@ -226,14 +303,103 @@ mod tests {
 
     #[test]
     fn braking_never_wakes_it_and_a_new_event_after_the_quiet_gap_is_judged_afresh() {
-        let mut f = FallbackAlgorithm::new(DEFAULT_DV_MPS);
+        let mut f = FallbackAlgorithm::new(DEFAULT_DV_MPS, NO_FLOOR);
         run(&mut f, 1.2, 200);
         assert_eq!(
             (f.decision(), f.onset_ns()),
             (FallbackDecision::Pending, None)
         );
-        let mut f = FallbackAlgorithm::new([0.1; KNOTS]);
+        let mut f = FallbackAlgorithm::new([0.1; KNOTS], NO_FLOOR);
         run(&mut f, 2.0, 1); // Δv 0.0196 < 0.1: pending
         assert_eq!(f.decision(), FallbackDecision::Pending);
+    }
+
+    /// Feeds `g(k)` for sample k = 0.. at 1 kHz from t = 1 s.
+    fn run_fn(f: &mut FallbackAlgorithm, ms: u64, g: impl Fn(u64) -> f64) {
+        for k in 0..ms {
+            f.push(
+                &params(),
+                &AccelSample {
+                    t_ns: 1_000_000_000 + k * 1_000_000,
+                    dt_s: 1e-3,
+                    decel_mps2: g(k) * G_MPS2,
+                },
+            );
+        }
+    }
+
+    #[test]
+    fn a_spike_never_decides_and_a_decision_ends_with_its_event() {
+        // Reproduction (issue 20): one 15 g sample (Δv 0.147 m/s ≥ T(1 ms) = 0.1375) used to
+        // latch a must-fire for good; a 4.5 g × 40 ms bump 0.5 s later then fired the airbag.
+        for spike_g in [15.0, 25.0, 40.0, 60.0, 150.0] {
+            let mut f = FallbackAlgorithm::new(DEFAULT_DV_MPS, floor());
+            run_fn(&mut f, 30, |k| if k == 5 { spike_g } else { 0.0 });
+            assert!(
+                !matches!(f.decision(), FallbackDecision::Fire { .. }),
+                "{spike_g} g spike: {:?}",
+                f.decision()
+            );
+        }
+        // Without the floor the old behaviour is visible: the spike alone decides must-fire…
+        let mut f = FallbackAlgorithm::new(DEFAULT_DV_MPS, NO_FLOOR);
+        run_fn(&mut f, 30, |k| if k == 5 { 15.0 } else { 0.0 });
+        // …and ended with its event (reset after the 10 ms quiet gap): a later event starts
+        // pending and cannot use it.
+        assert!(matches!(f.decision(), FallbackDecision::Fire { .. }));
+        run_fn(&mut f, 1, |_| 4.5);
+        assert_eq!(f.decision(), FallbackDecision::Pending);
+        assert_eq!(
+            FallbackDecision::Fire {
+                at_ns: 7,
+                onset_ns: 5
+            }
+            .fire_of(6),
+            None
+        );
+    }
+
+    #[test]
+    fn short_high_g_events_stay_under_the_floor_and_a_barrier_crash_fires() {
+        // Half-sines (peak g, ms): door slam, hammer blow, pothole, the 4.5 g bump. Δv of a
+        // half-sine = 2/π · peak · duration: 0.50, 0.31, 0.94, 1.77 m/s (the bump spreads its
+        // Δv over 40 ms, far under the boundary).
+        for (peak, dur) in [(40.0, 2.0), (100.0, 0.5), (15.0, 10.0), (4.5, 40.0)] {
+            let mut f = FallbackAlgorithm::new(DEFAULT_DV_MPS, floor());
+            // 8 kHz samples so the short events are resolved.
+            for k in 0..800u64 {
+                let t_ms = k as f64 * 0.125;
+                let x = (t_ms - 10.0) / dur;
+                let g = if (0.0..=1.0).contains(&x) {
+                    peak * (core::f64::consts::PI * x).sin()
+                } else {
+                    0.0
+                };
+                f.push(
+                    &params(),
+                    &AccelSample {
+                        t_ns: 1_000_000_000 + k * 125_000,
+                        dt_s: 125e-6,
+                        decel_mps2: g * G_MPS2,
+                    },
+                );
+            }
+            assert!(
+                !matches!(f.decision(), FallbackDecision::Fire { .. }),
+                "{peak} g × {dur} ms: {:?}",
+                f.decision()
+            );
+        }
+        // 20 g constant (a severe barrier crash's plateau): Δv = (n − ½)·0.196 m/s, T(τ) is
+        // below it from the 2nd sample on, the floor 1.0 m/s is reached at n = 6 (τ = 5 ms).
+        let mut f = FallbackAlgorithm::new(DEFAULT_DV_MPS, floor());
+        run(&mut f, 20.0, 20);
+        assert_eq!(
+            f.decision(),
+            FallbackDecision::Fire {
+                at_ns: 1_000_000_000 + 5_000_000,
+                onset_ns: 1_000_000_000
+            }
+        );
     }
 }

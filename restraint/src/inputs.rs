@@ -117,6 +117,9 @@ pub struct InputMonitor {
     pub(crate) last_accel_sequence: u64,
     /// Plausibility and freshness of the crash accelerometer.
     pub(crate) accel: AccelMonitor,
+    /// Plausibility and freshness of the safing accelerometer (the same checks, its range).
+    pub(crate) safing: AccelMonitor,
+    safing_rx_error_until_ns: Option<u64>,
     /// Receive errors reported by the I/O so far, and until when each port's are held.
     rx_errors: ReceiveErrors,
     object_rx_error_until_ns: Option<u64>,
@@ -158,6 +161,8 @@ impl InputMonitor {
             occupant_changed: false,
             last_accel_sequence: 0,
             accel: AccelMonitor::new(cfg.accel_limits()),
+            safing: AccelMonitor::new(cfg.safing_limits()),
+            safing_rx_error_until_ns: None,
             rx_errors: ReceiveErrors::default(),
             object_rx_error_until_ns: None,
             accel_rx_error_until_ns: None,
@@ -314,6 +319,18 @@ impl InputMonitor {
             .feed(now, a.first_timestamp_ns, a.sample_period_ns, s, out);
     }
 
+    /// One received safing-accelerometer batch: checked by its own [`AccelMonitor`], its
+    /// plausible samples put into `out` in time order.
+    pub(crate) fn on_safing(&mut self, a: &CrashAccelSample, now: u64, out: &mut PlausibleBatch) {
+        self.safing.feed(
+            now,
+            a.first_timestamp_ns,
+            a.sample_period_ns,
+            a.samples(),
+            out,
+        );
+    }
+
     /// The I/O's receive-error totals at `now`: new errors on a port hold its fault.
     pub(crate) fn on_receive_errors(&mut self, e: ReceiveErrors, now: u64) {
         let until = Some(now.saturating_add(self.hold_ns));
@@ -322,6 +339,9 @@ impl InputMonitor {
         }
         if e.accel > self.rx_errors.accel {
             self.accel_rx_error_until_ns = until;
+        }
+        if e.safing > self.rx_errors.safing {
+            self.safing_rx_error_until_ns = until;
         }
         self.rx_errors = e;
     }
@@ -353,6 +373,11 @@ impl InputMonitor {
         r.set(Degraded::OBJECT_INVALID, self.object_invalid);
         r.set(Degraded::ACCEL_INVALID, self.accel.invalid(now));
         r.set(Degraded::ACCEL_STALE, self.accel.stale(now));
+        r.set(Degraded::SAFING_STALE, self.safing.stale(now));
+        r.set(
+            Degraded::SAFING_INVALID,
+            self.safing.invalid(now) || self.safing_rx_error_until_ns.is_some_and(|t| now <= t),
+        );
         r.set(
             Degraded::IPC_ERROR,
             self.object_port_error(now) || self.accel_port_error(now),

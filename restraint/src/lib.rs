@@ -51,6 +51,7 @@ pub mod fallback;
 pub mod inputs;
 pub mod outputs;
 pub mod plan;
+pub mod safing;
 pub mod settings;
 pub mod signals;
 pub mod sim;

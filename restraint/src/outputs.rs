@@ -63,6 +63,8 @@ pub struct StatusFaults {
     pub overrun: bool,
     /// `FaultConfig` (the SecOC keys were unusable).
     pub config: bool,
+    /// `FaultSafingSensor`.
+    pub safing_sensor: bool,
 }
 
 /// One cyclic frame's schedule: last content sent and when the next repetition is due.
@@ -304,6 +306,7 @@ impl Outputs {
             lut: reasons.contains(Degraded::LUT_INVALID),
             overrun: info.overruns > 0,
             config: self.secoc_unavailable,
+            safing_sensor: reasons.intersects(Degraded::SAFING_STALE | Degraded::SAFING_INVALID),
         };
         let overruns = u16::try_from(info.overruns).unwrap_or(u16::MAX);
         // On change of mode or fault flags (not of the overrun count: a noisy host would
@@ -321,6 +324,7 @@ impl Outputs {
                 f.lut,
                 f.overrun,
                 f.config,
+                f.safing_sensor,
                 overruns,
                 self.lut_id,
             ) {

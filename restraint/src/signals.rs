@@ -166,6 +166,12 @@ bitflags::bitflags! {
         const CAN_DISABLED = 1 << 7;
         /// IPC receive errors (held 500 ms after the last).
         const IPC_ERROR = 1 << 8;
+        /// Safing accelerometer samples missing or stale (not degrading: the vehicle
+        /// deceleration stands in for it, module `safing`).
+        const SAFING_STALE = 1 << 9;
+        /// Safing accelerometer samples invalid, or receive errors on its port (not
+        /// degrading, as `SAFING_STALE`).
+        const SAFING_INVALID = 1 << 10;
     }
 }
 
@@ -351,5 +357,7 @@ mod tests {
         assert_eq!(Degraded::CAN_DISABLED.bits(), 0x80);
         assert_eq!(Degraded::IPC_ERROR.bits(), 0x100);
         assert_eq!(Degraded::DEGRADING.bits(), 0b1_1111_1111);
+        assert_eq!(Degraded::SAFING_STALE.bits(), 0x200);
+        assert_eq!(Degraded::SAFING_INVALID.bits(), 0x400);
     }
 }

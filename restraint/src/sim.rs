@@ -94,6 +94,14 @@ impl SimIo {
         push_dropping_oldest(&mut self.safing, a, &mut self.dropped);
     }
 
+    /// Queues the same batch on the crash and the safing accelerometer: a car whose two
+    /// sensors read exactly alike (benches and fuzz targets that exercise the cost or the
+    /// robustness of the cycle, not the sensors' independence).
+    pub fn push_both_accel(&mut self, a: CrashAccelSample) {
+        self.push_accel(a);
+        self.push_safing(a);
+    }
+
     /// Queues a received CAN frame for the next cycle.
     pub fn push_can(&mut self, f: RawFrame) {
         push_dropping_oldest(&mut self.can_rx, f, &mut self.dropped);

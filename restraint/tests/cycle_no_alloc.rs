@@ -84,7 +84,7 @@ fn no_allocation_in_precrash_and_crash_cycles() {
             };
             *s = (pulse + dither) as f32;
         }
-        io.push_accel(a);
+        io.push_both_accel(a);
         if ms.is_multiple_of(10) {
             io.push_can(bench.vehicle_frame(25.0));
         }

@@ -129,6 +129,8 @@ proptest! {
                 Event::Accel(mut a, ts_now) => {
                     if ts_now { a.first_timestamp_ns = now; }
                     b.io.push_accel(a);
+                    // Every other arbitrary batch goes to the safing channel too.
+                    if a.sequence % 2 == 1 { b.io.push_safing(a); }
                 }
                 Event::Raw(f) => b.io.push_can(f),
                 Event::Vehicle(v) => {

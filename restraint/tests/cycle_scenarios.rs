@@ -57,9 +57,12 @@ fn precrash_preset_pretensioner_at_planned_time_then_airbag_at_planned_time_and_
     assert_eq!(f.cmd_source(), BeltLimiterCmdCmdSource::Adaptive);
 
     // Prediction-matched confirmation: the ramp (k·v/m_ego = 30.3 m/s² per ms) wakes the
-    // detectors at C + 1 ms (3.1 g ≥ 1.5 g); at 1 kHz the fit needs 3 samples spanning ≥ 1 ms:
-    // confirmed with the C + 3 ms sample, with the predicted slope (ratio 1) and onset C.
-    assert_eq!(b.first_mode(EcuMode::Crash), Some(C + 3 * MS));
+    // detectors at C + 1 ms (3.1 g ≥ 1.5 g); at 1 kHz the fit needs 3 samples spanning ≥ 1 ms
+    // (matched with the C + 3 ms sample, predicted slope, ratio 1, onset C), and the velocity
+    // change since the onset must reach `match_min_dv_mps` = 0.3 m/s: trapezoids from the
+    // 0 g sample at C give Δv(C + k ms) = 30.3·k²/2 mm/s = 0.136, 0.242, 0.379 m/s for
+    // k = 3, 4, 5: confirmed with the C + 5 ms sample.
+    assert_eq!(b.first_mode(EcuMode::Crash), Some(C + 5 * MS));
     let Some(ConfirmKind::Matched(e)) = b.ecu.crash_kind() else {
         panic!("not prediction-matched: {:?}", b.ecu.crash_kind());
     };
@@ -410,13 +413,16 @@ fn missing_lut_runs_degraded_from_the_start_and_fires_the_reference() {
 }
 
 #[test]
-fn low_closing_speed_never_fires_the_airbag_but_the_belt_follows_the_reference() {
+fn low_closing_speed_fires_nothing_and_the_event_ends_back_in_monitoring() {
     let mut b = Bench::oracle(Some(test_lut()));
     // 4 m/s against 1600 kg (conservative): EBS = 4·1600/3385·3.6 = 6.8 km/h < 20 km/h.
     // 4.5 g: Δv = (n − ½)·0.04413 m/s after n samples → ≥ 0.5 m/s at n = 12 (C + 11 ms).
     // The accelerometer-only algorithm decides the airbag: Δv(τ) = 0.0221 + 0.0441·τ stays
     // under its boundary (0.25 m/s at 4 ms, then rising 0.11–0.16 m/s per ms) until the
-    // 60 ms window closes.
+    // 60 ms window closes. The pyrotechnic pretensioner has its own boundary (0.6 × the
+    // airbag's: 0.15 m/s at 4 ms, then rising 0.07–0.12 m/s per ms, 4.41 m/s from 48 ms):
+    // Δv(τ) crosses its first knot at τ ≈ 3 ms but the floor (0.8 m/s, reached at 17.6 ms,
+    // where the boundary is 1.30 m/s) is never met with the boundary: no pretensioner either.
     run_scenario(
         &mut b,
         C + 100 * MS,
@@ -425,7 +431,7 @@ fn low_closing_speed_never_fires_the_airbag_but_the_belt_follows_the_reference()
         4.0,
         C,
         Some(C),
-        &|_| 4.5,
+        &|ms| if ms < 100 { 4.5 } else { 0.0 },
     );
     assert_eq!(b.first_mode(EcuMode::PreCrash), None);
     assert_eq!(b.first_mode(EcuMode::Crash), Some(C + 11 * MS));
@@ -433,21 +439,27 @@ fn low_closing_speed_never_fires_the_airbag_but_the_belt_follows_the_reference()
         b.ecu.crash_kind(),
         Some(ConfirmKind::Generic { .. })
     ));
+    // While the event lasts the crash phase holds (CrashDetected on the bus).
+    assert_eq!(b.mode_at(C + 99 * MS), EcuMode::Crash as u8);
+    // The pulse ends at C + 100 ms; the event is over 10 ms of quiet later (the first sample
+    // more than 10 ms after the last awake one, C + 110 ms): nothing fired, so the decision
+    // ends with its event and the ECU monitors again — DEGRADED here, because this test's
+    // object list ended at the contact (stale since C + 90 ms), not latched in POST-CRASH.
+    b.run_until(C + 130 * MS);
+    assert_eq!(b.first_mode(EcuMode::PostCrash), None);
+    assert_eq!(b.mode_at(C + 109 * MS), EcuMode::Crash as u8);
+    assert_eq!(b.mode_at(C + 111 * MS), EcuMode::Degraded as u8);
+    assert_eq!(b.ecu.crash_kind(), None);
     assert!(b
         .airbag_frames()
         .iter()
         .all(|(_, f)| f.fire() == AirbagStageCmdFire::NoFire));
-    let last = b.airbag_frames().last().unwrap().1;
-    assert_eq!(last.stage(), AirbagStageCmdStage::NoStage);
-    // The window closed at the first sample more than 60 ms after the onset (C): PostCrash.
-    assert_eq!(b.first_mode(EcuMode::PostCrash), Some(C + 61 * MS));
-    let belt = b
+    assert!(b
         .belt_frames()
-        .into_iter()
-        .find(|(_, f)| f.pretensioner_cmd() == BeltLimiterCmdPretensionerCmd::Fire)
-        .expect("belt fires per reference");
-    assert_eq!(belt.0, C + 11 * MS);
-    assert_eq!(belt.1.load_limiter_level(), 8.5);
+        .iter()
+        .all(|(_, f)| f.pretensioner_cmd() != BeltLimiterCmdPretensionerCmd::Fire));
+    // The belt keeps the reference limiter level.
+    assert_eq!(b.belt_frames().last().unwrap().1.load_limiter_level(), 8.5);
 }
 
 #[test]

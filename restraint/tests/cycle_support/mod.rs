@@ -114,6 +114,11 @@ pub struct Bench {
     pub ego_long_accel_mps2: f32,
     /// The reading of the next step's sample, m/s² (taken by the step; then 0 again).
     pending_accel_mps2: Option<f32>,
+    /// The safing accelerometer delivers a sample every step (false: a dead safing sensor).
+    pub safing_live: bool,
+    /// A fault of one sensor for the next step: the crash (`.0`) or the safing (`.1`)
+    /// accelerometer reads this instead of the mechanical acceleration, m/s².
+    pending_fault_mps2: (Option<f32>, Option<f32>),
 }
 
 pub const T0: u64 = 10_000 * MS;
@@ -176,6 +181,8 @@ impl Bench {
             accel_dither: true,
             ego_long_accel_mps2: 0.0,
             pending_accel_mps2: None,
+            safing_live: true,
+            pending_fault_mps2: (None, None),
         }
     }
 
@@ -214,14 +221,25 @@ impl Bench {
             self.io.push_can(f);
         }
         let reading = self.pending_accel_mps2.take().unwrap_or(0.0);
+        let (crash_fault, safing_fault) = core::mem::take(&mut self.pending_fault_mps2);
         if self.accel_live {
             let dither = match (self.accel_dither, ms.is_multiple_of(2)) {
                 (false, _) => 0.0,
                 (true, true) => 0.05,
                 (true, false) => -0.05,
             };
-            self.io
-                .push_accel(accel_batch(T0 + ms * MS, reading + dither));
+            self.io.push_accel(accel_batch(
+                T0 + ms * MS,
+                crash_fault.unwrap_or(reading + dither),
+            ));
+        }
+        if self.safing_live {
+            // The second sensor sees the same car with its own (opposite-phase) dither.
+            let dither = if ms.is_multiple_of(2) { -0.07 } else { 0.07 };
+            self.io.push_safing(accel_batch(
+                T0 + ms * MS,
+                safing_fault.unwrap_or(reading + dither),
+            ));
         }
         let info = CycleInfo {
             cycle: self.cycle,
@@ -265,9 +283,20 @@ impl Bench {
         self.io.push_object(o);
     }
 
-    /// The accelerometer reads `accel_mps2` (negative = deceleration) in the next step.
+    /// The car undergoes `accel_mps2` (negative = deceleration) in the next step: both the
+    /// crash and the safing accelerometer read it.
     pub fn push_accel(&mut self, accel_mps2: f32) {
         self.pending_accel_mps2 = Some(accel_mps2);
+    }
+
+    /// A fault of the crash accelerometer alone: it reads `accel_mps2` in the next step.
+    pub fn push_crash_sensor_fault(&mut self, accel_mps2: f32) {
+        self.pending_fault_mps2.0 = Some(accel_mps2);
+    }
+
+    /// A fault of the safing accelerometer alone: it reads `accel_mps2` in the next step.
+    pub fn push_safing_sensor_fault(&mut self, accel_mps2: f32) {
+        self.pending_fault_mps2.1 = Some(accel_mps2);
     }
 
     pub fn decoded(&self) -> Vec<(u64, bus::Messages)> {
