@@ -2,7 +2,16 @@
 //! what travels ([`payload`]) and the node/port plumbing ([`port`]).
 //!
 //! Every process of the bench (ECU, sensor feeds, monitors, tests) talks over the services
-//! defined here. Keeping the payload layouts, the service names and **all** port settings in
+//! defined here:
+//!
+//! | service (under the prefix) | record | publisher → subscribers | ports |
+//! |---|---|---|---|
+//! | `ecu/in/object_state` | `ObjectState` | sensor feeds → ECU | [`OBJECT_STATE_PORTS`] |
+//! | `ecu/in/crash_accel` | `CrashAccelSample` (≤ 8 samples a batch) | sensor feeds → ECU (crash accelerometer) | [`CRASH_ACCEL_PORTS`] |
+//! | `ecu/in/safing_accel` | `CrashAccelSample` (≤ 8 samples a batch) | sensor feeds → ECU (safing accelerometer, the independent second channel) | [`SAFING_ACCEL_PORTS`] |
+//! | `ecu/out/diagnostics` | `EcuDiagnostics` | ECU → monitors | [`DIAGNOSTICS_PORTS`] |
+//! | `bench/truth` | [`BenchTruth`] | sensor feeds → actuator stubs, tests (never the ECU) | [`BENCH_TRUTH_PORTS`] |
+//! Keeping the payload layouts, the service names and **all** port settings in
 //! this one crate is what makes `open_or_create` succeed from any side: iceoryx2 refuses to
 //! open a service whose static settings are incompatible with the ones requested, so every
 //! opener must request the same ones.

@@ -11,6 +11,10 @@ pub const DEFAULT_SERVICE_PREFIX: &str = "restraint-bench";
 pub const OBJECT_STATE_SUFFIX: &str = "ecu/in/object_state";
 /// Suffix of the compartment crash-accelerometer service (sensor feeds → ECU).
 pub const CRASH_ACCEL_SUFFIX: &str = "ecu/in/crash_accel";
+/// Suffix of the safing-accelerometer service (sensor feeds → ECU): the independent second
+/// acceleration channel every Fire needs (SPEC "Single-fault tolerance"), on its own service
+/// so that nothing of the crash accelerometer's transport is shared with it.
+pub const SAFING_ACCEL_SUFFIX: &str = "ecu/in/safing_accel";
 /// Suffix of the ECU diagnostics service (ECU → monitors).
 pub const DIAGNOSTICS_SUFFIX: &str = "ecu/out/diagnostics";
 /// Suffix of the bench-truth service (sensor feeds → actuator stubs; never read by the ECU).
@@ -56,6 +60,11 @@ pub const CRASH_ACCEL_PORTS: PortSettings = PortSettings {
     max_borrowed: 2,
 };
 
+/// The safing accelerometer's batches: the same record and the same reasoning as the crash
+/// accelerometer's ([`CRASH_ACCEL_PORTS`]); at its default 2 kHz the queue covers the same
+/// ~64 ms of a stalled ECU (one batch per ms whatever the rate).
+pub const SAFING_ACCEL_PORTS: PortSettings = CRASH_ACCEL_PORTS;
+
 /// Diagnostics are published every ECU cycle; monitors only show the newest.
 pub const DIAGNOSTICS_PORTS: PortSettings = PortSettings {
     subscriber_buffer: 16,
@@ -84,6 +93,8 @@ pub struct ServiceNames {
     pub object_state: String,
     /// Crash accelerometer service.
     pub crash_accel: String,
+    /// Safing accelerometer service.
+    pub safing_accel: String,
     /// ECU diagnostics service.
     pub diagnostics: String,
     /// Bench-truth service (sensor feeds → actuator stubs).
@@ -97,6 +108,7 @@ impl ServiceNames {
         Self {
             object_state: format!("{p}/{OBJECT_STATE_SUFFIX}"),
             crash_accel: format!("{p}/{CRASH_ACCEL_SUFFIX}"),
+            safing_accel: format!("{p}/{SAFING_ACCEL_SUFFIX}"),
             diagnostics: format!("{p}/{DIAGNOSTICS_SUFFIX}"),
             bench_truth: format!("{p}/{BENCH_TRUTH_SUFFIX}"),
         }
@@ -118,6 +130,7 @@ mod tests {
         let n = ServiceNames::with_prefix("x/");
         assert_eq!(n.object_state, "x/ecu/in/object_state");
         assert_eq!(n.crash_accel, "x/ecu/in/crash_accel");
+        assert_eq!(n.safing_accel, "x/ecu/in/safing_accel");
         assert_eq!(n.diagnostics, "x/ecu/out/diagnostics");
         assert_eq!(n.bench_truth, "x/bench/truth");
     }

@@ -11,7 +11,7 @@ use restraint::{CrashAccelSample, EcuDiagnostics, ObjectState};
 
 use crate::names::{
     PortSettings, ServiceNames, BENCH_TRUTH_PORTS, CRASH_ACCEL_PORTS, DIAGNOSTICS_PORTS,
-    OBJECT_STATE_PORTS,
+    OBJECT_STATE_PORTS, SAFING_ACCEL_PORTS,
 };
 use crate::payload::{BenchTruth, Shm};
 
@@ -150,6 +150,11 @@ shm_topic!(
     AccelTopic, CrashAccelSample, CRASH_ACCEL_PORTS, crash_accel
 );
 shm_topic!(
+    /// Safing accelerometer (sensor feeds → ECU): the crash accelerometer's record on its own
+    /// service.
+    SafingTopic, CrashAccelSample, SAFING_ACCEL_PORTS, safing_accel
+);
+shm_topic!(
     /// ECU diagnostics (ECU → monitors).
     DiagnosticsTopic, EcuDiagnostics, DIAGNOSTICS_PORTS, diagnostics
 );
@@ -273,6 +278,8 @@ impl<T: Topic> PolledSubscriber<T> {
 pub type ObjectSubscriber = PolledSubscriber<ObjectTopic>;
 /// Crash accelerometer subscriber (ECU side).
 pub type AccelSubscriber = PolledSubscriber<AccelTopic>;
+/// Safing accelerometer subscriber (ECU side).
+pub type SafingSubscriber = PolledSubscriber<SafingTopic>;
 /// Diagnostics subscriber (monitor side).
 pub type DiagnosticsSubscriber = PolledSubscriber<DiagnosticsTopic>;
 /// Bench-truth subscriber (actuator stubs, tests).
@@ -361,6 +368,8 @@ pub type DiagnosticsPublisher = ZeroCopyPublisher<DiagnosticsTopic>;
 pub type ObjectPublisher = ZeroCopyPublisher<ObjectTopic>;
 /// Crash accelerometer publisher (sensor-feed / test side).
 pub type AccelPublisher = ZeroCopyPublisher<AccelTopic>;
+/// Safing accelerometer publisher (sensor-feed / test side).
+pub type SafingPublisher = ZeroCopyPublisher<SafingTopic>;
 /// Bench-truth publisher (sensor-feed side).
 pub type BenchTruthPublisher = ZeroCopyPublisher<BenchTruthTopic>;
 
@@ -421,5 +430,37 @@ mod tests {
             first,
             Some(total - CRASH_ACCEL_PORTS.subscriber_buffer as u64 + 1)
         );
+    }
+
+    #[test]
+    fn safing_and_crash_accelerometers_are_separate_services() {
+        let names = ServiceNames::with_prefix(&unique_prefix("safing"));
+        let (node, _) = create_node("ipc-test-safing", false).expect("node");
+        let mut crash_sub = AccelSubscriber::new(&node, &names).expect("crash sub");
+        let mut safing_sub = SafingSubscriber::new(&node, &names).expect("safing sub");
+        let mut crash_pub = AccelPublisher::new(&node, &names).expect("crash pub");
+        let mut safing_pub = SafingPublisher::new(&node, &names).expect("safing pub");
+        for seq in 1..=3u64 {
+            safing_pub
+                .publish_with(CrashAccelSample::EMPTY, |s| {
+                    s.sequence = seq;
+                    s.count = 1;
+                    s.accel_mps2[0] = -10.0 * seq as f32;
+                })
+                .expect("publish");
+        }
+        crash_pub
+            .publish_with(CrashAccelSample::EMPTY, |s| s.sequence = 100)
+            .expect("publish");
+        let mut safing = Vec::new();
+        assert_eq!(
+            safing_sub.drain(|s| safing.push((s.sequence, s.accel_mps2[0]))),
+            3
+        );
+        assert_eq!(safing, vec![(1, -10.0), (2, -20.0), (3, -30.0)]);
+        let mut crash = Vec::new();
+        assert_eq!(crash_sub.drain(|s| crash.push(s.sequence)), 1);
+        assert_eq!(crash, vec![100]);
+        assert_eq!(safing_sub.counters().received, 3);
     }
 }

@@ -3,13 +3,17 @@
 //!
 //! One 1 ms tick grid (absolute deadlines, no drift): object list over iceoryx2 at the
 //! scenario's period, EgoVehicleState (10 ms) and OccupantClassification (100 ms) over CAN with
-//! E2E, the compartment accelerometer in 1 ms batches (≥ 1 kHz samples; the TRUE crash pulse
-//! after contact), and BenchTruth every 10 ms for the actuator stubs.
+//! E2E, the compartment (crash) accelerometer and the independent safing accelerometer in 1 ms
+//! batches on their own services (≥ 1 kHz samples; the TRUE crash pulse after contact, plus the
+//! scenario's `[[accel_event]]`s), and BenchTruth every 10 ms for the actuator stubs.
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use ipc::{AccelPublisher, BenchTruth, BenchTruthPublisher, ObjectPublisher, ServiceNames};
+use ipc::{
+    AccelPublisher, BenchTruth, BenchTruthPublisher, ObjectPublisher, SafingPublisher, ServiceNames,
+};
 use sensor_feeds::player::TICK_NS;
+use sensor_feeds::scenario::{AccelEvent, AccelEventKind};
 use sensor_feeds::{monotonic_ns, sleep_until_ns, Player, Scenario, TickOutput, Truth};
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
@@ -76,6 +80,33 @@ fn describe(truth: &Truth) -> String {
     }
 }
 
+/// One line per `[[accel_event]]` (what `--check` and a run announce besides the contact).
+fn describe_event(i: usize, e: &AccelEvent) -> String {
+    let what = match e.kind {
+        AccelEventKind::HalfSine => format!(
+            "half_sine {} g × {} ms",
+            e.peak_g.unwrap_or(0.0),
+            e.duration_ms.unwrap_or(0.0)
+        ),
+        AccelEventKind::Spike => format!("spike {} g", e.peak_g.unwrap_or(0.0)),
+        AccelEventKind::RoughRoad => format!(
+            "rough_road {} g rms until {:.3} s",
+            e.rms_g.unwrap_or(0.0),
+            e.end_s.unwrap_or(0.0)
+        ),
+        AccelEventKind::Offset => format!(
+            "offset {} g until {:.3} s",
+            e.peak_g.unwrap_or(0.0),
+            e.end_s.unwrap_or(0.0)
+        ),
+    };
+    format!(
+        "accel_event[{i}]: {what} from {:.4} s on {}",
+        e.start_s,
+        e.sensor.name()
+    )
+}
+
 fn run(cli: &Cli) -> Result<()> {
     let scenario = Scenario::load(&cli.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
     if !(cli.speedup.is_finite() && cli.speedup >= 0.1 && cli.speedup <= 100.0) {
@@ -84,6 +115,9 @@ fn run(cli: &Cli) -> Result<()> {
     let truth =
         Truth::new(&scenario).map_err(|e| anyhow::anyhow!("{}: {e}", cli.scenario.display()))?;
     eprintln!("sensor-feeds: {}", describe(&truth));
+    for (i, e) in scenario.accel_events.iter().enumerate() {
+        eprintln!("sensor-feeds: {}", describe_event(i, e));
+    }
     if cli.check {
         return Ok(());
     }
@@ -97,6 +131,7 @@ fn run(cli: &Cli) -> Result<()> {
     let (node, _) = ipc::create_node(&node_name, false)?;
     let mut objects = ObjectPublisher::new(&node, &names)?;
     let mut accel = AccelPublisher::new(&node, &names)?;
+    let mut safing = SafingPublisher::new(&node, &names)?;
     let mut truth_pub = BenchTruthPublisher::new(&node, &names)?;
     let mut can = if cli.no_can {
         None
@@ -173,6 +208,11 @@ fn run(cli: &Cli) -> Result<()> {
                 counts.ipc_errors += 1;
             }
         }
+        for b in &out.safing {
+            if safing.publish(*b).is_err() {
+                counts.ipc_errors += 1;
+            }
+        }
         if let Some(sock) = can.as_mut() {
             for f in &out.can {
                 match sock.send(f) {
@@ -209,8 +249,8 @@ fn run(cli: &Cli) -> Result<()> {
     }
     let p = player.counts();
     eprintln!(
-        "sensor-feeds: done: {} objects ({} dropped, {} stale repeats), {} accel samples ({} faulty), {} CAN frames, {} CAN errors, {} IPC errors",
-        p.objects, p.objects_dropped, p.objects_frozen, p.accel_samples, p.accel_faulty, counts.can_frames, counts.can_errors, counts.ipc_errors
+        "sensor-feeds: done: {} objects ({} dropped, {} stale repeats), {} accel samples ({} faulty), {} safing samples ({} faulty), {} spikes, {} CAN frames, {} CAN errors, {} IPC errors",
+        p.objects, p.objects_dropped, p.objects_frozen, p.accel_samples, p.accel_faulty, p.safing_samples, p.safing_faulty, p.spikes, counts.can_frames, counts.can_errors, counts.ipc_errors
     );
     // Keep the publishers alive a moment so subscribers can read the last samples.
     std::thread::sleep(std::time::Duration::from_millis(50));

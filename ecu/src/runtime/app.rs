@@ -135,9 +135,10 @@ pub fn run_ecu(
     io.shutdown(); // sends the final diagnostics record
     let mut counters = Vec::new();
     activity.report_counters(&mut |name, v| counters.push((name, v)));
-    let (o, a, d) = (
+    let (o, a, sf, d) = (
         io.object_counters(),
         io.accel_counters(),
+        io.safing_counters(),
         io.diagnostics_counters(),
     );
     let ipc_status = IpcStatus {
@@ -148,6 +149,8 @@ pub fn run_ecu(
         object_rx_errors: o.errors,
         accel_rx: a.received,
         accel_rx_errors: a.errors,
+        safing_rx: sf.received,
+        safing_rx_errors: sf.errors,
         diagnostics_written: io.diagnostics_written(),
         diagnostics_tx: d.sent,
         diagnostics_tx_errors: d.errors,

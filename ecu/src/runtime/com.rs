@@ -1,5 +1,6 @@
-//! The real com layer: iceoryx2 subscribers, the diagnostics publisher and an optional
-//! CAN port.
+//! The real com layer: iceoryx2 subscribers (object list, crash accelerometer, safing
+//! accelerometer — each on its own service), the diagnostics publisher and an optional CAN
+//! port.
 //!
 //! Inputs are polled on the cycle thread (iceoryx2 `receive()` does not allocate).
 //! Diagnostics are *not* loaned on the cycle thread: iceoryx2 0.10's `loan_uninit`
@@ -18,7 +19,7 @@ use std::time::Duration;
 
 use ipc::{
     AccelSubscriber, CrashAccelSample, DiagnosticsPublisher, EcuDiagnostics, IpcError, IpcNode,
-    ObjectState, ObjectSubscriber, RxCounters, ServiceNames, TxCounters,
+    ObjectState, ObjectSubscriber, RxCounters, SafingSubscriber, ServiceNames, TxCounters,
 };
 use triple_buffer::triple_buffer;
 
@@ -141,6 +142,9 @@ impl Drop for DiagnosticsOffload {
 pub struct IceoryxIo {
     objects: ObjectSubscriber,
     accel: AccelSubscriber,
+    /// The safing accelerometer: an independent sensor on its own service (never merged with
+    /// the crash accelerometer's).
+    safing: SafingSubscriber,
     diagnostics: triple_buffer::Input<EcuDiagnostics>,
     offload: DiagnosticsOffload,
     diagnostics_written: u64,
@@ -160,6 +164,7 @@ impl IceoryxIo {
     ) -> Result<Self, IpcError> {
         let objects = ObjectSubscriber::new(node, names)?;
         let accel = AccelSubscriber::new(node, names)?;
+        let safing = SafingSubscriber::new(node, names)?;
         let (input, output) = triple_buffer(&EcuDiagnostics::ZERO);
         let offload = DiagnosticsOffload::spawn(
             format!("{}-diag", node.name().as_str()),
@@ -170,6 +175,7 @@ impl IceoryxIo {
         Ok(Self {
             objects,
             accel,
+            safing,
             diagnostics: input,
             offload,
             diagnostics_written: 0,
@@ -186,6 +192,11 @@ impl IceoryxIo {
     /// Accelerometer receive counters.
     pub fn accel_counters(&self) -> RxCounters {
         self.accel.counters()
+    }
+
+    /// Safing accelerometer receive counters.
+    pub fn safing_counters(&self) -> RxCounters {
+        self.safing.counters()
     }
 
     /// Records written by the cycle (every call of `publish_diagnostics`).
@@ -222,10 +233,10 @@ impl CycleIo for IceoryxIo {
         self.accel.drain(f)
     }
 
-    fn drain_safing(&mut self, _f: &mut dyn FnMut(&CrashAccelSample)) -> usize {
-        // Placeholder until the safing subscriber lands (issue 20): no safing data, so the
-        // safing function never agrees and nothing can fire.
-        0
+    fn drain_safing(&mut self, f: &mut dyn FnMut(&CrashAccelSample)) -> usize {
+        // The same poll-only drain as the crash accelerometer's: no allocation, no lock, no
+        // wait; a receive error ends the drain and is counted (`receive_errors().safing`).
+        self.safing.drain(f)
     }
 
     fn drain_can(&mut self, f: &mut dyn FnMut(&RawFrame)) -> usize {
@@ -277,7 +288,7 @@ impl CycleIo for IceoryxIo {
         ReceiveErrors {
             objects: self.objects.counters().errors,
             accel: self.accel.counters().errors,
-            safing: 0,
+            safing: self.safing.counters().errors,
         }
     }
 }

@@ -106,6 +106,10 @@ pub struct IpcStatus {
     pub accel_rx: u64,
     /// Accelerometer receive errors.
     pub accel_rx_errors: u64,
+    /// Safing accelerometer batches received.
+    pub safing_rx: u64,
+    /// Safing accelerometer receive errors.
+    pub safing_rx_errors: u64,
     /// Diagnostics records written by the cycle.
     pub diagnostics_written: u64,
     /// Diagnostics records sent over iceoryx2 (newest-wins; ≤ written).
@@ -225,12 +229,14 @@ impl<'a> TimingReport<'a> {
         if let Some(ipc) = &self.ipc {
             let _ = writeln!(
                 s,
-                "  iceoryx2 [{}]: objects rx {} (err {}), accel rx {} (err {}), diagnostics written {} tx {} (err {}), stale nodes cleaned {}",
+                "  iceoryx2 [{}]: objects rx {} (err {}), accel rx {} (err {}), safing rx {} (err {}), diagnostics written {} tx {} (err {}), stale nodes cleaned {}",
                 ipc.service_prefix,
                 ipc.object_rx,
                 ipc.object_rx_errors,
                 ipc.accel_rx,
                 ipc.accel_rx_errors,
+                ipc.safing_rx,
+                ipc.safing_rx_errors,
                 ipc.diagnostics_written,
                 ipc.diagnostics_tx,
                 ipc.diagnostics_tx_errors,

@@ -267,6 +267,15 @@ pub enum EventSensor {
 }
 
 impl EventSensor {
+    /// The name used in scenario files (`all`, `crash`, `safing`).
+    pub fn name(self) -> &'static str {
+        match self {
+            EventSensor::All => "all",
+            EventSensor::Crash => "crash",
+            EventSensor::Safing => "safing",
+        }
+    }
+
     /// True if `sensor` sees events of this reach.
     pub fn reaches(self, sensor: AccelSensor) -> bool {
         match self {
