@@ -274,7 +274,7 @@ fn worst_lateness_of_the_earliest_plan_ms() -> f64 {
     let cfg = restraint::CycleConfig::default();
     let table = diagram::Diagram::load("../data/default.lut").expect("shipped table");
     let mut worst = f64::NEG_INFINITY;
-    for (closing_kph, opponent_kg) in [40.0, 60.0, 80.0, 108.0]
+    for (closing_kph, opponent_kg) in [40.0, 60.0, 80.0, 100.0]
         .into_iter()
         .flat_map(|v| [(v, 800.0), (v, 3000.0)])
     {

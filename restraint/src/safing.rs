@@ -55,8 +55,6 @@ pub struct Safing {
     run: u32,
     /// Closed until this time (set when the closing event ended), ns.
     closed_until_ns: Option<u64>,
-    /// Time of the newest sample, ns.
-    last_ns: u64,
 }
 
 impl Safing {
@@ -68,14 +66,20 @@ impl Safing {
             closed: false,
             run: 0,
             closed_until_ns: None,
-            last_ns: 0,
         }
     }
 
-    /// The plausible samples of one safing batch, in time order.
+    /// The plausible samples of one safing batch, in time order. A quiet batch (every sample
+    /// below the wake threshold, no event in progress) only keeps its last reading for the
+    /// next trapezoid — every cycle of a drive, what the sample loop would do.
     pub fn on_batch(&mut self, batch: &PlausibleBatch) {
+        if !self.onset.awake() && batch.all_below(self.params.onset.wake_mps2) {
+            if let Some(last) = batch.last_decel_mps2() {
+                self.onset.note_quiet(last);
+            }
+            return;
+        }
         for s in batch.iter() {
-            self.last_ns = s.t_ns;
             match self.onset.push(&self.params.onset, &s) {
                 OnsetStep::Quiet => {}
                 OnsetStep::Reset => {

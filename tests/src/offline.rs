@@ -122,6 +122,7 @@ pub fn run(scenario: &Scenario, cfg: &OfflineConfig) -> Result<OfflineRun> {
             .map_err(|e| anyhow!("{}: feeds: {e:?}", scenario.name))?;
         out.objects.iter().for_each(|o| io.push_object(*o));
         out.accel.iter().for_each(|a| io.push_accel(*a));
+        out.safing.iter().for_each(|a| io.push_safing(*a));
         out.can.iter().for_each(|f| io.push_can(*f));
         let now = START_NS + tick * MS + cfg.ecu_phase_ns;
         let info = CycleInfo {

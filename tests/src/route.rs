@@ -210,11 +210,13 @@ fn injected_flags(scenario: &sensor_feeds::Scenario) -> Vec<&'static str> {
             DropoutTarget::Vehicle => &["vehicle_input"],
             DropoutTarget::Occupant => &["occupant_input"],
             DropoutTarget::Accel => &["accel_sensor"],
+            DropoutTarget::Safing => &["safing_sensor"],
             DropoutTarget::All => &[
                 "object_input",
                 "vehicle_input",
                 "occupant_input",
                 "accel_sensor",
+                "safing_sensor",
             ],
         });
     }
