@@ -1,25 +1,25 @@
-//! Scenario player library: scenario files ([`scenario`]), the true world ([`truth`]: closed-form
-//! pre-crash kinematics + the true collision physics after contact), the sensor model
-//! ([`sensors`]: noise, bias, latency, range, dropouts; the crash and the safing
-//! accelerometer) and what the acceleration sensors see besides a crash ([`events`]:
-//! `[[accel_event]]`). The `sensor-feeds` binary plays it in real time; `actuator-stubs` and
-//! the e2e tests use the same library to know the truth.
+//! Scenario player library: plays the bench's world (the `world` crate: scenario files, the
+//! true world, the sensor models, the acceleration events) tick by tick ([`player`]). The
+//! `sensor-feeds` binary publishes it in real time over iceoryx2 and CAN; the offline bench
+//! hands the same records to the ECU core under a simulated clock.
+//!
+//! The world's modules and types are re-exported under their old paths
+//! (`sensor_feeds::scenario`, `sensor_feeds::Truth`, …): they moved to `world` (issue 21),
+//! unchanged.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-pub mod events;
 pub mod player;
-pub mod scenario;
-pub mod sensors;
-pub mod truth;
 
 pub use player::{PlayCounts, Player, TickOutput};
-pub use scenario::{Scenario, ScenarioError};
-pub use sensors::SensorModelSim;
-pub use truth::{Truth, WorldState};
+pub use world::{events, scenario, sensors, truth};
+pub use world::{Scenario, ScenarioError, SensorModelSim, Truth, WorldState};
 
 /// The bench's clock, from the one clock module of the bench processes (`host`).
 pub use host::monotonic_ns;
 /// Sleeps until CLOCK_MONOTONIC reaches `deadline_ns` (absolute: no drift accumulates).
 pub use host::sleep_through_signals_until_ns as sleep_until_ns;
+
+// A scenario name must fit the bench truth record that carries it.
+const _: () = assert!(world::scenario::NAME_CAPACITY == ipc::SCENARIO_NAME_CAPACITY);

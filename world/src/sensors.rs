@@ -16,9 +16,9 @@ use bus::codec::{
     OccupantClassificationOccupantClass,
 };
 use bus::{EgoVehicleState, EncodeError, OccupantClassification};
-use ipc::ObjectState;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use restraint::ObjectState;
 
 /// Tracker id of the opponent (one tracked object).
 pub const OPPONENT_OBJECT_ID: u32 = 7;
@@ -104,7 +104,7 @@ impl SensorModelSim {
         o.opponent_mass_kg = mass.max(1.0) as f32;
         o.opponent_mass_sigma_kg = s.mass_sigma_kg as f32;
         o.confidence = s.confidence as f32;
-        o.valid = ipc::VALID;
+        o.valid = restraint::VALID;
         Some(o)
     }
 

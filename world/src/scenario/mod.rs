@@ -11,6 +11,10 @@ mod validate;
 
 pub use location::ScenarioError;
 
+/// Longest scenario `name` [bytes]: what the bench truth record carries
+/// (`ipc::SCENARIO_NAME_CAPACITY`; `sensor-feeds` asserts the two agree at compile time).
+pub const NAME_CAPACITY: usize = 64;
+
 use serde::Deserialize;
 use std::path::Path;
 

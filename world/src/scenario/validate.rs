@@ -64,10 +64,10 @@ impl Scenario {
             }
             Ok(())
         }
-        if self.name.is_empty() || self.name.len() > ipc::SCENARIO_NAME_CAPACITY {
+        if self.name.is_empty() || self.name.len() > super::NAME_CAPACITY {
             return Err((
                 "name".into(),
-                format!("must be 1..={} bytes", ipc::SCENARIO_NAME_CAPACITY),
+                format!("must be 1..={} bytes", super::NAME_CAPACITY),
             ));
         }
         if !self

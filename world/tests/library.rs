@@ -1,8 +1,8 @@
 //! The shipped scenario library loads, and its kinematics reproduce the impact speeds the
 //! cases are named after (the paper's Taurus cases, the FMVSS 208 barrier speeds).
 
-use sensor_feeds::{Scenario, Truth};
 use std::path::PathBuf;
+use world::{Scenario, Truth};
 
 fn library() -> Vec<PathBuf> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenarios");
