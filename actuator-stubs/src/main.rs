@@ -16,11 +16,11 @@ use bus::socket::BusSocket;
 use clap::Parser;
 use host::monotonic_ns;
 use ipc::{BenchTruth, BenchTruthSubscriber, ServiceNames};
-use sensor_feeds::{Scenario, Truth};
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
+use world::{Scenario, Truth};
 
 /// Belt retractor + airbag module stubs: validate, log, act on and judge commands.
 #[derive(Parser, Debug)]

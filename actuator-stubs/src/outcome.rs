@@ -147,8 +147,8 @@ pub struct Evaluated {
 /// # Errors
 /// An occupant simulation failed (invalid settings).
 pub fn evaluate(
-    scenario: &sensor_feeds::Scenario,
-    truth: &sensor_feeds::Truth,
+    scenario: &world::Scenario,
+    truth: &world::Truth,
     modules: &crate::commands::Modules,
     contact_ns: u64,
     reference: &physics::reference::ReferenceRestraint,

@@ -2,7 +2,7 @@
 //!
 //! For every scenario of the library with a contact, under several sensor variations and
 //! noise seeds, the object list is generated with the bench's sensor model
-//! (`sensor_feeds::SensorModelSim` over the scenario's `Truth`) and fed, under a simulated
+//! (`world::SensorModelSim` over the scenario's `Truth`) and fed, under a simulated
 //! 1 kHz clock, to
 //!
 //! * **filtered**: the restraint core itself (`restraint::RestraintCycle` with `SimIo`): its
@@ -37,9 +37,9 @@ use rayon::prelude::*;
 use restraint::{
     Activity, CycleConfig, CycleInfo, ObjectState, ReferenceSettings, RestraintCycle, SimIo,
 };
-use sensor_feeds::{scenario::OpponentKind, Scenario, SensorModelSim, Truth};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+use world::{scenario::OpponentKind, Scenario, SensorModelSim, Truth};
 
 const MS: u64 = 1_000_000;
 /// CLOCK_MONOTONIC of scenario time 0 in the simulation (any value > the longest latency).
@@ -275,7 +275,7 @@ pub fn simulate(
             next_pub_s += period_s;
             if sc
                 .sensor
-                .dropped(sensor_feeds::scenario::DropoutTarget::Object, t_pub)
+                .dropped(world::scenario::DropoutTarget::Object, t_pub)
                 || rng.gen_bool(variation.drop_probability)
             {
                 continue;

@@ -2,7 +2,7 @@
 
 use lut::estimation::{self, raw_estimate, VARIATIONS};
 use restraint::{ObjectState, VALID};
-use sensor_feeds::Scenario;
+use world::Scenario;
 
 fn scenario(extra_sensor: &str) -> Scenario {
     // Two 60 km/h cars, no braking: contact when the 40 m gap closes at 33.3 m/s.

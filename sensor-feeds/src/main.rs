@@ -13,10 +13,10 @@ use ipc::{
     AccelPublisher, BenchTruth, BenchTruthPublisher, ObjectPublisher, SafingPublisher, ServiceNames,
 };
 use sensor_feeds::player::TICK_NS;
-use sensor_feeds::scenario::{AccelEvent, AccelEventKind};
 use sensor_feeds::{monotonic_ns, sleep_until_ns, Player, Scenario, TickOutput, Truth};
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
+use world::scenario::{AccelEvent, AccelEventKind};
 
 /// Scenario player: object, vehicle, occupant and crash-accelerometer feeds.
 #[derive(Parser, Debug)]

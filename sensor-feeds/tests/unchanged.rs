@@ -88,19 +88,19 @@ fn a_library_file_plays_the_same_crash_sensor_whatever_the_safing_sensor_does() 
     s.sensor.safing_rate_hz = 8000.0;
     s.sensor.safing_noise_mps2 = 20.0;
     s.sensor.safing_full_scale_g = 10.0;
-    s.sensor.dropouts.push(sensor_feeds::scenario::Dropout {
+    s.sensor.dropouts.push(world::scenario::Dropout {
         start_s: 1.0,
         end_s: 1.5,
-        target: sensor_feeds::scenario::DropoutTarget::Safing,
+        target: world::scenario::DropoutTarget::Safing,
     });
-    s.accel_events.push(sensor_feeds::scenario::AccelEvent {
-        kind: sensor_feeds::scenario::AccelEventKind::Spike,
+    s.accel_events.push(world::scenario::AccelEvent {
+        kind: world::scenario::AccelEventKind::Spike,
         start_s: 1.6,
         peak_g: Some(40.0),
         duration_ms: None,
         rms_g: None,
         end_s: None,
-        sensor: sensor_feeds::scenario::EventSensor::Safing,
+        sensor: world::scenario::EventSensor::Safing,
     });
     s.validate().expect("valid");
     assert_eq!(fingerprint(&s), want);

@@ -149,8 +149,7 @@ pub fn run_host_timing(cfg: &HostTimingConfig) -> Result<HostTiming> {
             .spawn()
             .context("starting the ECU")?;
         std::thread::sleep(Duration::from_millis(300));
-        let scenario =
-            sensor_feeds::Scenario::load(&run.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let scenario = world::Scenario::load(&run.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
         let mut feeds = crate::feeds_command(&run, None)
             .stdout(Stdio::piped())
             .spawn()

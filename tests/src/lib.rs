@@ -54,7 +54,7 @@ pub fn fault_seen(changes: &[(f64, Vec<String>)], flag: &str, from_ms: f64) -> F
 /// `faults` are the EcuStatus flag changes in ms relative to the contact, which came at
 /// `contact_s` scenario seconds (None: no contact, so nothing before it).
 pub fn accel_fault_before_contact(
-    scenario: &sensor_feeds::Scenario,
+    scenario: &world::Scenario,
     faults: &[(f64, Vec<String>)],
     contact_s: Option<f64>,
 ) -> bool {
@@ -128,7 +128,7 @@ pub struct RunCtx<'a> {
     /// The run's configuration.
     pub cfg: &'a RunConfig,
     /// The scenario being played.
-    pub scenario: &'a sensor_feeds::Scenario,
+    pub scenario: &'a world::Scenario,
     /// The run's output folder.
     pub dir: PathBuf,
     /// CLOCK_MONOTONIC ns of scenario t = 0 (the feeds' `--epoch-ns`).
@@ -483,8 +483,7 @@ pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
 
 /// Runs one scenario through the real processes, disturbed by `dist`.
 pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunResult> {
-    let scenario =
-        sensor_feeds::Scenario::load(&cfg.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let scenario = world::Scenario::load(&cfg.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
     let dir = cfg.out.join(&scenario.name);
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     for stale in [
@@ -678,7 +677,7 @@ fn ms(v: Option<f64>) -> String {
 
 /// The readable summary of one run.
 pub fn summarise(
-    scenario: &sensor_feeds::Scenario,
+    scenario: &world::Scenario,
     r: &Report,
     ecu: Option<&serde_json::Value>,
     dir: &Path,

@@ -18,7 +18,8 @@ use actuator_stubs::outcome::{evaluate, Evaluated};
 use actuator_stubs::status::{ecu_fault_names, ecu_mode_name};
 use anyhow::{anyhow, Result};
 use restraint::{Activity, CycleConfig, CycleInfo, RestraintCycle, SimIo};
-use sensor_feeds::{Player, Scenario, TickOutput, Truth};
+use sensor_feeds::{Player, TickOutput};
+use world::{Scenario, Truth};
 
 /// Scenario time 0 on the simulated clock [ns] (any value clear of 0).
 const START_NS: u64 = 1_000_000_000;

@@ -11,10 +11,10 @@
 
 use actuator_stubs::report::Report;
 use e2e_tests::{harness, FIRE_LATE_ALLOWANCE_MS};
-use sensor_feeds::Scenario;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
+use world::Scenario;
 
 /// ECU `object_timeout_ms` (ecu/ecu.toml default) + one EcuStatus period (20 ms).
 const DOCUMENTED_FALLBACK_MS: f64 = 120.0;
@@ -244,7 +244,7 @@ fn avoided_collision_fires_no_airbag_and_releases_the_pretensioner() {
 fn dropout_degrades_to_the_reference_restraint_within_the_documented_time() {
     let (s, r) = load("sensor-dropout");
     let start_s = s.sensor.dropouts.first().expect("dropout window").start_s;
-    let tc_s = sensor_feeds::Truth::new(&s)
+    let tc_s = world::Truth::new(&s)
         .expect("truth")
         .contact_s
         .expect("contact");

@@ -12,9 +12,9 @@
 //!   the reference does not.
 
 use e2e_tests::offline::{run, table_row, OfflineConfig, OfflineRun, TABLE_HEADER};
-use sensor_feeds::Scenario;
 use std::fmt::Write as _;
 use std::path::PathBuf;
+use world::Scenario;
 
 fn root() -> PathBuf {
     e2e_tests::repo_root()
