@@ -1,4 +1,4 @@
-//! The scenario parser and validator of the bench (`sensor_feeds::Scenario::parse`) on
+//! The scenario parser and validator of the bench (`world::Scenario::parse`) on
 //! arbitrary text. Oracles beyond "no panic / no hang": errors render (Display), an error
 //! carrying a line number points inside the text, and parsing is deterministic.
 #![no_main]
@@ -9,9 +9,9 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    match sensor_feeds::Scenario::parse("fuzz.toml", text) {
+    match world::Scenario::parse("fuzz.toml", text) {
         // (Not compared with ==: a float field may legitimately hold NaN, NaN != NaN.)
-        Ok(_) => assert!(sensor_feeds::Scenario::parse("fuzz.toml", text).is_ok()),
+        Ok(_) => assert!(world::Scenario::parse("fuzz.toml", text).is_ok()),
         Err(e) => {
             let _ = e.to_string();
             if let Some(line) = e.line {
