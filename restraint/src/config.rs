@@ -123,8 +123,11 @@ pub struct CycleConfig {
     /// An event that does not reach it fires no pretensioner (a bump that the generic
     /// thresholds confirm is not a crash that needs one).
     pub pretensioner_dv_mps: [f64; crate::fallback::KNOTS],
-    /// The pretensioner's severity floor, m/s (*default* 0.8), with the same persistence rule
-    /// as `fallback_min_dv_mps`.
+    /// The pretensioner's severity floor, m/s (*default* 1.0), with the same persistence rule
+    /// as `fallback_min_dv_mps`. Why 1.0 and not lower: a pothole through the wheels carries
+    /// up to ≈ 1.2 m/s in the misuse matrix and a rough road one sensor's noise; at 0.8 they
+    /// fired the pretensioner, at 1.0 with the loading rule none does (`misuse-matrix`),
+    /// while the low-speed crashes it is meant for still reach it in time.
     pub pretensioner_min_dv_mps: f64,
     /// Prediction-matched confirmation: besides the onset ramp fitting the prediction, the
     /// velocity change since the onset must reach this, m/s, with the deceleration staying
@@ -134,6 +137,14 @@ pub struct CycleConfig {
     /// a crash of the table's range reaches 0.3 m/s 4–6 ms after contact, within the
     /// table's fire-delay tolerance of a +3 ms airbag.
     pub match_min_dv_mps: f64,
+    /// Every path's deciding sample must find the event still *loading*: its smoothed
+    /// deceleration (0.25 ms) at least this fraction of its peak since the onset
+    /// (`restraint::confirm::Loading`; *default* 0.85; 0 switches the rule off). Why: a crash's
+    /// deceleration rises as long as the structures are crushed (the force–deflection curves
+    /// only rise), so the rule costs a real crash nothing; a pothole, kerb strike or door slam
+    /// is a pulse that has peaked and is falling by the time it carries a floor's Δv. It lifts
+    /// the no-fire limit of a half-sine misuse pulse from the floor f to ≈ 1.3 f.
+    pub loading_fraction: f64,
 
     /// Safing channel (`safing`): its events begin at this deceleration, g (*default* 1.5).
     pub safing_wake_g: f64,
@@ -214,8 +225,9 @@ impl Default for CycleConfig {
             fallback_dv_mps: crate::fallback::DEFAULT_DV_MPS,
             fallback_min_dv_mps: 1.0,
             pretensioner_dv_mps: crate::fallback::DEFAULT_PRETENSIONER_DV_MPS,
-            pretensioner_min_dv_mps: 0.8,
+            pretensioner_min_dv_mps: 1.0,
             match_min_dv_mps: 0.3,
+            loading_fraction: 0.85,
             safing_wake_g: 1.5,
             safing_dv_mps: 0.2,
             safing_hold_ms: 20.0,
@@ -303,6 +315,7 @@ impl CycleConfig {
             20.0,
         )?;
         range("match_min_dv_mps", self.match_min_dv_mps, 0.0, 5.0)?;
+        range("loading_fraction", self.loading_fraction, 0.0, 1.0)?;
         range("safing_wake_g", self.safing_wake_g, 0.1, 50.0)?;
         range("safing_dv_mps", self.safing_dv_mps, 0.01, 5.0)?;
         range("safing_hold_ms", self.safing_hold_ms, 0.0, 1_000.0)?;
@@ -363,6 +376,7 @@ impl CycleConfig {
             ratio_min: self.match_ratio_min,
             ratio_max: self.match_ratio_max,
             min_dv_mps: self.match_min_dv_mps,
+            loading_fraction: self.loading_fraction,
         }
     }
 
@@ -372,6 +386,7 @@ impl CycleConfig {
             min_dv_mps: self.fallback_min_dv_mps,
             decel_mps2: self.confirm_decel_g * G_MPS2,
             samples: self.confirm_samples,
+            loading_fraction: self.loading_fraction,
         }
     }
 

@@ -106,6 +106,58 @@ impl Onset {
     }
 }
 
+/// Time constant of the deceleration that [`Loading`] smooths, s (0.25 ms: one to two samples
+/// of the 4 kHz sensor, enough that its noise of 0.5 m/s² cannot pull a 4 g pulse under 85 %
+/// of its peak, short enough not to carry a 5–15 ms pulse's crest past its fall — at 0.5 ms
+/// the lag let kerb strikes at a predicted contact decide before they were seen falling).
+pub const LOADING_SMOOTHING_S: f64 = 0.25e-3;
+
+/// Whether an event's deceleration is still *loading*: its smoothed value is still close to
+/// the highest it reached since the onset.
+///
+/// Why it discriminates: in a crash the compartment's deceleration is the contact force over
+/// the ego mass, and the force grows with the crush as long as the structures are loaded (the
+/// force–deflection curves only rise), so it does not fall during the tens of ms in which the
+/// restraint is decided. A misuse event of the whole car — pothole, kerb strike, door slam,
+/// hammer blow — is a short pulse that has peaked and is falling by the time it has carried
+/// the velocity change a decision needs. A decision that also requires "still loading"
+/// ([`Loading::holds`]) therefore costs a real crash nothing and lifts the no-fire limit of
+/// a half-sine misuse pulse (total Δv = 2·peak·duration/π) from the Δv floor f to
+/// 2f / (1 + √(1 − k²)): the pulse still holds k of its peak at most until sin θ = k past its
+/// crest, where it has carried (1 + √(1 − k²))/2 of its Δv. For the default k = 0.85 that is
+/// 1.31 f (less the smoothing's lag; tests in `fallback`, and `misuse-matrix`).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Loading {
+    smooth_mps2: f64,
+    peak_mps2: f64,
+}
+
+impl Loading {
+    /// Starts a new event at its first (wake-up) sample.
+    pub fn start(&mut self, decel_mps2: f64) {
+        *self = Self {
+            smooth_mps2: decel_mps2,
+            peak_mps2: decel_mps2,
+        };
+    }
+
+    /// One more sample of the event (`dt_s`: its interval; non-finite or non-positive
+    /// intervals leave the state unchanged).
+    pub fn push(&mut self, decel_mps2: f64, dt_s: f64) {
+        let a = dt_s / (LOADING_SMOOTHING_S + dt_s);
+        if a.is_finite() && a > 0.0 && decel_mps2.is_finite() {
+            self.smooth_mps2 += a * (decel_mps2 - self.smooth_mps2);
+            self.peak_mps2 = self.peak_mps2.max(self.smooth_mps2);
+        }
+    }
+
+    /// The smoothed deceleration is at least `fraction` of its peak since the onset (a
+    /// `fraction` ≤ 0 always holds: the rule switched off).
+    pub fn holds(&self, fraction: f64) -> bool {
+        fraction <= 0.0 || self.smooth_mps2 >= fraction * self.peak_mps2
+    }
+}
+
 /// Crash confirmation from the compartment accelerometer: deceleration over a threshold for
 /// N consecutive samples AND Δv integrated since wake-up over a threshold. Both are needed: the
 /// persistence rejects spikes, the Δv rejects short high-g events (door slam, pothole) that

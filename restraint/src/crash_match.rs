@@ -36,12 +36,20 @@
 use physics::{CollisionInput, CombinedSpring, ExactCollision};
 
 use crate::accel::AccelSample;
-use crate::confirm::{ConfirmParams, Onset, OnsetStep};
+use crate::confirm::{ConfirmParams, Loading, Onset, OnsetStep};
 
 /// Largest residual rms of the ramp fit, as a fraction of the fitted rise over the window.
 pub const FIT_TOLERANCE: f64 = 0.2;
 /// The ramp window ends at this fraction of the predicted first-knee time.
 const KNEE_FRACTION: f64 = 0.9;
+/// Once matched, every further sample must read at least this fraction of the fitted ramp
+/// at its time (inside the ramp window) or at the knee (after it): the predicted crash keeps
+/// rising along its ramp until the knee and its force only grows with the crush after it,
+/// while a pothole or kerb strike that began like it has crested and falls away from the
+/// line (a half-sine is at 0.45 of its extrapolated initial ramp when it has carried two
+/// thirds of its Δv). The sensor's noise (0.5 m/s² at 4 kHz) is a few per cent of the ramp
+/// by then.
+pub const RAMP_HOLD: f64 = 0.8;
 
 /// Matching settings in the matcher's units.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -61,6 +69,10 @@ pub struct MatchParams {
     /// Δv since the onset a matched pulse must reach before it confirms, m/s (the severity
     /// floor: a kerb strike at the predicted contact ramps like the crash for 2 ms).
     pub min_dv_mps: f64,
+    /// At the confirming sample the pulse must still be loading ([`Loading::holds`] with this
+    /// fraction; 0 = off): a kerb strike that ramps like the predicted crash has peaked and
+    /// falls before it carries the floor's Δv, the predicted crash keeps rising.
+    pub loading_fraction: f64,
 }
 
 /// The prediction frozen at the wake-up.
@@ -227,9 +239,12 @@ pub struct PulseMatch {
     prediction: PredictedPulse,
     frozen: bool,
     fit: LineFit,
+    loading: Loading,
     state: MatchState,
     /// The ramp matched; waiting for the severity floor (state stays `Fitting`).
     matched: Option<SeverityEstimate>,
+    /// The matched ramp (slope m/s² per ms, intercept m/s², x in ms since the wake-up).
+    ramp: (f64, f64),
 }
 
 impl PulseMatch {
@@ -241,8 +256,10 @@ impl PulseMatch {
             prediction: PredictedPulse::EMPTY,
             frozen: false,
             fit: LineFit::default(),
+            loading: Loading::default(),
             state: MatchState::Idle,
             matched: None,
+            ramp: (0.0, 0.0),
         }
     }
 
@@ -284,11 +301,14 @@ impl PulseMatch {
                 self.state = MatchState::Idle;
                 self.frozen = false;
                 self.matched = None;
+                self.ramp = (0.0, 0.0);
                 return;
             }
             OnsetStep::Woke => {
                 self.fit = LineFit::default();
+                self.loading.start(s.decel_mps2);
                 self.matched = None;
+                self.ramp = (0.0, 0.0);
                 self.frozen = freeze(&mut self.prediction);
                 self.state = if self.frozen {
                     MatchState::Fitting
@@ -296,7 +316,7 @@ impl PulseMatch {
                     MatchState::Idle
                 };
             }
-            OnsetStep::Awake => {}
+            OnsetStep::Awake => self.loading.push(s.decel_mps2, s.dt_s),
         }
         if self.state != MatchState::Fitting {
             return;
@@ -309,14 +329,23 @@ impl PulseMatch {
             self.state = MatchState::Mismatch(Mismatch::Shape);
             return;
         }
-        if let Some(e) = self.matched {
-            self.state = self.hold_for_floor(e, wake_ns, s.t_ns);
-            return;
-        }
         let x_ms = s.t_ns.saturating_sub(wake_ns) as f64 * 1e-6;
         // Time since the (predicted-slope) contact: the ramp ends at the first knee.
         let tau_ms = x_ms + self.params.onset.wake_mps2 / p.slope_mps2_per_ms;
         let in_ramp = tau_ms <= KNEE_FRACTION * p.knee_ms;
+        if let Some(e) = self.matched {
+            // The fitted ramp up to the knee, and its value at the knee after it: the
+            // predicted crash's force only grows with the crush.
+            let (j, b) = self.ramp;
+            let x_knee_ms = KNEE_FRACTION * p.knee_ms - (tau_ms - x_ms);
+            let line_mps2 = j * x_ms.min(x_knee_ms) + b;
+            self.state = if s.decel_mps2 < RAMP_HOLD * line_mps2 {
+                MatchState::Mismatch(Mismatch::Shape)
+            } else {
+                self.hold_for_floor(e, wake_ns, s.t_ns)
+            };
+            return;
+        }
         if in_ramp {
             self.fit.push(x_ms, s.decel_mps2);
         }
@@ -326,6 +355,9 @@ impl PulseMatch {
             self.state = match self.decide(p, wake_ns, s.t_ns) {
                 MatchState::Confirmed(e) => {
                     self.matched = Some(e);
+                    if let Some((j, b, _)) = self.fit.solve() {
+                        self.ramp = (j, b);
+                    }
                     self.hold_for_floor(e, wake_ns, s.t_ns)
                 }
                 other => other,
@@ -334,10 +366,13 @@ impl PulseMatch {
     }
 
     /// A matched ramp confirms once the velocity change since the onset reaches the floor
-    /// (the deceleration staying above the wake threshold meanwhile, checked by the caller);
-    /// an event that has not reached it within the match window is not this crash.
+    /// (the deceleration staying above the wake threshold meanwhile, checked by the caller)
+    /// while the pulse is still loading; a pulse that stops loading first, or has not reached
+    /// the floor within the match window, is not this crash.
     fn hold_for_floor(&self, e: SeverityEstimate, wake_ns: u64, t_ns: u64) -> MatchState {
-        if self.onset.delta_v_mps() >= self.params.min_dv_mps {
+        if !self.loading.holds(self.params.loading_fraction) {
+            MatchState::Mismatch(Mismatch::Shape)
+        } else if self.onset.delta_v_mps() >= self.params.min_dv_mps {
             MatchState::Confirmed(SeverityEstimate {
                 confirm_ns: t_ns,
                 ..e
@@ -406,6 +441,7 @@ mod tests {
             ratio_min: 0.5,
             ratio_max: 2.5,
             min_dv_mps: 0.0,
+            loading_fraction: 0.85,
         }
     }
 

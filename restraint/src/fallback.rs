@@ -21,7 +21,7 @@
 //! speed and structure; a light opponent's crash ends early and stays under the boundary.
 
 use crate::accel::AccelSample;
-use crate::confirm::{ConfirmParams, Onset, OnsetStep};
+use crate::confirm::{ConfirmParams, Loading, Onset, OnsetStep};
 use crate::settings::ConfigError;
 
 /// Number of threshold knots (0, 4, … 60 ms).
@@ -117,6 +117,10 @@ pub struct FireFloor {
     pub decel_mps2: f64,
     /// See `decel_mps2`.
     pub samples: u32,
+    /// The deciding sample's smoothed deceleration must still be at least this fraction of
+    /// its peak since the onset ([`Loading`]: a crash is still loading its structures, a
+    /// pothole or door slam that has carried this much Δv is already falling). 0 = off.
+    pub loading_fraction: f64,
 }
 
 /// State of the accelerometer-only algorithm (one event at a time; the decision belongs to
@@ -126,6 +130,7 @@ pub struct FallbackAlgorithm {
     thresholds: [f64; KNOTS],
     floor: FireFloor,
     onset: Onset,
+    loading: Loading,
     run: u32,
     decision: FallbackDecision,
 }
@@ -137,6 +142,7 @@ impl FallbackAlgorithm {
             thresholds,
             floor,
             onset: Onset::default(),
+            loading: Loading::default(),
             run: 0,
             decision: FallbackDecision::Pending,
         }
@@ -157,8 +163,9 @@ impl FallbackAlgorithm {
             OnsetStep::Woke => {
                 self.decision = FallbackDecision::Pending;
                 self.run = 0;
+                self.loading.start(s.decel_mps2);
             }
-            OnsetStep::Awake => {}
+            OnsetStep::Awake => self.loading.push(s.decel_mps2, s.dt_s),
         }
         self.run = if s.decel_mps2 >= self.floor.decel_mps2 {
             self.run.saturating_add(1)
@@ -178,6 +185,7 @@ impl FallbackAlgorithm {
         } else if dv >= threshold_mps(&self.thresholds, tau_ms)
             && dv >= self.floor.min_dv_mps
             && self.run >= self.floor.samples
+            && self.loading.holds(self.floor.loading_fraction)
         {
             self.decision = FallbackDecision::Fire {
                 at_ns: s.t_ns,
@@ -227,6 +235,7 @@ mod tests {
         min_dv_mps: 0.0,
         decel_mps2: 0.0,
         samples: 1,
+        loading_fraction: 0.0,
     };
 
     fn floor() -> FireFloor {
@@ -234,6 +243,7 @@ mod tests {
             min_dv_mps: 1.0,
             decel_mps2: 4.0 * G_MPS2,
             samples: 3,
+            loading_fraction: 0.85,
         }
     }
 
@@ -357,6 +367,77 @@ mod tests {
             .fire_of(6),
             None
         );
+    }
+
+    /// Feeds a half-sine of `peak_g` × `dur_ms` (8 kHz) starting at 10 ms; returns the
+    /// decision and the ramp's own fire time when it fired.
+    fn half_sine(f: &mut FallbackAlgorithm, peak_g: f64, dur_ms: f64) -> FallbackDecision {
+        for k in 0..1200u64 {
+            let x = (k as f64 * 0.125 - 10.0) / dur_ms;
+            let g = if (0.0..=1.0).contains(&x) {
+                peak_g * (core::f64::consts::PI * x).sin()
+            } else {
+                0.0
+            };
+            f.push(
+                &params(),
+                &AccelSample {
+                    t_ns: 1_000_000_000 + k * 125_000,
+                    dt_s: 125e-6,
+                    decel_mps2: g * G_MPS2,
+                },
+            );
+        }
+        f.decision()
+    }
+
+    #[test]
+    fn a_pulse_that_has_peaked_cannot_decide_and_a_rising_one_decides_as_before() {
+        // Oracle (closed form, `Loading` docs): a half-sine of total Δv D = 2·A·T/π still
+        // holds k = 0.85 of its crest until it has carried (1 + √(1 − k²))/2 = 0.764 D. With
+        // the floor f = 1.0 m/s and the boundary out of the way (flat 0.05 m/s) it can decide
+        // only if 0.764 D ≥ 1.0, i.e. D ≥ 1.31 m/s; without the rule, from D ≥ 1.0 m/s.
+        let flat = [0.05; KNOTS];
+        let mut no_rule = floor();
+        no_rule.loading_fraction = 0.0;
+        for (peak_g, dur_ms) in [(15.0, 12.0), (12.0, 15.0), (10.0, 18.0), (20.0, 9.0)] {
+            let dv = 2.0 * peak_g * G_MPS2 * dur_ms * 1e-3 / core::f64::consts::PI;
+            assert!(
+                (1.10..1.28).contains(&dv),
+                "{peak_g} g × {dur_ms} ms: Δv {dv}"
+            );
+            let with = half_sine(&mut FallbackAlgorithm::new(flat, floor()), peak_g, dur_ms);
+            let without = half_sine(&mut FallbackAlgorithm::new(flat, no_rule), peak_g, dur_ms);
+            assert!(
+                !matches!(with, FallbackDecision::Fire { .. }),
+                "{peak_g} × {dur_ms}: {with:?}"
+            );
+            assert!(
+                matches!(without, FallbackDecision::Fire { .. }),
+                "{peak_g} × {dur_ms}: {without:?}"
+            );
+        }
+        // Well above the limit (D ≈ 1.6 m/s) the pulse decides while still near its crest.
+        let d = half_sine(&mut FallbackAlgorithm::new(flat, floor()), 20.0, 13.0);
+        assert!(matches!(d, FallbackDecision::Fire { .. }), "{d:?}");
+        // A rising pulse (a crash's ramp, 2 g/ms) decides at the same sample with the rule
+        // as without it.
+        let ramp = |fl: FireFloor| {
+            let mut f = FallbackAlgorithm::new(flat, fl);
+            for k in 0..400u64 {
+                f.push(
+                    &params(),
+                    &AccelSample {
+                        t_ns: 1_000_000_000 + k * 125_000,
+                        dt_s: 125e-6,
+                        decel_mps2: (2.0 * k as f64 * 0.125).min(25.0) * G_MPS2,
+                    },
+                );
+            }
+            f.decision()
+        };
+        assert_eq!(ramp(floor()), ramp(no_rule));
+        assert!(matches!(ramp(floor()), FallbackDecision::Fire { .. }));
     }
 
     #[test]

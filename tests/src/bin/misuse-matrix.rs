@@ -12,7 +12,8 @@
 //!
 //! | family | what | range |
 //! |---|---|---|
-//! | pothole | half-sine, both sensors, driving 30–110 km/h, no object | 3–15 g × 5–20 ms |
+//! | pothole | half-sine, both sensors, driving 30–110 km/h, no object | 3–15 g × 5–20 ms, Δv ≤ 1.2 m/s (below) |
+//! | ghost-object-and-pothole | an object on collision course (closing 40–110 km/h) that vanishes 1–300 ms before the predicted contact (a radar ghost or an opponent that swerves), and a pothole from 0.1 s before it vanishes to 50 ms after the predicted contact: misuse during PRE-CRASH | as pothole |
 //! | kerb-strike | half-sine, both sensors, driving, no object | 3–12 g × 2–8 ms |
 //! | kerb-at-predicted-contact | a head-on approach (closing 40–110 km/h) whose opponent swerves 1 ms before the predicted contact, and a kerb strike at that instant | 3–10 g × 2–6 ms |
 //! | door-slam | half-sine, both sensors, car standing | 10–50 g × 1–3 ms |
@@ -20,9 +21,24 @@
 //! | spike | one sample on the crash sensor, the safing sensor or both | 10–200 g |
 //! | rough-road | band-limited random, both sensors, driving | 0.5–3 g rms for 0.3–0.6 s |
 //! | crash-sensor-offset / safing-sensor-offset | one sensor's reading shifted | 2–20 g for 50–500 ms |
-//! | crash-sensor-dead | the crash accelerometer's batches stop (dropout), driving | — |
+//! | crash-sensor-dead / safing-sensor-dead | that accelerometer's batches stop (dropout), driving | — |
+//! | sensor-stuck | the crash or the safing sensor stuck at its last reading or saturated at full scale (deceleration), driving | 50–500 ms |
+//! | sensor-noisy | one sensor (crash or safing) reads band-limited random acceleration (5–40 Hz), driving | 1–10 g rms for 0.1–0.5 s |
 //! | no-fire-crash | rigid barrier, object list dead or alive | 8–16 km/h (EBS below the 20 km/h no-fire line) |
-//! | must-fire-crash | rigid barrier 35–56 km/h or an equal car head-on at 70–112 km/h closing (EBS 35–56 km/h, above the must-fire line of `lut study fallback`) | — |
+//! | must-fire-crash / must-fire-car | rigid barrier 35–56 km/h or an equal car head-on at 70–112 km/h closing (EBS 35–56 km/h, above the must-fire line of `lut study fallback`) | — |
+//! | must-fire-misreported | car-to-car, opponent 1000–2800 kg, speeds for an ego EBS of 35–56 km/h; the object sensor's mass off by ±1200 kg or its closing speed by ±5 m/s | — |
+//! | must-fire-safing-dead | barrier 35–56 km/h with the safing accelerometer dead from 0.2 s (the decided fallback: the CAN vehicle deceleration stands in for it) | — |
+//!
+//! **Pothole.** The peak and duration describe what the ECU's sensors see (the tunnel adds
+//! structural amplification to the wheel's load path), but the velocity change a pothole takes
+//! out of the whole car is bounded by that load path: both front wheels at a severe abuse load
+//! of about 4 g of their static corner load each (≈ 17 kN per wheel for 1785 kg, the order of
+//! the longitudinal pothole load cases of suspension durability design), for at most the
+//! ≈ 20 ms in which a tyre passes the hole's edge at 30 km/h, give 2 · 17 kN · 20 ms / 1785 kg
+//! ≈ 0.4 m/s; the rear axle meets the edge one wheelbase later (> 90 ms), a separate event.
+//! The family keeps a threefold margin over that bound: variants are drawn from the peak ×
+//! duration range until their Δv (2·peak·duration/π) is at most 1.2 m/s — a half-sine of
+//! 15 g × 20 ms (Δv 1.9 m/s, 6.7 km/h) is a crash pulse, not a pothole.
 //!
 //! Required fire time of a must-fire crash: the classic "127 mm − 30 ms" criterion — the instant
 //! a free-flying (unbelted) occupant has moved 127 mm relative to the compartment in the TRUE
@@ -79,8 +95,9 @@ enum Requirement {
     MustFire,
 }
 
-const FAMILIES: [(&str, Requirement); 13] = [
+const FAMILIES: [(&str, Requirement); 19] = [
     ("pothole", Requirement::NoFire),
+    ("ghost-object-and-pothole", Requirement::NoFire),
     ("kerb-strike", Requirement::NoFire),
     ("kerb-at-predicted-contact", Requirement::NoFire),
     ("door-slam", Requirement::NoFire),
@@ -90,9 +107,14 @@ const FAMILIES: [(&str, Requirement); 13] = [
     ("crash-sensor-offset", Requirement::NoFire),
     ("safing-sensor-offset", Requirement::NoFire),
     ("crash-sensor-dead", Requirement::NoFire),
+    ("safing-sensor-dead", Requirement::NoFire),
+    ("sensor-stuck", Requirement::NoFire),
+    ("sensor-noisy", Requirement::NoFire),
     ("no-fire-crash", Requirement::NoAirbag),
     ("must-fire-crash", Requirement::MustFire),
     ("must-fire-car", Requirement::MustFire),
+    ("must-fire-misreported", Requirement::MustFire),
+    ("must-fire-safing-dead", Requirement::MustFire),
 ];
 
 /// A driving car with no object in range (a barrier 900 m ahead, beyond the 80 m sensor range), `event` appended.
@@ -104,6 +126,21 @@ fn driving(name: &str, seed: u64, speed_kph: f64, duration_s: f64, event: &str) 
          [sensor]\nmass_estimate_kg = 3000\n\
          [occupant]\nmass_kg = 75\nchest_to_wheel_mm = 300\nbelted = true\n{event}"
     )
+}
+
+/// Largest velocity change a pothole can take out of the car, m/s: the wheel-load path bound
+/// (module docs, "Pothole") with a threefold margin.
+const POTHOLE_MAX_DV_MPS: f64 = 1.2;
+
+/// A pothole as the ECU sees it: peak 3–15 g, 5–20 ms, drawn until its velocity change
+/// 2·peak·duration/π is at most [`POTHOLE_MAX_DV_MPS`].
+fn pothole(r: &mut ChaCha8Rng) -> (f64, f64) {
+    loop {
+        let (g, ms): (f64, f64) = (r.gen_range(3.0..15.0), r.gen_range(5.0..20.0));
+        if 2.0 * g * 9.806_65 * ms * 1e-3 / std::f64::consts::PI <= POTHOLE_MAX_DV_MPS {
+            return (g, ms);
+        }
+    }
 }
 
 fn half_sine(start_s: f64, peak_g: f64, ms: f64, sensor: &str) -> String {
@@ -120,13 +157,10 @@ fn variant(family: &str, i: u64, seed: u64) -> String {
     let t0 = r.gen_range(0.30..0.50);
     let drive = |r: &mut ChaCha8Rng| r.gen_range(30.0..110.0);
     match family {
-        "pothole" => driving(
-            &name,
-            i,
-            drive(&mut r),
-            0.8,
-            &half_sine(t0, r.gen_range(3.0..15.0), r.gen_range(5.0..20.0), "all"),
-        ),
+        "pothole" => {
+            let (g, ms) = pothole(&mut r);
+            driving(&name, i, drive(&mut r), 0.8, &half_sine(t0, g, ms, "all"))
+        }
         "kerb-strike" => driving(
             &name,
             i,
@@ -209,6 +243,89 @@ fn variant(family: &str, i: u64, seed: u64) -> String {
                 s = s.replace("[sensor]\n", "[sensor]\ndropouts = [{ start_s = 0.2, end_s = 100.0, target = \"object\" }]\n");
             }
             s
+        }
+        "sensor-stuck" => {
+            let sensor = ["crash", "safing"][r.gen_range(0..2)];
+            let kind = ["stuck", "saturated"][r.gen_range(0..2)];
+            let len = r.gen_range(0.05..0.5);
+            let s = driving(&name, i, drive(&mut r), 1.0, "");
+            s.replace(
+                "[sensor]\n",
+                &format!(
+                    "[sensor]\naccel_faults = [{{ start_s = {t0}, end_s = {}, kind = \"{kind}\", sensor = \"{sensor}\" }}]\n",
+                    t0 + len
+                ),
+            )
+        }
+        "sensor-noisy" => {
+            let sensor = ["crash", "safing"][r.gen_range(0..2)];
+            let (rms, len) = (r.gen_range(1.0..10.0), r.gen_range(0.1..0.5));
+            driving(&name, i, drive(&mut r), 1.0, &format!(
+                "[[accel_event]]\nkind = \"rough_road\"\nstart_s = {t0}\nrms_g = {rms}\nend_s = {}\nsensor = \"{sensor}\"\n",
+                t0 + len))
+        }
+        "safing-sensor-dead" => {
+            let s = driving(&name, i, drive(&mut r), 1.0, "");
+            s.replace(
+                "[sensor]\n",
+                &format!(
+                    "[sensor]\ndropouts = [{{ start_s = {t0}, end_s = 100.0, target = \"safing\" }}]\n"
+                ),
+            )
+        }
+        "ghost-object-and-pothole" => {
+            // An object on collision course that vanishes before the predicted contact (a
+            // radar ghost, or an opponent that swerves away) while the car meets a pothole
+            // anywhere from 0.1 s before the object vanishes to 50 ms after the predicted
+            // contact: misuse during PRE-CRASH.
+            let v = r.gen_range(20.0..55.0); // each car, km/h
+            let tc = r.gen_range(0.45..0.6);
+            let d = 2.0 * v / 3.6 * tc;
+            let evade = tc - r.gen_range(0.001..0.3);
+            let at = r.gen_range(evade - 0.1..tc + 0.05);
+            let (g, ms) = pothole(&mut r);
+            format!(
+                "name = \"{name}\"\nseed = {i}\nduration_s = {}\n\
+                 [ego]\nmass_kg = 1785\nclass = 4\nspeed_kph = {v}\n\
+                 [opponent]\nkind = \"vehicle\"\nmass_kg = {}\nspeed_kph = {v}\ninitial_distance_m = {d}\nevade_s = {evade}\n\
+                 [occupant]\nmass_kg = 75\nchest_to_wheel_mm = 300\nbelted = true\n{}",
+                tc + 0.3, r.gen_range(1000.0..2500.0), half_sine(at, g, ms, "all"))
+        }
+        "must-fire-safing-dead" => {
+            // The decided behaviour with a dead safing channel: the crash sensor's algorithm
+            // alone may not fire, the CAN-deceleration backup confirms (README, "Safing").
+            let v = r.gen_range(35.0..56.0);
+            let tc = r.gen_range(0.35..0.5);
+            driving(&name, i, v, tc + 0.25, "")
+                .replace(
+                    "initial_distance_m = 900.0",
+                    &format!("initial_distance_m = {}", v / 3.6 * tc),
+                )
+                .replace(
+                    "[sensor]\n",
+                    "[sensor]\ndropouts = [{ start_s = 0.2, end_s = 100.0, target = \"safing\" }]\n",
+                )
+        }
+        "must-fire-misreported" => {
+            // Car-to-car, opponent 1000–2800 kg, speeds chosen for an ego EBS of 35–56 km/h
+            // (plastic impact: ego Δv = closing · m_opp / (m_ego + m_opp)), with the object
+            // sensor's mass off by up to ±1200 kg or its closing speed by up to ±5 m/s.
+            let m_opp = r.gen_range(1000.0..2800.0);
+            let ebs = r.gen_range(35.0..56.0);
+            let v = ebs * (1785.0 + m_opp) / m_opp / 2.0; // each car, km/h
+            let tc = r.gen_range(0.35..0.5);
+            let (mass_bias, speed_bias) = if r.gen_bool(0.5) {
+                (r.gen_range(-1200.0..1200.0), 0.0)
+            } else {
+                (0.0, r.gen_range(-5.0..5.0))
+            };
+            format!(
+                "name = \"{name}\"\nseed = {i}\nduration_s = {}\n\
+                 [ego]\nmass_kg = 1785\nclass = 4\nspeed_kph = {v}\n\
+                 [opponent]\nkind = \"vehicle\"\nmass_kg = {m_opp}\nclass = 4\nspeed_kph = {v}\ninitial_distance_m = {}\n\
+                 [sensor]\nmass_bias_kg = {mass_bias}\nspeed_bias_mps = {speed_bias}\n\
+                 [occupant]\nmass_kg = 75\nchest_to_wheel_mm = 300\nbelted = true\n",
+                tc + 0.25, 2.0 * v / 3.6 * tc)
         }
         "must-fire-car" => {
             let v = r.gen_range(35.0..56.0); // each car, km/h: EBS = v
