@@ -145,6 +145,11 @@ pub struct CycleConfig {
     /// is a pulse that has peaked and is falling by the time it carries a floor's Δv. It lifts
     /// the no-fire limit of a half-sine misuse pulse from the floor f to ≈ 1.3 f.
     pub loading_fraction: f64,
+    /// The accelerometers' anti-alias group delay, ms (*default* 0.70: the ADXL180's
+    /// third-order Bessel low-pass at 400 Hz, as `world::lowpass` models it): a measured
+    /// onset is this much later than the contact that caused it, so the crash phase dates
+    /// the contact this much earlier and the plan's fire times keep their meaning.
+    pub accel_delay_ms: f64,
 
     /// Safing channel (`safing`): its events begin at this deceleration, g (*default* 1.5).
     pub safing_wake_g: f64,
@@ -228,6 +233,7 @@ impl Default for CycleConfig {
             pretensioner_min_dv_mps: 1.0,
             match_min_dv_mps: 0.3,
             loading_fraction: 0.85,
+            accel_delay_ms: 0.70,
             safing_wake_g: 1.5,
             safing_dv_mps: 0.2,
             safing_hold_ms: 20.0,
@@ -316,6 +322,7 @@ impl CycleConfig {
         )?;
         range("match_min_dv_mps", self.match_min_dv_mps, 0.0, 5.0)?;
         range("loading_fraction", self.loading_fraction, 0.0, 1.0)?;
+        range("accel_delay_ms", self.accel_delay_ms, 0.0, 5.0)?;
         range("safing_wake_g", self.safing_wake_g, 0.1, 50.0)?;
         range("safing_dv_mps", self.safing_dv_mps, 0.01, 5.0)?;
         range("safing_hold_ms", self.safing_hold_ms, 0.0, 1_000.0)?;

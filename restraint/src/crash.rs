@@ -48,8 +48,12 @@ pub enum ConfirmKind {
 pub struct Confirmation {
     /// When it was confirmed (sample or frame time), ns.
     pub at_ns: u64,
-    /// The contact instant it implies (measured onset; for the backup the predicted contact), ns.
+    /// The contact instant it implies, ns: the measured onset less the accelerometer's
+    /// filter delay (`accel_delay_ms`); for the backup the predicted contact.
     pub contact_ns: u64,
+    /// The accelerometer event it belongs to (its wake-up sample, ns; the backup's: the
+    /// predicted contact): the conventional path's decisions are matched to it.
+    pub onset_ns: u64,
     /// The path.
     pub kind: ConfirmKind,
 }
@@ -75,6 +79,8 @@ pub struct CrashMonitor {
     pretensioner: FallbackAlgorithm,
     window_ns: u64,
     backup_decel_mps2: f64,
+    /// The accelerometers' anti-alias group delay, ns: a measured onset is this late.
+    accel_delay_ns: u64,
     confirmation: Option<Confirmation>,
 }
 
@@ -90,6 +96,7 @@ impl CrashMonitor {
             pretensioner: FallbackAlgorithm::new(cfg.pretensioner_dv_mps, cfg.pretensioner_floor()),
             window_ns: ms_to_ns(cfg.match_window_ms),
             backup_decel_mps2: cfg.backup_confirm_g * G_MPS2,
+            accel_delay_ns: ms_to_ns(cfg.accel_delay_ms),
             confirmation: None,
         }
     }
@@ -145,7 +152,8 @@ impl CrashMonitor {
         if let MatchState::Confirmed(e) = self.matcher.state() {
             self.confirmation = Some(Confirmation {
                 at_ns: e.confirm_ns,
-                contact_ns: e.onset_ns,
+                contact_ns: e.onset_ns.saturating_sub(self.accel_delay_ns),
+                onset_ns: e.onset_ns,
                 kind: ConfirmKind::Matched(e),
             });
         } else if let (Some(at_ns), Some(onset)) =
@@ -153,7 +161,8 @@ impl CrashMonitor {
         {
             self.confirmation = Some(Confirmation {
                 at_ns,
-                contact_ns: onset,
+                contact_ns: onset.saturating_sub(self.accel_delay_ns),
+                onset_ns: onset,
                 kind: ConfirmKind::Generic {
                     prediction_refuted: matches!(self.matcher.state(), MatchState::Mismatch(_)),
                 },
@@ -183,6 +192,7 @@ impl CrashMonitor {
             self.confirmation = Some(Confirmation {
                 at_ns: rx_ns,
                 contact_ns: sit.contact_ns,
+                onset_ns: sit.contact_ns,
                 kind: ConfirmKind::Backup,
             });
         }

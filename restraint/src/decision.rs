@@ -127,6 +127,8 @@ pub struct Decision {
     airbag_fired: bool,
     armed: bool,
     contact_ns: Option<u64>,
+    /// The accelerometer event of the crash phase (`Confirmation::onset_ns`).
+    event_onset_ns: u64,
     gate: AirbagGate,
     /// The pyrotechnic pretensioner's gate in the crash phase.
     pt_gate: AirbagGate,
@@ -171,6 +173,7 @@ impl Decision {
             airbag_fired: false,
             armed: false,
             contact_ns: None,
+            event_onset_ns: 0,
             gate: AirbagGate::Decided,
             pt_gate: AirbagGate::Decided,
             safing_wait_ns: ms_to_ns(cfg.safing_wait_ms),
@@ -276,6 +279,7 @@ impl Decision {
         self.gate = gate;
         self.crash_fired = false;
         self.contact_ns = Some(contact);
+        self.event_onset_ns = c.onset_ns;
         self.armed = true;
         // The conventional path's pretensioner has its own boundary (like the airbag); the
         // adaptive and backup paths fire it as planned. Either way only with safing.
@@ -303,7 +307,7 @@ impl Decision {
         }
         let contact = self.contact_ns.unwrap_or(now);
         let window_over = now > at(contact, (WINDOW_MS + 1.0) as f32);
-        match (fallback.fire_of(contact), fallback) {
+        match (fallback.fire_of(self.event_onset_ns), fallback) {
             (Some(t), _) if self.crash_plan.airbag_fires() => {
                 self.airbag_fire_at_ns = Some(at(contact, self.crash_plan.airbag_time_ms).max(t));
                 self.gate = AirbagGate::Decided;
@@ -324,7 +328,7 @@ impl Decision {
         }
         let contact = self.contact_ns.unwrap_or(now);
         let window_over = now > at(contact, (WINDOW_MS + 1.0) as f32);
-        match (decision.fire_of(contact), decision) {
+        match (decision.fire_of(self.event_onset_ns), decision) {
             (Some(t), _) => {
                 self.pretensioner_at_ns =
                     Some(at(contact, self.crash_plan.pretensioner_time_ms).max(t));

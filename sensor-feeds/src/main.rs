@@ -99,6 +99,13 @@ fn describe_event(i: usize, e: &AccelEvent) -> String {
             e.peak_g.unwrap_or(0.0),
             e.end_s.unwrap_or(0.0)
         ),
+        AccelEventKind::Ringing => format!(
+            "ringing ±{} g at {} Hz × {} ms, net Δv {} m/s",
+            e.peak_g.unwrap_or(0.0),
+            e.frequency_hz.unwrap_or(0.0),
+            e.duration_ms.unwrap_or(0.0),
+            e.net_dv_mps.unwrap_or(0.0)
+        ),
     };
     format!(
         "accel_event[{i}]: {what} from {:.4} s on {}",

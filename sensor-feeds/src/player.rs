@@ -421,13 +421,14 @@ mod tests {
         (crash, safing)
     }
 
-    /// A player whose sensors read the truth exactly (no noise; constant speeds: 0 m/s² until
-    /// the contact at 2.0 s) plus `events` (`[[accel_event]]` tables).
+    /// A player whose sensors read the truth exactly (no noise, no anti-alias filter — it is
+    /// tested in `world::lowpass`; constant speeds: 0 m/s² until the contact at 2.0 s) plus
+    /// `events` (`[[accel_event]]` tables).
     fn quiet(events: &str) -> Player {
         let text = format!(
             "name = \"t\"\nduration_s = 2\n[ego]\nmass_kg = 1785\nspeed_kph = 36\n\
              [opponent]\nkind = \"vehicle\"\nmass_kg = 1500\nspeed_kph = 36\ninitial_distance_m = 40\n\
-             [sensor]\naccel_noise_mps2 = 0\nsafing_noise_mps2 = 0\n[occupant]\nmass_kg = 75\n{events}"
+             [sensor]\naccel_noise_mps2 = 0\nsafing_noise_mps2 = 0\naccel_lowpass_hz = 0\n[occupant]\nmass_kg = 75\n{events}"
         );
         let s = Scenario::parse("t.toml", &text).expect("valid");
         Player::new(Truth::new(&s).expect("truth"), 1_000, 1.0, 0)
@@ -694,7 +695,7 @@ mod tests {
 
     #[test]
     fn an_offset_shifts_the_mean_of_its_sensor_inside_its_window() {
-        let text = "[sensor]\naccel_noise_mps2 = 2\nsafing_noise_mps2 = 2\n";
+        let text = "[sensor]\naccel_noise_mps2 = 2\nsafing_noise_mps2 = 2\naccel_lowpass_hz = 0\n";
         let base = |events: &str| {
             let t = format!(
                 "name = \"t\"\nduration_s = 2\n[ego]\nmass_kg = 1785\nspeed_kph = 36\n\
@@ -739,7 +740,7 @@ mod tests {
             let text = format!(
                 "name = \"t\"\nduration_s = 1.3\n[ego]\nmass_kg = 1785\nspeed_kph = 40\n\
                  [opponent]\nkind = \"vehicle\"\nmass_kg = 1785\nspeed_kph = 40\ninitial_distance_m = 22.2222222\n\
-                 [occupant]\nmass_kg = 75\n{events}"
+                 [sensor]\naccel_lowpass_hz = 0\n[occupant]\nmass_kg = 75\n{events}"
             );
             let s = Scenario::parse("t.toml", &text).expect("valid");
             play(

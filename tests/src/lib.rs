@@ -9,6 +9,7 @@
 
 pub mod faults;
 pub mod host_timing;
+pub mod misuse;
 pub mod offline;
 pub mod route;
 pub mod timeline;

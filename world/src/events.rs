@@ -13,6 +13,14 @@
 //! | `spike` | the first sample at or after `start_s` reads `−peak_g·g` (replaces the reading) |
 //! | `rough_road` | band-limited random signal with `rms_g` over `[start_s, end_s)`, added ([`ROUGH_ROAD_BAND_HZ`]) |
 //! | `offset` | `−peak_g·g` over `[start_s, end_s)`, added |
+//! | `ringing` | `d/dt[−peak_g·g/ω · sin(ωτ + φ) · sin²(πτ/T)] − (π·net_dv/2T) · sin(πτ/T)` for `τ = t − start_s ∈ [0, T]`, `T = duration_ms`, `ω = 2π·frequency_hz`, `φ = phase_deg`: zero-mean ringing (≈ `peak_g` at its crests when ω ≫ π/T) over a rigid-body pulse that carries exactly `net_dv_mps`, added |
+//!
+//! Why `ringing` is written as a derivative: the ringing is the acceleration of a velocity
+//! wiggle that starts and ends at rest (`sin²` is 0 at both ends), so its integral — the
+//! velocity change it gives the car — is exactly zero whatever the frequency, phase or
+//! envelope; what the car's speed changes by is `net_dv_mps` alone, the bound a misuse
+//! contact's impulse sets (Δv = J / m). A one-signed `half_sine` instead moves the whole car
+//! by its area (2·peak·duration/π).
 
 use crate::scenario::{AccelEvent, AccelEventKind, AccelSensor, EventSensor, Scenario};
 use physics::defaults::STANDARD_GRAVITY_MPS2 as G;
@@ -66,6 +74,37 @@ enum Signal {
         end_s: f64,
         shift_mps2: f64,
     },
+    Ringing(Ringing),
+}
+
+/// A `ringing` event, prepared (module docs).
+#[derive(Clone, Copy, Debug)]
+struct Ringing {
+    start_s: f64,
+    duration_s: f64,
+    /// Ringing amplitude [m/s², negative = deceleration first].
+    amp_mps2: f64,
+    omega_rad_s: f64,
+    phase_rad: f64,
+    /// Peak of the rigid-body half-sine [m/s², negative = deceleration].
+    body_peak_mps2: f64,
+}
+
+impl Ringing {
+    fn at(&self, t_s: f64) -> Option<f64> {
+        let tau = t_s - self.start_s;
+        if !(tau >= -EDGE_S && tau <= self.duration_s + EDGE_S) {
+            return None;
+        }
+        let tau = tau.clamp(0.0, self.duration_s);
+        let k = std::f64::consts::PI / self.duration_s;
+        let (s1, c1) = (k * tau).sin_cos();
+        let window = s1 * s1;
+        let window_rate = k * 2.0 * s1 * c1;
+        let (sw, cw) = (self.omega_rad_s * tau + self.phase_rad).sin_cos();
+        let ringing = self.amp_mps2 * (cw * window + sw * window_rate / self.omega_rad_s);
+        Some(ringing + self.body_peak_mps2 * s1)
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -131,6 +170,7 @@ impl AccelEvents {
                     end_s,
                     shift_mps2,
                 } => (t_s >= start_s - EDGE_S && t_s < end_s - EDGE_S).then_some(*shift_mps2),
+                Signal::Ringing(r) => r.at(t_s),
                 Signal::Spike { .. } => None,
             };
             if let Some(v) = v {
@@ -138,6 +178,33 @@ impl AccelEvents {
             }
         }
         sum
+    }
+
+    /// The longest substep [s] that resolves what the additive events reaching `sensor` put
+    /// into `[t0_s, t1_s]` for the accelerometers' anti-alias filter ([`crate::lowpass`]):
+    /// a twentieth of a half-sine's or a ringing envelope's length, a twelfth of a ringing's
+    /// period, a rough road's grid step; [`crate::lowpass::DEFAULT_STEP_S`] when none is active.
+    pub fn finest_step_s(&self, sensor: AccelSensor, t0_s: f64, t1_s: f64) -> f64 {
+        let overlaps = |a: f64, b: f64| a <= t1_s + EDGE_S && b >= t0_s - EDGE_S;
+        let mut step = crate::lowpass::DEFAULT_STEP_S;
+        for e in self.events.iter().filter(|e| e.reach.reaches(sensor)) {
+            let s = match &e.signal {
+                Signal::HalfSine {
+                    start_s,
+                    duration_s,
+                    ..
+                } if overlaps(*start_s, start_s + duration_s) => duration_s / 20.0,
+                Signal::Ringing(r) if overlaps(r.start_s, r.start_s + r.duration_s) => {
+                    (r.duration_s / 20.0).min(std::f64::consts::TAU / (12.0 * r.omega_rad_s))
+                }
+                Signal::RoughRoad { start_s, end_s, .. } if overlaps(*start_s, *end_s) => {
+                    1.0 / ROUGH_ROAD_GRID_HZ
+                }
+                _ => continue,
+            };
+            step = step.min(s);
+        }
+        step
     }
 
     /// The reading of a spike that replaces `sensor`'s sample at `t_s`, whose samples are
@@ -168,6 +235,18 @@ fn prepare(scenario: &Scenario, index: usize, e: &AccelEvent) -> Signal {
             duration_s: e.duration_ms.unwrap_or(1.0) * 1e-3,
             peak_mps2,
         },
+        AccelEventKind::Ringing => {
+            let duration_s = e.duration_ms.unwrap_or(1.0) * 1e-3;
+            Signal::Ringing(Ringing {
+                start_s: e.start_s,
+                duration_s,
+                amp_mps2: peak_mps2,
+                omega_rad_s: 2.0 * std::f64::consts::PI * e.frequency_hz.unwrap_or(1.0),
+                phase_rad: e.phase_deg.unwrap_or(0.0).to_radians(),
+                body_peak_mps2: -e.net_dv_mps.unwrap_or(0.0) * std::f64::consts::PI
+                    / (2.0 * duration_s),
+            })
+        }
         AccelEventKind::Spike => Signal::Spike {
             start_s: e.start_s,
             value_mps2: peak_mps2,
@@ -338,5 +417,50 @@ mod tests {
         let inside = &t[..4000];
         let rms = (inside.iter().map(|v| v * v).sum::<f64>() / 4000.0).sqrt();
         assert!((rms - 2.0 * G).abs() < 1e-9, "{rms}");
+    }
+
+    /// The velocity change a `ringing` event gives the car is its `net_dv_mps` and nothing
+    /// more, at any frequency and phase (trapezoid over a grid 200× finer than the carrier),
+    /// and its crests reach `peak_g` (+ the body pulse) — checked against the closed forms.
+    #[test]
+    fn ringing_carries_exactly_its_net_dv_and_reaches_its_peak() {
+        for (f_hz, phase_deg, net_dv, peak_g, ms) in [
+            (300.0, 0.0, 0.0, 20.0, 30.0),
+            (4000.0, 0.0, 0.0, 45.0, 25.0),
+            (4000.0, 90.0, 0.3, 45.0, 4.0),
+            (8000.0, 33.0, -0.2, 30.0, 3.0),
+            (150.0, 180.0, 0.6, 5.0, 20.0),
+        ] {
+            let r = Ringing {
+                start_s: 0.1,
+                duration_s: ms * 1e-3,
+                amp_mps2: -peak_g * G,
+                omega_rad_s: 2.0 * std::f64::consts::PI * f_hz,
+                phase_rad: f64::to_radians(phase_deg),
+                body_peak_mps2: -net_dv * std::f64::consts::PI / (2.0 * ms * 1e-3),
+            };
+            let h = 1.0 / (200.0 * f_hz);
+            let n = (ms * 1e-3 / h).ceil() as usize + 1;
+            let (mut dv, mut prev, mut peak) = (0.0, r.at(0.1).unwrap_or(0.0), 0.0_f64);
+            for k in 1..=n {
+                let a = r.at(0.1 + k as f64 * h).unwrap_or(0.0);
+                dv += 0.5 * (a + prev) * h;
+                peak = peak.max(a.abs());
+                prev = a;
+            }
+            let body = (net_dv * std::f64::consts::PI / (2.0 * ms * 1e-3)).abs();
+            assert!(
+                (-dv - net_dv).abs() < 1e-4,
+                "{f_hz} Hz {phase_deg}°: Δv {} for {net_dv}",
+                -dv
+            );
+            assert!(
+                peak <= peak_g * G * 1.05 + body && peak >= peak_g * G * 0.9,
+                "{f_hz} Hz: peak {} g for {peak_g} g",
+                peak / G
+            );
+            assert_eq!(r.at(0.1 - 1e-6), None);
+            assert_eq!(r.at(0.1 + ms * 1e-3 + 1e-6), None);
+        }
     }
 }

@@ -11,6 +11,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod events;
+pub mod lowpass;
 pub mod scenario;
 pub mod sensors;
 pub mod truth;

@@ -9,6 +9,7 @@
 //! `[[accel_event]]` entries that reach them ([`crate::events`]).
 
 use crate::events::AccelEvents;
+use crate::lowpass::AntiAlias;
 use crate::scenario::{AccelSensor, BrakeStateName, Scenario};
 use crate::truth::Truth;
 use bus::codec::{
@@ -33,6 +34,8 @@ pub struct SensorModelSim {
     rng: ChaCha8Rng,
     safing_rng: ChaCha8Rng,
     events: AccelEvents,
+    /// The anti-alias filters of the crash and the safing accelerometer.
+    lowpass: [AntiAlias; 2],
     object_sequence: u64,
 }
 
@@ -51,6 +54,7 @@ impl SensorModelSim {
         safing_rng.set_stream(SAFING_STREAM);
         SensorModelSim {
             events: AccelEvents::new(truth.scenario()),
+            lowpass: [(); 2].map(|_| AntiAlias::new(truth.scenario().sensor.accel_lowpass_hz)),
             truth,
             rng: ChaCha8Rng::seed_from_u64(seed),
             safing_rng,
@@ -127,21 +131,30 @@ impl SensorModelSim {
         self.reading_mps2(AccelSensor::Safing, t_s)
     }
 
-    /// `sensor`'s reading at `t_s` [m/s²] (one noise draw from its stream per call).
+    /// `sensor`'s reading at `t_s` [m/s²] (one noise draw from its stream per call): the
+    /// true acceleration and the events it sees, through the sensor's anti-alias low-pass
+    /// ([`crate::lowpass`], stepped from this sensor's previous reading), plus the sensor's
+    /// noise, clipped to its range. Readings of one sensor come in time order (an earlier one
+    /// restarts its filter, as a restarted feed does).
     pub fn reading_mps2(&mut self, sensor: AccelSensor, t_s: f64) -> f64 {
-        let w = self.truth.state(t_s);
         let (_, noise_sd, full_scale_g) = self.truth.scenario().sensor.accel_params(sensor);
-        let rng = match sensor {
-            AccelSensor::Crash => &mut self.rng,
-            AccelSensor::Safing => &mut self.safing_rng,
+        let (rng, filter) = match sensor {
+            AccelSensor::Crash => (&mut self.rng, &mut self.lowpass[0]),
+            AccelSensor::Safing => (&mut self.safing_rng, &mut self.lowpass[1]),
         };
         let full_scale = full_scale_g * physics::defaults::STANDARD_GRAVITY_MPS2;
         let noise = noise_sd * gauss(rng);
-        let mut a = w.ego_accel_mps2;
-        // Only when an event is active: otherwise the sum is the one it always was, bit for bit.
-        if let Some(e) = self.events.added_mps2(sensor, t_s) {
-            a += e;
-        }
+        let (truth, events) = (&self.truth, &self.events);
+        let input = |t: f64| {
+            let a = truth.ego_accel_mps2(t);
+            // Only when an event is active: otherwise the sum is the one it always was.
+            match events.added_mps2(sensor, t) {
+                Some(e) => a + e,
+                None => a,
+            }
+        };
+        let step_s = events.finest_step_s(sensor, t_s - 0.02, t_s);
+        let a = filter.read(t_s, step_s, input);
         (a + noise).clamp(-full_scale, full_scale)
     }
 

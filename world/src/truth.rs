@@ -209,6 +209,15 @@ impl Truth {
         }
     }
 
+    /// The ego compartment's true acceleration at `t_s` [m/s²] (= `state(t_s).ego_accel_mps2`,
+    /// without the rest of the state: the accelerometers' filter reads it on substeps).
+    pub fn ego_accel_mps2(&self, t_s: f64) -> f64 {
+        match self.contact_s {
+            Some(tc) if t_s >= tc => self.pulse_at(self.pulse.ego_accel_mps2(), t_s - tc),
+            _ => self.ego_motion(t_s).2,
+        }
+    }
+
     fn crash_state(&self, dt: f64) -> WorldState {
         let p = &self.pulse;
         let dve = self.pulse_at(p.ego_vel_mps(), dt);

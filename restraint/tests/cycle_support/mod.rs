@@ -140,16 +140,28 @@ pub fn sync_time_us(now_ns: u64) -> u64 {
 /// noise-free samples on the motion model's own trajectory (constant closing acceleration)
 /// reproduces them exactly — every innovation is zero — so the estimate is the closed form.
 /// The knobs themselves are tested in `cycle_estimate.rs` and the filter's unit tests.
+/// The benches' accelerometer samples are ideal (no anti-alias filter), so their onset is
+/// the contact: `accel_delay_ms = 0` (`ideal_sensor_config`).
 pub fn oracle_config() -> CycleConfig {
-    let mut cfg = CycleConfig::default();
+    let mut cfg = ideal_sensor_config();
     cfg.track.contact_time_k = 0.0;
     cfg.track.mass_sigma_correlation = 1.0;
     cfg
 }
 
+/// The default configuration for a sensor without anti-alias filter: the samples these
+/// benches push are the pulse itself at their instants, so no filter delay is to be taken
+/// off the measured onset (`accel_delay_ms = 0`).
+pub fn ideal_sensor_config() -> CycleConfig {
+    CycleConfig {
+        accel_delay_ms: 0.0,
+        ..CycleConfig::default()
+    }
+}
+
 impl Bench {
     pub fn new(lut: Option<Diagram>) -> Self {
-        Self::with_config(CycleConfig::default(), lut)
+        Self::with_config(ideal_sensor_config(), lut)
     }
 
     /// A bench with [`oracle_config`].

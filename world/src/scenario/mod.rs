@@ -242,6 +242,14 @@ pub enum AccelEventKind {
     /// The reading shifted by `peak_g` over `[start_s, end_s)` (a biased sensor, or with
     /// `sensor = "all"` a sustained body acceleration).
     Offset,
+    /// A misuse event as physics makes it: zero-mean structural ringing of amplitude `peak_g`
+    /// at `frequency_hz` under a Hann envelope of `duration_ms`, starting at `phase_deg`
+    /// (default 0: a crest at `start_s`), over a one-signed rigid-body pulse (a half-sine of the
+    /// same duration) that carries the event's net velocity change `net_dv_mps` (default 0,
+    /// + = the car slows down). The ringing integrates to exactly zero, so the event changes
+    /// the car's speed by `net_dv_mps` and nothing more — the bound its contact's impulse sets
+    /// (`net_dv = J / m`; `world::events` and `../shared/misuse-envelopes.md`).
+    Ringing,
 }
 
 impl AccelEventKind {
@@ -252,6 +260,7 @@ impl AccelEventKind {
             AccelEventKind::Spike => "spike",
             AccelEventKind::RoughRoad => "rough_road",
             AccelEventKind::Offset => "offset",
+            AccelEventKind::Ringing => "ringing",
         }
     }
 }
@@ -291,9 +300,11 @@ impl EventSensor {
 }
 
 /// One `[[accel_event]]`: what the acceleration sensors see besides a crash. Which keys a kind
-/// needs (and which it rejects) is checked by validation: `peak_g` for `half_sine`, `spike`
-/// and `offset`; `duration_ms` for `half_sine` only; `rms_g` for `rough_road` only; `end_s` for
-/// `rough_road` and `offset`. Signs as the crash: `peak_g > 0` is a deceleration.
+/// needs (and which it rejects) is checked by validation: `peak_g` for `half_sine`, `spike`,
+/// `offset` and `ringing`; `duration_ms` for `half_sine` and `ringing`; `rms_g` for
+/// `rough_road` only; `end_s` for `rough_road` and `offset`; `frequency_hz` (required),
+/// `net_dv_mps` and `phase_deg` (optional) for `ringing` only. Signs as the crash:
+/// `peak_g > 0` is a deceleration.
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct AccelEvent {
@@ -304,8 +315,14 @@ pub struct AccelEvent {
     /// Peak deceleration of a half-sine, the reading of a spike, the shift of an offset [g]
     /// (+ = deceleration).
     pub peak_g: Option<f64>,
-    /// Length of a half-sine [ms].
+    /// Length of a half-sine or of a ringing's envelope [ms].
     pub duration_ms: Option<f64>,
+    /// Ringing frequency [Hz] (`ringing`).
+    pub frequency_hz: Option<f64>,
+    /// Net velocity change of a `ringing` event [m/s, + = the car slows down; default 0].
+    pub net_dv_mps: Option<f64>,
+    /// Phase of a `ringing` event's carrier at `start_s` [deg; default 0: a crest].
+    pub phase_deg: Option<f64>,
     /// Root mean square of a rough road over its window [g].
     pub rms_g: Option<f64>,
     /// End of a rough road or offset [s after scenario start] (exclusive).
@@ -364,6 +381,10 @@ pub struct SensorModel {
     /// Measuring range of the safing accelerometer [g]: readings are clipped to ±this, and a
     /// saturated safing sensor reads −this.
     pub safing_full_scale_g: f64,
+    /// −3 dB corner of both accelerometers' anti-alias low-pass before sampling [Hz]: a
+    /// third-order Bessel, as the ADXL180 airbag accelerometer's default (`world::lowpass`);
+    /// 0 = an ideal sampler without filter.
+    pub accel_lowpass_hz: f64,
     /// Feed dropouts.
     pub dropouts: Vec<Dropout>,
     /// Stuck object-list windows (stale data: the last sample repeated).
@@ -395,6 +416,7 @@ impl Default for SensorModel {
             safing_rate_hz: 2000.0,
             safing_noise_mps2: 1.0,
             safing_full_scale_g: 50.0,
+            accel_lowpass_hz: 400.0,
             dropouts: Vec::new(),
             freezes: Vec::new(),
             accel_faults: Vec::new(),
@@ -909,6 +931,46 @@ sensor = \"safing\"
         let inline = "accel_event = [{ kind = \"spike\", start_s = 0.5, peak_g = 0 }]\n";
         let s = Scenario::parse("x.toml", &format!("{inline}{OK}")).expect("valid");
         assert_eq!(s.accel_events[0].peak_g, Some(0.0));
+    }
+
+    #[test]
+    fn a_ringing_event_takes_its_keys_and_rejects_the_others() {
+        let ok = "[[accel_event]]\nkind = \"ringing\"\nstart_s = 0.5\npeak_g = 30\nduration_ms = 20\nfrequency_hz = 4000\n";
+        let s = Scenario::parse("x.toml", &format!("{OK}{ok}")).expect("valid");
+        let e = s.accel_events[0];
+        assert_eq!(e.kind, AccelEventKind::Ringing);
+        assert_eq!(
+            (e.frequency_hz, e.net_dv_mps, e.phase_deg),
+            (Some(4000.0), None, None)
+        );
+        let full = format!("{ok}net_dv_mps = 0.3\nphase_deg = 90\n");
+        let s = Scenario::parse("x.toml", &format!("{OK}{full}")).expect("valid");
+        assert_eq!(s.accel_events[0].net_dv_mps, Some(0.3));
+        for (text, field) in [
+            (
+                ok.replace("frequency_hz = 4000\n", ""),
+                "accel_event[0].frequency_hz",
+            ),
+            (format!("{ok}rms_g = 1\n"), "accel_event[0].rms_g"),
+            (ok.replace("4000", "0.5"), "accel_event[0].frequency_hz"),
+            (
+                format!("{ok}net_dv_mps = 30\n"),
+                "accel_event[0].net_dv_mps",
+            ),
+            (
+                EVENTS.replacen(
+                    "duration_ms = 4.0\n",
+                    "duration_ms = 4.0\nnet_dv_mps = 0.2\n",
+                    1,
+                ),
+                "accel_event[0].net_dv_mps",
+            ),
+        ] {
+            let err = Scenario::parse("x.toml", &format!("{OK}{text}"))
+                .expect_err(field)
+                .to_string();
+            assert!(err.contains(field), "{field}: {err}");
+        }
     }
 
     #[test]

@@ -9,6 +9,14 @@ use super::{AccelEvent, AccelEventKind, Braking, OpponentKind, Scenario};
 pub const EVENT_PEAK_G: (f64, f64) = (-200.0, 200.0);
 /// Range of a half-sine's `duration_ms` [ms].
 pub const EVENT_DURATION_MS: (f64, f64) = (0.1, 200.0);
+/// Range of a ringing's `peak_g` [g] (a hammer blow on the housing rings at > 1 000 g).
+pub const RINGING_PEAK_G: (f64, f64) = (-2000.0, 2000.0);
+/// Range of a ringing's `frequency_hz` [Hz].
+pub const EVENT_FREQUENCY_HZ: (f64, f64) = (1.0, 100_000.0);
+/// Range of a ringing's `net_dv_mps` [m/s].
+pub const EVENT_NET_DV_MPS: (f64, f64) = (-20.0, 20.0);
+/// Range of a ringing's `phase_deg` [deg].
+pub const EVENT_PHASE_DEG: (f64, f64) = (-360.0, 360.0);
 /// Range of a rough road's `rms_g` [g].
 pub const EVENT_RMS_G: (f64, f64) = (0.0, 20.0);
 
@@ -237,6 +245,15 @@ impl Scenario {
             1000.0,
             "g",
         )?;
+        if s.accel_lowpass_hz != 0.0 {
+            range(
+                "sensor.accel_lowpass_hz",
+                s.accel_lowpass_hz,
+                50.0,
+                2000.0,
+                "Hz (or 0: no filter)",
+            )?;
+        }
         let windows = s
             .dropouts
             .iter()
@@ -285,6 +302,14 @@ impl Scenario {
     }
 }
 
+/// Whether an `[[accel_event]]` kind takes a key.
+#[derive(Clone, Copy, PartialEq)]
+enum Key {
+    Need,
+    May,
+    No,
+}
+
 /// The checks of `accel_event[i]`: onset within the run, the kind's keys present and no
 /// other kind's, ranges, `end_s` after `start_s`.
 fn validate_event(i: usize, e: &AccelEvent, duration_s: f64) -> Result<(), (String, String)> {
@@ -298,25 +323,31 @@ fn validate_event(i: usize, e: &AccelEvent, duration_s: f64) -> Result<(), (Stri
     };
     in_range("start_s", e.start_s, (0.0, duration_s), "s (the run)")?;
     let kind = e.kind.name();
-    // Which keys the kind needs: peak_g, duration_ms, rms_g, end_s.
+    // Which keys the kind takes: peak_g, duration_ms, rms_g, end_s, frequency_hz,
+    // net_dv_mps, phase_deg (Need: required, May: optional, No: rejected).
+    use Key::{May, Need, No};
     let needs = match e.kind {
-        AccelEventKind::HalfSine => [true, true, false, false],
-        AccelEventKind::Spike => [true, false, false, false],
-        AccelEventKind::RoughRoad => [false, false, true, true],
-        AccelEventKind::Offset => [true, false, false, true],
+        AccelEventKind::HalfSine => [Need, Need, No, No, No, No, No],
+        AccelEventKind::Spike => [Need, No, No, No, No, No, No],
+        AccelEventKind::RoughRoad => [No, No, Need, Need, No, No, No],
+        AccelEventKind::Offset => [Need, No, No, Need, No, No, No],
+        AccelEventKind::Ringing => [Need, Need, No, No, Need, May, May],
     };
     let keys = [
         ("peak_g", e.peak_g),
         ("duration_ms", e.duration_ms),
         ("rms_g", e.rms_g),
         ("end_s", e.end_s),
+        ("frequency_hz", e.frequency_hz),
+        ("net_dv_mps", e.net_dv_mps),
+        ("phase_deg", e.phase_deg),
     ];
     for ((key, value), needed) in keys.into_iter().zip(needs) {
         match (value, needed) {
-            (None, true) => {
+            (None, Need) => {
                 return Err((field(key), format!("required for kind = \"{kind}\"")));
             }
-            (Some(_), false) => {
+            (Some(_), No) => {
                 return Err((
                     field(key),
                     format!("not used by kind = \"{kind}\": remove this key"),
@@ -326,13 +357,27 @@ fn validate_event(i: usize, e: &AccelEvent, duration_s: f64) -> Result<(), (Stri
         }
     }
     if let Some(v) = e.peak_g {
-        in_range("peak_g", v, EVENT_PEAK_G, "g")?;
+        let bounds = if e.kind == AccelEventKind::Ringing {
+            RINGING_PEAK_G
+        } else {
+            EVENT_PEAK_G
+        };
+        in_range("peak_g", v, bounds, "g")?;
     }
     if let Some(v) = e.duration_ms {
         in_range("duration_ms", v, EVENT_DURATION_MS, "ms")?;
     }
     if let Some(v) = e.rms_g {
         in_range("rms_g", v, EVENT_RMS_G, "g")?;
+    }
+    if let Some(v) = e.frequency_hz {
+        in_range("frequency_hz", v, EVENT_FREQUENCY_HZ, "Hz")?;
+    }
+    if let Some(v) = e.net_dv_mps {
+        in_range("net_dv_mps", v, EVENT_NET_DV_MPS, "m/s")?;
+    }
+    if let Some(v) = e.phase_deg {
+        in_range("phase_deg", v, EVENT_PHASE_DEG, "deg")?;
     }
     if let Some(end) = e.end_s {
         if !(end.is_finite() && end > e.start_s) {
