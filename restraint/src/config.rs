@@ -150,6 +150,26 @@ pub struct CycleConfig {
     /// onset is this much later than the contact that caused it, so the crash phase dates
     /// the contact this much earlier and the plan's fire times keep their meaning.
     pub accel_delay_ms: f64,
+    /// One object fault must not move a crash across the no-fire line (issue 31): a crash
+    /// the prediction matched fires before the measured pulse confirms it only when it would
+    /// be above the no-fire line even with the lightest opponent on the road
+    /// (`lightest_opponent_kg`, *default* 800 kg: a mass the object sensor misreports can be
+    /// any) and a closing speed `speed_misreport_mps` lower (*default* 5 m/s, the bound the
+    /// table is robust to); otherwise the airbag waits for the accelerometer-only boundary to
+    /// say must-fire for the event (the adaptive plan kept, its fire no earlier than the
+    /// boundary). Above ≈ 83 km/h closing nothing waits.
+    pub lightest_opponent_kg: f64,
+    /// See `lightest_opponent_kg`.
+    pub speed_misreport_mps: f64,
+    /// A tracked low-speed object (EBS below the no-fire line) whose predicted contact is
+    /// within `avoided_margin_ms` of the measured onset fires the airbag only when the event's
+    /// measured Δv exceeds the low-speed crash's own (EBS × `low_speed_dv_factor`, *default*
+    /// 1.3: restitution) plus this, m/s (*default* 1.2: the largest misuse Δv the matrix
+    /// samples, a pothole × 1.5) — a kerb or pothole inside a low-speed crash never does; a
+    /// crash far more severe than tracked still does, late.
+    pub low_speed_misuse_dv_mps: f64,
+    /// See `low_speed_misuse_dv_mps`.
+    pub low_speed_dv_factor: f64,
 
     /// Safing channel (`safing`): its events begin at this deceleration, g (*default* 1.5).
     pub safing_wake_g: f64,
@@ -234,6 +254,10 @@ impl Default for CycleConfig {
             match_min_dv_mps: 0.3,
             loading_fraction: 0.85,
             accel_delay_ms: 0.70,
+            lightest_opponent_kg: 800.0,
+            speed_misreport_mps: 5.0,
+            low_speed_misuse_dv_mps: 1.2,
+            low_speed_dv_factor: 1.3,
             safing_wake_g: 1.5,
             safing_dv_mps: 0.2,
             safing_hold_ms: 20.0,
@@ -323,6 +347,20 @@ impl CycleConfig {
         range("match_min_dv_mps", self.match_min_dv_mps, 0.0, 5.0)?;
         range("loading_fraction", self.loading_fraction, 0.0, 1.0)?;
         range("accel_delay_ms", self.accel_delay_ms, 0.0, 5.0)?;
+        range(
+            "lightest_opponent_kg",
+            self.lightest_opponent_kg,
+            100.0,
+            5000.0,
+        )?;
+        range("speed_misreport_mps", self.speed_misreport_mps, 0.0, 30.0)?;
+        range(
+            "low_speed_misuse_dv_mps",
+            self.low_speed_misuse_dv_mps,
+            0.0,
+            10.0,
+        )?;
+        range("low_speed_dv_factor", self.low_speed_dv_factor, 1.0, 3.0)?;
         range("safing_wake_g", self.safing_wake_g, 0.1, 50.0)?;
         range("safing_dv_mps", self.safing_dv_mps, 0.01, 5.0)?;
         range("safing_hold_ms", self.safing_hold_ms, 0.0, 1_000.0)?;

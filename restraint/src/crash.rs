@@ -153,7 +153,9 @@ impl CrashMonitor {
             self.confirmation = Some(Confirmation {
                 at_ns: e.confirm_ns,
                 contact_ns: e.onset_ns.saturating_sub(self.accel_delay_ns),
-                onset_ns: e.onset_ns,
+                // The conventional path's decisions belong to its own event (the same onset
+                // rule; a gated matched fire waits for them).
+                onset_ns: self.fallback.onset_ns().unwrap_or(e.onset_ns),
                 kind: ConfirmKind::Matched(e),
             });
         } else if let (Some(at_ns), Some(onset)) =
@@ -201,6 +203,11 @@ impl CrashMonitor {
     /// The latched confirmation.
     pub fn confirmation(&self) -> Option<Confirmation> {
         self.confirmation
+    }
+
+    /// The velocity change of the current accelerometer event since its onset, m/s.
+    pub fn event_dv_mps(&self) -> f64 {
+        self.fallback.event_dv_mps()
     }
 
     /// The accelerometer-only algorithm's decision on the current event.

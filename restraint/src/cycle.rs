@@ -278,6 +278,7 @@ impl Activity for RestraintCycle<'_> {
             pretensioner_fallback: self.crash.pretensioner(),
             safing,
             event_in_progress: self.crash.event_in_progress(),
+            event_dv_mps: self.crash.event_dv_mps(),
             replan: &mut replan,
         };
         self.decision.step(now, &mut x);

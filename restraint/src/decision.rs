@@ -95,6 +95,8 @@ pub(crate) struct DecisionInputs<'d> {
     pub safing: bool,
     /// An accelerometer event is still in progress.
     pub event_in_progress: bool,
+    /// The velocity change of the current accelerometer event since its onset, m/s.
+    pub event_dv_mps: f64,
     /// The table's plan for an adaptive crash at a closing speed (m/s): `None` when that
     /// severity is below the no-fire line (`crash::plan_for`).
     pub replan: &'d mut dyn FnMut(f64) -> Option<RestraintPlan>,
@@ -129,6 +131,16 @@ pub struct Decision {
     contact_ns: Option<u64>,
     /// The accelerometer event of the crash phase (`Confirmation::onset_ns`).
     event_onset_ns: u64,
+    /// A tracked low-speed crash: the airbag needs the event's Δv above this, m/s.
+    low_speed_dv_limit_mps: Option<f64>,
+    /// `CycleConfig::lightest_opponent_kg`, `speed_misreport_mps`, `ego_mass_kg`,
+    /// `no_fire_ebs_kph`, `low_speed_misuse_dv_mps`, `low_speed_dv_factor`.
+    lightest_opponent_kg: f64,
+    speed_misreport_mps: f64,
+    ego_mass_kg: f64,
+    no_fire_ebs_kph: f64,
+    low_speed_misuse_dv_mps: f64,
+    low_speed_dv_factor: f64,
     gate: AirbagGate,
     /// The pyrotechnic pretensioner's gate in the crash phase.
     pt_gate: AirbagGate,
@@ -174,6 +186,13 @@ impl Decision {
             armed: false,
             contact_ns: None,
             event_onset_ns: 0,
+            low_speed_dv_limit_mps: None,
+            lightest_opponent_kg: cfg.lightest_opponent_kg,
+            speed_misreport_mps: cfg.speed_misreport_mps,
+            ego_mass_kg: cfg.ego_mass_kg,
+            no_fire_ebs_kph: cfg.no_fire_ebs_kph,
+            low_speed_misuse_dv_mps: cfg.low_speed_misuse_dv_mps,
+            low_speed_dv_factor: cfg.low_speed_dv_factor,
             gate: AirbagGate::Decided,
             pt_gate: AirbagGate::Decided,
             safing_wait_ns: ms_to_ns(cfg.safing_wait_ms),
@@ -248,21 +267,46 @@ impl Decision {
 
     /// The crash plan and its airbag gate for confirmation `c` (table in the module docs).
     fn crash_plan_for(
-        &self,
+        &mut self,
         c: &Confirmation,
         x: &mut DecisionInputs<'_>,
     ) -> (RestraintPlan, AirbagGate) {
         let predicted = self.phase == Phase::PreCrash && !x.degraded;
         if let (ConfirmKind::Matched(e), true) = (c.kind, predicted) {
+            // A fire only the prediction justifies waits for the measured pulse unless one
+            // object fault (any mass, a closing speed `speed_misreport_mps` high) could not
+            // have lifted the crash over the no-fire line.
+            let closing = x
+                .situation
+                .map_or(0.0, |s| s.closing_speed_mps)
+                .min(e.closing_mps);
+            let worst_ebs = crate::estimate::equivalent_barrier_speed_kph(
+                (closing - self.speed_misreport_mps).max(0.0),
+                self.ego_mass_kg,
+                self.lightest_opponent_kg,
+            );
+            let gate = if worst_ebs >= self.no_fire_ebs_kph {
+                AirbagGate::Decided
+            } else {
+                AirbagGate::Fallback
+            };
             // Follows the prediction: the preset plan (the radar's speed is the better
             // estimate; the onset slope mixes speed with the structures' stiffness, which
             // differs by up to ±10 % between the classes). Departs: the re-estimated severity.
             if e.follows {
-                return (self.plan, AirbagGate::Decided);
+                return (self.plan, gate);
             }
             if let Some(plan) = (x.replan)(e.closing_mps) {
-                return (plan, AirbagGate::Decided);
+                return (plan, gate);
             }
+        }
+        // A tracked low-speed object whose predicted contact is the measured one: its own
+        // Δv (and a misuse event's on top) never fires the airbag.
+        if let Some(s) = x.situation.filter(|s| {
+            s.low_speed && s.contact_estimate_ns.abs_diff(c.contact_ns) <= self.avoided_margin_ns
+        }) {
+            self.low_speed_dv_limit_mps =
+                Some(s.ebs_kph / 3.6 * self.low_speed_dv_factor + self.low_speed_misuse_dv_mps);
         }
         if c.kind == ConfirmKind::Backup {
             return (self.reference, AirbagGate::Decided);
@@ -271,6 +315,7 @@ impl Decision {
     }
 
     fn enter_crash(&mut self, c: Confirmation, x: &mut DecisionInputs<'_>) {
+        self.low_speed_dv_limit_mps = None;
         let (plan, gate) = self.crash_plan_for(&c, x);
         let (confirm_ns, contact) = (c.at_ns, c.contact_ns);
         self.before_crash = self.phase;
@@ -301,14 +346,23 @@ impl Decision {
     /// The conventional path: the reference airbag when the accelerometer-only algorithm says
     /// must-fire for the confirmed event (and only for it); no airbag when it says no-fire,
     /// or its window has passed.
-    fn gate_airbag(&mut self, now: u64, fallback: FallbackDecision) {
+    fn gate_airbag(&mut self, now: u64, fallback: FallbackDecision, event_dv_mps: f64) {
         if self.gate != AirbagGate::Fallback {
             return;
         }
         let contact = self.contact_ns.unwrap_or(now);
         let window_over = now > at(contact, (WINDOW_MS + 1.0) as f32);
+        let below_low_speed = self
+            .low_speed_dv_limit_mps
+            .is_some_and(|limit| !(event_dv_mps > limit));
         match (fallback.fire_of(self.event_onset_ns), fallback) {
-            (Some(t), _) if self.crash_plan.airbag_fires() => {
+            (Some(_), _) if below_low_speed && !window_over => {}
+            (Some(t), _) if self.crash_plan.airbag_fires() && !below_low_speed => {
+                let t = if self.low_speed_dv_limit_mps.is_some() {
+                    t.max(now)
+                } else {
+                    t
+                };
                 self.airbag_fire_at_ns = Some(at(contact, self.crash_plan.airbag_time_ms).max(t));
                 self.gate = AirbagGate::Decided;
             }
@@ -364,7 +418,7 @@ impl Decision {
             self.enter_crash(c, x);
         }
         if self.phase == Phase::Crash {
-            self.gate_airbag(now, x.fallback);
+            self.gate_airbag(now, x.fallback, x.event_dv_mps);
             self.gate_pretensioner(now, x.pretensioner_fallback);
         }
         match self.phase {

@@ -205,6 +205,16 @@ impl FallbackAlgorithm {
     }
 
     /// An event is in progress.
+    /// The velocity change of the current event since its onset, m/s (0 when quiet).
+    pub fn event_dv_mps(&self) -> f64 {
+        if self.onset.awake() {
+            self.onset.delta_v_mps()
+        } else {
+            0.0
+        }
+    }
+
+    /// Whether an event is in progress.
     pub fn awake(&self) -> bool {
         self.onset.awake()
     }

