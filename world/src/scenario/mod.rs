@@ -245,8 +245,8 @@ pub enum AccelEventKind {
     /// A misuse event as physics makes it: zero-mean structural ringing of amplitude `peak_g`
     /// at `frequency_hz` under a Hann envelope of `duration_ms`, starting at `phase_deg`
     /// (default 0: a crest at `start_s`), over a one-signed rigid-body pulse (a half-sine of the
-    /// same duration) that carries the event's net velocity change `net_dv_mps` (default 0,
-    /// + = the car slows down). The ringing integrates to exactly zero, so the event changes
+    /// same duration) that carries the event's net velocity change `net_dv_mps` (default 0;
+    /// positive: the car slows down). The ringing integrates to exactly zero, so the event changes
     /// the car's speed by `net_dv_mps` and nothing more — the bound its contact's impulse sets
     /// (`net_dv = J / m`; `world::events` and `../shared/misuse-envelopes.md`).
     Ringing,
