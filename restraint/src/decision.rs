@@ -133,12 +133,12 @@ pub struct Decision {
     event_onset_ns: u64,
     /// A tracked low-speed crash: the airbag needs the event's Δv above this, m/s.
     low_speed_dv_limit_mps: Option<f64>,
-    /// `CycleConfig::lightest_opponent_kg`, `speed_misreport_mps`, `ego_mass_kg`,
-    /// `no_fire_ebs_kph`, `low_speed_misuse_dv_mps`, `low_speed_dv_factor`.
-    lightest_opponent_kg: f64,
-    speed_misreport_mps: f64,
-    ego_mass_kg: f64,
-    no_fire_ebs_kph: f64,
+    /// The closing speed from which one object fault (any opponent mass down to
+    /// `lightest_opponent_kg`, the closing speed `speed_misreport_mps` high) cannot have lifted
+    /// a crash over the no-fire line, m/s: a matched crash slower than this waits for the
+    /// measured pulse ([`unguarded_closing_mps`]).
+    unguarded_closing_mps: f64,
+    /// `CycleConfig::low_speed_misuse_dv_mps`, `low_speed_dv_factor`.
     low_speed_misuse_dv_mps: f64,
     low_speed_dv_factor: f64,
     gate: AirbagGate,
@@ -161,6 +161,22 @@ pub struct Decision {
 
 fn time_ms_to_ns(t_ms: f32) -> i64 {
     (f64::from(t_ms) * 1.0e6) as i64
+}
+
+/// The closing speed [m/s] at which a crash is above the no-fire line even with the lightest
+/// opponent (`lightest_opponent_kg`) and a closing speed `speed_misreport_mps` lower than
+/// measured: the EBS v·m/(m_ego + m) solved for v (`estimate::equivalent_barrier_speed_kph`),
+/// plus the misreport. −∞ when the line is at 0 (every crash is above it).
+fn unguarded_closing_mps(cfg: &CycleConfig) -> f64 {
+    if cfg.no_fire_ebs_kph <= 0.0 {
+        return f64::NEG_INFINITY;
+    }
+    let per_mps_kph = crate::estimate::equivalent_barrier_speed_kph(
+        1.0,
+        cfg.ego_mass_kg,
+        cfg.lightest_opponent_kg,
+    );
+    cfg.speed_misreport_mps + cfg.no_fire_ebs_kph / per_mps_kph
 }
 
 fn at(base_ns: u64, offset_ms: f32) -> u64 {
@@ -187,10 +203,7 @@ impl Decision {
             contact_ns: None,
             event_onset_ns: 0,
             low_speed_dv_limit_mps: None,
-            lightest_opponent_kg: cfg.lightest_opponent_kg,
-            speed_misreport_mps: cfg.speed_misreport_mps,
-            ego_mass_kg: cfg.ego_mass_kg,
-            no_fire_ebs_kph: cfg.no_fire_ebs_kph,
+            unguarded_closing_mps: unguarded_closing_mps(cfg),
             low_speed_misuse_dv_mps: cfg.low_speed_misuse_dv_mps,
             low_speed_dv_factor: cfg.low_speed_dv_factor,
             gate: AirbagGate::Decided,
@@ -274,18 +287,12 @@ impl Decision {
         let predicted = self.phase == Phase::PreCrash && !x.degraded;
         if let (ConfirmKind::Matched(e), true) = (c.kind, predicted) {
             // A fire only the prediction justifies waits for the measured pulse unless one
-            // object fault (any mass, a closing speed `speed_misreport_mps` high) could not
-            // have lifted the crash over the no-fire line.
+            // object fault could not have lifted the crash over the no-fire line.
             let closing = x
                 .situation
                 .map_or(0.0, |s| s.closing_speed_mps)
                 .min(e.closing_mps);
-            let worst_ebs = crate::estimate::equivalent_barrier_speed_kph(
-                (closing - self.speed_misreport_mps).max(0.0),
-                self.ego_mass_kg,
-                self.lightest_opponent_kg,
-            );
-            let gate = if worst_ebs >= self.no_fire_ebs_kph {
+            let gate = if closing >= self.unguarded_closing_mps {
                 AirbagGate::Decided
             } else {
                 AirbagGate::Fallback

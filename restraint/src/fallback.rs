@@ -204,14 +204,9 @@ impl FallbackAlgorithm {
         self.onset.onset_ns()
     }
 
-    /// An event is in progress.
     /// The velocity change of the current event since its onset, m/s (0 when quiet).
     pub fn event_dv_mps(&self) -> f64 {
-        if self.onset.awake() {
-            self.onset.delta_v_mps()
-        } else {
-            0.0
-        }
+        self.onset.delta_v_mps()
     }
 
     /// Whether an event is in progress.
@@ -379,26 +374,43 @@ mod tests {
         );
     }
 
-    /// Feeds a half-sine of `peak_g` × `dur_ms` (8 kHz) starting at 10 ms; returns the
-    /// decision and the ramp's own fire time when it fired.
-    fn half_sine(f: &mut FallbackAlgorithm, peak_g: f64, dur_ms: f64) -> FallbackDecision {
-        for k in 0..1200u64 {
-            let x = (k as f64 * 0.125 - 10.0) / dur_ms;
-            let g = if (0.0..=1.0).contains(&x) {
-                peak_g * (core::f64::consts::PI * x).sin()
-            } else {
-                0.0
-            };
+    /// Feeds `n` samples at 8 kHz (so short events are resolved) of the deceleration
+    /// `g_at(t_ms)`, in g; returns the decision.
+    fn feed_8khz(f: &mut FallbackAlgorithm, n: u64, g_at: impl Fn(f64) -> f64) -> FallbackDecision {
+        for k in 0..n {
             f.push(
                 &params(),
                 &AccelSample {
                     t_ns: 1_000_000_000 + k * 125_000,
                     dt_s: 125e-6,
-                    decel_mps2: g * G_MPS2,
+                    decel_mps2: g_at(k as f64 * 0.125) * G_MPS2,
                 },
             );
         }
         f.decision()
+    }
+
+    /// Feeds a half-sine of `peak_g` × `dur_ms` (8 kHz) starting at 10 ms, `n` samples in
+    /// all; returns the decision.
+    fn half_sine_n(
+        f: &mut FallbackAlgorithm,
+        peak_g: f64,
+        dur_ms: f64,
+        n: u64,
+    ) -> FallbackDecision {
+        feed_8khz(f, n, |t_ms| {
+            let x = (t_ms - 10.0) / dur_ms;
+            if (0.0..=1.0).contains(&x) {
+                peak_g * (core::f64::consts::PI * x).sin()
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// [`half_sine_n`] over 150 ms.
+    fn half_sine(f: &mut FallbackAlgorithm, peak_g: f64, dur_ms: f64) -> FallbackDecision {
+        half_sine_n(f, peak_g, dur_ms, 1200)
     }
 
     #[test]
@@ -433,18 +445,9 @@ mod tests {
         // A rising pulse (a crash's ramp, 2 g/ms) decides at the same sample with the rule
         // as without it.
         let ramp = |fl: FireFloor| {
-            let mut f = FallbackAlgorithm::new(flat, fl);
-            for k in 0..400u64 {
-                f.push(
-                    &params(),
-                    &AccelSample {
-                        t_ns: 1_000_000_000 + k * 125_000,
-                        dt_s: 125e-6,
-                        decel_mps2: (2.0 * k as f64 * 0.125).min(25.0) * G_MPS2,
-                    },
-                );
-            }
-            f.decision()
+            feed_8khz(&mut FallbackAlgorithm::new(flat, fl), 400, |t_ms| {
+                (2.0 * t_ms).min(25.0)
+            })
         };
         assert_eq!(ramp(floor()), ramp(no_rule));
         assert!(matches!(ramp(floor()), FallbackDecision::Fire { .. }));
@@ -457,24 +460,7 @@ mod tests {
         // Δv over 40 ms, far under the boundary).
         for (peak, dur) in [(40.0, 2.0), (100.0, 0.5), (15.0, 10.0), (4.5, 40.0)] {
             let mut f = FallbackAlgorithm::new(DEFAULT_DV_MPS, floor());
-            // 8 kHz samples so the short events are resolved.
-            for k in 0..800u64 {
-                let t_ms = k as f64 * 0.125;
-                let x = (t_ms - 10.0) / dur;
-                let g = if (0.0..=1.0).contains(&x) {
-                    peak * (core::f64::consts::PI * x).sin()
-                } else {
-                    0.0
-                };
-                f.push(
-                    &params(),
-                    &AccelSample {
-                        t_ns: 1_000_000_000 + k * 125_000,
-                        dt_s: 125e-6,
-                        decel_mps2: g * G_MPS2,
-                    },
-                );
-            }
+            half_sine_n(&mut f, peak, dur, 800);
             assert!(
                 !matches!(f.decision(), FallbackDecision::Fire { .. }),
                 "{peak} g × {dur} ms: {:?}",

@@ -363,6 +363,25 @@ fn ringing(
     )
 }
 
+/// An `offset` event.
+fn offset_event(start_s: f64, peak_g: f64, end_s: f64, sensor: &str) -> String {
+    format!(
+        "[[accel_event]]\nkind = \"offset\"\nstart_s = {start_s}\npeak_g = {peak_g}\nend_s = {end_s}\nsensor = \"{sensor}\"\n"
+    )
+}
+
+/// A `spike` event.
+fn spike_event(start_s: f64, peak_g: f64, sensor: &str) -> String {
+    format!("[[accel_event]]\nkind = \"spike\"\nstart_s = {start_s}\npeak_g = {peak_g}\nsensor = \"{sensor}\"\n")
+}
+
+/// A `rough_road` event.
+fn rough_road_event(start_s: f64, rms_g: f64, end_s: f64, sensor: &str) -> String {
+    format!(
+        "[[accel_event]]\nkind = \"rough_road\"\nstart_s = {start_s}\nrms_g = {rms_g}\nend_s = {end_s}\nsensor = \"{sensor}\"\n"
+    )
+}
+
 fn half_sine(start_s: f64, peak_g: f64, ms: f64, sensor: &str) -> String {
     format!(
         "[[accel_event]]\nkind = \"half_sine\"\nstart_s = {start_s}\npeak_g = {peak_g}\n\
@@ -370,60 +389,84 @@ fn half_sine(start_s: f64, peak_g: f64, ms: f64, sensor: &str) -> String {
     )
 }
 
-/// A mechanical event through the wheels: a rigid-body pulse of net `dv` over `ms` (its peak
-/// capped at `body_peak_g`: the Δv is lowered where the duration cannot carry it) with
-/// zero-mean ringing of up to `ring_g` at `f_range` Hz, random phase.
-#[allow(clippy::too_many_arguments)]
-fn wheel_event(
-    r: &mut ChaCha8Rng,
-    start_s: f64,
-    dv_max: f64,
+/// The envelope of a mechanical event through the wheels (module docs' table, unscaled: the
+/// variants draw up to [`MARGIN`] × each bound).
+struct WheelEnvelope {
+    /// Net Δv bound, m/s.
+    dv_mps: f64,
+    /// Rigid-body peak bound, g (the Δv is lowered where the duration cannot carry it).
     body_peak_g: f64,
+    /// Ringing amplitude bound, g.
     ring_g: f64,
-    f_range: (f64, f64),
-    ms_range: (f64, f64),
-) -> (String, f64) {
-    let ms = r.gen_range(ms_range.0..ms_range.1);
-    let cap = body_peak_g * G * 2.0 * ms * 1e-3 / std::f64::consts::PI;
-    let dv = r.gen_range(0.0..dv_max).min(cap);
-    let text = ringing(
+    /// Ringing frequencies, Hz.
+    f_hz: (f64, f64),
+    /// Durations, ms.
+    ms: (f64, f64),
+}
+
+const POTHOLE: WheelEnvelope = WheelEnvelope {
+    dv_mps: 0.8,
+    body_peak_g: 5.0,
+    ring_g: 10.0,
+    f_hz: (10.0, 300.0),
+    ms: (10.0, 30.0),
+};
+const KERB: WheelEnvelope = WheelEnvelope {
+    dv_mps: 0.8,
+    body_peak_g: 7.0,
+    ring_g: 10.0,
+    f_hz: (20.0, 300.0),
+    ms: (10.0, 30.0),
+};
+const SPEED_BUMP: WheelEnvelope = WheelEnvelope {
+    dv_mps: 0.3,
+    body_peak_g: 3.0,
+    ring_g: 3.0,
+    f_hz: (10.0, 100.0),
+    ms: (20.0, 60.0),
+};
+const JUMP_LANDING: WheelEnvelope = WheelEnvelope {
+    dv_mps: 0.6,
+    body_peak_g: 5.0,
+    ring_g: 5.0,
+    f_hz: (10.0, 100.0),
+    ms: (20.0, 80.0),
+};
+/// Roe deer; its Δv bound depends on the speed (`animal_strike`).
+const ANIMAL: WheelEnvelope = WheelEnvelope {
+    dv_mps: 0.4,
+    body_peak_g: 10.0,
+    ring_g: 5.0,
+    f_hz: (20.0, 200.0),
+    ms: (20.0, 60.0),
+};
+
+/// One event of `env` at `start_s` (its Δv bound `dv_mps`, usually `env.dv_mps`): a rigid-body
+/// pulse drawn up to 1.5 × the bounds with zero-mean ringing, random phase.
+fn wheel_event(r: &mut ChaCha8Rng, start_s: f64, env: &WheelEnvelope, dv_mps: f64) -> String {
+    let ms = r.gen_range(env.ms.0..env.ms.1);
+    let cap = env.body_peak_g * MARGIN * G * 2.0 * ms * 1e-3 / std::f64::consts::PI;
+    let dv = r.gen_range(0.0..dv_mps * MARGIN).min(cap);
+    ringing(
         start_s,
-        r.gen_range(0.0..ring_g),
-        r.gen_range(f_range.0..f_range.1),
+        r.gen_range(0.0..env.ring_g * MARGIN),
+        r.gen_range(env.f_hz.0..env.f_hz.1),
         ms,
         dv,
         r.gen_range(0.0..360.0),
         "all",
-    );
-    (text, dv)
+    )
 }
 
 /// A pothole: front axle at `start_s`, the rear axle a wheelbase / v later (`v_mps`; left out
-/// when it falls after `end_s`), each up to the envelope × 1.5 (`dv_max`: the Δv bound).
-fn pothole_events(r: &mut ChaCha8Rng, start_s: f64, v_mps: f64, dv_max: f64, end_s: f64) -> String {
-    let (front, _) = wheel_event(
-        r,
-        start_s,
-        dv_max,
-        5.0 * MARGIN,
-        10.0 * MARGIN,
-        (10.0, 300.0),
-        (10.0, 30.0),
-    );
+/// when it falls after `end_s`).
+fn pothole_events(r: &mut ChaCha8Rng, start_s: f64, v_mps: f64, end_s: f64) -> String {
+    let front = wheel_event(r, start_s, &POTHOLE, POTHOLE.dv_mps);
     let rear_at = start_s + WHEELBASE_M / v_mps.max(1.0);
     if rear_at >= end_s {
         return front;
     }
-    let (rear, _) = wheel_event(
-        r,
-        rear_at,
-        dv_max,
-        5.0 * MARGIN,
-        10.0 * MARGIN,
-        (10.0, 300.0),
-        (10.0, 30.0),
-    );
-    front + &rear
+    front + &wheel_event(r, rear_at, &POTHOLE, POTHOLE.dv_mps)
 }
 
 /// A pothole with rebound of exactly `dv` m/s: the far edge's rigid-body pulse with ringing
@@ -449,22 +492,46 @@ fn drive_kph(r: &mut ChaCha8Rng) -> f64 {
 
 fn pothole(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let (t0, v) = (r.gen_range(0.3..0.5), drive_kph(r));
-    let ev = pothole_events(r, t0, v / 3.6, 0.8 * MARGIN, 0.9);
+    let ev = pothole_events(r, t0, v / 3.6, 0.9);
     driving(name, i, &ego(v, None), 0.9, "", &ev)
 }
 
 fn kerb_strike(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let (t0, v) = (r.gen_range(0.3..0.5), r.gen_range(10.0..50.0));
-    let (ev, _) = wheel_event(
+    let ev = wheel_event(r, t0, &KERB, KERB.dv_mps);
+    driving(name, i, &ego(v, None), 0.8, "", &ev)
+}
+
+/// A standing car's panel or housing event (door, hood, hammer): ringing with amplitude,
+/// frequency and length drawn from their ranges and a net Δv within ±`dv_mps` × 1.5.
+fn panel_event(
+    r: &mut ChaCha8Rng,
+    t0: f64,
+    peak_g: (f64, f64),
+    f_hz: (f64, f64),
+    ms: (f64, f64),
+    dv_mps: f64,
+) -> String {
+    ringing(
+        t0,
+        r.gen_range(peak_g.0..peak_g.1),
+        r.gen_range(f_hz.0..f_hz.1),
+        r.gen_range(ms.0..ms.1),
+        r.gen_range(-dv_mps..dv_mps) * MARGIN,
+        r.gen_range(0.0..360.0),
+        "all",
+    )
+}
+
+fn door_slam_event(r: &mut ChaCha8Rng, t0: f64) -> String {
+    panel_event(
         r,
         t0,
-        0.8 * MARGIN,
-        7.0 * MARGIN,
-        10.0 * MARGIN,
-        (20.0, 300.0),
-        (10.0, 30.0),
-    );
-    driving(name, i, &ego(v, None), 0.8, "", &ev)
+        (0.5, 40.0 * MARGIN),
+        (125.0, 250.0),
+        (20.0, 100.0),
+        0.01,
+    )
 }
 
 fn door_slam(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
@@ -472,42 +539,28 @@ fn door_slam(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     driving(name, i, &ego(0.0, None), 0.8, "", &door_slam_event(r, t0))
 }
 
-fn door_slam_event(r: &mut ChaCha8Rng, t0: f64) -> String {
-    ringing(
-        t0,
-        r.gen_range(0.5..40.0 * MARGIN),
-        r.gen_range(125.0..250.0),
-        r.gen_range(20.0..100.0),
-        r.gen_range(-0.01..0.01) * MARGIN,
-        r.gen_range(0.0..360.0),
-        "all",
-    )
-}
-
 fn hood_slam(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let t0 = r.gen_range(0.3..0.5);
-    let ev = ringing(
+    let ev = panel_event(
+        r,
         t0,
-        r.gen_range(0.5..3.0 * MARGIN),
-        r.gen_range(20.0..300.0),
-        r.gen_range(20.0..100.0),
-        r.gen_range(-0.06..0.06) * MARGIN,
-        r.gen_range(0.0..360.0),
-        "all",
+        (0.5, 3.0 * MARGIN),
+        (20.0, 300.0),
+        (20.0, 100.0),
+        0.06,
     );
     driving(name, i, &ego(0.0, None), 0.8, "", &ev)
 }
 
 fn hammer_blow(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let t0 = r.gen_range(0.3..0.5);
-    let ev = ringing(
+    let ev = panel_event(
+        r,
         t0,
-        r.gen_range(100.0..1000.0 * MARGIN),
-        r.gen_range(1000.0..10_000.0),
-        r.gen_range(0.2..2.0),
-        r.gen_range(-0.01..0.01) * MARGIN,
-        r.gen_range(0.0..360.0),
-        "all",
+        (100.0, 1000.0 * MARGIN),
+        (1000.0, 10_000.0),
+        (0.2, 2.0),
+        0.01,
     );
     driving(name, i, &ego(0.0, None), 0.8, "", &ev)
 }
@@ -520,11 +573,7 @@ fn rough_road(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     } else {
         r.gen_range(0.3..1.0)
     };
-    let ev = format!(
-        "[[accel_event]]\nkind = \"rough_road\"\nstart_s = {t0}\nrms_g = {}\nend_s = {}\nsensor = \"all\"\n",
-        r.gen_range(0.5..3.0 * MARGIN),
-        t0 + len
-    );
+    let ev = rough_road_event(t0, r.gen_range(0.5..3.0 * MARGIN), t0 + len, "all");
     let v = drive_kph(r);
     driving(name, i, &ego(v, None), t0 + len + 0.1, "", &ev)
 }
@@ -533,16 +582,9 @@ fn speed_bump(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let (t0, v) = (r.gen_range(0.3..0.5), r.gen_range(30.0..80.0));
     let mut ev = String::new();
     for at in [t0, t0 + WHEELBASE_M / (v / 3.6)] {
-        // Up then down the bump: the net over both halves ≈ 0; each half carries ±Δv.
-        let (up, _) = wheel_event(
-            r,
-            at,
-            0.3 * MARGIN,
-            3.0 * MARGIN,
-            3.0 * MARGIN,
-            (10.0, 100.0),
-            (20.0, 60.0),
-        );
+        // Each axle's burst carries a deceleration up to the bound (the up-and-down of a
+        // real bump, whose net is ≈ 0, is not assumed: the conservative sign).
+        let up = wheel_event(r, at, &SPEED_BUMP, SPEED_BUMP.dv_mps);
         ev += &up;
     }
     driving(name, i, &ego(v, None), 0.9, "", &ev)
@@ -550,15 +592,7 @@ fn speed_bump(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
 
 fn jump_landing(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let (t0, v) = (r.gen_range(0.3..0.5), drive_kph(r));
-    let (ev, _) = wheel_event(
-        r,
-        t0,
-        0.6 * MARGIN,
-        5.0 * MARGIN,
-        5.0 * MARGIN,
-        (10.0, 100.0),
-        (20.0, 80.0),
-    );
+    let ev = wheel_event(r, t0, &JUMP_LANDING, JUMP_LANDING.dv_mps);
     driving(name, i, &ego(v, None), 0.8, "", &ev)
 }
 
@@ -566,15 +600,7 @@ fn animal_strike(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let (t0, v) = (r.gen_range(0.3..0.5), r.gen_range(40.0..110.0));
     // Roe deer (≤ 25 kg): v·m_a/(m_a + m_car)·(1 + e), e ≤ 0.3.
     let dv_bound = v / 3.6 * 25.0 / (25.0 + 1785.0) * 1.3;
-    let (ev, _) = wheel_event(
-        r,
-        t0,
-        dv_bound * MARGIN,
-        10.0 * MARGIN,
-        5.0 * MARGIN,
-        (20.0, 200.0),
-        (20.0, 60.0),
-    );
+    let ev = wheel_event(r, t0, &ANIMAL, dv_bound);
     driving(name, i, &ego(v, None), 0.8, "", &ev)
 }
 
@@ -582,15 +608,7 @@ fn kerb_at_predicted_contact(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let v = r.gen_range(20.0..55.0);
     let tc = r.gen_range(0.45..0.6);
     let opp = r.gen_range(1000.0..2500.0);
-    let (ev, _) = wheel_event(
-        r,
-        tc,
-        0.8 * MARGIN,
-        7.0 * MARGIN,
-        10.0 * MARGIN,
-        (20.0, 300.0),
-        (10.0, 30.0),
-    );
+    let ev = wheel_event(r, tc, &KERB, KERB.dv_mps);
     head_on(name, i, v, opp, tc, Some(tc - 0.001), tc + 0.3, "", &ev)
 }
 
@@ -600,7 +618,7 @@ fn ghost_object_and_pothole(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let evade = tc - r.gen_range(0.001..0.3);
     let at = r.gen_range(evade - 0.1..tc + 0.05);
     let opp = r.gen_range(1000.0..2500.0);
-    let ev = pothole_events(r, at, v / 3.6, 0.8 * MARGIN, tc + 0.3);
+    let ev = pothole_events(r, at, v / 3.6, tc + 0.3);
     head_on(name, i, v, opp, tc, Some(evade), tc + 0.3, "", &ev)
 }
 
@@ -610,9 +628,7 @@ fn spike(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let t0 = r.gen_range(0.3..0.5);
     let sensor = ["all", "crash", "safing"][r.gen_range(0..3)];
     let g = r.gen_range(10.0..200.0);
-    let ev = format!(
-        "[[accel_event]]\nkind = \"spike\"\nstart_s = {t0}\npeak_g = {g}\nsensor = \"{sensor}\"\n"
-    );
+    let ev = spike_event(t0, g, sensor);
     let v = drive_kph(r);
     driving(name, i, &ego(v, None), 0.8, "", &ev)
 }
@@ -621,10 +637,7 @@ fn offset(r: &mut ChaCha8Rng, name: &str, i: u64, sensor: &str) -> String {
     let t0 = r.gen_range(0.3..0.5);
     let g = r.gen_range(2.0..20.0) * if r.gen_bool(0.5) { 1.0 } else { -1.0 };
     let len = r.gen_range(0.05..0.5);
-    let ev = format!(
-        "[[accel_event]]\nkind = \"offset\"\nstart_s = {t0}\npeak_g = {g}\nend_s = {}\nsensor = \"{sensor}\"\n",
-        t0 + len
-    );
+    let ev = offset_event(t0, g, t0 + len, sensor);
     let v = drive_kph(r);
     driving(name, i, &ego(v, None), 1.0, "", &ev)
 }
@@ -670,10 +683,7 @@ fn sensor_noisy(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let t0 = r.gen_range(0.3..0.5);
     let sensor = ["crash", "safing"][r.gen_range(0..2)];
     let (rms, len) = (r.gen_range(1.0..10.0), r.gen_range(0.1..0.5));
-    let ev = format!(
-        "[[accel_event]]\nkind = \"rough_road\"\nstart_s = {t0}\nrms_g = {rms}\nend_s = {}\nsensor = \"{sensor}\"\n",
-        t0 + len
-    );
+    let ev = rough_road_event(t0, rms, t0 + len, sensor);
     let v = drive_kph(r);
     driving(name, i, &ego(v, None), 1.0, "", &ev)
 }
@@ -695,10 +705,10 @@ fn spike_in_pothole(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let t0 = r.gen_range(0.3..0.5);
     let dv = r.gen_range(0.6..0.8) * MARGIN;
     let mut ev = pothole_with_rebound(r, t0, dv);
-    ev += &format!(
-        "[[accel_event]]\nkind = \"spike\"\nstart_s = {}\npeak_g = {}\nsensor = \"crash\"\n",
+    ev += &spike_event(
         t0 + r.gen_range(0.0..0.03),
-        r.gen_range(150.0..199.0)
+        r.gen_range(150.0..199.0),
+        "crash",
     );
     let v = drive_kph(r);
     driving(name, i, &ego(v, None), 0.8, "", &ev)
@@ -710,10 +720,11 @@ fn offset_with_pothole(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
         let dv = r.gen_range(0.1..0.3) * MARGIN;
         pothole_with_rebound(r, t0, dv)
     };
-    ev += &format!(
-        "[[accel_event]]\nkind = \"offset\"\nstart_s = {t0}\npeak_g = {}\nend_s = {}\nsensor = \"crash\"\n",
+    ev += &offset_event(
+        t0,
         r.gen_range(2.0..8.0) * MARGIN,
-        t0 + r.gen_range(0.1..0.5)
+        t0 + r.gen_range(0.1..0.5),
+        "crash",
     );
     let v = drive_kph(r);
     driving(name, i, &ego(v, None), 1.0, "", &ev)
@@ -767,10 +778,11 @@ fn braking_and_pothole(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
             pothole_with_rebound(r, t0, dv)
         }
     } else {
-        format!(
-            "[[accel_event]]\nkind = \"offset\"\nstart_s = {t0}\npeak_g = {}\nend_s = {}\nsensor = \"crash\"\n",
+        offset_event(
+            t0,
             r.gen_range(0.5..1.3) * MARGIN,
-            t0 + r.gen_range(0.1..0.5)
+            t0 + r.gen_range(0.1..0.5),
+            "crash",
         )
     };
     driving(name, i, &ego(v, Some((brake_at, g))), 1.2, "", &ev)

@@ -27,8 +27,9 @@ const BESSEL3_CORNER: f64 = 1.755_7;
 pub const DEFAULT_STEP_S: f64 = 50e-6;
 
 /// A gap between two readings longer than this [s] (a dropout) is not integrated through:
-/// the filter restarts this long before the new reading (≈ 30 time constants at 400 Hz).
-const RESTART_GAP_S: f64 = 0.02;
+/// the filter restarts this long before the new reading (≈ 30 time constants at 400 Hz). It is
+/// also the longest span one reading integrates over.
+pub const RESTART_GAP_S: f64 = 0.02;
 
 /// The group delay at DC of a third-order Bessel low-pass with −3 dB at `corner_hz` [s].
 pub fn group_delay_s(corner_hz: f64) -> f64 {

@@ -153,7 +153,8 @@ impl SensorModelSim {
                 None => a,
             }
         };
-        let step_s = events.finest_step_s(sensor, t_s - 0.02, t_s);
+        // What the input holds over the longest span this reading integrates.
+        let step_s = events.finest_step_s(sensor, t_s - crate::lowpass::RESTART_GAP_S, t_s);
         let a = filter.read(t_s, step_s, input);
         (a + noise).clamp(-full_scale, full_scale)
     }
