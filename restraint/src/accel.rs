@@ -33,6 +33,9 @@ pub struct PlausibleBatch {
     dt_s: f64,
     /// (index in the batch, acceleration m/s², negative = deceleration).
     readings: heapless::Vec<(u8, f32), ACCEL_BATCH_CAPACITY>,
+    /// The lowest reading (the highest deceleration), m/s² (+∞ when empty): every detector
+    /// asks whether a batch is quiet, so it is answered once while the batch is built.
+    min_accel_mps2: f32,
 }
 
 impl PlausibleBatch {
@@ -43,7 +46,20 @@ impl PlausibleBatch {
             period_ns: 0,
             dt_s: 0.0,
             readings: heapless::Vec::new(),
+            min_accel_mps2: f32::INFINITY,
         }
+    }
+
+    fn clear(&mut self) {
+        self.readings.clear();
+        self.min_accel_mps2 = f32::INFINITY;
+    }
+
+    #[inline]
+    fn push(&mut self, i: u8, a: f32) {
+        // Cannot fail: at most ACCEL_BATCH_CAPACITY samples are read.
+        let _ = self.readings.push((i, a));
+        self.min_accel_mps2 = self.min_accel_mps2.min(a);
     }
 
     /// Number of plausible samples.
@@ -59,14 +75,20 @@ impl PlausibleBatch {
     /// Every sample's deceleration is below `decel_mps2` (true when empty).
     pub fn all_below(&self, decel_mps2: f64) -> bool {
         // decel = −a < d  ⇔  a > −d (the readings are finite: the monitor checked them).
-        self.readings
-            .iter()
-            .all(|&(_, a)| f64::from(a) > -decel_mps2)
+        f64::from(self.min_accel_mps2) > -decel_mps2
     }
 
     /// The deceleration of the newest sample, m/s².
     pub fn last_decel_mps2(&self) -> Option<f64> {
         self.readings.last().map(|&(_, a)| -f64::from(a))
+    }
+
+    /// The newest sample: its time (ns) and deceleration (m/s²).
+    pub fn last_sample(&self) -> Option<(u64, f64)> {
+        self.readings.last().map(|&(i, a)| {
+            let t = u64::from(i).saturating_mul(self.period_ns);
+            (self.first_ns.saturating_add(t), -f64::from(a))
+        })
     }
 
     /// The samples, in time order.
@@ -187,7 +209,7 @@ impl AccelMonitor {
         samples: &[f32],
         out: &mut PlausibleBatch,
     ) {
-        out.readings.clear();
+        out.clear();
         let too_old = now.saturating_sub(first_ns) > self.timeout_ns;
         let in_future = first_ns > now.saturating_add(FUTURE_SLACK_NS);
         let backwards = self.next_from_ns.is_some_and(|t| first_ns < t);
@@ -221,8 +243,7 @@ impl AccelMonitor {
                     break;
                 }
                 prev = bits;
-                // Cannot fail: at most ACCEL_BATCH_CAPACITY samples are read.
-                let _ = out.readings.push((i, a));
+                out.push(i, a);
             }
             if bulk {
                 self.last_bits = Some(last.to_bits());
@@ -233,7 +254,7 @@ impl AccelMonitor {
         }
         // Sample by sample: a reading out of range, saturated, or repeated (the state in
         // locals, written back once).
-        out.readings.clear();
+        out.clear();
         let (mut last_bits, mut stuck) = (self.last_bits, self.stuck);
         // The index of the newest change of reading in this batch (its time is computed once,
         // after the loop, or where a repeated reading needs it).
@@ -269,8 +290,7 @@ impl AccelMonitor {
                 changed_at = Some(i);
                 stuck = false;
             }
-            // Cannot fail: at most ACCEL_BATCH_CAPACITY samples are read.
-            let _ = out.readings.push((i, a));
+            out.push(i, a);
         }
         (self.last_bits, self.stuck) = (last_bits, stuck);
         if let Some(i) = changed_at {

@@ -8,6 +8,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::accel::AccelLimits;
+use crate::agreement::{AgreementParams, SeverityAgreement};
 use crate::confirm::ConfirmParams;
 use crate::fallback::FireFloor;
 use crate::safing::SafingParams;
@@ -184,6 +185,15 @@ pub struct CycleConfig {
     /// With the safing sensor faulty, a vehicle deceleration (`EgoLongAccel`) at least this
     /// stands in for it, g (*default* 2.0: above braking, ≤ 1.2 g).
     pub safing_substitute_g: f64,
+    /// Severity agreement (`agreement`): the crash sensor's Δv over the confirmed event may
+    /// exceed the safing sensor's over the same window by at most this plus
+    /// `severity_tolerance_fraction` × its own, m/s (*default* 0.10: two healthy sensors on
+    /// the same pulse differ by ≤ 0.03 m/s in the matrix's must-fire crashes); beyond it the
+    /// crash sensor is implausible for the event and nothing of it fires.
+    pub severity_tolerance_dv_mps: f64,
+    /// See `severity_tolerance_dv_mps` (*default* 0.10: two sensors' sensitivity tolerances,
+    /// ±5 % each).
+    pub severity_tolerance_fraction: f64,
     /// Safing sensor measuring range, g (*default* 50): readings at it are saturated, beyond
     /// it impossible (`SAFING_INVALID`). Its timeout and stuck time are the crash
     /// accelerometer's (`accel_timeout_ms`, `accel_stuck_ms`).
@@ -263,6 +273,8 @@ impl Default for CycleConfig {
             safing_hold_ms: 20.0,
             safing_wait_ms: 30.0,
             safing_substitute_g: 2.0,
+            severity_tolerance_dv_mps: 0.10,
+            severity_tolerance_fraction: 0.10,
             safing_full_scale_g: 50.0,
             accel_timeout_ms: 50.0,
             accel_stuck_ms: 20.0,
@@ -367,6 +379,18 @@ impl CycleConfig {
         range("safing_wait_ms", self.safing_wait_ms, 0.0, 1_000.0)?;
         range("safing_substitute_g", self.safing_substitute_g, 1.5, 15.0)?;
         range(
+            "severity_tolerance_dv_mps",
+            self.severity_tolerance_dv_mps,
+            0.0,
+            5.0,
+        )?;
+        range(
+            "severity_tolerance_fraction",
+            self.severity_tolerance_fraction,
+            0.0,
+            1.0,
+        )?;
+        range(
             "safing_full_scale_g",
             self.safing_full_scale_g,
             10.0,
@@ -454,6 +478,20 @@ impl CycleConfig {
             hold_ns: ms_to_ns(self.safing_hold_ms),
             substitute_mps2: self.safing_substitute_g * G_MPS2,
         }
+    }
+
+    /// The severity agreement of the two accelerometers (`severity_tolerance_*`; events as
+    /// the safing function's).
+    pub fn severity_agreement(&self) -> SeverityAgreement {
+        let p = self.safing_params();
+        SeverityAgreement::new(
+            AgreementParams {
+                tolerance_dv_mps: self.severity_tolerance_dv_mps,
+                tolerance_fraction: self.severity_tolerance_fraction,
+            },
+            p.onset.wake_mps2,
+            p.onset.reset_gap_ns,
+        )
     }
 
     /// The safing sensor's monitor limits (the crash accelerometer's timeout and stuck time,

@@ -9,6 +9,7 @@ use bus::secoc::SecOcTx;
 use bus::{EnumCount, RejectReason, VariantArray};
 use physics::CollisionSummary;
 
+use crate::agreement::SeverityAgreement;
 use crate::config::CycleConfig;
 use crate::contract::{Activity, CycleInfo, CycleIo, StartupError};
 use crate::counters::CycleCounters;
@@ -40,6 +41,8 @@ pub struct RestraintCycle<'lut> {
     decision: Decision,
     crash: CrashMonitor,
     safing: Safing,
+    /// The two accelerometers' Δv over the same window (issue 31 item 1).
+    agreement: SeverityAgreement,
     outputs: Outputs,
     reasons: Degraded,
     counters: CycleCounters,
@@ -76,6 +79,7 @@ impl<'lut> RestraintCycle<'lut> {
             decision: Decision::new(&cfg, reference),
             crash: CrashMonitor::new(&cfg),
             safing: Safing::new(cfg.safing_params()),
+            agreement: cfg.severity_agreement(),
             outputs: Outputs::new(lut_id),
             reasons: Degraded::empty(),
             counters: CycleCounters::default(),
@@ -143,6 +147,10 @@ impl<'lut> RestraintCycle<'lut> {
     pub fn safing(&self) -> &Safing {
         &self.safing
     }
+    /// The two accelerometers' severity agreement.
+    pub fn agreement(&self) -> &SeverityAgreement {
+        &self.agreement
+    }
     /// Whether the airbag fire command has been sent.
     pub fn airbag_fired(&self) -> bool {
         self.decision.airbag_fired()
@@ -197,10 +205,12 @@ impl Activity for RestraintCycle<'_> {
             estimator: &self.estimate,
         };
         let crash = &mut self.crash;
+        let agreement = &mut self.agreement;
         let mut plausible = crate::accel::PlausibleBatch::new();
         io.drain_accel(&mut |a| {
             inputs.on_accel(a, now, c, &mut plausible);
             crash.on_batch(&plausible, &freeze);
+            agreement.crash.on_batch(&plausible);
         });
         // The independent safing channel: its own monitor, its own function.
         let safing = &mut self.safing;
@@ -208,6 +218,7 @@ impl Activity for RestraintCycle<'_> {
         io.drain_safing(&mut |a| {
             inputs.on_safing(a, now, &mut safing_batch);
             safing.on_batch(&safing_batch);
+            agreement.safing.on_batch(&safing_batch);
         });
         inputs.on_receive_errors(io.receive_errors(), now);
         let lut_present = self.estimate.lut().is_some();
@@ -251,9 +262,18 @@ impl Activity for RestraintCycle<'_> {
         let safing_faulty = self
             .reasons
             .intersects(Degraded::SAFING_STALE | Degraded::SAFING_INVALID);
-        let safing = self
+        let mut safing = self
             .safing
             .agrees(now, safing_faulty, self.inputs.vehicle_decel(now));
+        // With a healthy safing sensor, safing must also agree in severity on the confirmed
+        // event (module `agreement`) — also once the crash sensor is found faulty (a stuck
+        // sensor's first 20 ms were plausible); the backup path (confirmed by the vehicle
+        // deceleration) has no crash-sensor event to compare.
+        if let Some(c) = self.crash.confirmation() {
+            if !safing_faulty && c.kind != crate::crash::ConfirmKind::Backup {
+                safing &= self.agreement.agrees(c.onset_ns);
+            }
+        }
         self.crash.end_cycle(
             now,
             accel_faulty,
@@ -342,6 +362,7 @@ impl Activity for RestraintCycle<'_> {
                 self.inputs.safing.faults.stuck_events,
             ),
             ("fires_vetoed_by_safing", self.decision.vetoed_fires()),
+            ("severity_disagreements", self.agreement.disagreements()),
             ("can_frames_rx", c.can_frames_rx),
             ("can_accepted", e2e.accepted),
             ("can_lost_frames", e2e.lost_frames),

@@ -17,6 +17,7 @@
 //! | [`confirm`] | generic crash confirmation from the compartment accelerometer |
 //! | [`crash_match`] | prediction-matched confirmation and the in-crash severity estimate |
 //! | [`fallback`] | the accelerometer-only airbag algorithm (no usable prediction) |
+//! | [`agreement`] | the two accelerometers' severity agreement (velocity traces over the same window) |
 //! | [`crash`] | the crash phase's evidence: which path confirmed, the backup, the re-plan |
 //! | [`estimate`] | track filter ([`estimate::track`]), situation, closed-form collision prediction, LUT query, diagnostics pulse |
 //! | [`decision`] | the state machine: preset, arm, fire, release, fall back |
@@ -38,6 +39,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod accel;
+pub mod agreement;
 pub mod config;
 pub mod confirm;
 pub mod contract;

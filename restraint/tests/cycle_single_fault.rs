@@ -201,3 +201,70 @@ fn a_real_crash_with_a_dead_safing_sensor_fires_when_the_vehicle_deceleration_ag
     assert!(!airbag_fired(&b));
     assert!(b.ecu.vetoed_fires() > 0);
 }
+
+/// Issue 31 item 1: a crash-sensor fault inside a real misuse event that satisfies the safing
+/// sensor. `tolerance_dv_mps` = the severity agreement's absolute tolerance (5 m/s: off).
+fn fault_inside_event(case: &str, tolerance_dv_mps: f64) -> Bench {
+    let cfg = restraint::CycleConfig {
+        severity_tolerance_dv_mps: tolerance_dv_mps,
+        ..ideal_sensor_config()
+    };
+    let mut b = Bench::with_config(cfg, Some(test_lut()));
+    drive(&mut b, T0 + 500 * MS);
+    for k in 0..400u64 {
+        let t_s = k as f64 * 1e-3;
+        match case {
+            // A door slam: 30 g of zero-mean ringing at 125 Hz for 48 ms on both sensors (a
+            // lobe is 0.75 m/s: the safing channel closes); the crash sensor sticks at the
+            // crest of k = 10 for 100 ms.
+            "stuck crash sensor in a door slam" => {
+                let ring = if k < 48 {
+                    -(30.0 * (2.0 * std::f64::consts::PI * 125.0 * t_s).sin()) as f32 * G
+                } else {
+                    0.0
+                };
+                b.push_accel(ring);
+                if (10..110).contains(&k) {
+                    b.push_crash_sensor_fault(-30.0 * G);
+                }
+            }
+            // A pothole (6 g × 20 ms half-sine, 0.75 m/s) on both; the crash sensor alone
+            // reads +8 g more from its start for 300 ms.
+            "offset from a pothole" => {
+                let pothole = if k < 20 {
+                    6.0 * (std::f64::consts::PI * t_s / 0.020).sin() as f32
+                } else {
+                    0.0
+                };
+                b.push_accel(-pothole * G);
+                if k < 300 {
+                    b.push_crash_sensor_fault(-(pothole + 8.0) * G);
+                }
+            }
+            _ => unreachable!(),
+        }
+        b.push_object_none();
+        b.step();
+    }
+    drive(&mut b, T0 + 1_500 * MS);
+    b
+}
+
+#[test]
+fn a_crash_sensor_fault_inside_a_real_misuse_event_fires_nothing() {
+    for case in ["stuck crash sensor in a door slam", "offset from a pothole"] {
+        let b = fault_inside_event(case, 0.10);
+        assert!(!airbag_fired(&b), "{case}: airbag fired");
+        assert!(!pretensioner_fired(&b), "{case}: pretensioner fired");
+        assert!(b.ecu.agreement().disagreements() >= 1, "{case}");
+        // The crash phase ends with the event: back to monitoring.
+        assert_eq!(b.ecu.phase(), restraint::Phase::Monitoring, "{case}");
+        // Without the severity agreement the safing channel (closed by the real event) lets
+        // the faulty sensor fire: the test sees what it guards against.
+        let off = fault_inside_event(case, 5.0);
+        assert!(
+            airbag_fired(&off) || pretensioner_fired(&off),
+            "{case}: fires nothing even without the agreement"
+        );
+    }
+}

@@ -76,6 +76,9 @@ pub struct OfflineRun {
     pub faults: Vec<(f64, Vec<String>)>,
     /// How the core confirmed the crash (its `ConfirmKind`, as text).
     pub confirmed_by: Option<String>,
+    /// Largest crash-minus-safing Δv over a confirmed event's window, m/s (`None`: no event
+    /// judged): what two sensors showed against the severity agreement's tolerance.
+    pub severity_excess_mps: Option<f64>,
 }
 
 impl OfflineRun {
@@ -150,6 +153,7 @@ pub fn run(scenario: &Scenario, cfg: &OfflineConfig) -> Result<OfflineRun> {
         }
     }
     let confirmed_by = ecu.crash_kind().map(|k| format!("{k:?}"));
+    let severity_excess_mps = ecu.agreement().worst_excess_mps();
     let truth = Truth::new(scenario).map_err(|e| anyhow!("{}: {e}", scenario.name))?;
     let contact_ns = contact_s.map_or(u64::MAX, |tc| START_NS + (tc * 1e9).round() as u64);
     let evaluated = match contact_s {
@@ -175,6 +179,7 @@ pub fn run(scenario: &Scenario, cfg: &OfflineConfig) -> Result<OfflineRun> {
         evaluated,
         modules,
         confirmed_by,
+        severity_excess_mps,
     })
 }
 

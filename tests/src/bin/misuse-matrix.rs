@@ -66,6 +66,8 @@ struct Outcome {
     /// The ECU's last mode was CrashDetected at the end of the run (a crash phase that never
     /// ended).
     stuck_in_crash: bool,
+    /// Largest crash-minus-safing Δv of a confirmed event, m/s.
+    severity_excess_mps: Option<f64>,
 }
 
 /// "127 mm − 30 ms": when the free-flying occupant has moved 127 mm relative to the car.
@@ -108,6 +110,7 @@ fn run_variant(cfg: &OfflineConfig, text: &str) -> Result<Outcome> {
         pretensioner_kept: fired > released,
         required_ms: required,
         stuck_in_crash: r.modes.last().is_some_and(|m| m.1 == "CrashDetected"),
+        severity_excess_mps: r.severity_excess_mps,
     })
 }
 
@@ -171,6 +174,8 @@ fn main() -> Result<()> {
         "family", "variants", "airbag!", "pretens!", "missed", "stuck", "errors"
     )?;
     let mut json_rows = Vec::new();
+    // Two healthy sensors on real crashes: the must-fire families' largest crash − safing Δv.
+    let mut healthy_excess = f64::NEG_INFINITY;
     for (f, family) in families.iter().enumerate() {
         let (name, req) = (family.name, family.requirement);
         let open = cli.gate && misuse::OPEN.contains(&name);
@@ -198,6 +203,11 @@ fn main() -> Result<()> {
                     family.variant(*i, cli.seed)
                 ))
             };
+            if req == Requirement::MustFire {
+                if let Some(x) = o.severity_excess_mps {
+                    healthy_excess = healthy_excess.max(x);
+                }
+            }
             match req {
                 Requirement::NoFire => {
                     if let Some(t) = o.airbag_ms {
@@ -278,6 +288,15 @@ fn main() -> Result<()> {
             "fire_minus_required_ms_p50": margins.get(margins.len() / 2),
             "fire_minus_required_ms_worst": margins.last(),
         }));
+    }
+    if healthy_excess.is_finite() {
+        let c = &cfg.cycle;
+        writeln!(
+            out,
+            "severity agreement: two healthy sensors in the must-fire crashes differ by at most {healthy_excess:+.3} m/s (crash − safing Δv); a crash sensor beyond {:.2} m/s + {:.0} % of its Δv is implausible",
+            c.severity_tolerance_dv_mps,
+            c.severity_tolerance_fraction * 100.0
+        )?;
     }
     writeln!(out, "{} variants in {:.1} s (seed {}); airbag! / pretens! = fired where none may (must be 0), missed = must-fire crashes without airbag (must be 0), stuck = crash phases that fired nothing and never ended (must be 0)",
         results.len(), start.elapsed().as_secs_f64(), cli.seed)?;
