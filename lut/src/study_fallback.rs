@@ -144,7 +144,7 @@ pub fn run(args: &FallbackArgs) -> Result<()> {
             }
         );
     }
-    let bad = violations(&rows, no_fire, must, t_ref_ms);
+    let bad = violations(&rows, no_fire, must, t_ref_ms, 0.0);
     for b in &bad {
         println!("VIOLATION: {b}");
     }

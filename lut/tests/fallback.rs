@@ -5,6 +5,7 @@
 
 use lut::fallback_study::{
     calibrate, must_fire_line, run_sweep, violations, Family, SensorSpec, Sweep,
+    ACCEL_ONLY_LATENESS_BOUND_MS,
 };
 use restraint::fallback::DEFAULT_DV_MPS;
 use restraint::CycleConfig;
@@ -29,7 +30,7 @@ fn the_shipped_boundary_is_the_calibration_of_the_sweep_and_meets_its_requiremen
     // at 300 mm bottom out from a 28 km/h rigid barrier on.
     let must = must_fire_line(&rows).expect("a must-fire line");
     assert_eq!(must, 28.0);
-    let bad = violations(&rows, cfg.no_fire_ebs_kph, must, t_ref_ms());
+    let bad = violations(&rows, cfg.no_fire_ebs_kph, must, t_ref_ms(), 0.0);
     assert!(bad.is_empty(), "{bad:#?}");
 }
 
@@ -60,7 +61,21 @@ fn it_also_holds_on_crashes_it_was_not_calibrated_on() {
         ],
     };
     let rows = run_sweep(&cfg, &sweep).expect("sweep");
-    let bad = violations(&rows, cfg.no_fire_ebs_kph, 28.0, t_ref_ms());
+    // Off the calibration sweep the path may be late — by at most the bound of the safety
+    // order (issue 30, decision 1; `ACCEL_ONLY_LATENESS_BOUND_MS`): its floors sit above the
+    // largest misuse Δv, and no misuse may fire comes before fire time. The lateness is a
+    // reported figure: printed here per case.
+    let late: Vec<String> = violations(&rows, cfg.no_fire_ebs_kph, 28.0, t_ref_ms(), 0.0);
+    for l in &late {
+        eprintln!("late (within the bound): {l}");
+    }
+    let bad = violations(
+        &rows,
+        cfg.no_fire_ebs_kph,
+        28.0,
+        t_ref_ms(),
+        ACCEL_ONLY_LATENESS_BOUND_MS,
+    );
     assert!(bad.is_empty(), "{bad:#?}");
     // Slow barriers and bumps (EBS < 20 km/h) never fire, whatever the sensor.
     assert!(rows

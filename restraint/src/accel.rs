@@ -62,6 +62,20 @@ impl PlausibleBatch {
         self.min_accel_mps2 = self.min_accel_mps2.min(a);
     }
 
+    /// Takes off a deceleration the car's braking explains (`decel_mps2` ≥ 0, m/s²): every
+    /// reading as if the car were not braking (module `crash`: sustained braking is not crash
+    /// evidence).
+    pub fn remove_decel(&mut self, decel_mps2: f64) {
+        if !(decel_mps2 > 0.0) {
+            return;
+        }
+        let b = decel_mps2 as f32;
+        for r in self.readings.iter_mut() {
+            r.1 += b;
+        }
+        self.min_accel_mps2 += b;
+    }
+
     /// Number of plausible samples.
     pub fn len(&self) -> usize {
         self.readings.len()

@@ -21,6 +21,7 @@ use crate::outputs::{publish_diagnostics, Outputs};
 use crate::plan::{ReferenceSettings, RestraintPlan};
 use crate::safing::Safing;
 use crate::settings::ConfigError;
+use crate::settings::G_MPS2;
 use crate::signals::Degraded;
 
 /// What [`RestraintCycle::new`] found (for start-up messages).
@@ -43,6 +44,9 @@ pub struct RestraintCycle<'lut> {
     safing: Safing,
     /// The two accelerometers' Δv over the same window (issue 31 item 1).
     agreement: SeverityAgreement,
+    /// The deceleration the car's braking explains, m/s², held while an accelerometer event
+    /// is in progress (`braking_compensation_max_g`).
+    braking_decel_mps2: f64,
     outputs: Outputs,
     reasons: Degraded,
     counters: CycleCounters,
@@ -80,6 +84,7 @@ impl<'lut> RestraintCycle<'lut> {
             crash: CrashMonitor::new(&cfg),
             safing: Safing::new(cfg.safing_params()),
             agreement: cfg.severity_agreement(),
+            braking_decel_mps2: 0.0,
             outputs: Outputs::new(lut_id),
             reasons: Degraded::empty(),
             counters: CycleCounters::default(),
@@ -204,13 +209,29 @@ impl Activity for RestraintCycle<'_> {
             armed: self.decision.phase() == Phase::PreCrash,
             estimator: &self.estimate,
         };
+        // The braking the vehicle frame explains, as it was before the event began (a crash
+        // shows on the vehicle frame too, one frame later: it must not explain itself). Not in
+        // PRE-CRASH: there the crash is predicted, its own (AEB) braking belongs to it and
+        // the plan's fire times were made with it (config docs).
+        if !self.crash.event_in_progress() {
+            self.braking_decel_mps2 = if self.decision.phase() == Phase::PreCrash {
+                0.0
+            } else {
+                inputs.braking_decel(now, self.cfg.braking_compensation_max_g * G_MPS2)
+            };
+        }
+        let braking = self.braking_decel_mps2;
         let crash = &mut self.crash;
         let agreement = &mut self.agreement;
         let mut plausible = crate::accel::PlausibleBatch::new();
         io.drain_accel(&mut |a| {
             inputs.on_accel(a, now, c, &mut plausible);
-            crash.on_batch(&plausible, &freeze);
+            // The agreement compares the two sensors as they read.
             agreement.crash.on_batch(&plausible);
+            if braking > 0.0 {
+                plausible.remove_decel(braking);
+            }
+            crash.on_batch(&plausible, &freeze);
         });
         // The independent safing channel: its own monitor, its own function.
         let safing = &mut self.safing;

@@ -9,7 +9,10 @@
 //! the degraded reasons of the cycle. Allocation-free: the burst window is a fixed-capacity
 //! `heapless` queue.
 
-use bus::codec::{OccupantClassificationBeltBuckle, OccupantClassificationOccupantClass};
+use bus::codec::{
+    EgoVehicleStateBrakeState, OccupantClassificationBeltBuckle,
+    OccupantClassificationOccupantClass,
+};
 use bus::{E2eChecker, Messages, RawFrame, RejectReason, CAN_EFF_FLAG};
 use heapless::Deque;
 
@@ -107,6 +110,8 @@ pub struct InputMonitor {
     ego_speed_mps: f32,
     /// Newest `EgoLongAccel`, m/s² (negative = decelerating).
     ego_long_accel_mps2: f32,
+    /// The newest `BrakeState` is not `Released`.
+    ego_braking: bool,
     vehicle_rx_ns: Option<u64>,
     /// Occupant as last reported.
     pub(crate) occupant: Occupant,
@@ -150,6 +155,7 @@ impl InputMonitor {
             new_object: false,
             ego_speed_mps: 0.0,
             ego_long_accel_mps2: 0.0,
+            ego_braking: false,
             vehicle_rx_ns: None,
             occupant: Occupant {
                 mass_kg: f32::NAN,
@@ -221,6 +227,7 @@ impl InputMonitor {
             Ok(Messages::EgoVehicleState(m)) => {
                 self.ego_speed_mps = m.ego_speed();
                 self.ego_long_accel_mps2 = m.ego_long_accel();
+                self.ego_braking = m.brake_state() != EgoVehicleStateBrakeState::Released;
                 self.vehicle_rx_ns = Some(now);
             }
             Ok(Messages::OccupantClassification(m)) => {
@@ -361,6 +368,20 @@ impl InputMonitor {
     pub(crate) fn vehicle_decel(&self, now: u64) -> Option<(f64, u64)> {
         let rx = self.vehicle_rx_ns.filter(|_| !self.vehicle_stale(now))?;
         Some((-f64::from(self.ego_long_accel_mps2), rx))
+    }
+
+    /// The deceleration the car's own braking explains, m/s²: the fresh vehicle frame's
+    /// deceleration while its brake state says braking, within [0, `max_mps2`]; 0 otherwise
+    /// (no brake, stale frame, NaN).
+    pub(crate) fn braking_decel(&self, now: u64, max_mps2: f64) -> f64 {
+        // Every cycle of a drive asks: the common answer (not braking) without the clock.
+        if !(self.ego_braking && self.ego_long_accel_mps2 < 0.0) {
+            return 0.0;
+        }
+        match self.vehicle_decel(now) {
+            Some((d, _)) if self.ego_braking && d > 0.0 => d.min(max_mps2),
+            _ => 0.0,
+        }
     }
 
     /// The degraded reasons at `now` (`lut_present`: a usable LUT was loaded).

@@ -112,6 +112,8 @@ pub struct Bench {
     pub accel_dither: bool,
     /// `EgoLongAccel` of the vehicle frames, m/s² (the vehicle-dynamics sensor).
     pub ego_long_accel_mps2: f32,
+    /// The vehicle frames' brake state says ABS braking (else released).
+    pub abs_braking: bool,
     /// The reading of the next step's sample, m/s² (taken by the step; then 0 again).
     pending_accel_mps2: Option<f32>,
     /// The safing accelerometer delivers a sample every step (false: a dead safing sensor).
@@ -192,6 +194,7 @@ impl Bench {
             accel_live: true,
             accel_dither: true,
             ego_long_accel_mps2: 0.0,
+            abs_braking: false,
             pending_accel_mps2: None,
             safing_live: true,
             pending_fault_mps2: (None, None),
@@ -199,12 +202,12 @@ impl Bench {
     }
 
     pub fn vehicle_frame(&mut self, speed_mps: f32) -> RawFrame {
-        let m = EgoVehicleState::encode(
-            EgoVehicleStateBrakeState::Released,
-            speed_mps,
-            self.ego_long_accel_mps2,
-        )
-        .unwrap();
+        let brake = if self.abs_braking {
+            EgoVehicleStateBrakeState::AbsActive
+        } else {
+            EgoVehicleStateBrakeState::Released
+        };
+        let m = EgoVehicleState::encode(brake, speed_mps, self.ego_long_accel_mps2).unwrap();
         self.tx.seal(m)
     }
 
