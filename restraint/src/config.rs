@@ -165,12 +165,14 @@ pub struct CycleConfig {
     pub lightest_opponent_kg: f64,
     /// See `lightest_opponent_kg`.
     pub speed_misreport_mps: f64,
-    /// A tracked low-speed object (EBS below the no-fire line) whose predicted contact is
-    /// within `avoided_margin_ms` of the measured onset fires the airbag only when the event's
-    /// measured Δv exceeds the low-speed crash's own (EBS × `low_speed_dv_factor`, *default*
-    /// 1.3: restitution) plus this, m/s (*default* 1.2: the largest misuse Δv the matrix
-    /// samples, a pothole × 1.5) — a kerb or pothole inside a low-speed crash never does; a
-    /// crash far more severe than tracked still does, late.
+    /// A tracked low-speed object (EBS below the no-fire line even with the opponent
+    /// `mass_misreport_kg` heavier than reported) whose predicted contact is within
+    /// `avoided_margin_ms` of the measured onset fires the airbag only when the event's
+    /// measured Δv exceeds the most that crash can carry (the closing speed — the EBS of an
+    /// opponent of any mass is at most that — × `low_speed_dv_factor`, *default* 1.3:
+    /// restitution) plus this, m/s (*default* 1.2: the largest misuse Δv the matrix samples,
+    /// a pothole × 1.5) — a kerb or pothole inside a low-speed crash never does; a crash far
+    /// more severe than tracked still does, late.
     pub low_speed_misuse_dv_mps: f64,
     /// See `low_speed_misuse_dv_mps`.
     pub low_speed_dv_factor: f64,

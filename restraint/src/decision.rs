@@ -141,6 +141,11 @@ pub struct Decision {
     /// `CycleConfig::low_speed_misuse_dv_mps`, `low_speed_dv_factor`.
     low_speed_misuse_dv_mps: f64,
     low_speed_dv_factor: f64,
+    /// For the low-speed limit: the ego mass, the opponent-mass misreport one fault may carry
+    /// (`mass_misreport_kg`) and the no-fire line.
+    ego_mass_kg: f64,
+    mass_misreport_kg: f64,
+    no_fire_ebs_kph: f64,
     gate: AirbagGate,
     /// The pyrotechnic pretensioner's gate in the crash phase.
     pt_gate: AirbagGate,
@@ -206,6 +211,9 @@ impl Decision {
             unguarded_closing_mps: unguarded_closing_mps(cfg),
             low_speed_misuse_dv_mps: cfg.low_speed_misuse_dv_mps,
             low_speed_dv_factor: cfg.low_speed_dv_factor,
+            ego_mass_kg: cfg.ego_mass_kg,
+            mass_misreport_kg: cfg.mass_misreport_kg,
+            no_fire_ebs_kph: cfg.no_fire_ebs_kph,
             gate: AirbagGate::Decided,
             pt_gate: AirbagGate::Decided,
             safing_wait_ns: ms_to_ns(cfg.safing_wait_ms),
@@ -308,12 +316,23 @@ impl Decision {
             }
         }
         // A tracked low-speed object whose predicted contact is the measured one: its own
-        // Δv (and a misuse event's on top) never fires the airbag.
+        // Δv (and a misuse event's on top) never fires the airbag. Low-speed here even with
+        // the opponent `mass_misreport_kg` heavier than reported (one misreport cannot make a
+        // severe crash look low-speed); the bound takes the closing speed, not the EBS: the
+        // opponent's mass only lowers the ego's Δv (EBS ≤ closing speed), and the reported
+        // mass is what a barrier reported as a 3 000 kg object gets wrong.
         if let Some(s) = x.situation.filter(|s| {
-            s.low_speed && s.contact_estimate_ns.abs_diff(c.contact_ns) <= self.avoided_margin_ns
+            let robust_ebs_kph = crate::estimate::equivalent_barrier_speed_kph(
+                s.closing_speed_mps,
+                self.ego_mass_kg,
+                s.opponent_mass_estimate_kg + self.mass_misreport_kg,
+            );
+            s.low_speed
+                && robust_ebs_kph < self.no_fire_ebs_kph
+                && s.contact_estimate_ns.abs_diff(c.contact_ns) <= self.avoided_margin_ns
         }) {
             self.low_speed_dv_limit_mps =
-                Some(s.ebs_kph / 3.6 * self.low_speed_dv_factor + self.low_speed_misuse_dv_mps);
+                Some(s.closing_speed_mps * self.low_speed_dv_factor + self.low_speed_misuse_dv_mps);
         }
         if c.kind == ConfirmKind::Backup {
             return (self.reference, AirbagGate::Decided);

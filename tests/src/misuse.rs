@@ -257,7 +257,6 @@ pub const OPEN: &[&str] = &[
     "spike-in-pothole",          // 9 + 2 (the pothole alone decides, before the spike)
     "braking-and-pothole",       // 6 + 0 (a pothole at its envelope's edge, 1.1 m/s)
     "near-miss",                 // 40 + 131, 2 stuck
-    "low-speed-crash-and-kerb",  // 163 airbag
 ];
 
 /// The family called `name`.
