@@ -293,6 +293,13 @@ impl PulseMatch {
     /// not in PRE-CRASH, or the model refused the situation).
     pub fn push(&mut self, s: &AccelSample, freeze: &mut dyn FnMut(&mut PredictedPulse) -> bool) {
         if matches!(self.state, MatchState::Confirmed(_)) {
+            // The confirmed pulse is no longer fitted, but its end still counts: the event
+            // ends when its quiet gap has passed, and with it a crash phase that fired nothing
+            // (issue 31 item 7: the ECU stayed in CrashDetected, the reversible pretensioner
+            // tensioned, after a pothole matched an avoided collision's prediction).
+            if self.onset.awake() {
+                let _ = self.onset.push(&self.params.onset, s);
+            }
             return;
         }
         match self.onset.push(&self.params.onset, s) {

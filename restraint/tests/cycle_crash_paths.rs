@@ -399,3 +399,41 @@ fn a_dead_accelerometer_fires_nothing_without_both_a_predicted_crash_and_a_crash
     assert!(no_airbag_fired(&b));
     assert_ne!(b.ecu.phase(), Phase::Crash);
 }
+
+#[test]
+fn a_matched_pulse_that_fires_nothing_ends_its_crash_phase_with_the_event() {
+    // Issue 31 item 7. Predicted at 20 m/s (72 km/h: below the closing speed from which a
+    // matched crash may fire on the prediction alone, so its airbag waits for the measured
+    // pulse). The object list stops at C (the opponent evaded); at C a pothole ramps exactly
+    // like the predicted crash for 6 ms (≈ 0.44 m/s: the matcher confirms) and then falls
+    // away — 0.7 m/s in all, below every floor. Nothing fires, and once the event is over the
+    // ECU leaves CrashDetected and releases the reversible pre-crash pretensioner.
+    let mut b = Bench::new(Some(test_lut()));
+    run_scenario(
+        &mut b,
+        C + 300 * MS,
+        T0 + 200 * MS,
+        C,
+        20.0,
+        C,
+        Some(C),
+        &|ms| match ms {
+            0..6 => ramp_g(20.0, ms),
+            6..10 => ramp_g(20.0, 6) * (10 - ms) as f32 / 4.0,
+            _ => 0.0,
+        },
+    );
+    assert!(
+        b.first_mode(EcuMode::Crash).is_some(),
+        "the pulse confirmed"
+    );
+    assert!(no_airbag_fired(&b));
+    assert_ne!(
+        b.mode_at(b.now - MS),
+        EcuMode::Crash as u8,
+        "stuck in CrashDetected"
+    );
+    // Degraded: the object list stopped (stale); not the crash phase.
+    assert!(!matches!(b.ecu.phase(), Phase::Crash | Phase::PostCrash));
+    assert_ne!(b.ecu.pretensioner(), restraint::Pretensioner::Fired);
+}
