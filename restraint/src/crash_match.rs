@@ -245,6 +245,9 @@ pub struct PulseMatch {
     matched: Option<SeverityEstimate>,
     /// The matched ramp (slope m/s² per ms, intercept m/s², x in ms since the wake-up).
     ramp: (f64, f64),
+    /// After the confirmation: the first sample that fell below [`RAMP_HOLD`] of the fitted
+    /// ramp (its course broke: the pulse crested like a pothole, not like the crash), ns.
+    course_broken_ns: Option<u64>,
 }
 
 impl PulseMatch {
@@ -260,6 +263,7 @@ impl PulseMatch {
             state: MatchState::Idle,
             matched: None,
             ramp: (0.0, 0.0),
+            course_broken_ns: None,
         }
     }
 
@@ -297,8 +301,19 @@ impl PulseMatch {
             // ends when its quiet gap has passed, and with it a crash phase that fired nothing
             // (issue 31 item 7: the ECU stayed in CrashDetected, the reversible pretensioner
             // tensioned, after a pothole matched an avoided collision's prediction).
+            // Its course is still watched: a fire planned after the confirmation goes out
+            // only while the pulse keeps to the matched ramp (issue 31: a pothole at the
+            // predicted contact of an avoided collision ramps like the crash for a few ms,
+            // then crests; the crash keeps loading).
             if self.onset.awake() {
-                let _ = self.onset.push(&self.params.onset, s);
+                let step = self.onset.push(&self.params.onset, s);
+                if step == OnsetStep::Awake && self.course_broken_ns.is_none() {
+                    if let Some(line_mps2) = self.ramp_line_mps2(s.t_ns) {
+                        if s.decel_mps2 < RAMP_HOLD * line_mps2 {
+                            self.course_broken_ns = Some(s.t_ns);
+                        }
+                    }
+                }
             }
             return;
         }
@@ -340,12 +355,7 @@ impl PulseMatch {
         // Time since the (predicted-slope) contact: the ramp ends at the first knee.
         let tau_ms = x_ms + self.params.onset.wake_mps2 / p.slope_mps2_per_ms;
         let in_ramp = tau_ms <= KNEE_FRACTION * p.knee_ms;
-        if let Some(e) = self.matched {
-            // The fitted ramp up to the knee, and its value at the knee after it: the
-            // predicted crash's force only grows with the crush.
-            let (j, b) = self.ramp;
-            let x_knee_ms = KNEE_FRACTION * p.knee_ms - (tau_ms - x_ms);
-            let line_mps2 = j * x_ms.min(x_knee_ms) + b;
+        if let (Some(e), Some(line_mps2)) = (self.matched, self.ramp_line_mps2(s.t_ns)) {
             self.state = if s.decel_mps2 < RAMP_HOLD * line_mps2 {
                 MatchState::Mismatch(Mismatch::Shape)
             } else {
@@ -370,6 +380,28 @@ impl PulseMatch {
                 other => other,
             };
         }
+    }
+
+    /// The matched ramp's deceleration at `t_ns`, m/s²: the fitted line up to the knee, and its
+    /// value at the knee after it (the predicted crash's force only grows with the crush).
+    /// `None` before a match.
+    fn ramp_line_mps2(&self, t_ns: u64) -> Option<f64> {
+        let (true, Some(wake_ns), Some(_)) = (self.frozen, self.onset.onset_ns(), self.matched)
+        else {
+            return None;
+        };
+        let p = &self.prediction;
+        let x_ms = t_ns.saturating_sub(wake_ns) as f64 * 1e-6;
+        // The wake-up lies this long after the (predicted-slope) contact.
+        let lead_ms = self.params.onset.wake_mps2 / p.slope_mps2_per_ms;
+        let x_knee_ms = KNEE_FRACTION * p.knee_ms - lead_ms;
+        let (j, b) = self.ramp;
+        Some(j * x_ms.min(x_knee_ms) + b)
+    }
+
+    /// After a confirmation: when the pulse left the matched ramp (`None`: it keeps to it).
+    pub fn course_broken_ns(&self) -> Option<u64> {
+        self.course_broken_ns
     }
 
     /// A matched ramp confirms once the velocity change since the onset reaches the floor

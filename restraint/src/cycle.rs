@@ -320,6 +320,7 @@ impl Activity for RestraintCycle<'_> {
             safing,
             event_in_progress: self.crash.event_in_progress(),
             event_dv_mps: self.crash.event_dv_mps(),
+            matched_course_broken: self.crash.matcher().course_broken_ns().is_some(),
             replan: &mut replan,
         };
         self.decision.step(now, &mut x);

@@ -97,6 +97,8 @@ pub(crate) struct DecisionInputs<'d> {
     pub event_in_progress: bool,
     /// The velocity change of the current accelerometer event since its onset, m/s.
     pub event_dv_mps: f64,
+    /// A matched confirmation's pulse has left its ramp (`PulseMatch::course_broken_ns`).
+    pub matched_course_broken: bool,
     /// The table's plan for an adaptive crash at a closing speed (m/s): `None` when that
     /// severity is below the no-fire line (`crash::plan_for`).
     pub replan: &'d mut dyn FnMut(f64) -> Option<RestraintPlan>,
@@ -369,6 +371,22 @@ impl Decision {
         self.phase = Phase::Crash;
     }
 
+    /// A matched crash whose pulse left the matched ramp before its fires went out: the
+    /// prediction no longer explains the event, so the fires still pending are decided by the
+    /// accelerometer-only boundaries of the event, as for a crash without a prediction
+    /// (issue 31: a pothole at the predicted contact of an avoided collision).
+    fn hand_over_to_the_conventional_path(&mut self) {
+        if self.gate == AirbagGate::Decided && self.airbag_fire_at_ns.take().is_some() {
+            self.gate = AirbagGate::Fallback;
+        }
+        if self.pt_gate == AirbagGate::Decided
+            && self.pretensioner != Pretensioner::Fired
+            && self.pretensioner_at_ns.take().is_some()
+        {
+            self.pt_gate = AirbagGate::Fallback;
+        }
+    }
+
     /// The conventional path: the reference airbag when the accelerometer-only algorithm says
     /// must-fire for the confirmed event (and only for it); no airbag when it says no-fire,
     /// or its window has passed.
@@ -442,6 +460,12 @@ impl Decision {
             (x.confirmation, self.phase)
         {
             self.enter_crash(c, x);
+        }
+        if self.phase == Phase::Crash
+            && x.matched_course_broken
+            && matches!(self.crash_kind, Some(ConfirmKind::Matched(_)))
+        {
+            self.hand_over_to_the_conventional_path();
         }
         if self.phase == Phase::Crash {
             self.gate_airbag(now, x.fallback, x.event_dv_mps);

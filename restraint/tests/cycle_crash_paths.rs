@@ -437,3 +437,31 @@ fn a_matched_pulse_that_fires_nothing_ends_its_crash_phase_with_the_event() {
     assert!(!matches!(b.ecu.phase(), Phase::Crash | Phase::PostCrash));
     assert_ne!(b.ecu.pretensioner(), restraint::Pretensioner::Fired);
 }
+
+#[test]
+fn a_matched_pulse_that_leaves_its_ramp_before_the_planned_fire_is_decided_conventionally() {
+    // Issue 31 (near miss, kerb at a predicted contact). Predicted at 28 m/s (101 km/h: above
+    // the closing speed from which a matched crash fires on its plan). The pulse ramps exactly
+    // like the predicted crash for 6 ms — the matcher confirms at C + 5 ms, the plan's airbag
+    // is due at ≈ C + 15 ms — and then falls to nothing within 2 ms, as a pothole or kerb
+    // strike crests (0.8 m/s in all). The pulse left the matched ramp before the fire went out:
+    // the accelerometer-only boundary decides the event, and it says no-fire.
+    let mut b = Bench::new(Some(test_lut()));
+    run_scenario(
+        &mut b,
+        C + 300 * MS,
+        T0 + 200 * MS,
+        C,
+        28.0,
+        C,
+        Some(C),
+        &|ms| match ms {
+            0..6 => ramp_g(28.0, ms),
+            6..8 => ramp_g(28.0, 6) * (8 - ms) as f32 / 2.0,
+            _ => 0.0,
+        },
+    );
+    assert_eq!(b.first_mode(EcuMode::Crash), Some(C + 5 * MS), "matched");
+    assert!(no_airbag_fired(&b), "{:?}", first_fire(&b));
+    assert!(!matches!(b.ecu.phase(), Phase::Crash | Phase::PostCrash));
+}
