@@ -22,7 +22,7 @@ use sensor_feeds::{Player, TickOutput};
 use world::{Scenario, Truth};
 
 /// Scenario time 0 on the simulated clock [ns] (any value clear of 0).
-const START_NS: u64 = 1_000_000_000;
+pub const START_NS: u64 = 1_000_000_000;
 const MS: u64 = 1_000_000;
 
 /// What the offline bench runs the ECU core with.

@@ -243,3 +243,45 @@ fn the_campaigns_scenario_variants_meet_their_expectations_offline() {
     assert!(n >= 15, "{n} variant cases");
     assert!(bad.is_empty(), "{bad:#?}\n{table}");
 }
+
+#[test]
+fn offline_bench_json_actions_carry_ms_after_the_scenario_start() {
+    // Issue 30 item 7: every action has `t_ms` (ms after the scenario start) beside `t_ns`
+    // (the simulated clock, scenario time + 1 s). Checked against the run's own contact-relative
+    // times, which come another way (`OfflineRun::action`: ms after the true contact).
+    let name = "taurus-48-48-abs";
+    let out = std::env::temp_dir().join(format!("offline-bench-t-ms-{}.json", std::process::id()));
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_offline-bench"))
+        .arg("--scenario")
+        .arg(root().join(format!("scenarios/{name}.toml")))
+        .arg("--json")
+        .arg(&out)
+        .stdout(std::process::Stdio::null())
+        .status()
+        .expect("offline-bench runs");
+    assert!(status.success());
+    let text = std::fs::read_to_string(&out).expect("json written");
+    let _ = std::fs::remove_file(&out);
+    let json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let run_json = &json[0];
+    let contact_ms = run_json["contact_s"].as_f64().expect("contact") * 1e3;
+    let actions = run_json["actions"].as_array().expect("actions");
+    assert!(!actions.is_empty());
+    let r = run(&scenario(name), &cfg()).expect("offline run");
+    for a in actions {
+        let (t_ns, t_ms) = (a["t_ns"].as_u64().unwrap(), a["t_ms"].as_f64().unwrap());
+        assert!(
+            (t_ms - (t_ns - 1_000_000_000) as f64 * 1e-6).abs() < 1e-9,
+            "{a}"
+        );
+        let what = a["what"].as_str().unwrap();
+        if let Some((rel_ms, ..)) = r.action(what) {
+            if r.modules.actions.iter().filter(|x| x.what == what).count() == 1 {
+                assert!(
+                    (t_ms - contact_ms - rel_ms).abs() < 1e-6,
+                    "{what}: {t_ms} vs {rel_ms}"
+                );
+            }
+        }
+    }
+}

@@ -2,10 +2,16 @@
 //! restraint core under a simulated clock with the real sensor model and the actuator stubs'
 //! judge (`e2e_tests::offline`), and prints the outcome table. No vcan, no processes, no
 //! emulator: deterministic, ≈ 50 ms per scenario. Default: the whole library (`scenarios/`).
+//!
+//! Time bases of `--json` (one array, an object per scenario): `actions[].t_ns` is the ECU's
+//! simulated clock, which starts at 1 s (scenario time + 1 s, so that no time stamp is 0);
+//! `actions[].t_ms` is the same instant in ms after the scenario start; `modes`, `faults` and
+//! `crash_mode_ms` are ms after the true contact (`contact_s`, s after the start), or after
+//! the scenario start when there is no contact.
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use e2e_tests::offline::{run, table_row, OfflineConfig, TABLE_HEADER};
+use e2e_tests::offline::{run, table_row, OfflineConfig, START_NS, TABLE_HEADER};
 use std::path::PathBuf;
 
 /// Scenario library through the ECU core, offline.
@@ -56,7 +62,7 @@ fn main() -> Result<()> {
             "confirmed_by": r.confirmed_by,
             "modes": r.modes,
             "faults": r.faults,
-            "actions": r.modules.actions,
+            "actions": actions_json(&r.modules.actions)?,
             "outcome": r.evaluated.as_ref().map(|e| &e.outcome),
         }));
     }
@@ -66,4 +72,19 @@ fn main() -> Result<()> {
             .with_context(|| format!("writing {}", p.display()))?;
     }
     Ok(())
+}
+
+/// The actions as recorded, each with `t_ms` (ms after the scenario start) added.
+fn actions_json<T: serde::Serialize>(actions: &[T]) -> Result<Vec<serde_json::Value>> {
+    actions
+        .iter()
+        .map(|a| {
+            let mut v = serde_json::to_value(a)?;
+            if let Some(t_ns) = v.get("t_ns").and_then(serde_json::Value::as_u64) {
+                let t_ms = t_ns.saturating_sub(START_NS) as f64 * 1e-6;
+                v["t_ms"] = serde_json::json!(t_ms);
+            }
+            Ok(v)
+        })
+        .collect()
 }
