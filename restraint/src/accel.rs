@@ -62,9 +62,9 @@ impl PlausibleBatch {
         self.min_accel_mps2 = self.min_accel_mps2.min(a);
     }
 
-    /// Takes off a deceleration the car's braking explains (`decel_mps2` ≥ 0, m/s²): every
-    /// reading as if the car were not braking (module `crash`: sustained braking is not crash
-    /// evidence).
+    /// Takes off a deceleration the car's braking explains (`decel_mps2`, m/s²; nothing when it
+    /// is not positive): every reading as if the car were not braking (sustained braking is not
+    /// crash evidence; `CycleConfig::braking_compensation_max_g`).
     pub fn remove_decel(&mut self, decel_mps2: f64) {
         if !(decel_mps2 > 0.0) {
             return;

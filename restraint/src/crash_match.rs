@@ -297,14 +297,13 @@ impl PulseMatch {
     /// not in PRE-CRASH, or the model refused the situation).
     pub fn push(&mut self, s: &AccelSample, freeze: &mut dyn FnMut(&mut PredictedPulse) -> bool) {
         if matches!(self.state, MatchState::Confirmed(_)) {
-            // The confirmed pulse is no longer fitted, but its end still counts: the event
-            // ends when its quiet gap has passed, and with it a crash phase that fired nothing
-            // (issue 31 item 7: the ECU stayed in CrashDetected, the reversible pretensioner
-            // tensioned, after a pothole matched an avoided collision's prediction).
-            // Its course is still watched: a fire planned after the confirmation goes out
-            // only while the pulse keeps to the matched ramp (issue 31: a pothole at the
-            // predicted contact of an avoided collision ramps like the crash for a few ms,
-            // then crests; the crash keeps loading).
+            // The confirmed pulse is no longer fitted, but the event is followed to its end
+            // (issue 31 item 7: a crash phase that fired nothing ends with it — the ECU stayed
+            // in CrashDetected, the reversible pretensioner tensioned, after a pothole matched
+            // an avoided collision's prediction) and its course is still watched: a fire
+            // planned after the confirmation goes out only while the pulse keeps to the
+            // matched ramp (such a pothole ramps like the crash for a few ms, then crests; the
+            // crash keeps loading).
             if self.onset.awake() {
                 let step = self.onset.push(&self.params.onset, s);
                 if step == OnsetStep::Awake && self.course_broken_ns.is_none() {

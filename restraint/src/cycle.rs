@@ -228,9 +228,7 @@ impl Activity for RestraintCycle<'_> {
             inputs.on_accel(a, now, c, &mut plausible);
             // The agreement compares the two sensors as they read.
             agreement.crash.on_batch(&plausible);
-            if braking > 0.0 {
-                plausible.remove_decel(braking);
-            }
+            plausible.remove_decel(braking);
             crash.on_batch(&plausible, &freeze);
         });
         // The independent safing channel: its own monitor, its own function.

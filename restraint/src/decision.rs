@@ -379,10 +379,8 @@ impl Decision {
         if self.gate == AirbagGate::Decided && self.airbag_fire_at_ns.take().is_some() {
             self.gate = AirbagGate::Fallback;
         }
-        if self.pt_gate == AirbagGate::Decided
-            && self.pretensioner != Pretensioner::Fired
-            && self.pretensioner_at_ns.take().is_some()
-        {
+        // A pending pretensioner fire is one not yet fired (scheduled only while not fired).
+        if self.pt_gate == AirbagGate::Decided && self.pretensioner_at_ns.take().is_some() {
             self.pt_gate = AirbagGate::Fallback;
         }
     }

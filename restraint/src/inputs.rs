@@ -378,10 +378,8 @@ impl InputMonitor {
         if !(self.ego_braking && self.ego_long_accel_mps2 < 0.0) {
             return 0.0;
         }
-        match self.vehicle_decel(now) {
-            Some((d, _)) if self.ego_braking && d > 0.0 => d.min(max_mps2),
-            _ => 0.0,
-        }
+        self.vehicle_decel(now)
+            .map_or(0.0, |(d, _)| d.min(max_mps2))
     }
 
     /// The degraded reasons at `now` (`lut_present`: a usable LUT was loaded).

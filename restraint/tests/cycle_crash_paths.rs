@@ -408,21 +408,7 @@ fn a_matched_pulse_that_fires_nothing_ends_its_crash_phase_with_the_event() {
     // like the predicted crash for 6 ms (≈ 0.44 m/s: the matcher confirms) and then falls
     // away — 0.7 m/s in all, below every floor. Nothing fires, and once the event is over the
     // ECU leaves CrashDetected and releases the reversible pre-crash pretensioner.
-    let mut b = Bench::new(Some(test_lut()));
-    run_scenario(
-        &mut b,
-        C + 300 * MS,
-        T0 + 200 * MS,
-        C,
-        20.0,
-        C,
-        Some(C),
-        &|ms| match ms {
-            0..6 => ramp_g(20.0, ms),
-            6..10 => ramp_g(20.0, 6) * (10 - ms) as f32 / 4.0,
-            _ => 0.0,
-        },
-    );
+    let b = prediction_then_a_cresting_ramp(20.0, 4);
     assert!(
         b.first_mode(EcuMode::Crash).is_some(),
         "the pulse confirmed"
@@ -446,22 +432,35 @@ fn a_matched_pulse_that_leaves_its_ramp_before_the_planned_fire_is_decided_conve
     // is due at ≈ C + 15 ms — and then falls to nothing within 2 ms, as a pothole or kerb
     // strike crests (0.8 m/s in all). The pulse left the matched ramp before the fire went out:
     // the accelerometer-only boundary decides the event, and it says no-fire.
+    let b = prediction_then_a_cresting_ramp(28.0, 2);
+    assert_eq!(b.first_mode(EcuMode::Crash), Some(C + 5 * MS), "matched");
+    assert!(no_airbag_fired(&b), "{:?}", first_fire(&b));
+    assert!(!matches!(b.ecu.phase(), Phase::Crash | Phase::PostCrash));
+}
+
+/// A crash predicted at `closing_mps` for C (object list from 200 ms, until C) and a pulse at C
+/// that ramps exactly like the predicted crash for 6 ms, then falls linearly to nothing over
+/// `fall_ms` (a pothole or kerb strike that began like the crash and crested); 300 ms run on.
+fn prediction_then_a_cresting_ramp(closing_mps: f64, fall_ms: u64) -> Bench {
     let mut b = Bench::new(Some(test_lut()));
+    let crest = ramp_g(closing_mps, 6);
     run_scenario(
         &mut b,
         C + 300 * MS,
         T0 + 200 * MS,
         C,
-        28.0,
+        closing_mps as f32,
         C,
         Some(C),
-        &|ms| match ms {
-            0..6 => ramp_g(28.0, ms),
-            6..8 => ramp_g(28.0, 6) * (8 - ms) as f32 / 2.0,
-            _ => 0.0,
+        &|ms| {
+            if ms < 6 {
+                ramp_g(closing_mps, ms)
+            } else if ms < 6 + fall_ms {
+                crest * (6 + fall_ms - ms) as f32 / fall_ms as f32
+            } else {
+                0.0
+            }
         },
     );
-    assert_eq!(b.first_mode(EcuMode::Crash), Some(C + 5 * MS), "matched");
-    assert!(no_airbag_fired(&b), "{:?}", first_fire(&b));
-    assert!(!matches!(b.ecu.phase(), Phase::Crash | Phase::PostCrash));
+    b
 }
