@@ -14,18 +14,19 @@
 //! reported `bottoming_out` flag is the physical one (excursion beyond the available ride-down),
 //! never hidden; an optimum that only eats into the reserve is reported with its excursion.
 //!
-//! **Fire-delay robustness**: the ECU may fire the airbag only after crash confirmation; the
-//! table's plans are executed on the prediction-matched confirmation (`restraint::crash_match`),
-//! which since issue 20 waits for a velocity change of 0.3 m/s (`match_min_dv_mps`: a kerb
-//! strike at the predicted contact must not pass for the crash) and so comes 4.4–5.7 ms after
-//! contact at the table's closing speeds from 60 km/h on (1.5–3.5 ms before), plus up to a
-//! cycle and the CAN transfer, so a plan earlier than that is executed late. Every setting that
-//! fires the airbag is therefore also evaluated with the airbag
-//! [`OptimiserConfig::fire_delay_tolerance_s`] (*default* 5 ms; 3 ms before issue 20) later, and the worse of the two costs counts: the optimum must stay free of
-//! bottoming-out when the bag comes that much late. (Until issue 14 the ECU confirmed on its
-//! generic thresholds, ≈ 5.5 ms after contact, and the tolerance was 8 ms.) The reported outcomes are those at the
-//! planned times (what the table predicts when the ECU is on time). The conventional reference
-//! restraint (`lut reference`) keeps the paper's fixed definition (tolerance 0).
+//! **Plan = fire** (issue 30): the ECU fires a crash-phase airbag only once its event has
+//! carried the airbag's severity floor (no misuse event does), so each cell's airbag time is
+//! searched from [`OptimiserConfig::earliest_airbag_s`] on — the instant the cell's own pulse
+//! carries the floor, plus the ECU's latency — and the bus's FireTime is when the bag fires.
+//!
+//! **Fire-delay robustness**: what is left between plan and fire (a lighter opponent than the
+//! planning mass carries the floor later, the batch is read a cycle later, the CAN transfer):
+//! every setting that fires the airbag is also evaluated with the airbag
+//! [`OptimiserConfig::fire_delay_tolerance_s`] (*default* 3 ms) later, and the worse of the two
+//! costs counts: the optimum must stay free of bottoming-out when the bag comes that much late.
+//! (8 ms while the ECU confirmed on its generic thresholds, 5 ms with the matched path's 0.3 m/s
+//! floor of issue 20.) The reported outcomes are those at the planned times. The conventional
+//! reference restraint (`lut reference`) keeps the paper's fixed definition (tolerance 0).
 //!
 //! **Search space**: the optimisers work on the unit cube (one coordinate per free variable,
 //! mapped linearly onto its bounds), which gives Nelder–Mead a well-scaled simplex. Outside the
@@ -119,6 +120,29 @@ impl SearchSpace {
         }
     }
 
+    /// This space with the airbag fired no earlier than `earliest_s` after contact (plan =
+    /// fire: [`OptimiserConfig::earliest_airbag_s`]); a free airbag time keeps its upper bound,
+    /// and is held there when `earliest_s` lies beyond it.
+    pub fn with_earliest_airbag_s(self, earliest_s: f64) -> Self {
+        let airbag_time_s = match self.airbag_time_s {
+            Var::Free { min, max } if earliest_s > min => {
+                if earliest_s >= max {
+                    Var::Fixed(max)
+                } else {
+                    Var::Free {
+                        min: earliest_s,
+                        max,
+                    }
+                }
+            }
+            v => v,
+        };
+        SearchSpace {
+            airbag_time_s,
+            ..self
+        }
+    }
+
     fn vars(&self) -> [Var; 4] {
         [
             self.load_limiter_n,
@@ -185,15 +209,57 @@ pub struct OptimiserConfig {
     /// A firing airbag is also evaluated this much later; the worse cost counts [s]
     /// (see module docs, "Fire-delay robustness"). 0 disables it.
     pub fire_delay_tolerance_s: f64,
+    /// Plan = fire (issue 30): the ECU's crash-phase airbag waits until the event has carried
+    /// this velocity change since its onset [m/s] (`restraint`'s `fallback_min_dv_mps`, which
+    /// the matched path's fires wait for too: no misuse event carries it), so a cell's airbag is
+    /// planned no earlier than its own pulse reaches it plus [`Self::ecu_latency_s`]. 0 = off.
+    pub airbag_floor_dv_mps: f64,
+    /// What the ECU adds to the instant the floor is reached [s]: the accelerometer's
+    /// anti-alias group delay (`accel_delay_ms`) and one 1 ms cycle until the decision runs.
+    pub ecu_latency_s: f64,
 }
 
-/// *Default* fire-delay tolerance [s]: how late the ECU can execute the table's plans: its
-/// prediction-matched confirmation (with the 0.3 m/s severity floor of issue 20) comes up to
-/// 5.7 ms after contact where the table plans the airbag at +3 ms (60 km/h against 3000 kg, the
-/// slowest accelerometer a scenario may have, 1 kHz), the batch is read up to two 1 ms cycles
-/// later: 4.7 ms late, plus the CAN transfer, rounded up (`lut/tests/optimiser.rs` recomputes it
-/// with the ECU core's matcher against the shipped table's plans).
-pub const DEFAULT_FIRE_DELAY_TOLERANCE_S: f64 = 0.005;
+/// *Default* airbag floor of the plan [m/s]: the ECU's (`restraint::CycleConfig`).
+pub fn default_airbag_floor_dv_mps() -> f64 {
+    restraint::CycleConfig::default().fallback_min_dv_mps
+}
+
+/// *Default* ECU latency after the floor [s]: the accelerometer's group delay + one cycle.
+pub fn default_ecu_latency_s() -> f64 {
+    (restraint::CycleConfig::default().accel_delay_ms + 1.0) * 1e-3
+}
+
+impl OptimiserConfig {
+    /// The earliest airbag time the ECU can execute on `pulse` [s after contact]: the first
+    /// instant its velocity change reaches [`Self::airbag_floor_dv_mps`], plus
+    /// [`Self::ecu_latency_s`]; `f64::INFINITY` when the pulse never carries the floor, 0
+    /// when the floor is off.
+    pub fn earliest_airbag_s(&self, pulse: &CompartmentPulse<'_>) -> f64 {
+        // NaN counts as off, like 0.
+        if self.airbag_floor_dv_mps.is_nan() || self.airbag_floor_dv_mps <= 0.0 {
+            return 0.0;
+        }
+        let mut dv_mps = 0.0;
+        let mut prev = 0.0;
+        for (i, &a) in pulse.accel_mps2.iter().enumerate() {
+            // Deceleration is negative acceleration; trapezoidal rule.
+            dv_mps -= 0.5 * (prev + a) * pulse.step_s;
+            prev = a;
+            if dv_mps >= self.airbag_floor_dv_mps {
+                return i as f64 * pulse.step_s + self.ecu_latency_s;
+            }
+        }
+        f64::INFINITY
+    }
+}
+
+/// *Default* fire-delay tolerance [s]: how late the ECU can execute the table's plans now that
+/// each plan waits for its cell's pulse to carry the airbag's floor (plan = fire,
+/// [`OptimiserConfig::airbag_floor_dv_mps`]): a lighter opponent than the planning mass carries
+/// it later, the batch is read up to a cycle later — 1.3 ms worst against the shipped table —
+/// plus the CAN transfer, rounded up (`lut/tests/optimiser.rs` recomputes it with the ECU core's
+/// matcher and floor against the shipped table's plans).
+pub const DEFAULT_FIRE_DELAY_TOLERANCE_S: f64 = 0.003;
 
 /// *Default* ride-down reserve [m].
 pub const DEFAULT_RESERVE_M: f64 = 0.010;
@@ -211,6 +277,8 @@ impl Default for OptimiserConfig {
             no_fire_below_n: f64::from(diagram::AirbagThresholds::DEFAULT.no_fire_below_kn) * 1.0e3,
             reserve_m: DEFAULT_RESERVE_M,
             fire_delay_tolerance_s: DEFAULT_FIRE_DELAY_TOLERANCE_S,
+            airbag_floor_dv_mps: default_airbag_floor_dv_mps(),
+            ecu_latency_s: default_ecu_latency_s(),
         }
     }
 }

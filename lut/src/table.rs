@@ -105,6 +105,8 @@ const EXTRA_NM_TOL: &str = "optimiser.nm_sd_tolerance_g";
 const EXTRA_NO_FIRE: &str = "optimiser.no_fire_below_kn";
 const EXTRA_RESERVE: &str = "optimiser.ride_down_reserve_mm";
 const EXTRA_FIRE_DELAY: &str = "optimiser.fire_delay_tolerance_ms";
+const EXTRA_AIRBAG_FLOOR: &str = "optimiser.airbag_floor_dv_mps";
+const EXTRA_ECU_LATENCY: &str = "optimiser.ecu_latency_ms";
 
 impl Grid {
     /// Parse and validate grid TOML; `origin` names the source in errors.
@@ -180,6 +182,14 @@ impl Grid {
             format!("{}", o.fire_delay_tolerance_s * 1e3),
         );
         extra.insert(
+            EXTRA_AIRBAG_FLOOR.into(),
+            format!("{}", o.airbag_floor_dv_mps),
+        );
+        extra.insert(
+            EXTRA_ECU_LATENCY.into(),
+            format!("{}", o.ecu_latency_s * 1e3),
+        );
+        extra.insert(
             "occupant".into(),
             "belted; seat friction and hardware: physics::defaults".into(),
         );
@@ -222,6 +232,9 @@ impl Grid {
             no_fire_below_n: get(EXTRA_NO_FIRE)?.parse::<f64>()? * 1e3,
             reserve_m: get(EXTRA_RESERVE)?.parse::<f64>()? * 1e-3,
             fire_delay_tolerance_s: get(EXTRA_FIRE_DELAY)?.parse::<f64>()? * 1e-3,
+            // Tables built before plan = fire (issue 30) have no floor: 0 rebuilds them as built.
+            airbag_floor_dv_mps: get(EXTRA_AIRBAG_FLOOR).map_or(Ok(0.0), |v| v.parse())?,
+            ecu_latency_s: get(EXTRA_ECU_LATENCY).map_or(Ok(0.0), |v| v.parse::<f64>())? * 1e-3,
         };
         Ok(Grid {
             ego: Ego {
@@ -339,13 +352,9 @@ pub fn optimise_point(grid: &Grid, p: &GridPoint, cfg: &OptimiserConfig) -> Resu
         pulse: pulse.ego(),
         occupant: occupant_at(&p.query),
     };
-    let optimum = optimise::optimise(
-        &[case],
-        &SearchSpace::adaptive(),
-        &RestraintHardware::default(),
-        cfg,
-    )
-    .with_context(|| format!("cell {} {:?}", p.index, p.coords))?;
+    let space = SearchSpace::adaptive().with_earliest_airbag_s(cfg.earliest_airbag_s(&case.pulse));
+    let optimum = optimise::optimise(&[case], &space, &RestraintHardware::default(), cfg)
+        .with_context(|| format!("cell {} {:?}", p.index, p.coords))?;
     let o = optimum
         .outcomes
         .first()

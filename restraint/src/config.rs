@@ -109,18 +109,21 @@ pub struct CycleConfig {
     /// `lut study fallback --derive`, restraint/README.md, "Crash phase"). Reaching it fires
     /// the reference airbag; not reaching it within 60 ms is a no-fire.
     pub fallback_dv_mps: [f64; crate::fallback::KNOTS],
-    /// Accelerometer-only algorithm, airbag: a must-fire also needs at least this velocity
-    /// change since the onset, m/s, and the generic confirmation's persistence
-    /// (`confirm_decel_g` for `confirm_samples`) at the deciding sample (*default* 1.0 ≈
-    /// 3.6 km/h). Why: the boundary's first knots are low so that a severe crash is recognised
-    /// in its first ms; a door slam (40 g × 2 ms ≈ 0.5 m/s), a hammer blow on the housing or a
-    /// pothole crosses them but rarely carries 1 m/s. *Open conflict* (issue 31): the matrix's
-    /// largest misuse Δv is a pothole under both front wheels at 1.5 × its envelope, 1.2 m/s,
-    /// and at 1.0 such potholes at the envelope's edge still fire the airbag (10–17 of 1 000
-    /// with ABS braking or a later spike). At 1.25 none does, but the FMVSS 208 56 km/h belted
-    /// case's reference airbag comes 1 ms later (+11.5 ms) and the occupant bottoms out
-    /// (+18.5 % against the reference restraint at its own +10 ms): the floor stays until the
-    /// pulse's course (not its Δv) separates the two.
+    /// The airbag's severity floor, m/s (*default* 1.25 ≈ 4.5 km/h): a conventional must-fire
+    /// needs at least this velocity change since the onset and the generic confirmation's
+    /// persistence (`confirm_decel_g` for `confirm_samples`) at the deciding sample, and a
+    /// prediction-matched airbag waits for it too (`Decision::hold_below_floor`). Why: the
+    /// boundary's first knots are low so that a severe crash is recognised in its first ms, and
+    /// a pothole or kerb strike at the predicted contact of a near miss can follow the predicted
+    /// ramp; none carries this much — the matrix's largest misuse Δv is a pothole under both
+    /// front wheels at 1.5 × its envelope, 1.2 m/s (at 1.0 such potholes still fired the airbag:
+    /// near miss 32, spike in a pothole 17, braking and pothole 10 of 1 000, seed 1). *What it
+    /// costs* (issue 30's order: no inadvertent fire before fire time): the accelerometer-only
+    /// airbag fires +1.2 ms (p50) / +1.7 ms (worst) after "127 mm − 30 ms" instead of −0.2 /
+    /// +0.5 ms; the FMVSS 208 56 km/h belted case, whose barrier refutes the prediction made for
+    /// a 3 000 kg object, fires +11.5 ms instead of +10.5 and its occupant bottoms out (+18.5 %
+    /// against the reference restraint at its own +10 ms). The table plans every adaptive airbag
+    /// no earlier than its cell's pulse carries this floor (`lut`'s plan = fire).
     pub fallback_min_dv_mps: f64,
     /// The pyrotechnic pretensioner on the conventional path (no adaptive plan): its own
     /// velocity-time boundary, m/s at 0, 4, … 60 ms after the onset (*default* 0.6 × the
@@ -274,7 +277,7 @@ impl Default for CycleConfig {
             mass_misreport_kg: 1200.0,
             backup_confirm_g: 4.0,
             fallback_dv_mps: crate::fallback::DEFAULT_DV_MPS,
-            fallback_min_dv_mps: 1.0,
+            fallback_min_dv_mps: 1.25,
             pretensioner_dv_mps: crate::fallback::DEFAULT_PRETENSIONER_DV_MPS,
             pretensioner_min_dv_mps: 1.25,
             match_min_dv_mps: 0.3,

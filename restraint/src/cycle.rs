@@ -382,6 +382,7 @@ impl Activity for RestraintCycle<'_> {
                 self.inputs.safing.faults.stuck_events,
             ),
             ("fires_vetoed_by_safing", self.decision.vetoed_fires()),
+            ("fires_below_floor", self.decision.fires_below_floor()),
             ("severity_disagreements", self.agreement.disagreements()),
             ("can_frames_rx", c.can_frames_rx),
             ("can_accepted", e2e.accepted),

@@ -164,6 +164,13 @@ pub struct Decision {
     vetoed: u64,
     /// How the crash was confirmed (latched with the crash plan).
     crash_kind: Option<ConfirmKind>,
+    /// The severity floors a matched crash's fires wait for, m/s (airbag, pyrotechnic
+    /// pretensioner): the conventional path's `fallback_min_dv_mps` and
+    /// `pretensioner_min_dv_mps` ([`Decision::hold_below_floor`]).
+    airbag_floor_mps: f64,
+    pretensioner_floor_mps: f64,
+    /// Matched fires dropped because their event ended below the floor.
+    held_below_floor: u64,
 }
 
 fn time_ms_to_ns(t_ms: f32) -> i64 {
@@ -224,7 +231,16 @@ impl Decision {
             abandoned: false,
             vetoed: 0,
             crash_kind: None,
+            airbag_floor_mps: cfg.fallback_min_dv_mps,
+            pretensioner_floor_mps: cfg.pretensioner_min_dv_mps,
+            held_below_floor: 0,
         }
+    }
+
+    /// Matched crash-phase fires dropped because their event ended before it carried the
+    /// restraint's severity floor.
+    pub fn fires_below_floor(&self) -> u64 {
+        self.held_below_floor
     }
 
     /// Crash-phase fires the safing function vetoed (not agreeing within `safing_wait_ms`).
@@ -435,6 +451,31 @@ impl Decision {
         }
     }
 
+    /// A matched crash's fire that is due waits until its event has carried `floor_mps` since
+    /// the onset (issue 31, near misses): a pothole or kerb strike at the predicted contact of
+    /// a collision that does not happen can follow the predicted ramp for the few ms before a
+    /// planned fire, but carries at most the misuse envelope's Δv (1.2 m/s at 1.5 × the
+    /// pothole's), which the floors exceed; a crash of the table's range carries it 4–9 ms
+    /// after contact. Postponed to the next cycle while below; dropped (`true`) when the event
+    /// ended without it.
+    fn hold_below_floor(
+        slot: &mut Option<u64>,
+        floor_mps: f64,
+        now: u64,
+        x: &DecisionInputs<'_>,
+    ) -> bool {
+        let Some(t) = *slot else { return false };
+        if now.saturating_add(x.half_period_ns) < t || x.event_dv_mps >= floor_mps {
+            return false;
+        }
+        if !x.event_in_progress {
+            *slot = None;
+            return true;
+        }
+        *slot = Some(now.saturating_add(x.half_period_ns).saturating_add(1));
+        false
+    }
+
     /// A scheduled fire at `t`: whether it goes out now (`Some(true)`), is dropped
     /// (`Some(false)`: the safing function did not agree within the wait), or waits (`None`).
     /// Pre-crash (reversible pretensioner) fires need no safing.
@@ -537,6 +578,17 @@ impl Decision {
         // time (a crash fire is never scheduled before its confirmation, which is past).
         // A crash-phase fire also needs the safing function (module `safing`).
         let in_crash = self.phase == Phase::Crash;
+        if in_crash && matches!(self.crash_kind, Some(ConfirmKind::Matched(_))) {
+            let mut slots = [
+                (self.airbag_fire_at_ns, self.airbag_floor_mps),
+                (self.pretensioner_at_ns, self.pretensioner_floor_mps),
+            ];
+            for (slot, floor) in &mut slots {
+                self.held_below_floor += u64::from(Self::hold_below_floor(slot, *floor, now, x));
+            }
+            self.airbag_fire_at_ns = slots[0].0;
+            self.pretensioner_at_ns = slots[1].0;
+        }
         if let Some(t) = self.pretensioner_at_ns {
             if let Some(go) = self.release(t, now, x.half_period_ns, x.safing) {
                 if go {

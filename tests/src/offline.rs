@@ -54,6 +54,22 @@ impl OfflineConfig {
             ecu_phase_ns: MS / 2,
         })
     }
+
+    /// Replaces the decision settings with a file of `[cycle]` keys (as in ecu.toml's
+    /// `[cycle]`, without the header; absent keys keep their defaults): for calibrating a
+    /// threshold on the matrix and the library before it is changed in the code.
+    ///
+    /// # Errors
+    /// The file does not read, does not parse, or a value is out of its range.
+    pub fn with_cycle_file(mut self, path: &std::path::Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| anyhow!("reading {}: {e}", path.display()))?;
+        self.cycle = toml::from_str(&text).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        self.cycle
+            .validate()
+            .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        Ok(self)
+    }
 }
 
 /// One offline run: what the modules did and how it came out.
@@ -224,4 +240,35 @@ pub fn table_row(r: &OfflineRun) -> String {
             "WORSE"
         }
     )
+}
+
+/// Library cases (and variants) allowed to come out worse than the reference restraint, with the most they
+/// may lose (%) and why: the safety order of issue 30 (no inadvertent fire before fire time)
+/// decided against them, with the figures in restraint/README.md ("Severity floors").
+pub const ACCEPTED_COSTS: &[(&str, f64, &str)] = &[
+    (
+        "fmvss208-56-belted",
+        20.0,
+        "the barrier refutes the prediction made for a 3 000 kg object, so the \
+         accelerometer-only airbag decides; its 1.25 m/s floor (above the matrix's largest \
+         misuse Δv, 1.2 m/s) fires it at +11.5 ms instead of +10.5 and the occupant bottoms \
+         out: +18.5 %",
+    ),
+    (
+        "taurus-52-52-none-speed+5",
+        8.0,
+        "with the closing speed reported 5 m/s high the reversible pre-crash pretensioner \
+         does not fire before contact; in the crash phase it waits for its 1.25 m/s floor \
+         (+12.5 ms; +5.8 ms before the floor held matched fires): +6.9 % (+4.6 % with the \
+         table before plan = fire)",
+    ),
+];
+
+/// The accepted cost of scenario `name`: the most it may lose against the reference, %, and
+/// why (`None`: it must be no worse).
+pub fn accepted_cost(name: &str) -> Option<(f64, &'static str)> {
+    ACCEPTED_COSTS
+        .iter()
+        .find(|c| c.0 == name)
+        .map(|c| (c.1, c.2))
 }

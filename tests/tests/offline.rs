@@ -4,9 +4,11 @@
 //! real processes, checked here on every change:
 //!
 //! * every library scenario meets its `[expect]` block and is no worse than the reference
-//!   restraint (the judge's verdict);
+//!   restraint (the judge's verdict), but for the costs the safety order of issue 30 accepts,
+//!   each named with its bound and reason (`e2e_tests::offline::ACCEPTED_COSTS`);
 //! * an adaptive airbag fires within 1 ms of its plan whenever the plan is later than the
-//!   confirmation (issue 14);
+//!   confirmation (issue 14; plan = fire, issue 30), a misreported crash's within the table's
+//!   fire-delay tolerance after it;
 //! * the opponent's mass misreported by up to ±1 200 kg, and its closing speed by up to
 //!   ±5 m/s, never makes the outcome worse than the reference restraint, nor bottoms out where
 //!   the reference does not.
@@ -40,8 +42,9 @@ fn cfg() -> OfflineConfig {
     OfflineConfig::shipped(&root()).expect("shipped table and reference")
 }
 
-/// Problems of one run with its expectations and the judge's verdict.
-fn problems(s: &Scenario, r: &OfflineRun) -> Vec<String> {
+/// Problems of one run with its expectations and the judge's verdict; an adaptive airbag may
+/// come up to `late_ms` after its plan (1 ms on the library: plan = fire).
+fn problems(s: &Scenario, r: &OfflineRun, late_ms: f64) -> Vec<String> {
     let mut bad = Vec::new();
     let e = &s.expect;
     let mut check = |what: &str, want: Option<bool>, got: bool| {
@@ -82,7 +85,14 @@ fn problems(s: &Scenario, r: &OfflineRun) -> Vec<String> {
         e2e_tests::accel_fault_before_contact(s, &r.faults, r.contact_s),
     );
     if let Some(ev) = &r.evaluated {
-        if !ev.outcome.adaptive_no_worse {
+        if let Some((max_pct, why)) = e2e_tests::offline::accepted_cost(&s.name) {
+            if ev.outcome.change_pct > max_pct {
+                bad.push(format!(
+                    "{}: {:+.1} % against the reference, beyond its accepted {max_pct:+.1} % ({why})",
+                    s.name, ev.outcome.change_pct
+                ));
+            }
+        } else if !ev.outcome.adaptive_no_worse {
             bad.push(format!(
                 "{}: worse than the reference restraint ({:+.1} %)",
                 s.name, ev.outcome.change_pct
@@ -92,7 +102,7 @@ fn problems(s: &Scenario, r: &OfflineRun) -> Vec<String> {
     if let (Some((t, plan, _, "adaptive")), Some(confirm)) =
         (r.action("airbag_fire"), r.crash_mode_ms)
     {
-        if plan >= confirm && (t - plan).abs() > 1.0 {
+        if plan >= confirm && !(-1.0..=late_ms).contains(&(t - plan)) {
             bad.push(format!(
                 "{}: adaptive airbag at {t:+.2} ms, planned {plan:+.2} ms (confirmed {confirm:+.2} ms)",
                 s.name
@@ -113,10 +123,20 @@ fn the_library_meets_its_expectations_and_fires_on_plan() {
         let r = run(s, &cfg).expect("offline run");
         table.push_str(&table_row(&r));
         table.push('\n');
-        bad.extend(problems(s, &r));
+        bad.extend(problems(s, &r, 1.0));
     }
     eprintln!("{table}");
     assert!(bad.is_empty(), "{bad:#?}\n{table}");
+}
+
+/// The shipped table's fire-delay tolerance, ms (its header): how late its optima may have the
+/// airbag and stay free of bottoming-out. A misreported opponent's pulse carries the airbag's
+/// floor later than the cell's pulse the plan was made for, so its airbag may be this late.
+fn fire_delay_tolerance_ms(cfg: &OfflineConfig) -> f64 {
+    let lut = cfg.lut.as_ref().expect("shipped table");
+    lut.header().build.extra["optimiser.fire_delay_tolerance_ms"]
+        .parse()
+        .expect("tolerance in the table header")
 }
 
 /// `base` with the opponent truly `true_kg` (class by mass) and reported as `reported_kg`.
@@ -135,6 +155,7 @@ fn misreported(base: &Scenario, true_kg: f64, reported_kg: f64) -> Scenario {
 #[test]
 fn a_misreported_opponent_mass_up_to_1200_kg_is_never_worse_than_the_reference() {
     let cfg = cfg();
+    let late_ms = fire_delay_tolerance_ms(&cfg);
     let mut table = format!("{TABLE_HEADER}\n");
     let mut bad = Vec::new();
     let mut runs = 0;
@@ -157,7 +178,7 @@ fn a_misreported_opponent_mass_up_to_1200_kg_is_never_worse_than_the_reference()
                 runs += 1;
                 table.push_str(&table_row(&r));
                 table.push('\n');
-                bad.extend(problems(&s, &r));
+                bad.extend(problems(&s, &r, late_ms));
             }
         }
     }
@@ -169,6 +190,7 @@ fn a_misreported_opponent_mass_up_to_1200_kg_is_never_worse_than_the_reference()
 #[test]
 fn a_misreported_closing_speed_up_to_5_mps_is_never_worse_than_the_reference() {
     let cfg = cfg();
+    let late_ms = fire_delay_tolerance_ms(&cfg);
     let mut table = format!("{TABLE_HEADER}\n");
     let mut bad = Vec::new();
     for base in [
@@ -186,7 +208,7 @@ fn a_misreported_closing_speed_up_to_5_mps_is_never_worse_than_the_reference() {
             let r = run(&s, &cfg).expect("offline run");
             table.push_str(&table_row(&r));
             table.push('\n');
-            bad.extend(problems(&s, &r));
+            bad.extend(problems(&s, &r, late_ms));
             // Which path confirmed: with the track filter a 5 m/s bias is seen as outliers and
             // the range keeps the track (prediction-matched, re-planned in the crash); a 3 m/s
             // bias that the filter absorbs can put the predicted contact outside the match
@@ -234,7 +256,7 @@ fn the_campaigns_scenario_variants_meet_their_expectations_offline() {
         n += 1;
         table.push_str(&format!("{:<22} {}\n", case.name, table_row(&r)));
         bad.extend(
-            problems(&s, &r)
+            problems(&s, &r, 1.0)
                 .into_iter()
                 .map(|p| format!("{}: {p}", case.name)),
         );

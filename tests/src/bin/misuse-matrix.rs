@@ -122,12 +122,7 @@ fn main() -> Result<()> {
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(".."));
     let mut cfg = OfflineConfig::shipped(&repo).context("offline bench configuration")?;
     if let Some(path) = &cli.cycle_config {
-        let text =
-            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-        cfg.cycle = toml::from_str(&text).with_context(|| format!("{}", path.display()))?;
-        cfg.cycle
-            .validate()
-            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        cfg = cfg.with_cycle_file(path)?;
     }
     for f in &cli.families {
         anyhow::ensure!(

@@ -1,4 +1,4 @@
-//! `offline-bench [--scenario FILE …] [--no-lut] [--json FILE]`: runs scenarios through the
+//! `offline-bench [--scenario FILE …] [--no-lut] [--json FILE] [--cycle-config FILE]`: runs scenarios through the
 //! restraint core under a simulated clock with the real sensor model and the actuator stubs'
 //! judge (`e2e_tests::offline`), and prints the outcome table. No vcan, no processes, no
 //! emulator: deterministic, ≈ 50 ms per scenario. Default: the whole library (`scenarios/`).
@@ -30,6 +30,10 @@ struct Cli {
     /// Also write every run's modes, faults, actions and outcome as JSON.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
+    /// A TOML file of `[cycle]` keys (as in ecu.toml's `[cycle]`, without the header) that
+    /// replace the defaults: what a threshold change does to the library, before it is made.
+    #[arg(long, value_name = "FILE")]
+    cycle_config: Option<PathBuf>,
 }
 
 fn main() -> Result<()> {
@@ -46,6 +50,9 @@ fn main() -> Result<()> {
         files.sort();
     }
     let mut cfg = OfflineConfig::shipped(&repo)?;
+    if let Some(path) = &cli.cycle_config {
+        cfg = cfg.with_cycle_file(path)?;
+    }
     if cli.no_lut {
         cfg.lut = None;
     }
