@@ -35,6 +35,16 @@ const MASK: usize = TRACE_POINTS - 1;
 /// sample, the 4 kHz crash sensor every other; Δv between points is interpolated linearly).
 const POINT_SPACING_NS: u64 = 450_000;
 
+/// How far one sensor's trace is carried past its newest sample to the other's, ns: a little
+/// more than the 2 kHz safing sensor's period (its batch may end that much earlier). A real
+/// crash's deceleration changes by a few g per ms, so the carried velocity is off by
+/// ≈ 0.01 m/s at most; a wild sample of the other sensor is not in it.
+const MAX_EXTRAPOLATION_NS: u64 = 600_000;
+/// How far past the newest instant the pair is compared, ns: one period of the 4 kHz crash
+/// sensor, so that its newest sample counts with its whole weight (the trapezoid has added
+/// half of it so far).
+const LOOKAHEAD_NS: u64 = 250_000;
+
 /// A sensor's velocity integrated over its events (trapezoidal), as time-stamped points in a
 /// ring (plain arrays: this runs for every sample of an event, on both sensors).
 #[derive(Debug, Clone)]
@@ -158,6 +168,15 @@ impl VelocityTrace {
         self.len > 0 && self.point_ns[self.next.wrapping_sub(1) & MASK] >= t_ns
     }
 
+    /// [`Self::v_at`], and after the newest sample its velocity carried on with its newest
+    /// deceleration (the caller bounds how far: [`MAX_EXTRAPOLATION_NS`]), m/s.
+    pub fn v_ahead(&self, t_ns: u64) -> f64 {
+        if self.seen && t_ns > self.last_ns {
+            return self.v_mps + self.last_decel_mps2 * (t_ns - self.last_ns) as f64 * 1e-9;
+        }
+        self.v_at(t_ns)
+    }
+
     /// The integrated velocity at `t_ns` (linear between points; the newest value after the
     /// newest sample; the oldest point's before it — check [`Self::covered_from_ns`]), m/s.
     pub fn v_at(&self, t_ns: u64) -> f64 {
@@ -239,7 +258,17 @@ impl SeverityAgreement {
         let (Some(tc), Some(ts)) = (self.crash.latest_ns(), self.safing.latest_ns()) else {
             return true;
         };
-        let t1 = tc.min(ts);
+        // Compared a little ahead of the newest samples, each trace carried on with its newest
+        // deceleration ([`LOOKAHEAD_NS`]): the trapezoid has put only half of a newest sample
+        // into the velocity yet, and a wild crash sample decides its fire in the very cycle it
+        // arrives (issue 31: a 177 g sample in a pothole fired with half its 0.43 m/s counted,
+        // an excess of 0.20 m/s, inside the tolerance; the other half came a cycle too late).
+        // The newest instant either sensor measured counts, the other one carried to it too
+        // (the 4 kHz crash sensor's batch may end after the 2 kHz safing sensor's).
+        let t1 = tc
+            .max(ts)
+            .min(tc.min(ts).saturating_add(MAX_EXTRAPOLATION_NS))
+            .saturating_add(LOOKAHEAD_NS);
         let t0 = onset_ns
             .max(self.crash.covered_from_ns())
             .max(self.safing.covered_from_ns());
@@ -256,8 +285,8 @@ impl SeverityAgreement {
                 v0
             }
         };
-        let dv_crash = self.crash.v_at(t1) - vc0;
-        let dv_safing = self.safing.v_at(t1) - vs0;
+        let dv_crash = self.crash.v_ahead(t1) - vc0;
+        let dv_safing = self.safing.v_ahead(t1) - vs0;
         let excess = dv_crash - dv_safing;
         self.worst_excess_mps = self.worst_excess_mps.max(excess);
         let p = self.params;
@@ -398,6 +427,22 @@ mod tests {
         });
         feed(&mut a.safing, 500, 30_000, &pothole);
         assert!(!a.agrees(10 * MS));
+    }
+
+    #[test]
+    fn a_wild_sample_that_ends_its_batch_disagrees_in_that_cycle() {
+        // Issue 31: the wild sample is the newest of its batch, so the trapezoid holds half of
+        // it (0.19 m/s of 0.37, inside the tolerance) and its fire is decided in this very
+        // cycle: the pair is compared one crash-sensor period ahead, each trace carried on
+        // with its newest deceleration, so the whole sample counts now.
+        let pothole = half_sine(10.0, 10_000, 10_000);
+        let mut a = agreement();
+        // Batches of t..t+750 µs: the sample at 13 750 µs ends the batch fed up to 14 000.
+        feed(&mut a.crash, 250, 14_000, |t| {
+            pothole(t) + if t == 13_750 { 150.0 } else { 0.0 }
+        });
+        feed(&mut a.safing, 500, 14_000, &pothole);
+        assert!(!a.agrees(10 * MS), "{:?}", a.worst_excess_mps());
     }
 
     #[test]

@@ -7,7 +7,8 @@
 //! simulated clock, which starts at 1 s (scenario time + 1 s, so that no time stamp is 0);
 //! `actions[].t_ms` is the same instant in ms after the scenario start; `modes`, `faults` and
 //! `crash_mode_ms` are ms after the true contact (`contact_s`, s after the start), or after
-//! the scenario start when there is no contact.
+//! the scenario start when there is no contact. `severity_excess_mps`: the largest crash −
+//! safing sensor Δv over a confirmed event (restraint's severity agreement; `null`: none judged).
 
 use anyhow::{Context, Result};
 use clap::Parser;
@@ -67,6 +68,7 @@ fn main() -> Result<()> {
             "contact_s": r.contact_s,
             "crash_mode_ms": r.crash_mode_ms,
             "confirmed_by": r.confirmed_by,
+            "severity_excess_mps": r.severity_excess_mps,
             "modes": r.modes,
             "faults": r.faults,
             "actions": actions_json(&r.modules.actions)?,
