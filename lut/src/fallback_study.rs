@@ -249,12 +249,14 @@ pub fn measure(cfg: &CycleConfig, samples: &[AccelSample], contact_ns: u64) -> M
     let mut onset = Onset::default();
     let mut generic = CrashDetector::default();
     let mut algo = FallbackAlgorithm::new(cfg.fallback_dv_mps, cfg.fallback_floor());
+    let mut roughness = cfg.roughness();
     let mut curve = Vec::new();
     let mut first_event = true;
     let rel = |t: u64| (t as f64 - contact_ns as f64) * 1e-6;
     for s in samples {
         generic.push(&p, s);
-        algo.push(&p, s);
+        roughness.push(s.decel_mps2 * s.dt_s, s.dt_s);
+        algo.push(&p, s, roughness.floor_lift_mps());
         match onset.push(&p, s) {
             OnsetStep::Reset => first_event = false,
             OnsetStep::Woke | OnsetStep::Awake if first_event => {

@@ -36,6 +36,8 @@ pub struct PlausibleBatch {
     /// The lowest reading (the highest deceleration), m/s² (+∞ when empty): every detector
     /// asks whether a batch is quiet, so it is answered once while the batch is built.
     min_accel_mps2: f32,
+    /// The readings' sum, m/s² (for the batch's velocity change, [`Self::decel_integral_mps`]).
+    sum_accel_mps2: f32,
 }
 
 impl PlausibleBatch {
@@ -47,12 +49,14 @@ impl PlausibleBatch {
             dt_s: 0.0,
             readings: heapless::Vec::new(),
             min_accel_mps2: f32::INFINITY,
+            sum_accel_mps2: 0.0,
         }
     }
 
     fn clear(&mut self) {
         self.readings.clear();
         self.min_accel_mps2 = f32::INFINITY;
+        self.sum_accel_mps2 = 0.0;
     }
 
     #[inline]
@@ -60,6 +64,7 @@ impl PlausibleBatch {
         // Cannot fail: at most ACCEL_BATCH_CAPACITY samples are read.
         let _ = self.readings.push((i, a));
         self.min_accel_mps2 = self.min_accel_mps2.min(a);
+        self.sum_accel_mps2 += a;
     }
 
     /// Takes off a deceleration the car's braking explains (`decel_mps2`, m/s²; nothing when it
@@ -74,6 +79,7 @@ impl PlausibleBatch {
             r.1 += b;
         }
         self.min_accel_mps2 += b;
+        self.sum_accel_mps2 += b * self.readings.len() as f32;
     }
 
     /// Number of plausible samples.
@@ -90,6 +96,14 @@ impl PlausibleBatch {
     pub fn all_below(&self, decel_mps2: f64) -> bool {
         // decel = −a < d  ⇔  a > −d (the readings are finite: the monitor checked them).
         f64::from(self.min_accel_mps2) > -decel_mps2
+    }
+
+    /// The batch's deceleration integrated with the rectangle rule, m/s (Σ decel · dt: how much
+    /// the samples slowed the car), and the time they cover, s — for measures that need the
+    /// batch's velocity, not each sample's (`roughness`).
+    pub fn decel_integral_mps(&self) -> (f64, f64) {
+        let span_s = self.dt_s * self.readings.len() as f64;
+        (-f64::from(self.sum_accel_mps2) * self.dt_s, span_s)
     }
 
     /// The deceleration of the newest sample, m/s².

@@ -213,6 +213,19 @@ pub struct CycleConfig {
     /// See `severity_tolerance_dv_mps` (*default* 0.10: two sensors' sensitivity tolerances,
     /// ±5 % each).
     pub severity_tolerance_fraction: f64,
+    /// Road roughness (`roughness`): this many times the road's recent forward velocity
+    /// excursion beyond 0.05 m/s (the crash sensor's velocity high-passed at 50 ms, its
+    /// positive peak held) is added to every crash-phase fire's severity floor (*default* 2.0;
+    /// 0 = off). Why: a rough road swings the car's velocity as far back as forward, a crash
+    /// only slows it; at the matrix's 3–4.5 g rms a backward swing now and then carried the
+    /// 1.25 m/s floor and fired the pyrotechnic pretensioner (25 of 1 000, seed 1; 1 of 24 000
+    /// left at 2.0, seeds 1, 7, 2 — 5 at 1.5; must-fire crashes on a smooth road unchanged).
+    pub roughness_k: f64,
+    /// How long the held forward excursion takes to decay to 1/e, ms (*default* 500: a rough
+    /// road's lobes refresh it every few tens of ms; after a pothole's forward rebound, up to
+    /// 1.2 m/s, the floors are lifted by up to 2.3 m/s, 0.85 m/s half a second later — a crash
+    /// right after a pothole fires a few ms later, the safe direction).
+    pub roughness_hold_ms: f64,
     /// Safing sensor measuring range, g (*default* 50): readings at it are saturated, beyond
     /// it impossible (`SAFING_INVALID`). Its timeout and stuck time are the crash
     /// accelerometer's (`accel_timeout_ms`, `accel_stuck_ms`).
@@ -295,6 +308,8 @@ impl Default for CycleConfig {
             safing_substitute_g: 2.0,
             severity_tolerance_dv_mps: 0.10,
             severity_tolerance_fraction: 0.10,
+            roughness_k: 2.0,
+            roughness_hold_ms: 500.0,
             safing_full_scale_g: 50.0,
             accel_timeout_ms: 50.0,
             accel_stuck_ms: 20.0,
@@ -416,6 +431,8 @@ impl CycleConfig {
             0.0,
             1.0,
         )?;
+        range("roughness_k", self.roughness_k, 0.0, 5.0)?;
+        range("roughness_hold_ms", self.roughness_hold_ms, 100.0, 10_000.0)?;
         range(
             "safing_full_scale_g",
             self.safing_full_scale_g,
@@ -473,6 +490,11 @@ impl CycleConfig {
             min_dv_mps: self.match_min_dv_mps,
             loading_fraction: self.loading_fraction,
         }
+    }
+
+    /// The road-roughness measure (`roughness_k`, `roughness_hold_ms`).
+    pub fn roughness(&self) -> crate::roughness::Roughness {
+        crate::roughness::Roughness::new(self.roughness_k, self.roughness_hold_ms * 1e-3)
     }
 
     /// The airbag's floor on the conventional path (`fallback_min_dv_mps` + persistence).

@@ -25,6 +25,7 @@ use crate::estimate::{equivalent_barrier_speed_kph, Estimator, Situation};
 use crate::fallback::{FallbackAlgorithm, FallbackDecision};
 use crate::inputs::InputMonitor;
 use crate::plan::RestraintPlan;
+use crate::roughness::Roughness;
 use crate::settings::{ms_to_ns, G_MPS2};
 
 /// Which path confirmed the crash.
@@ -82,6 +83,8 @@ pub struct CrashMonitor {
     /// The accelerometers' anti-alias group delay, ns: a measured onset is this late.
     accel_delay_ns: u64,
     confirmation: Option<Confirmation>,
+    /// The road's roughness: lifts every fire's severity floor.
+    roughness: Roughness,
 }
 
 impl CrashMonitor {
@@ -98,6 +101,7 @@ impl CrashMonitor {
             backup_decel_mps2: cfg.backup_confirm_g * G_MPS2,
             accel_delay_ns: ms_to_ns(cfg.accel_delay_ms),
             confirmation: None,
+            roughness: cfg.roughness(),
         }
     }
 
@@ -121,13 +125,22 @@ impl CrashMonitor {
             }
             return;
         }
+        let lift = self.roughness.floor_lift_mps();
         for s in batch.iter() {
-            self.on_sample(&s, ctx);
+            self.on_sample(&s, ctx, lift);
         }
     }
 
+    /// The road-roughness measure's batch: the readings as the sensor gave them, before the
+    /// braking compensation (braking only slows the car, so it never lifts the measure; a
+    /// compensation that runs ahead of the sensor's own braking ramp would read as forward).
+    pub(crate) fn on_raw_batch(&mut self, batch: &PlausibleBatch) {
+        let (dv_mps, span_s) = batch.decel_integral_mps();
+        self.roughness.push(dv_mps, span_s);
+    }
+
     /// One plausible accelerometer sample for all three detectors.
-    fn on_sample(&mut self, s: &AccelSample, ctx: &FreezeContext<'_, '_>) {
+    fn on_sample(&mut self, s: &AccelSample, ctx: &FreezeContext<'_, '_>, lift: f64) {
         self.matcher.push(s, &mut |slot| {
             let Some(sit) = ctx.situation.filter(|_| ctx.armed) else {
                 return false;
@@ -144,8 +157,8 @@ impl CrashMonitor {
             )
         });
         self.generic.push(&self.onset_params, s);
-        self.fallback.push(&self.onset_params, s);
-        self.pretensioner.push(&self.onset_params, s);
+        self.fallback.push(&self.onset_params, s, lift);
+        self.pretensioner.push(&self.onset_params, s, lift);
         if self.confirmation.is_some() {
             return;
         }
@@ -208,6 +221,11 @@ impl CrashMonitor {
     /// The velocity change of the current accelerometer event since its onset, m/s.
     pub fn event_dv_mps(&self) -> f64 {
         self.fallback.event_dv_mps()
+    }
+
+    /// What the road's roughness adds to every fire's severity floor now, m/s.
+    pub fn floor_lift_mps(&self) -> f64 {
+        self.roughness.floor_lift_mps()
     }
 
     /// The accelerometer-only algorithm's decision on the current event.

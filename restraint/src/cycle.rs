@@ -152,6 +152,11 @@ impl<'lut> RestraintCycle<'lut> {
     pub fn safing(&self) -> &Safing {
         &self.safing
     }
+    /// What the road's roughness adds to every fire's severity floor now, m/s (`roughness`).
+    pub fn floor_lift_mps(&self) -> f64 {
+        self.crash.floor_lift_mps()
+    }
+
     /// The two accelerometers' severity agreement.
     pub fn agreement(&self) -> &SeverityAgreement {
         &self.agreement
@@ -226,8 +231,9 @@ impl Activity for RestraintCycle<'_> {
         let mut plausible = crate::accel::PlausibleBatch::new();
         io.drain_accel(&mut |a| {
             inputs.on_accel(a, now, c, &mut plausible);
-            // The agreement compares the two sensors as they read.
+            // The agreement and the road's roughness take the readings as they are.
             agreement.crash.on_batch(&plausible);
+            crash.on_raw_batch(&plausible);
             plausible.remove_decel(braking);
             crash.on_batch(&plausible, &freeze);
         });
@@ -318,6 +324,7 @@ impl Activity for RestraintCycle<'_> {
             safing,
             event_in_progress: self.crash.event_in_progress(),
             event_dv_mps: self.crash.event_dv_mps(),
+            floor_lift_mps: self.crash.floor_lift_mps(),
             matched_course_broken: self.crash.matcher().course_broken_ns().is_some(),
             replan: &mut replan,
         };

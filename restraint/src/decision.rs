@@ -97,6 +97,8 @@ pub(crate) struct DecisionInputs<'d> {
     pub event_in_progress: bool,
     /// The velocity change of the current accelerometer event since its onset, m/s.
     pub event_dv_mps: f64,
+    /// What the road's roughness adds to every severity floor, m/s (`roughness`).
+    pub floor_lift_mps: f64,
     /// A matched confirmation's pulse has left its ramp (`PulseMatch::course_broken_ns`).
     pub matched_course_broken: bool,
     /// The table's plan for an adaptive crash at a closing speed (m/s): `None` when that
@@ -465,7 +467,9 @@ impl Decision {
         x: &DecisionInputs<'_>,
     ) -> bool {
         let Some(t) = *slot else { return false };
-        if now.saturating_add(x.half_period_ns) < t || x.event_dv_mps >= floor_mps {
+        if now.saturating_add(x.half_period_ns) < t
+            || x.event_dv_mps >= floor_mps + x.floor_lift_mps
+        {
             return false;
         }
         if !x.event_in_progress {

@@ -148,8 +148,10 @@ impl FallbackAlgorithm {
         }
     }
 
-    /// Feeds one plausible sample (`p`: the wake threshold and quiet gap of the onset).
-    pub fn push(&mut self, p: &ConfirmParams, s: &AccelSample) {
+    /// Feeds one plausible sample (`p`: the wake threshold and quiet gap of the onset;
+    /// `floor_lift_mps`: what the road's roughness adds to the severity floor now,
+    /// [`crate::roughness`]).
+    pub fn push(&mut self, p: &ConfirmParams, s: &AccelSample, floor_lift_mps: f64) {
         match self.onset.push(p, s) {
             OnsetStep::Quiet => return,
             OnsetStep::Reset => {
@@ -183,7 +185,7 @@ impl FallbackAlgorithm {
         if tau_ms > WINDOW_MS {
             self.decision = FallbackDecision::NoFire(s.t_ns);
         } else if dv >= threshold_mps(&self.thresholds, tau_ms)
-            && dv >= self.floor.min_dv_mps
+            && dv >= self.floor.min_dv_mps + floor_lift_mps
             && self.run >= self.floor.samples
             && self.loading.holds(self.floor.loading_fraction)
         {
@@ -262,6 +264,7 @@ mod tests {
                     dt_s: 1e-3,
                     decel_mps2: g * G_MPS2,
                 },
+                0.0,
             );
         }
     }
@@ -339,6 +342,7 @@ mod tests {
                     dt_s: 1e-3,
                     decel_mps2: g(k) * G_MPS2,
                 },
+                0.0,
             );
         }
     }
@@ -385,6 +389,7 @@ mod tests {
                     dt_s: 125e-6,
                     decel_mps2: g_at(k as f64 * 0.125) * G_MPS2,
                 },
+                0.0,
             );
         }
         f.decision()

@@ -17,6 +17,7 @@
 //! | [`confirm`] | generic crash confirmation from the compartment accelerometer |
 //! | [`crash_match`] | prediction-matched confirmation and the in-crash severity estimate |
 //! | [`fallback`] | the accelerometer-only airbag algorithm (no usable prediction) |
+//! | [`roughness`] | road roughness: the recent forward velocity excursion, added to every fire's floor |
 //! | [`agreement`] | the two accelerometers' severity agreement (velocity traces over the same window) |
 //! | [`crash`] | the crash phase's evidence: which path confirmed, the backup, the re-plan |
 //! | [`estimate`] | track filter ([`estimate::track`]), situation, closed-form collision prediction, LUT query, diagnostics pulse |
@@ -53,6 +54,7 @@ pub mod fallback;
 pub mod inputs;
 pub mod outputs;
 pub mod plan;
+pub mod roughness;
 pub mod safing;
 pub mod settings;
 pub mod signals;

@@ -319,3 +319,68 @@ fn sustained_braking_the_vehicle_frame_explains_is_not_crash_evidence() {
         "raw Δv {raw} vs {with_braking}"
     );
 }
+
+/// Zero-mean rectangular swings the whole car feels, `cycles` of them: `g` forward for
+/// `half_ms`, then `g` backward for `half_ms` (a rough road's velocity goes as far forward as
+/// back; a crash only slows the car).
+fn swings(b: &mut Bench, g: f32, half_ms: u64, cycles: u32) {
+    for _ in 0..cycles {
+        for forward in [true, false] {
+            for _ in 0..half_ms {
+                b.push_accel(if forward { g * G } else { -g * G });
+                b.push_object_none();
+                b.step();
+            }
+        }
+    }
+}
+
+fn rough_road_run(roughness_k: f64) -> Bench {
+    let cfg = restraint::CycleConfig {
+        roughness_k,
+        ..ideal_sensor_config()
+    };
+    let mut b = Bench::with_config(cfg, Some(test_lut()));
+    drive(&mut b, T0 + 500 * MS);
+    // Each backward half carries 8 g × 30 ms = 2.35 m/s since its onset: past the
+    // pretensioner's boundary (1.53 m/s at 20 ms) and its 1.25 m/s floor.
+    swings(&mut b, 8.0, 30, 4);
+    drive(&mut b, T0 + 1_000 * MS);
+    b
+}
+
+#[test]
+fn a_rough_roads_backward_swings_fire_nothing_its_forward_swings_lift_the_floors() {
+    // Issue 30 (rough road): the forward swings lift every floor by 2 × the held forward
+    // excursion beyond 0.05 m/s (here ≈ 1.8 m/s → +3.5 m/s), so no backward swing carries its
+    // floor.
+    let b = rough_road_run(restraint::CycleConfig::default().roughness_k);
+    assert!(!pretensioner_fired(&b), "pretensioner fired");
+    assert!(!airbag_fired(&b), "airbag fired");
+    // Without the roughness measure the same swings fire the pyrotechnic pretensioner.
+    assert!(
+        pretensioner_fired(&rough_road_run(0.0)),
+        "the swings are not severe enough to test"
+    );
+}
+
+#[test]
+fn a_crash_on_a_smooth_road_is_not_delayed_by_the_roughness_measure() {
+    let fire_at = |roughness_k: f64| {
+        let cfg = restraint::CycleConfig {
+            roughness_k,
+            ..ideal_sensor_config()
+        };
+        let mut b = Bench::with_config(cfg, Some(test_lut()));
+        drive(&mut b, T0 + 500 * MS);
+        bump(&mut b, 20.0, 80); // a 20 g × 80 ms barrier-like pulse: Δv 15.7 m/s
+        drive(&mut b, T0 + 700 * MS);
+        b.airbag_frames()
+            .into_iter()
+            .find(|(_, f)| f.fire() == AirbagStageCmdFire::Fire)
+            .map(|(t, _)| t)
+    };
+    let with = fire_at(restraint::CycleConfig::default().roughness_k);
+    assert!(with.is_some(), "the crash fired no airbag");
+    assert_eq!(with, fire_at(0.0));
+}
