@@ -226,7 +226,48 @@ fn injected_flags(scenario: &sensor_feeds::Scenario) -> Vec<&'static str> {
     if !s.accel_faults.is_empty() {
         v.push("accel_sensor");
     }
+    // `[[accel_event]]` faults of one sensor (a spike at its rail, an offset) raise that
+    // sensor's flag: the case's own, never an excuse for a run.
+    use sensor_feeds::scenario::EventSensor;
+    for e in &scenario.accel_events {
+        match e.sensor {
+            EventSensor::Crash => v.push("accel_sensor"),
+            EventSensor::Safing => v.push("safing_sensor"),
+            EventSensor::All => {}
+        }
+    }
     v
+}
+
+/// The fault-flag changes with only the flags raised after their input had been clear once:
+/// the start-up report, before an input's first sample arrived, is not starvation (issue 30:
+/// a run whose object list is dead by design is not "never Normal" because of it).
+fn raised_after_clear(faults: &[(f64, Vec<String>)]) -> Vec<(f64, Vec<String>)> {
+    let mut cleared: Vec<&str> = Vec::new();
+    let mut out = Vec::new();
+    let mut previous: &[String] = &[];
+    for (t, flags) in faults {
+        for f in previous {
+            if !flags.contains(f) && !cleared.contains(&f.as_str()) {
+                cleared.push(f);
+            }
+        }
+        let raised: Vec<String> = flags
+            .iter()
+            .filter(|f| cleared.contains(&f.as_str()) || !is_first_report(faults, f))
+            .cloned()
+            .collect();
+        out.push((*t, raised));
+        previous = flags;
+    }
+    out
+}
+
+/// `flag` was set in the first fault report (the start-up one).
+fn is_first_report(faults: &[(f64, Vec<String>)], flag: &str) -> bool {
+    faults
+        .first()
+        .is_some_and(|(_, flags)| flags.iter().any(|f| f == flag))
 }
 
 pub fn starved_run(
@@ -246,10 +287,16 @@ pub fn starved_run(
         .iter()
         .find(|(_, m)| m == "Normal")
         .map(|(t, _)| *t);
-    let contact = if r.contact_ns != 0 { 0.0 } else { f64::MAX };
+    // Judged up to the contact, or a no-crash run up to the scenario's own end (the feeds stop
+    // there, and their inputs go stale by design).
+    let contact = if r.contact_ns != 0 {
+        0.0
+    } else {
+        scenario.duration_s * 1e3
+    };
+    let faults = raised_after_clear(&r.ecu_faults);
     if let (true, Some(from)) = (injected.is_empty(), first_normal) {
-        if let Some((t, flags)) = r
-            .ecu_faults
+        if let Some((t, flags)) = faults
             .iter()
             .find(|(t, flags)| *t > from && *t < contact && flags.iter().any(starving))
         {
@@ -263,8 +310,7 @@ pub fn starved_run(
     // (e.g. the accelerometer's first batches late at start-up on a loaded emulator): the
     // run never reached the state the scenario's faults are meant to disturb.
     if first_normal.is_none_or(|t| t >= contact) {
-        if let Some((t, flags)) = r
-            .ecu_faults
+        if let Some((t, flags)) = faults
             .iter()
             .find(|(t, flags)| *t < contact && flags.iter().any(starving))
         {
@@ -332,6 +378,32 @@ mod tests {
     const FIRE_AT_7: &str = r#"{"t_ns": 9, "what": "airbag_fire", "level_kn": 4.5, "planned_ms": 3.0, "source": "adaptive", "t_ms": 7.0}"#;
 
     #[test]
+    fn a_no_crash_run_is_judged_up_to_its_end_and_its_injected_sensor_faults_are_its_own() {
+        // misuse-door-slam: no contact; the feeds stop at its end and the inputs go stale.
+        let s = scenario("misuse-door-slam");
+        let end = s.duration_s * 1e3;
+        let mut r = report(
+            &format!(
+                r#"[[0.5, ["object_input"]], [20.0, []], [{}, ["object_input", "accel_sensor"]]]"#,
+                end + 100.0
+            ),
+            "",
+        );
+        r.contact_ns = 0;
+        r.ecu_modes = vec![(0.5, "ReferenceFallback".into()), (20.0, "Normal".into())];
+        r.actions.clear();
+        assert_eq!(starved_run(&s, &r), None, "the scenario's own end");
+        // ... but a stale input inside the run is starvation
+        r.ecu_faults
+            .insert(2, (end / 2.0, vec!["vehicle_input".into()]));
+        let why = starved_run(&s, &r).expect("starved inside the run");
+        assert!(why.contains("vehicle_input"), "{why}");
+        // a crash-sensor fault the case injects with [[accel_event]] is its own flag
+        let s = scenario("fault-crash-sensor-spike");
+        assert!(injected_flags(&s).contains(&"accel_sensor"));
+    }
+
+    #[test]
     fn a_run_is_starved_by_stale_inputs_before_contact_or_a_late_fire_only() {
         let s = scenario("taurus-48-48-abs");
         // start-up faults before the first Normal and the object list ending after contact
@@ -362,10 +434,14 @@ mod tests {
             r.ecu_modes.retain(|(_, m)| m != "Normal");
             starved_run(&scenario("sensor-dropout"), &r)
         };
-        let accel = r#"[[-1254.0, ["accel_sensor"]], [-810.0, ["object_input", "accel_sensor"]], [-768.0, ["object_input"]]]"#;
-        let why = never_normal(accel).expect("starved at start-up");
+        // the start-up report (before the accelerometer's first batch) is not starvation ...
+        let startup = r#"[[-1254.0, ["accel_sensor"]], [-810.0, ["object_input", "accel_sensor"]], [-768.0, ["object_input"]]]"#;
+        assert_eq!(never_normal(startup), None);
+        // ... an accelerometer that went stale after it had delivered is
+        let accel = r#"[[-1254.0, ["accel_sensor"]], [-810.0, ["object_input"]], [-700.0, ["object_input", "accel_sensor"]], [-650.0, ["object_input"]]]"#;
+        let why = never_normal(accel).expect("starved after start-up");
         assert!(
-            why.contains("never Normal") && why.contains("accel_sensor"),
+            why.contains("never Normal") && why.contains("-700 ms") && why.contains("accel_sensor"),
             "{why}"
         );
         assert_eq!(never_normal(r#"[[-810.0, ["object_input"]]]"#), None);

@@ -47,21 +47,28 @@ fn main() -> std::process::ExitCode {
 }
 
 /// One scenario run; where the route's timing is emulated, a run the machine starved
-/// ([`e2e_tests::route::starved_run`]) is run again, up to the route's allowance, and the
-/// summary says which earlier runs were starved and why. With real timers: one run, judged as
-/// it is.
-fn run_until_measured(cfg: &RunConfig) -> Result<e2e_tests::RunResult> {
+/// ([`e2e_tests::route::starved_run`]) is run again, up to the route's allowance — but never a
+/// run whose fire / no-fire outcome contradicts the scenario's `[expect] airbag_fires`: that
+/// verdict stands as measured (issue 30). Every retry is in the summary, in `report.json`
+/// (`retries`: why each earlier run was not taken) and on the `--brief` line. With real
+/// timers: one run, judged as it is.
+fn run_until_measured(cfg: &RunConfig) -> Result<(e2e_tests::RunResult, Vec<String>)> {
     let route = e2e_tests::Route::current();
     let attempts = route.allowances().time_limit_attempts;
+    let scenario = sensor_feeds::Scenario::load(&cfg.scenario).ok();
     let mut earlier = Vec::new();
     let mut attempt = 1;
     loop {
         let mut r = run_scenario(cfg)?;
-        let starved = sensor_feeds::Scenario::load(&cfg.scenario)
-            .ok()
-            .and_then(|s| e2e_tests::route::starved_run(&s, &r.report));
+        let contradicts = scenario
+            .as_ref()
+            .and_then(|s| s.expect.airbag_fires)
+            .is_some_and(|want| want != r.report.airbag_fired);
+        let starved = scenario
+            .as_ref()
+            .and_then(|s| e2e_tests::route::starved_run(s, &r.report));
         match starved {
-            Some(why) if attempt < attempts => {
+            Some(why) if attempt < attempts && !contradicts => {
                 eprintln!(
                     "hil-bench: {}: run {attempt} starved by the emulated machine ({why}); running it again",
                     r.name
@@ -78,11 +85,26 @@ fn run_until_measured(cfg: &RunConfig) -> Result<e2e_tests::RunResult> {
                     );
                     r.summary.push_str(&note);
                     std::fs::write(r.dir.join("summary.txt"), &r.summary)?;
+                    record_retries(&r.dir.join("report.json"), &earlier)?;
                 }
-                return Ok(r);
+                return Ok((r, earlier));
             }
         }
     }
+}
+
+/// Adds `retries` (why each earlier run was not taken) to the stubs' `report.json`.
+fn record_retries(path: &std::path::Path, earlier: &[String]) -> Result<()> {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return Ok(()); // no report written: the run's own error says why
+    };
+    let mut v: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    if let Some(o) = v.as_object_mut() {
+        o.insert("retries".into(), serde_json::json!(earlier));
+    }
+    std::fs::write(path, serde_json::to_string_pretty(&v)?)?;
+    Ok(())
 }
 
 fn run() -> Result<bool> {
@@ -111,7 +133,7 @@ fn run() -> Result<bool> {
             stubs_args: e2e_tests::default_stubs_args(),
         };
         match run_until_measured(&cfg) {
-            Ok(r) => {
+            Ok((r, retries)) => {
                 if cli.brief {
                     let verdict = r
                         .report
@@ -128,8 +150,17 @@ fn run() -> Result<bool> {
                                 }
                             )
                         });
+                    let retried = if retries.is_empty() {
+                        String::new()
+                    } else {
+                        format!(
+                            " (run {}; retried: {})",
+                            retries.len() + 1,
+                            retries.join("; ")
+                        )
+                    };
                     println!(
-                        "{}: airbag {}, {verdict}",
+                        "{}: airbag {}, {verdict}{retried}",
                         r.name,
                         if r.report.airbag_fired {
                             "fired"
