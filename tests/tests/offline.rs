@@ -307,3 +307,18 @@ fn offline_bench_json_actions_carry_ms_after_the_scenario_start() {
         }
     }
 }
+
+/// Issue 31 item 3: the library's 4 kHz ringing in phase with the samples fires nothing through
+/// the sensors' anti-alias filter — and fires the airbag with an ideal sampler, so the file
+/// tests the filter, not a pulse too small to matter.
+#[test]
+fn in_phase_4_khz_ringing_fires_only_without_the_anti_alias_filter() {
+    let cfg = cfg();
+    let filtered = scenario("misuse-aliased-ringing");
+    let r = run(&filtered, &cfg).expect("offline run");
+    assert!(r.action("airbag_fire").is_none(), "{}", table_row(&r));
+    let mut ideal = filtered.clone();
+    ideal.sensor.accel_lowpass_hz = 0.0;
+    let r = run(&ideal, &cfg).expect("offline run");
+    assert!(r.action("airbag_fire").is_some(), "{}", table_row(&r));
+}
