@@ -394,6 +394,37 @@ fn crash_phase_cases() -> Vec<Case> {
             Variant::AsIs,
             "16 km/h rigid barrier, object list silent from 0.5 s",
         ),
+        // Issue 30 item 5: misuse and safing cases on the real bench, judged like every case.
+        v(
+            "misuse-pothole",
+            "misuse-pothole",
+            Variant::AsIs,
+            "pothole at 50 km/h, nothing ahead: nothing may fire",
+        ),
+        v(
+            "misuse-kerb-at-predicted-contact",
+            "misuse-kerb-strike-at-predicted-contact",
+            Variant::AsIs,
+            "50 + 50 km/h, the opponent swerves out 1 ms before the predicted contact while the car strikes a kerb: no airbag",
+        ),
+        v(
+            "misuse-rough-road",
+            "misuse-rough-road",
+            Variant::AsIs,
+            "3 s of 2 g rms rough road at 50 km/h: nothing may fire",
+        ),
+        v(
+            "crash-sensor-spike-then-bump",
+            "fault-crash-sensor-spike",
+            Variant::AsIs,
+            "a 40 g crash-sensor spike, then a 4.5 g × 40 ms bump: nothing may fire",
+        ),
+        v(
+            "safing-sensor-dead-in-a-crash",
+            "fault-safing-sensor-dead",
+            Variant::AsIs,
+            "48 + 48 km/h with the safing accelerometer silent from 0.5 s: the crash still fires",
+        ),
     ]
 }
 
