@@ -11,7 +11,7 @@
 //! The text parsers are pure functions, tested on output captured from Slurm 22.05.
 
 use anyhow::{anyhow, bail, Context, Result};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// CPUs Slurm gave this task (`SLURM_CPUS_PER_TASK`, set when the job asked for
@@ -280,6 +280,72 @@ pub fn array_list(tasks: &[u32]) -> String {
         i = j + 1;
     }
     parts.join(",")
+}
+
+/// A throw-away one-node Slurm cluster (munged + slurmctld + slurmd on free local ports) started
+/// by the repository's `tests/slurm-cluster.sh` (root; it installs slurm-wlm and munge where
+/// missing): for the tests of every `--slurm N` command and for trying one without a cluster.
+/// Stopped when dropped.
+pub struct OneNodeCluster {
+    script: PathBuf,
+    dir: PathBuf,
+    conf: PathBuf,
+}
+
+impl OneNodeCluster {
+    /// Starts it with its configuration, state and logs in `dir`.
+    ///
+    /// # Errors
+    /// The script did not start the daemons (its output is in the error).
+    pub fn start(script: &Path, dir: &Path) -> Result<Self> {
+        let free_port = || -> Result<u16> {
+            Ok(std::net::TcpListener::bind("127.0.0.1:0")?
+                .local_addr()?
+                .port())
+        };
+        let out = Command::new("bash")
+            .arg(script)
+            .arg("start")
+            .arg(dir)
+            .env("SLURMCTLD_PORT", free_port()?.to_string())
+            .env("SLURMD_PORT", free_port()?.to_string())
+            .output()
+            .with_context(|| format!("cannot run {}", script.display()))?;
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let conf = stdout
+            .lines()
+            .find_map(|l| l.strip_prefix("export SLURM_CONF="))
+            .map(PathBuf::from);
+        match (out.status.success(), conf) {
+            (true, Some(conf)) => Ok(Self {
+                script: script.to_path_buf(),
+                dir: dir.to_path_buf(),
+                conf,
+            }),
+            _ => bail!(
+                "the one-node Slurm cluster did not start ({} must run as root; \
+                 tests/setup-host.sh installs slurm-wlm and munge). Exit {}.\nstdout:\n{stdout}\nstderr:\n{}",
+                script.display(),
+                out.status,
+                String::from_utf8_lossy(&out.stderr)
+            ),
+        }
+    }
+
+    /// Its `SLURM_CONF`.
+    pub fn conf(&self) -> &Path {
+        &self.conf
+    }
+}
+
+impl Drop for OneNodeCluster {
+    fn drop(&mut self) {
+        let _ = Command::new("bash")
+            .arg(&self.script)
+            .arg("stop")
+            .arg(&self.dir)
+            .output();
+    }
 }
 
 #[cfg(test)]

@@ -21,75 +21,27 @@ fn workspace() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// A free TCP port on 127.0.0.1 (the OS picks it; released before slurmctld binds it).
-fn free_port() -> u16 {
-    std::net::TcpListener::bind("127.0.0.1:0")
-        .and_then(|l| l.local_addr())
-        .map(|a| a.port())
-        .expect("no free TCP port on 127.0.0.1")
-}
-
-struct Cluster {
-    dir: PathBuf,
-    conf: PathBuf,
-}
+struct Cluster(lut::slurm::OneNodeCluster);
 
 impl Cluster {
-    fn script() -> PathBuf {
-        workspace().join("tests/slurm-cluster.sh")
-    }
-
     fn start(dir: &Path) -> Cluster {
-        let (ctld, slurmd) = (free_port(), free_port());
-        let out = Command::new("bash")
-            .arg(Self::script())
-            .arg("start")
-            .arg(dir)
-            .env("SLURMCTLD_PORT", ctld.to_string())
-            .env("SLURMD_PORT", slurmd.to_string())
-            .output()
-            .expect("cannot run tests/slurm-cluster.sh");
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        let conf = stdout
-            .lines()
-            .find_map(|l| l.strip_prefix("export SLURM_CONF="))
-            .map(PathBuf::from);
-        match (out.status.success(), conf) {
-            (true, Some(conf)) => Cluster {
-                dir: dir.to_path_buf(),
-                conf,
-            },
-            _ => panic!(
-                "the one-node Slurm cluster did not start (tests/slurm-cluster.sh must run as root; \
-                 tests/setup-host.sh installs slurm-wlm and munge). Exit {}.\nstdout:\n{stdout}\nstderr:\n{}",
-                out.status,
-                String::from_utf8_lossy(&out.stderr)
-            ),
-        }
+        let script = workspace().join("tests/slurm-cluster.sh");
+        Cluster(lut::slurm::OneNodeCluster::start(&script, dir).unwrap_or_else(|e| panic!("{e:#}")))
     }
 
     fn lut(&self) -> Command {
         let mut c = Command::new(env!("CARGO_BIN_EXE_lut"));
-        c.env("SLURM_CONF", &self.conf).env_remove("RUST_BACKTRACE");
+        c.env("SLURM_CONF", self.0.conf())
+            .env_remove("RUST_BACKTRACE");
         c
     }
 
     fn tool(&self, name: &str, args: &[&str]) -> Output {
         Command::new(name)
             .args(args)
-            .env("SLURM_CONF", &self.conf)
+            .env("SLURM_CONF", self.0.conf())
             .output()
             .unwrap_or_else(|e| panic!("cannot run {name}: {e}"))
-    }
-}
-
-impl Drop for Cluster {
-    fn drop(&mut self) {
-        let _ = Command::new("bash")
-            .arg(Self::script())
-            .arg("stop")
-            .arg(&self.dir)
-            .output();
     }
 }
 

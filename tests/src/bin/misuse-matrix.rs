@@ -53,9 +53,185 @@ struct Cli {
     /// replace the defaults: for calibrating thresholds on the matrix.
     #[arg(long, value_name = "FILE")]
     cycle_config: Option<PathBuf>,
+    /// Run the matrix as a Slurm job array of N tasks (`sbatch` / `squeue` from PATH, the
+    /// caller's `SLURM_CONF` and `SBATCH_*`), wait for it, and print the same table a local run
+    /// prints (the variants and their order do not depend on where they ran).
+    #[arg(long, value_name = "N")]
+    slurm: Option<u32>,
+    /// Work directory of a `--slurm` run: the batch script, each task's outcomes and log
+    /// (default: `misuse-matrix-slurm/` in the current directory).
+    #[arg(long, value_name = "DIR", requires = "slurm")]
+    work_dir: Option<PathBuf>,
+    /// CPUs per array task of a `--slurm` run.
+    #[arg(long, default_value_t = 2, requires = "slurm")]
+    cpus_per_task: u32,
+    /// Further sbatch options for a `--slurm` run, as given (repeatable, e.g. `--mem=2G`).
+    #[arg(
+        long = "sbatch-arg",
+        value_name = "OPT",
+        allow_hyphen_values = true,
+        requires = "slurm"
+    )]
+    sbatch_args: Vec<String>,
+    /// Compute only every N-th variant from the K-th on (`K/N`) and write their outcomes to
+    /// `--outcomes` instead of a table: one task of a `--slurm` run.
+    #[arg(
+        long,
+        value_name = "K/N",
+        requires = "outcomes",
+        conflicts_with = "slurm"
+    )]
+    shard: Option<String>,
+    /// Where `--shard` writes its outcomes (JSON).
+    #[arg(long, value_name = "FILE", requires = "shard")]
+    outcomes: Option<PathBuf>,
+}
+
+/// One computed variant as a shard file holds it: family index, variant index, outcome or
+/// error text.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct ShardRow {
+    family: usize,
+    variant: u64,
+    outcome: Option<Outcome>,
+    error: Option<String>,
+}
+
+/// `K/N` → (K, N) with K < N.
+fn parse_shard(s: &str) -> Result<(usize, usize)> {
+    let (k, n) = s
+        .split_once('/')
+        .ok_or_else(|| anyhow::anyhow!("--shard {s:?}: expected K/N"))?;
+    let (k, n): (usize, usize) = (k.trim().parse()?, n.trim().parse()?);
+    anyhow::ensure!(n > 0 && k < n, "--shard {s}: K must be below N > 0");
+    Ok((k, n))
+}
+
+/// The arguments that make a task compute the same variants as this run.
+fn matrix_args(cli: &Cli, repo: &std::path::Path) -> Result<Vec<String>> {
+    let abs = |p: &PathBuf| -> Result<String> {
+        Ok(std::fs::canonicalize(p)
+            .with_context(|| format!("{}", p.display()))?
+            .display()
+            .to_string())
+    };
+    let mut a = vec![
+        "--variants".to_string(),
+        cli.variants.to_string(),
+        "--seed".into(),
+        cli.seed.to_string(),
+        "--repo".into(),
+        abs(&repo.to_path_buf())?,
+        "--quiet".into(),
+    ];
+    for f in &cli.families {
+        a.extend(["--family".to_string(), f.clone()]);
+    }
+    if let Some(c) = &cli.cycle_config {
+        a.extend(["--cycle-config".to_string(), abs(c)?]);
+    }
+    Ok(a)
+}
+
+/// Single-quoted for bash.
+fn sh_quote(s: &str) -> String {
+    format!("'{}'", s.replace('\'', "'\\''"))
+}
+
+/// Runs the matrix as a Slurm array of `n` tasks and returns every variant's outcome.
+fn run_on_slurm(
+    cli: &Cli,
+    repo: &std::path::Path,
+    n: u32,
+) -> Result<Vec<(usize, u64, Result<Outcome>)>> {
+    anyhow::ensure!(n > 0, "--slurm 0: at least one task");
+    let work = cli
+        .work_dir
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("misuse-matrix-slurm"));
+    std::fs::create_dir_all(work.join("logs"))
+        .with_context(|| format!("creating {}", work.display()))?;
+    let work = std::fs::canonicalize(&work)?;
+    for k in 0..n {
+        let _ = std::fs::remove_file(work.join(format!("shard-{k}.json")));
+    }
+    let exe = std::env::current_exe()?;
+    let mut line = vec![sh_quote(&exe.display().to_string())];
+    line.extend(matrix_args(cli, repo)?.iter().map(|a| sh_quote(a)));
+    line.push(format!("--shard \"$SLURM_ARRAY_TASK_ID/{n}\""));
+    line.push(format!(
+        "--outcomes {}/shard-\"$SLURM_ARRAY_TASK_ID\".json",
+        sh_quote(&work.display().to_string())
+    ));
+    let script = work.join("task.sh");
+    std::fs::write(
+        &script,
+        format!(
+            "#!/bin/bash\n# misuse-matrix --slurm {n}: one array task\nexec {}\n",
+            line.join(" ")
+        ),
+    )?;
+    let id = lut::slurm::sbatch(&lut::slurm::Submit {
+        job_name: "misuse-matrix".into(),
+        array: Some(format!("0-{}", n - 1)),
+        cpus_per_task: cli.cpus_per_task,
+        output: work.join("logs/shard-%a.log"),
+        chdir: work.clone(),
+        after_ok: None,
+        extra: cli.sbatch_args.clone(),
+        script,
+    })?;
+    eprintln!(
+        "misuse-matrix: Slurm job array {id}, {n} tasks, work directory {}",
+        work.display()
+    );
+    let bar = if cli.quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(u64::from(n))
+    };
+    bar.set_style(ProgressStyle::with_template(
+        "{bar:40} {pos}/{len} tasks, {elapsed}",
+    )?);
+    let ids = [id];
+    loop {
+        let queued = lut::slurm::squeue(&ids)?;
+        let done = (0..n)
+            .filter(|k| work.join(format!("shard-{k}.json")).exists())
+            .count();
+        bar.set_position(done as u64);
+        if queued.is_empty() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(500));
+    }
+    bar.finish_and_clear();
+    let mut results = Vec::new();
+    for k in 0..n {
+        let path = work.join(format!("shard-{k}.json"));
+        let text = std::fs::read_to_string(&path).with_context(|| {
+            format!(
+                "task {k} left no outcomes ({}); its log: {}",
+                path.display(),
+                work.join(format!("logs/shard-{k}.log")).display()
+            )
+        })?;
+        let rows: Vec<ShardRow> =
+            serde_json::from_str(&text).with_context(|| format!("{}", path.display()))?;
+        results.extend(rows.into_iter().map(|r| {
+            let o = match (r.outcome, r.error) {
+                (Some(o), _) => Ok(o),
+                (None, e) => Err(anyhow::anyhow!(e.unwrap_or_else(|| "no outcome".into()))),
+            };
+            (r.family, r.variant, o)
+        }));
+    }
+    results.sort_by_key(|r| (r.0, r.1));
+    Ok(results)
 }
 
 /// One variant's result.
+#[derive(serde::Serialize, serde::Deserialize)]
 struct Outcome {
     /// Airbag fired (ms rel. contact or since start).
     airbag_ms: Option<f64>,
@@ -139,28 +315,68 @@ fn main() -> Result<()> {
     let jobs: Vec<(usize, u64)> = (0..families.len())
         .flat_map(|f| (0..per).map(move |i| (f, i)))
         .collect();
-    let bar = if cli.quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::new(jobs.len() as u64)
+    let shard = cli.shard.as_deref().map(parse_shard).transpose()?;
+    let jobs: Vec<(usize, u64)> = match shard {
+        Some((k, n)) => jobs.into_iter().skip(k).step_by(n).collect(),
+        None => jobs,
     };
-    bar.set_style(ProgressStyle::with_template(
-        "{bar:40} {pos}/{len} variants, {elapsed} ({eta} left)",
-    )?);
-    let done = AtomicU64::new(0);
+    if let Some(threads) = lut::slurm::cpus_per_task() {
+        // Inside a Slurm task: the CPUs it was given, not every core of the node.
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build_global();
+    }
     let start = std::time::Instant::now();
-    let results: Vec<(usize, u64, Result<Outcome>)> = jobs
-        .par_iter()
-        .map(|&(f, i)| {
-            let text = families[f].variant(i, cli.seed);
-            let o = run_variant(&cfg, &text);
-            if done.fetch_add(1, Ordering::Relaxed).is_multiple_of(256) {
-                bar.set_position(done.load(Ordering::Relaxed));
-            }
-            (f, i, o)
-        })
-        .collect();
-    bar.finish_and_clear();
+    let results: Vec<(usize, u64, Result<Outcome>)> = match cli.slurm {
+        Some(n) => run_on_slurm(&cli, &repo, n)?,
+        None => {
+            let bar = if cli.quiet {
+                ProgressBar::hidden()
+            } else {
+                ProgressBar::new(jobs.len() as u64)
+            };
+            bar.set_style(ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} variants, {elapsed} ({eta} left)",
+            )?);
+            let done = AtomicU64::new(0);
+            let r = jobs
+                .par_iter()
+                .map(|&(f, i)| {
+                    let text = families[f].variant(i, cli.seed);
+                    let o = run_variant(&cfg, &text);
+                    if done.fetch_add(1, Ordering::Relaxed).is_multiple_of(256) {
+                        bar.set_position(done.load(Ordering::Relaxed));
+                    }
+                    (f, i, o)
+                })
+                .collect();
+            bar.finish_and_clear();
+            r
+        }
+    };
+    if let (Some(_), Some(path)) = (shard, &cli.outcomes) {
+        let rows: Vec<ShardRow> = results
+            .into_iter()
+            .map(|(family, variant, o)| {
+                let (outcome, error) = match o {
+                    Ok(o) => (Some(o), None),
+                    Err(e) => (None, Some(format!("{e:#}"))),
+                };
+                ShardRow {
+                    family,
+                    variant,
+                    outcome,
+                    error,
+                }
+            })
+            .collect();
+        // Written whole, then renamed: a task that dies leaves no half file.
+        let tmp = path.with_extension("json.tmp");
+        std::fs::write(&tmp, serde_json::to_string(&rows)?)
+            .with_context(|| format!("writing {}", tmp.display()))?;
+        std::fs::rename(&tmp, path)?;
+        return Ok(());
+    }
     let mut out = String::new();
     let mut failures = Vec::new();
     writeln!(
