@@ -327,23 +327,14 @@ fn worst_lateness_of_the_earliest_plan_ms() -> f64 {
                     panic!("{closing_kph} km/h, {opponent_kg} kg at {rate_hz} Hz: not matched")
                 });
             // The matched airbag also waits until the event carries the airbag's floor
-            // (`Decision::hold_below_floor`): Δv since the first sample at the wake threshold.
-            let wake = cfg.confirm_wake_g * 9.80665;
-            let mut dv = 0.0;
-            let mut prev: Option<(u64, f64)> = None;
+            // (`Decision::hold_below_floor`): Δv since the onset, as the ECU's `Onset` has it.
+            let p = cfg.confirm_params();
+            let mut onset = restraint::confirm::Onset::default();
             let floor_ms = samples
                 .iter()
                 .find_map(|s| {
-                    let decel = s.decel_mps2;
-                    match prev {
-                        Some((t0, d0)) => {
-                            dv += 0.5 * (d0 + decel) * (s.t_ns - t0) as f64 * 1e-9;
-                            prev = Some((s.t_ns, decel));
-                        }
-                        None if decel >= wake => prev = Some((s.t_ns, decel)),
-                        None => {}
-                    }
-                    (dv >= cfg.fallback_min_dv_mps)
+                    onset.push(&p, s);
+                    (onset.delta_v_mps() >= cfg.fallback_min_dv_mps)
                         .then_some((s.t_ns as f64 - contact_ns as f64) * 1e-6)
                 })
                 .unwrap_or_else(|| panic!("{closing_kph} km/h: never carries the floor"));

@@ -417,16 +417,21 @@ mod tests {
         assert!(a.agrees(500 * MS));
     }
 
-    #[test]
-    fn one_wild_sample_in_a_shared_event_disagrees() {
-        // 150 g for one 4 kHz sample (0.37 m/s) inside a 10 g pothole.
+    /// A 10 g pothole both sensors see, and the crash sensor alone reading 150 g more at
+    /// `wild_us` (one 4 kHz sample: 0.37 m/s); both fed up to `until_us`.
+    fn wild_sample_in_a_pothole(wild_us: u64, until_us: u64) -> SeverityAgreement {
         let pothole = half_sine(10.0, 10_000, 10_000);
         let mut a = agreement();
-        feed(&mut a.crash, 250, 30_000, |t| {
-            pothole(t) + if t == 13_000 { 150.0 } else { 0.0 }
+        feed(&mut a.crash, 250, until_us, |t| {
+            pothole(t) + if t == wild_us { 150.0 } else { 0.0 }
         });
-        feed(&mut a.safing, 500, 30_000, &pothole);
-        assert!(!a.agrees(10 * MS));
+        feed(&mut a.safing, 500, until_us, &pothole);
+        a
+    }
+
+    #[test]
+    fn one_wild_sample_in_a_shared_event_disagrees() {
+        assert!(!wild_sample_in_a_pothole(13_000, 30_000).agrees(10 * MS));
     }
 
     #[test]
@@ -435,13 +440,8 @@ mod tests {
         // it (0.19 m/s of 0.37, inside the tolerance) and its fire is decided in this very
         // cycle: the pair is compared one crash-sensor period ahead, each trace carried on
         // with its newest deceleration, so the whole sample counts now.
-        let pothole = half_sine(10.0, 10_000, 10_000);
-        let mut a = agreement();
         // Batches of t..t+750 µs: the sample at 13 750 µs ends the batch fed up to 14 000.
-        feed(&mut a.crash, 250, 14_000, |t| {
-            pothole(t) + if t == 13_750 { 150.0 } else { 0.0 }
-        });
-        feed(&mut a.safing, 500, 14_000, &pothole);
+        let mut a = wild_sample_in_a_pothole(13_750, 14_000);
         assert!(!a.agrees(10 * MS), "{:?}", a.worst_excess_mps());
     }
 

@@ -152,11 +152,6 @@ impl<'lut> RestraintCycle<'lut> {
     pub fn safing(&self) -> &Safing {
         &self.safing
     }
-    /// What the road's roughness adds to every fire's severity floor now, m/s (`roughness`).
-    pub fn floor_lift_mps(&self) -> f64 {
-        self.crash.floor_lift_mps()
-    }
-
     /// The two accelerometers' severity agreement.
     pub fn agreement(&self) -> &SeverityAgreement {
         &self.agreement

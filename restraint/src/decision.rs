@@ -583,15 +583,15 @@ impl Decision {
         // A crash-phase fire also needs the safing function (module `safing`).
         let in_crash = self.phase == Phase::Crash;
         if in_crash && matches!(self.crash_kind, Some(ConfirmKind::Matched(_))) {
-            let mut slots = [
-                (self.airbag_fire_at_ns, self.airbag_floor_mps),
-                (self.pretensioner_at_ns, self.pretensioner_floor_mps),
-            ];
-            for (slot, floor) in &mut slots {
-                self.held_below_floor += u64::from(Self::hold_below_floor(slot, *floor, now, x));
-            }
-            self.airbag_fire_at_ns = slots[0].0;
-            self.pretensioner_at_ns = slots[1].0;
+            let airbag =
+                Self::hold_below_floor(&mut self.airbag_fire_at_ns, self.airbag_floor_mps, now, x);
+            let pretensioner = Self::hold_below_floor(
+                &mut self.pretensioner_at_ns,
+                self.pretensioner_floor_mps,
+                now,
+                x,
+            );
+            self.held_below_floor += u64::from(airbag) + u64::from(pretensioner);
         }
         if let Some(t) = self.pretensioner_at_ns {
             if let Some(go) = self.release(t, now, x.half_period_ns, x.safing) {

@@ -480,18 +480,25 @@ fn floor_reached_ms(g: &dyn Fn(u64) -> f32, floor_mps: f64) -> u64 {
     unreachable!()
 }
 
+/// A crash predicted at 28 m/s for C (the standard approach) with the airbag's floor at
+/// `floor_mps`, and the pulse `g(ms after C)`, run until `end`.
+fn predicted_28_mps_with_airbag_floor(floor_mps: f64, end: u64, g: &dyn Fn(u64) -> f32) -> Bench {
+    let cfg = restraint::CycleConfig {
+        fallback_min_dv_mps: floor_mps,
+        ..ideal_sensor_config()
+    };
+    let mut b = Bench::with_config(cfg, Some(test_lut()));
+    run_scenario(&mut b, end, T0 + 200 * MS, C, 28.0, C, Some(C), g);
+    b
+}
+
 #[test]
 fn a_matched_airbag_waits_until_its_crash_carries_the_floor() {
     // Issue 31 (near miss): a pothole at the predicted contact can follow the predicted ramp
     // up to a +3 ms plan; no misuse event carries the floor. Floor raised to 2.5 m/s so that
     // it is reached after the plan (+15.1 ms, as above): the airbag waits for it.
-    let cfg = restraint::CycleConfig {
-        fallback_min_dv_mps: 2.5,
-        ..ideal_sensor_config()
-    };
-    let mut b = Bench::with_config(cfg, Some(test_lut()));
     let g = |ms: u64| ramp_g(28.0, ms);
-    run_scenario(&mut b, C + 100 * MS, T0 + 200 * MS, C, 28.0, C, Some(C), &g);
+    let b = predicted_28_mps_with_airbag_floor(2.5, C + 100 * MS, &g);
     assert!(matches!(b.ecu.crash_kind(), Some(ConfirmKind::Matched(_))));
     let k = floor_reached_ms(&g, 2.5);
     assert!(k > 16, "the floor comes after the plan: {k}");
@@ -509,13 +516,8 @@ fn a_matched_pulse_that_follows_its_ramp_past_the_plan_below_the_floor_fires_not
     // time (+15.1 ms) and then stops, as a near miss's pothole or kerb strike would if it
     // were that long: ≈ 2.2 m/s, below the (raised) 3 m/s floor. The matched airbag is never
     // commanded and the crash phase ends with the event.
-    let cfg = restraint::CycleConfig {
-        fallback_min_dv_mps: 3.0,
-        ..ideal_sensor_config()
-    };
-    let mut b = Bench::with_config(cfg, Some(test_lut()));
     let g = |ms: u64| if ms < 17 { ramp_g(28.0, ms) } else { 0.0 };
-    run_scenario(&mut b, C + 200 * MS, T0 + 200 * MS, C, 28.0, C, Some(C), &g);
+    let b = predicted_28_mps_with_airbag_floor(3.0, C + 200 * MS, &g);
     assert!(b.first_mode(EcuMode::Crash).is_some(), "matched");
     assert!(no_airbag_fired(&b), "{:?}", first_fire(&b));
     assert!(!matches!(b.ecu.phase(), Phase::Crash | Phase::PostCrash));

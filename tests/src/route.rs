@@ -194,11 +194,6 @@ pub const STARVED_INPUT_FLAGS: [&str; 5] = [
     "overrun",
 ];
 
-/// Why a scenario run did not measure the bench because the machine starved it, if it did not:
-/// between the ECU's first Normal and the contact it raised a stale-input fault that the
-/// scenario does not inject (no dropout, freeze or accelerometer fault declared), or the airbag fired more than
-/// [`crate::FIRE_LATE_ALLOWANCE_MS`] after its plan. Under emulated timing such a run is run
-/// again ([`Allowances::time_limit_attempts`]); with real timers it is a failure like any other.
 /// The EcuStatus input flags a scenario's declared faults raise.
 fn injected_flags(scenario: &sensor_feeds::Scenario) -> Vec<&'static str> {
     use sensor_feeds::scenario::DropoutTarget;
@@ -243,33 +238,27 @@ fn injected_flags(scenario: &sensor_feeds::Scenario) -> Vec<&'static str> {
 /// the start-up report, before an input's first sample arrived, is not starvation (issue 30:
 /// a run whose object list is dead by design is not "never Normal" because of it).
 fn raised_after_clear(faults: &[(f64, Vec<String>)]) -> Vec<(f64, Vec<String>)> {
-    let mut cleared: Vec<&str> = Vec::new();
-    let mut out = Vec::new();
-    let mut previous: &[String] = &[];
-    for (t, flags) in faults {
-        for f in previous {
-            if !flags.contains(f) && !cleared.contains(&f.as_str()) {
-                cleared.push(f);
-            }
-        }
-        let raised: Vec<String> = flags
-            .iter()
-            .filter(|f| cleared.contains(&f.as_str()) || !is_first_report(faults, f))
-            .cloned()
-            .collect();
-        out.push((*t, raised));
-        previous = flags;
-    }
-    out
-}
-
-/// `flag` was set in the first fault report (the start-up one).
-fn is_first_report(faults: &[(f64, Vec<String>)], flag: &str) -> bool {
-    faults
+    // The start-up report's flags that have stayed set ever since.
+    let mut startup: Vec<&String> = faults
         .first()
-        .is_some_and(|(_, flags)| flags.iter().any(|f| f == flag))
+        .map_or(Vec::new(), |(_, f)| f.iter().collect());
+    faults
+        .iter()
+        .map(|(t, flags)| {
+            startup.retain(|f| flags.contains(f));
+            let raised = flags.iter().filter(|f| !startup.contains(f)).cloned();
+            (*t, raised.collect())
+        })
+        .collect()
 }
 
+/// Why a scenario run did not measure the bench because the machine starved it, if it did not:
+/// between the ECU's first Normal and the contact (a no-crash run: the scenario's end) it
+/// raised a stale-input fault that the scenario does not inject (no dropout, freeze or
+/// accelerometer fault declared; the start-up report does not count), or the airbag fired more
+/// than [`crate::FIRE_LATE_ALLOWANCE_MS`] after its plan. Under emulated timing such a run is
+/// run again ([`Allowances::time_limit_attempts`]); with real timers it is a failure like any
+/// other.
 pub fn starved_run(
     scenario: &sensor_feeds::Scenario,
     r: &actuator_stubs::report::Report,

@@ -134,9 +134,8 @@ fn the_library_meets_its_expectations_and_fires_on_plan() {
 /// floor later than the cell's pulse the plan was made for, so its airbag may be this late.
 fn fire_delay_tolerance_ms(cfg: &OfflineConfig) -> f64 {
     let lut = cfg.lut.as_ref().expect("shipped table");
-    lut.header().build.extra["optimiser.fire_delay_tolerance_ms"]
-        .parse()
-        .expect("tolerance in the table header")
+    let grid = lut::table::Grid::from_table(lut).expect("the table's build settings");
+    grid.optimiser.fire_delay_tolerance_s * 1e3
 }
 
 /// `base` with the opponent truly `true_kg` (class by mass) and reported as `reported_kg`.
