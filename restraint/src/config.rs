@@ -131,10 +131,16 @@ pub struct CycleConfig {
     /// An event that does not reach it fires no pretensioner (a bump that the generic
     /// thresholds confirm is not a crash that needs one).
     pub pretensioner_dv_mps: [f64; crate::fallback::KNOTS],
-    /// The pretensioner's severity floor, m/s (*default* 1.25), with the same persistence rule
-    /// as `fallback_min_dv_mps` and for the same reason: a pothole through the wheels carries
-    /// up to 1.2 m/s in the misuse matrix (× 1.5 of its envelope); at 0.8 they fired the
-    /// pretensioner, at 1.0 with the loading rule the ones at the envelope's edge still did.
+    /// The pretensioner's severity floor on the conventional path, m/s (*default* 1.5), with
+    /// the same persistence rule as `fallback_min_dv_mps`. Why above the airbag's 1.25: the
+    /// pretensioner's boundary is 0.6 × the airbag's, so a rough road's first lobe (before the
+    /// roughness measure has seen the road) could carry the floor alone — at 3.9–4.5 g rms
+    /// 2 in 96 000 rough-road variants fired it at 1.25 (seeds 1 and 3), 0 in 144 000 at 1.5
+    /// (seeds 1, 3, 5). The airbag's must-fire fires the pretensioner too, at the same
+    /// instant (`Decision::gate_pretensioner`), so crashes above the airbag's line lose
+    /// nothing; below it the pretensioner fires ≈ 2 ms later (library: +0.5 to +0.7 points on
+    /// the five low-speed cases, all still no worse than the reference). A prediction-matched
+    /// pretensioner waits for the lower of the two floors (`Decision::hold_below_floor`).
     pub pretensioner_min_dv_mps: f64,
     /// Prediction-matched confirmation: besides the onset ramp fitting the prediction, the
     /// velocity change since the onset must reach this, m/s, with the deceleration staying
@@ -219,7 +225,9 @@ pub struct CycleConfig {
     /// 0 = off). Why: a rough road swings the car's velocity as far back as forward, a crash
     /// only slows it; at the matrix's 3–4.5 g rms a backward swing now and then carried the
     /// 1.25 m/s floor and fired the pyrotechnic pretensioner (25 of 1 000, seed 1; 1 of 24 000
-    /// left at 2.0, seeds 1, 7, 2 — 5 at 1.5; must-fire crashes on a smooth road unchanged).
+    /// left at 2.0, seeds 1, 7, 2 — 5 at 1.5; must-fire crashes on a smooth road unchanged;
+    /// the last ones, first lobes before any forward swing, went with a physical rough road
+    /// (`world::events`: from rest, crest factor 3) and `pretensioner_min_dv_mps` 1.5).
     pub roughness_k: f64,
     /// How long the held forward excursion takes to decay to 1/e, ms (*default* 500: a rough
     /// road's lobes refresh it every few tens of ms; after a pothole's forward rebound, up to
@@ -292,7 +300,7 @@ impl Default for CycleConfig {
             fallback_dv_mps: crate::fallback::DEFAULT_DV_MPS,
             fallback_min_dv_mps: 1.25,
             pretensioner_dv_mps: crate::fallback::DEFAULT_PRETENSIONER_DV_MPS,
-            pretensioner_min_dv_mps: 1.25,
+            pretensioner_min_dv_mps: 1.5,
             match_min_dv_mps: 0.3,
             loading_fraction: 0.85,
             accel_delay_ms: 0.70,

@@ -223,6 +223,12 @@ impl CrashMonitor {
         self.fallback.event_dv_mps()
     }
 
+    /// Onset of the accelerometer event in progress (the accelerometer-only boundaries' τ = 0),
+    /// ns.
+    pub fn event_onset_ns(&self) -> Option<u64> {
+        self.fallback.onset_ns()
+    }
+
     /// What the road's roughness adds to every fire's severity floor now, m/s.
     pub fn floor_lift_mps(&self) -> f64 {
         self.roughness.floor_lift_mps()

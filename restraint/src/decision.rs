@@ -234,7 +234,11 @@ impl Decision {
             vetoed: 0,
             crash_kind: None,
             airbag_floor_mps: cfg.fallback_min_dv_mps,
-            pretensioner_floor_mps: cfg.pretensioner_min_dv_mps,
+            // A matched pretensioner waits for the lower of the two floors: the matched hold is
+            // against misuse at a predicted contact (≤ 1.2 m/s), which the airbag's floor
+            // already exceeds; the pretensioner's own, higher floor is for the conventional
+            // path, where a rough road's first lobe has no prediction to be refuted by.
+            pretensioner_floor_mps: cfg.pretensioner_min_dv_mps.min(cfg.fallback_min_dv_mps),
             held_below_floor: 0,
         }
     }
@@ -435,21 +439,26 @@ impl Decision {
     }
 
     /// The conventional path's pyrotechnic pretensioner: at max(decision, contact + t_pt)
-    /// when its own boundary says must-fire for the confirmed event; none otherwise.
-    fn gate_pretensioner(&mut self, now: u64, decision: FallbackDecision) {
+    /// when its own boundary — or the airbag's — says must-fire for the confirmed event; none
+    /// otherwise. Why the airbag's too: its floor is lower than the pretensioner's
+    /// (`pretensioner_min_dv_mps`), and a crash that needs the airbag needs the belt at the
+    /// same instant, never after it.
+    fn gate_pretensioner(&mut self, now: u64, own: FallbackDecision, airbag: FallbackDecision) {
         if self.pt_gate != AirbagGate::Fallback {
             return;
         }
         let contact = self.contact_ns.unwrap_or(now);
         let window_over = now > at(contact, (WINDOW_MS + 1.0) as f32);
-        match (decision.fire_of(self.event_onset_ns), decision) {
-            (Some(t), _) => {
+        let onset = self.event_onset_ns;
+        let pending = own == FallbackDecision::Pending || airbag == FallbackDecision::Pending;
+        match own.fire_of(onset).or_else(|| airbag.fire_of(onset)) {
+            Some(t) => {
                 self.pretensioner_at_ns =
                     Some(at(contact, self.crash_plan.pretensioner_time_ms).max(t));
                 self.pt_gate = AirbagGate::Decided;
             }
-            (None, FallbackDecision::Pending) if !window_over => {}
-            _ => self.pt_gate = AirbagGate::Decided,
+            None if pending && !window_over => {}
+            None => self.pt_gate = AirbagGate::Decided,
         }
     }
 
@@ -512,7 +521,7 @@ impl Decision {
         }
         if self.phase == Phase::Crash {
             self.gate_airbag(now, x.fallback, x.event_dv_mps);
-            self.gate_pretensioner(now, x.pretensioner_fallback);
+            self.gate_pretensioner(now, x.pretensioner_fallback, x.fallback);
         }
         match self.phase {
             Phase::Monitoring => {

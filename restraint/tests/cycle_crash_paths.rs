@@ -6,7 +6,9 @@
 
 mod cycle_support;
 
-use bus::codec::{AirbagStageCmdCmdSource, AirbagStageCmdFire, EcuStatusEcuMode};
+use bus::codec::{
+    AirbagStageCmdCmdSource, AirbagStageCmdFire, BeltLimiterCmdPretensionerCmd, EcuStatusEcuMode,
+};
 use cycle_support::*;
 use restraint::crash::ConfirmKind;
 use restraint::crash_match::{MatchState, Mismatch};
@@ -238,6 +240,37 @@ fn without_a_prediction_a_bump_fires_nothing_and_a_severe_crash_fires_the_refere
     let (t, f) = first_fire(&b).expect("reference airbag");
     assert_eq!(f.cmd_source(), AirbagStageCmdCmdSource::Reference);
     assert_eq!(t, C + 10 * MS);
+}
+
+#[test]
+fn the_conventional_airbags_must_fire_fires_the_pretensioner_at_the_same_instant() {
+    // No prediction, a constant 12 g crash: Δv grows 12 g × 1 ms = 0.118 m/s per sample, over
+    // the airbag's boundary and its 1.25 m/s floor at τ ≈ 11 ms; the pretensioner's own floor
+    // (1.5 m/s) only at 1.5 / 0.118 = 12.7 ms. A crash that needs the airbag needs the belt at
+    // the same instant, never after it.
+    let cfg = restraint::CycleConfig::default();
+    assert!(cfg.pretensioner_min_dv_mps > cfg.fallback_min_dv_mps);
+    let mut b = Bench::new(Some(test_lut()));
+    run_scenario(
+        &mut b,
+        C + 100 * MS,
+        u64::MAX,
+        0,
+        0.0,
+        u64::MAX,
+        Some(C),
+        &|_| 12.0,
+    );
+    let (bag, _) = first_fire(&b).expect("reference airbag");
+    let pretensioner = b
+        .belt_frames()
+        .into_iter()
+        .find(|(_, f)| f.pretensioner_cmd() == BeltLimiterCmdPretensionerCmd::Fire)
+        .map(|(t, _)| t)
+        .expect("pretensioner");
+    let own_floor_ns = C + (cfg.pretensioner_min_dv_mps / (12.0 * f64::from(G)) * 1e9) as u64;
+    assert_eq!(pretensioner, bag);
+    assert!(bag < own_floor_ns, "{} ms", (bag - C) as f64 * 1e-6);
 }
 
 // --- Accelerometer faults ---------------------------------------------------------------

@@ -343,7 +343,7 @@ fn rough_road_run(roughness_k: f64) -> Bench {
     let mut b = Bench::with_config(cfg, Some(test_lut()));
     drive(&mut b, T0 + 500 * MS);
     // Each backward half carries 8 g × 30 ms = 2.35 m/s since its onset: past the
-    // pretensioner's boundary (1.53 m/s at 20 ms) and its 1.25 m/s floor.
+    // pretensioner's boundary (1.53 m/s at 20 ms) and its 1.5 m/s floor.
     swings(&mut b, 8.0, 30, 4);
     drive(&mut b, T0 + 1_000 * MS);
     b

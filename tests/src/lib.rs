@@ -11,6 +11,7 @@ pub mod faults;
 pub mod host_timing;
 pub mod misuse;
 pub mod offline;
+pub mod offline_plot;
 pub mod route;
 pub mod timeline;
 

@@ -118,12 +118,91 @@ impl OfflineRun {
     }
 }
 
+/// What the sensors read and where the decision stood, on scenario time: what an engineer looks
+/// at first when a case fires that must not (`offline-bench --plot`, [`crate::offline_plot`]).
+#[derive(Debug, Default, Clone)]
+pub struct Trace {
+    /// Crash accelerometer readings as published: (ms after the scenario start, deceleration
+    /// in g, positive = slowing).
+    pub crash_g: Vec<(f64, f64)>,
+    /// Safing accelerometer readings, as `crash_g`.
+    pub safing_g: Vec<(f64, f64)>,
+    /// The core's state after each ECU cycle.
+    pub cycles: Vec<TraceCycle>,
+}
+
+/// The core's crash-phase state after one cycle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TraceCycle {
+    /// ms after the scenario start.
+    pub t_ms: f64,
+    /// `EcuDiagnostics::mode` (restraint's `EcuMode` as a byte).
+    pub mode: u8,
+    /// Velocity change of the accelerometer event in progress since its onset, m/s (0: none).
+    pub event_dv_mps: f64,
+    /// The accelerometer-only airbag boundary at this τ after the onset, m/s (`None`: no event).
+    pub airbag_boundary_mps: Option<f64>,
+    /// The pyrotechnic pretensioner's boundary at this τ, m/s (`None`: no event).
+    pub pretensioner_boundary_mps: Option<f64>,
+    /// The airbag's severity floor with the road's roughness lift, m/s.
+    pub airbag_floor_mps: f64,
+    /// The pretensioner's severity floor with the roughness lift, m/s.
+    pub pretensioner_floor_mps: f64,
+}
+
+/// Scenario-time readings of one published batch: (ms after start, deceleration g).
+fn batch_g(b: &restraint::CrashAccelSample) -> impl Iterator<Item = (f64, f64)> + '_ {
+    b.samples().iter().enumerate().map(move |(i, a)| {
+        let t_ns = b.first_timestamp_ns + i as u64 * u64::from(b.sample_period_ns);
+        (
+            t_ns.saturating_sub(START_NS) as f64 * 1e-6,
+            -f64::from(*a) / physics::defaults::STANDARD_GRAVITY_MPS2,
+        )
+    })
+}
+
+impl TraceCycle {
+    fn of(ecu: &RestraintCycle, now_ns: u64, mode: u8) -> Self {
+        let cfg = ecu.config();
+        let crash = ecu.crash();
+        let lift = crash.floor_lift_mps();
+        let tau_ms = crash
+            .event_onset_ns()
+            .map(|o| now_ns.saturating_sub(o) as f64 * 1e-6);
+        let boundary = |t: &[f64; restraint::fallback::KNOTS]| {
+            tau_ms.map(|tau| restraint::fallback::threshold_mps(t, tau))
+        };
+        Self {
+            t_ms: now_ns.saturating_sub(START_NS) as f64 * 1e-6,
+            mode,
+            event_dv_mps: crash.event_dv_mps(),
+            airbag_boundary_mps: boundary(&cfg.fallback_dv_mps),
+            pretensioner_boundary_mps: boundary(&cfg.pretensioner_dv_mps),
+            airbag_floor_mps: cfg.fallback_min_dv_mps + lift,
+            pretensioner_floor_mps: cfg.pretensioner_min_dv_mps + lift,
+        }
+    }
+}
+
 /// Runs `scenario` through the core with `cfg`.
 ///
 /// # Errors
 /// The cycle configuration is invalid, the scenario has no consistent truth, or the judge
 /// failed.
 pub fn run(scenario: &Scenario, cfg: &OfflineConfig) -> Result<OfflineRun> {
+    run_traced(scenario, cfg, None)
+}
+
+/// [`run`], also recording into `trace` what the sensors read and the core's crash-phase state
+/// every cycle.
+///
+/// # Errors
+/// As [`run`].
+pub fn run_traced(
+    scenario: &Scenario,
+    cfg: &OfflineConfig,
+    mut trace: Option<&mut Trace>,
+) -> Result<OfflineRun> {
     let truth = Truth::new(scenario).map_err(|e| anyhow!("{}: {e}", scenario.name))?;
     let contact_s = truth.contact_s;
     let lut = cfg.lut.as_ref().map(ecu::lut_input);
@@ -144,6 +223,12 @@ pub fn run(scenario: &Scenario, cfg: &OfflineConfig) -> Result<OfflineRun> {
         out.accel.iter().for_each(|a| io.push_accel(*a));
         out.safing.iter().for_each(|a| io.push_safing(*a));
         out.can.iter().for_each(|f| io.push_can(*f));
+        if let Some(t) = trace.as_deref_mut() {
+            out.accel.iter().for_each(|b| t.crash_g.extend(batch_g(b)));
+            out.safing
+                .iter()
+                .for_each(|b| t.safing_g.extend(batch_g(b)));
+        }
         let now = START_NS + tick * MS + cfg.ecu_phase_ns;
         let info = CycleInfo {
             cycle: tick,
@@ -162,6 +247,9 @@ pub fn run(scenario: &Scenario, cfg: &OfflineConfig) -> Result<OfflineRun> {
             }
         }
         let m = io.diagnostics.mode;
+        if let Some(t) = trace.as_deref_mut() {
+            t.cycles.push(TraceCycle::of(&ecu, now, m));
+        }
         let crashed =
             m == restraint::EcuMode::Crash as u8 || m == restraint::EcuMode::PostCrash as u8;
         if crash_mode_ns.is_none() && crashed {

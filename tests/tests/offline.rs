@@ -321,3 +321,57 @@ fn in_phase_4_khz_ringing_fires_only_without_the_anti_alias_filter() {
     let r = run(&ideal, &cfg).expect("offline run");
     assert!(r.action("airbag_fire").is_some(), "{}", table_row(&r));
 }
+
+#[test]
+fn offline_bench_plots_what_a_pothole_did_to_the_sensors_and_the_decision() {
+    // Issue 32 item 7: `--plot DIR` draws each run. The trace it draws is checked against the
+    // scenario's closed form — a 10 g × 8 ms half-sine at 1.5 s, Δv = 2·a·T/π = 0.50 m/s — and
+    // the picture is written at its size.
+    let name = "misuse-pothole";
+    let mut trace = e2e_tests::offline::Trace::default();
+    let r = e2e_tests::offline::run_traced(&scenario(name), &cfg(), Some(&mut trace))
+        .expect("offline run");
+    assert!(r.modules.actions.is_empty(), "{:?}", r.modules.actions);
+    let peak_g = trace
+        .crash_g
+        .iter()
+        .filter(|(t, _)| (1495.0..1515.0).contains(t))
+        .fold(0.0f64, |m, (_, g)| m.max(*g));
+    assert!(
+        (8.5..11.0).contains(&peak_g),
+        "crash sensor peak {peak_g} g"
+    );
+    let event: Vec<_> = trace
+        .cycles
+        .iter()
+        .filter(|c| c.airbag_boundary_mps.is_some())
+        .collect();
+    let first = event.first().expect("an accelerometer event").t_ms;
+    assert!((1500.0..1506.0).contains(&first), "event from {first} ms");
+    let dv = event.iter().map(|c| c.event_dv_mps).fold(0.0f64, f64::max);
+    let closed_form = 2.0 * 10.0 * 9.806_65 * 0.008 / std::f64::consts::PI;
+    assert!(
+        dv > 0.7 * closed_form && dv <= closed_form * 1.05,
+        "Δv {dv} for {closed_form}"
+    );
+    assert!(event.iter().all(|c| c.airbag_floor_mps > dv));
+
+    let dir = std::env::temp_dir().join(format!("offline-bench-plot-{}", std::process::id()));
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_offline-bench"))
+        .arg("--scenario")
+        .arg(root().join(format!("scenarios/{name}.toml")))
+        .arg("--plot")
+        .arg(&dir)
+        .stdout(std::process::Stdio::null())
+        .status()
+        .expect("offline-bench runs");
+    assert!(status.success());
+    let png = std::fs::read(dir.join(format!("{name}.png"))).expect("plot written");
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(&png[1..4], b"PNG");
+    let (w, h) = (
+        u32::from_be_bytes(png[16..20].try_into().unwrap()),
+        u32::from_be_bytes(png[20..24].try_into().unwrap()),
+    );
+    assert_eq!((w, h), (1200, 1000));
+}

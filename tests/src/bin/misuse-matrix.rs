@@ -239,8 +239,8 @@ struct Outcome {
     pretensioner_kept: bool,
     /// Required airbag time of a crash ("127 mm − 30 ms"), ms after contact.
     required_ms: Option<f64>,
-    /// The ECU's last mode was CrashDetected at the end of the run (a crash phase that never
-    /// ended).
+    /// The ECU's last mode was CrashDetected at the end of the run, entered at least
+    /// [`UNFINISHED_MS`] before it (a crash phase that never ended).
     stuck_in_crash: bool,
     /// Largest crash-minus-safing Δv of a confirmed event, m/s.
     severity_excess_mps: Option<f64>,
@@ -259,6 +259,11 @@ fn required_ms(truth: &world::Truth) -> Option<f64> {
     }
     None
 }
+
+/// A crash phase entered less than this before the run's end is unfinished, not stuck, ms: the
+/// accelerometer-only decision window (60 ms) and the event's own end after it (a rough road
+/// or offset that lasts to within a few ms of the end would otherwise count).
+const UNFINISHED_MS: f64 = 150.0;
 
 fn run_variant(cfg: &OfflineConfig, text: &str) -> Result<Outcome> {
     let scenario =
@@ -285,7 +290,11 @@ fn run_variant(cfg: &OfflineConfig, text: &str) -> Result<Outcome> {
         airbag_ms,
         pretensioner_kept: fired > released,
         required_ms: required,
-        stuck_in_crash: r.modes.last().is_some_and(|m| m.1 == "CrashDetected"),
+        stuck_in_crash: r.modes.last().is_some_and(|m| {
+            // Modes count from the contact, or from the start without one.
+            let end_ms = (scenario.duration_s - r.contact_s.unwrap_or(0.0)) * 1e3;
+            m.1 == "CrashDetected" && end_ms - m.0 >= UNFINISHED_MS
+        }),
         severity_excess_mps: r.severity_excess_mps,
     })
 }

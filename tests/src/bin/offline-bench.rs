@@ -12,7 +12,7 @@
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use e2e_tests::offline::{run, table_row, OfflineConfig, START_NS, TABLE_HEADER};
+use e2e_tests::offline::{run_traced, table_row, OfflineConfig, Trace, START_NS, TABLE_HEADER};
 use std::path::PathBuf;
 
 /// Scenario library through the ECU core, offline.
@@ -35,6 +35,10 @@ struct Cli {
     /// replace the defaults: what a threshold change does to the library, before it is made.
     #[arg(long, value_name = "FILE")]
     cycle_config: Option<PathBuf>,
+    /// Draw each run to DIR/<scenario>.png: the accelerometers, the event's Δv against the
+    /// boundaries and floors, the ECU's mode and every restraint action (created if missing).
+    #[arg(long, value_name = "DIR")]
+    plot: Option<PathBuf>,
 }
 
 fn main() -> Result<()> {
@@ -57,11 +61,19 @@ fn main() -> Result<()> {
     if cli.no_lut {
         cfg.lut = None;
     }
+    if let Some(dir) = &cli.plot {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
     println!("{TABLE_HEADER}");
     let mut json = Vec::new();
     for f in &files {
         let s = sensor_feeds::Scenario::load(f).map_err(|e| anyhow::anyhow!("{e}"))?;
-        let r = run(&s, &cfg)?;
+        let mut trace = Trace::default();
+        let r = run_traced(&s, &cfg, cli.plot.is_some().then_some(&mut trace))?;
+        if let Some(dir) = &cli.plot {
+            e2e_tests::offline_plot::draw(&dir.join(format!("{}.png", r.name)), &r, &trace)
+                .map_err(anyhow::Error::msg)?;
+        }
         println!("{}", table_row(&r));
         json.push(serde_json::json!({
             "scenario": r.name,

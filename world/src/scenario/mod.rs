@@ -236,7 +236,8 @@ pub enum AccelEventKind {
     HalfSine,
     /// One sample — the first at or after `start_s` — reads `peak_g` instead of its value.
     Spike,
-    /// Band-limited random deceleration (road excitation, 5–40 Hz) with `rms_g` over
+    /// Band-limited random deceleration (road excitation, 5–40 Hz, from rest at `start_s`,
+    /// peaks clipped at 3 × the rms) with `rms_g` over
     /// `[start_s, end_s)`.
     RoughRoad,
     /// The reading shifted by `peak_g` over `[start_s, end_s)` (a biased sensor, or with
