@@ -221,7 +221,9 @@ pub struct CycleConfig {
     pub severity_tolerance_fraction: f64,
     /// Road roughness (`roughness`): this many times the road's recent forward velocity
     /// excursion beyond 0.05 m/s (the crash sensor's velocity high-passed at 50 ms, its
-    /// positive peak held) is added to every crash-phase fire's severity floor (*default* 2.0;
+    /// positive peak held) is added to every crash-phase fire's severity floor and to the
+    /// generic confirmation's `confirm_delta_v_mps` (no CrashDetected on the bus for a rough
+    /// road's lobes) (*default* 2.0;
     /// 0 = off). Why: a rough road swings the car's velocity as far back as forward, a crash
     /// only slows it; at the matrix's 3–4.5 g rms a backward swing now and then carried the
     /// 1.25 m/s floor and fired the pyrotechnic pretensioner (25 of 1 000, seed 1; 1 of 24 000

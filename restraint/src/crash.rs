@@ -156,7 +156,15 @@ impl CrashMonitor {
                 sit.contact_ns,
             )
         });
-        self.generic.push(&self.onset_params, s);
+        // A rough road's lobes are no crash evidence for the generic confirmation either (nor
+        // for the CrashDetected it puts on the bus, which body ECUs act on): its Δv threshold
+        // carries the roughness lift too. On a smooth road the lift is 0; on a rough one every
+        // fire needs floor + lift, more than this, so no fire waits for it.
+        let generic = ConfirmParams {
+            delta_v_mps: self.onset_params.delta_v_mps + lift,
+            ..self.onset_params
+        };
+        self.generic.push(&generic, s);
         self.fallback.push(&self.onset_params, s, lift);
         self.pretensioner.push(&self.onset_params, s, lift);
         if self.confirmation.is_some() {

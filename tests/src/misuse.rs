@@ -66,10 +66,24 @@ pub enum Requirement {
     Report,
 }
 
+impl Requirement {
+    /// The requirement in words (`misuse-matrix --list`).
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::NoFire => "no fire",
+            Self::NoAirbag => "no airbag",
+            Self::MustFire => "must fire",
+            Self::Report => "report only",
+        }
+    }
+}
+
 /// One family of the matrix.
 pub struct Family {
     /// Its name (`--family`).
     pub name: &'static str,
+    /// What its variants sample (`misuse-matrix --list`; the sources are in the module docs).
+    pub envelope: &'static str,
     /// What it requires.
     pub requirement: Requirement,
     /// The scenario file text of one variant, from its own random stream.
@@ -86,161 +100,193 @@ const WHEELBASE_M: f64 = 2.7;
 pub const FAMILIES: &[Family] = &[
     Family {
         name: "pothole",
+        envelope: "driving 30–110 km/h; front axle then rear a wheelbase / v later: net Δv ≤ 0.8 m/s, rigid-body ≤ 5 g, ringing ≤ 10 g at 10–300 Hz, 10–30 ms (each × 1.5)",
         requirement: Requirement::NoFire,
         make: pothole,
     },
     Family {
         name: "kerb-strike",
+        envelope: "climbing a kerb at 10–50 km/h: net Δv ≤ 0.8 m/s, rigid-body ≤ 7 g, ringing ≤ 10 g at 20–300 Hz, 10–30 ms (each × 1.5)",
         requirement: Requirement::NoFire,
         make: kerb_strike,
     },
     Family {
         name: "door-slam",
+        envelope: "standing car: ringing 0.5–60 g at 125–250 Hz for 20–100 ms, net Δv ≤ 0.015 m/s",
         requirement: Requirement::NoFire,
         make: door_slam,
     },
     Family {
         name: "hood-slam",
+        envelope: "standing car: ringing 0.5–4.5 g at 20–300 Hz for 20–100 ms, net Δv ≤ 0.09 m/s",
         requirement: Requirement::NoFire,
         make: hood_slam,
     },
     Family {
         name: "hammer-blow",
+        envelope: "standing car: ringing 100–1 500 g at 1–10 kHz for 0.2–2 ms, net Δv ≤ 0.015 m/s",
         requirement: Requirement::NoFire,
         make: hammer_blow,
     },
     Family {
         name: "rough-road",
+        envelope: "driving 30–110 km/h: 0.5–4.5 g rms, 5–40 Hz from rest, crest factor 3, for 0.3–5 s, both sensors",
         requirement: Requirement::NoFire,
         make: rough_road,
     },
     Family {
         name: "speed-bump",
+        envelope: "30–80 km/h, each axle: net Δv ≤ 0.3 m/s, rigid-body ≤ 3 g, ringing ≤ 3 g at 10–100 Hz, 20–60 ms (each × 1.5)",
         requirement: Requirement::NoFire,
         make: speed_bump,
     },
     Family {
         name: "jump-landing",
+        envelope: "driving 30–110 km/h: net Δv ≤ 0.6 m/s, rigid-body ≤ 5 g, ringing ≤ 5 g at 10–100 Hz, 20–80 ms (each × 1.5)",
         requirement: Requirement::NoFire,
         make: jump_landing,
     },
     Family {
         name: "animal-strike",
+        envelope: "roe deer at 40–110 km/h: net Δv ≤ v·25/(25 + 1 785)·1.3, ringing ≤ 5 g at 20–200 Hz, 20–60 ms (each × 1.5)",
         requirement: Requirement::NoFire,
         make: animal_strike,
     },
     Family {
         name: "kerb-at-predicted-contact",
+        envelope: "a tracked object (20–55 km/h each, 1 000–2 500 kg) evading 1 ms before the predicted contact, a kerb strike (as kerb-strike) at it",
         requirement: Requirement::NoFire,
         make: kerb_at_predicted_contact,
     },
     Family {
         name: "ghost-object-and-pothole",
+        envelope: "a tracked object evading 1–300 ms before the predicted contact, a pothole (as pothole) from 100 ms before the evasion to 50 ms after the contact",
         requirement: Requirement::NoFire,
         make: ghost_object_and_pothole,
     },
     Family {
         name: "spike",
+        envelope: "one sample of 10–200 g on the crash, the safing or both sensors, driving",
         requirement: Requirement::NoFire,
         make: spike,
     },
     Family {
         name: "crash-sensor-offset",
+        envelope: "the crash sensor offset by ±2–20 g for 50–500 ms, driving",
         requirement: Requirement::NoFire,
         make: crash_sensor_offset,
     },
     Family {
         name: "safing-sensor-offset",
+        envelope: "the safing sensor offset by ±2–20 g for 50–500 ms, driving",
         requirement: Requirement::NoFire,
         make: safing_sensor_offset,
     },
     Family {
         name: "crash-sensor-dead",
+        envelope: "the crash sensor stops publishing and stays dead, driving",
         requirement: Requirement::NoFire,
         make: crash_sensor_dead,
     },
     Family {
         name: "safing-sensor-dead",
+        envelope: "the safing sensor stops publishing and stays dead, driving",
         requirement: Requirement::NoFire,
         make: safing_sensor_dead,
     },
     Family {
         name: "sensor-stuck",
+        envelope: "the crash or safing sensor stuck or saturated for 50–500 ms, driving",
         requirement: Requirement::NoFire,
         make: sensor_stuck,
     },
     Family {
         name: "sensor-noisy",
+        envelope: "one sensor (crash or safing) noisy: 1–10 g rms for 0.1–0.5 s, the other quiet",
         requirement: Requirement::NoFire,
         make: sensor_noisy,
     },
     Family {
         name: "stuck-crash-sensor-in-door-slam",
+        envelope: "a door slam (as door-slam) while the crash sensor sticks for 100 ms",
         requirement: Requirement::NoFire,
         make: stuck_in_door_slam,
     },
     Family {
         name: "spike-in-pothole",
+        envelope: "one 150–199 g crash-sensor sample inside a 0.9–1.2 m/s pothole with rebound",
         requirement: Requirement::NoFire,
         make: spike_in_pothole,
     },
     Family {
         name: "offset-with-pothole",
+        envelope: "a crash-sensor offset of 3–12 g for 0.1–0.5 s starting with a 0.15–0.45 m/s pothole",
         requirement: Requirement::NoFire,
         make: offset_with_pothole,
     },
     Family {
         name: "aliased-ringing",
+        envelope: "zero-mean ringing near 4 kHz in phase with the samples (45–73.5 g, 3–4 ms), at 3.95–4.05 kHz (45–67.5 g, 20–30 ms), or at 2–16 kHz multiples (15–75 g, 3–30 ms)",
         requirement: Requirement::NoFire,
         make: aliased_ringing,
     },
     Family {
         name: "braking-and-pothole",
+        envelope: "ABS braking at 0.6–1 g, 50–110 km/h, with a 1.08–1.14 m/s pothole with rebound or a 0.75–1.95 g crash-sensor offset",
         requirement: Requirement::NoFire,
         make: braking_and_pothole,
     },
     Family {
         name: "near-miss",
+        envelope: "closing 30–110 km/h, the opponent evading 1–50 ms before the predicted contact, a 0.6–1.2 m/s pothole within ±20 ms of it; also back to Normal",
         requirement: Requirement::NoFire,
         make: near_miss,
     },
     Family {
         name: "no-fire-crash",
+        envelope: "barrier 8–16 km/h, objects live or dead",
         requirement: Requirement::NoAirbag,
         make: no_fire_crash,
     },
     Family {
         name: "misreported-low-speed",
+        envelope: "below the no-fire line with one object fault: 14.5 + 14.5 km/h reported 4 000 kg, 16 + 16 km/h reported 2 800 kg, 1 000–1 300 kg opponents reported 3 000–4 000 kg (EBS 13–16 km/h), a 15.5 km/h barrier reported 5 m/s faster",
         requirement: Requirement::NoAirbag,
         make: misreported_low_speed,
     },
     Family {
         name: "low-speed-crash-and-kerb",
+        envelope: "barrier 12–16 km/h or 12 + 12 to 15 + 15 km/h cars, tracked, a 0.75–1.2 m/s kerb strike 0–10 ms after contact",
         requirement: Requirement::NoAirbag,
         make: low_speed_crash_and_kerb,
     },
     Family {
         name: "must-fire-crash",
+        envelope: "barrier 35–56 km/h, objects live or dead; fire − required (127 mm − 30 ms) reported",
         requirement: Requirement::MustFire,
         make: must_fire_crash,
     },
     Family {
         name: "must-fire-car",
+        envelope: "equal cars 35 + 35 to 56 + 56 km/h",
         requirement: Requirement::MustFire,
         make: must_fire_car,
     },
     Family {
         name: "must-fire-misreported",
+        envelope: "1 000–2 800 kg opponents at an ego EBS of 35–56 km/h, the mass reported ±1 200 kg off or the closing speed ±5 m/s",
         requirement: Requirement::MustFire,
         make: must_fire_misreported,
     },
     Family {
         name: "must-fire-safing-dead",
+        envelope: "barrier 35–56 km/h with the safing sensor dead",
         requirement: Requirement::MustFire,
         make: must_fire_safing_dead,
     },
     Family {
         name: "beyond-physics-half-sine",
+        envelope: "one-signed half-sine 3–15 g × 5–20 ms on both sensors (its whole area a Δv of the car): where each floor sits, printed, not judged",
         requirement: Requirement::Report,
         make: beyond_physics,
     },

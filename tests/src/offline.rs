@@ -90,8 +90,12 @@ pub struct OfflineRun {
     pub modes: Vec<(f64, String)>,
     /// Every EcuStatus fault-flag change: (ms, flag names).
     pub faults: Vec<(f64, Vec<String>)>,
-    /// How the core confirmed the crash (its `ConfirmKind`, as text).
-    pub confirmed_by: Option<String>,
+    /// How the core confirmed the crash.
+    pub confirmed_by: Option<restraint::crash::ConfirmKind>,
+    /// The core's mode (`restraint::EcuMode` as a byte) in the cycle that sent each of
+    /// `modules.actions` (same order): a pretensioner fired in the crash phase is the
+    /// pyrotechnic one, before it the reversible pre-crash one.
+    pub action_modes: Vec<u8>,
     /// Largest crash-minus-safing Δv over a confirmed event's window, m/s (`None`: no event
     /// judged): what two sensors showed against the severity agreement's tolerance.
     pub severity_excess_mps: Option<f64>,
@@ -214,6 +218,7 @@ pub fn run_traced(
     let mut out = TickOutput::default();
     let mut modules = Modules::default();
     let mut crash_mode_ns = None;
+    let mut action_modes = Vec::new();
     let ticks = (scenario.duration_s * 1e3).round() as u64;
     for tick in 0..=ticks {
         player
@@ -241,12 +246,13 @@ pub fn run_traced(
         };
         let before = io.can_tx_total;
         ecu.step(&info, &mut io);
+        let m = io.diagnostics.mode;
         for f in io.sent_since(before) {
-            if let Ok(m) = bus::decode(f.id, f.payload()) {
-                modules.apply(now, &decode(&m));
+            if let Ok(msg) = bus::decode(f.id, f.payload()) {
+                modules.apply(now, &decode(&msg));
             }
         }
-        let m = io.diagnostics.mode;
+        action_modes.resize(modules.actions.len(), m);
         if let Some(t) = trace.as_deref_mut() {
             t.cycles.push(TraceCycle::of(&ecu, now, m));
         }
@@ -256,7 +262,7 @@ pub fn run_traced(
             crash_mode_ns = Some(now);
         }
     }
-    let confirmed_by = ecu.crash_kind().map(|k| format!("{k:?}"));
+    let confirmed_by = ecu.crash_kind();
     let severity_excess_mps = ecu.agreement().worst_excess_mps();
     let truth = Truth::new(scenario).map_err(|e| anyhow!("{}: {e}", scenario.name))?;
     let contact_ns = contact_s.map_or(u64::MAX, |tc| START_NS + (tc * 1e9).round() as u64);
@@ -283,51 +289,192 @@ pub fn run_traced(
         evaluated,
         modules,
         confirmed_by,
+        action_modes,
         severity_excess_mps,
     })
 }
 
-/// Header of [`table_row`].
-pub const TABLE_HEADER: &str = "scenario                      confirm  airbag ms (plan)  src   adaptive a_max/a_mean/exc   reference a_max/a_mean/exc   change  verdict";
+/// Width of the scenario column the library's tables use (the binary fits its longest name).
+pub const NAME_WIDTH: usize = 28;
 
-/// One line of the outcome table.
-pub fn table_row(r: &OfflineRun) -> String {
+/// Header of [`table_row`] with a scenario column `width` wide.
+pub fn table_header(width: usize) -> String {
+    format!(
+        "{:<width$} confirm  airbag ms (plan)  src   adaptive a_max/a_mean/exc   reference a_max/a_mean/exc   change  verdict",
+        "scenario"
+    )
+}
+
+/// What one module action was, in words: (name, kind of restraint).
+fn action_words(what: &str, mode: Option<u8>) -> (&'static str, &'static str) {
+    let crash_phase = mode.is_some_and(|m| {
+        m == restraint::EcuMode::Crash as u8 || m == restraint::EcuMode::PostCrash as u8
+    });
+    match what {
+        "airbag_fire" => ("airbag fired", ""),
+        "airbag_fire_ignored_disarmed" => ("airbag fire ignored (disarmed)", ""),
+        "pretensioner_fire" if crash_phase => ("pretensioner fired", "pyrotechnic"),
+        "pretensioner_fire" => ("pretensioner fired", "reversible, pre-crash"),
+        "pretensioner_release" => ("pretensioner released", "reversible"),
+        _ => ("module action", ""),
+    }
+}
+
+/// The kind of a pretensioner fire as the JSON names it: `pyrotechnic` (crash phase) or
+/// `reversible` (pre-crash); `None` for other actions.
+pub fn pretensioner_kind(what: &str, mode: Option<u8>) -> Option<&'static str> {
+    match action_words(what, mode).1 {
+        "pyrotechnic" => Some("pyrotechnic"),
+        "" => None,
+        _ => Some("reversible"),
+    }
+}
+
+/// One run of the outcome table: the outcome line, then one indented line per restraint
+/// action (airbag, pyrotechnic and reversible pretensioner) with its source and time — ms after
+/// the true contact, or after the scenario start in a run without contact, which says so.
+pub fn table_row(r: &OfflineRun, width: usize) -> String {
     let bang = |b: bool| if b { "!" } else { " " };
     let confirm = r
         .crash_mode_ms
         .filter(|_| r.contact_s.is_some())
         .map_or("    —".to_owned(), |t| format!("{t:+5.1}"));
-    let bag = r
-        .action("airbag_fire")
-        .map_or("no fire          ".to_owned(), |(t, p, _, _)| {
-            format!("{t:+5.1} ({p:+5.1})     ")
-        });
+    let bag = match (r.action("airbag_fire"), r.contact_s) {
+        (Some((t, p, _, _)), Some(_)) => format!("{t:+5.1} ({p:+5.1})     "),
+        (Some(_), None) => "FIRED, no contact".to_owned(),
+        (None, _) => "no fire          ".to_owned(),
+    };
     let src = r
         .action("airbag_fire")
         .or_else(|| r.action("pretensioner_fire"))
         .map_or("—", |a| if a.3 == "adaptive" { "adpt" } else { "ref" });
-    let Some(e) = &r.evaluated else {
-        return format!("{:<28} {confirm}  {bag} {src:<4}  no contact", r.name);
-    };
-    let (a, f) = (&e.outcome.adaptive, &e.outcome.reference);
-    format!(
-        "{:<28} {confirm}  {bag} {src:<4}  {:5.1} g/{:5.1} g/{:4.0} mm{}   {:5.1} g/{:5.1} g/{:4.0} mm{}   {:+6.1} %  {}",
-        r.name,
-        a.a_max_g,
-        a.a_mean_g,
-        a.excursion_mm,
-        bang(a.bottomed_out),
-        f.a_max_g,
-        f.a_mean_g,
-        f.excursion_mm,
-        bang(f.bottomed_out),
-        e.outcome.change_pct,
-        if e.outcome.adaptive_no_worse {
-            "no worse"
-        } else {
-            "WORSE"
+    let mut out = match &r.evaluated {
+        None => format!("{:<width$} {confirm}  {bag} {src:<4}  no contact", r.name),
+        Some(e) => {
+            let (a, f) = (&e.outcome.adaptive, &e.outcome.reference);
+            format!(
+                "{:<width$} {confirm}  {bag} {src:<4}  {:5.1} g/{:5.1} g/{:4.0} mm{}   {:5.1} g/{:5.1} g/{:4.0} mm{}   {:+6.1} %  {}",
+                r.name,
+                a.a_max_g,
+                a.a_mean_g,
+                a.excursion_mm,
+                bang(a.bottomed_out),
+                f.a_max_g,
+                f.a_mean_g,
+                f.excursion_mm,
+                bang(f.bottomed_out),
+                e.outcome.change_pct,
+                if e.outcome.adaptive_no_worse {
+                    "no worse"
+                } else {
+                    "WORSE"
+                }
+            )
         }
-    )
+    };
+    for (i, a) in r.modules.actions.iter().enumerate() {
+        let (name, kind) = action_words(&a.what, r.action_modes.get(i).copied());
+        let named = if kind.is_empty() {
+            name.to_owned()
+        } else {
+            format!("{name} ({kind})")
+        };
+        let t_ms = OfflineRun::rel_ms(r.contact_s, a.t_ns);
+        let when = match r.contact_s {
+            Some(_) => format!("{t_ms:+7.1} ms after contact"),
+            None => format!("{t_ms:7.1} ms after the start, no contact"),
+        };
+        let _ = std::fmt::Write::write_fmt(
+            &mut out,
+            format_args!(
+                "\n    {named:<40} {when}  {} (planned {:+.1} ms, {:.2} kN)",
+                a.source, a.planned_ms, a.level_kn
+            ),
+        );
+    }
+    out
+}
+
+/// `confirmed_by` of the JSON: which path confirmed the crash, typed.
+fn confirmed_json(k: &restraint::crash::ConfirmKind) -> serde_json::Value {
+    use restraint::crash::ConfirmKind;
+    match k {
+        ConfirmKind::Matched(e) => serde_json::json!({
+            "path": "matched",
+            "closing_mps": e.closing_mps,
+            "slope_ratio": e.ratio,
+            "opponent_mass_kg": e.opponent_mass_kg,
+            "follows_prediction": e.follows,
+        }),
+        ConfirmKind::Generic { prediction_refuted } => serde_json::json!({
+            "path": "generic",
+            "prediction_refuted": prediction_refuted,
+        }),
+        ConfirmKind::Backup => serde_json::json!({ "path": "backup" }),
+    }
+}
+
+/// One run as `offline-bench --json` writes it (schema: tests/README.md, "offline-bench
+/// JSON"). Every time is `t_ms`, ms after the scenario start, with `after_contact_ms` beside
+/// it (`null` without contact); `actions[].t_ns` is the simulated clock (scenario time + 1 s).
+pub fn run_json(
+    r: &OfflineRun,
+    file: &std::path::Path,
+    mismatches: Option<&[crate::expect::Mismatch]>,
+) -> serde_json::Value {
+    let contact_ms = r.contact_s.map(|c| c * 1e3);
+    // `modes`, `faults`, `crash_mode_ms` are held relative to the contact (or the start).
+    let at = |rel_ms: f64| {
+        let t_ms = rel_ms + contact_ms.unwrap_or(0.0);
+        (t_ms, contact_ms.map(|c| t_ms - c))
+    };
+    let actions: Vec<_> = r
+        .modules
+        .actions
+        .iter()
+        .enumerate()
+        .map(|(i, a)| {
+            let t_ms = a.t_ns.saturating_sub(START_NS) as f64 * 1e-6;
+            serde_json::json!({
+                "what": a.what,
+                "kind": pretensioner_kind(&a.what, r.action_modes.get(i).copied()),
+                "source": a.source,
+                "t_ms": t_ms,
+                "after_contact_ms": contact_ms.map(|c| t_ms - c),
+                "t_ns": a.t_ns,
+                "planned_ms": a.planned_ms,
+                "level_kn": a.level_kn,
+            })
+        })
+        .collect();
+    serde_json::json!({
+        "scenario": r.name,
+        "file": file.display().to_string(),
+        "contact_ms": contact_ms,
+        "contact_s": r.contact_s,
+        "crash_mode": r.crash_mode_ms.map(|m| {
+            let (t_ms, after) = at(m);
+            serde_json::json!({ "t_ms": t_ms, "after_contact_ms": after })
+        }),
+        "confirmed_by": r.confirmed_by.as_ref().map(confirmed_json),
+        "severity_excess_mps": r.severity_excess_mps,
+        "modes": r.modes.iter().map(|(m, name)| {
+            let (t_ms, after) = at(*m);
+            serde_json::json!({ "t_ms": t_ms, "after_contact_ms": after, "mode": name })
+        }).collect::<Vec<_>>(),
+        "faults": r.faults.iter().map(|(m, flags)| {
+            let (t_ms, after) = at(*m);
+            serde_json::json!({ "t_ms": t_ms, "after_contact_ms": after, "flags": flags })
+        }).collect::<Vec<_>>(),
+        "actions": actions,
+        "outcome": r.evaluated.as_ref().map(|e| &e.outcome),
+        "expect": mismatches.map(|m| serde_json::json!({
+            "met": m.is_empty(),
+            "mismatches": m.iter().map(|x| serde_json::json!({
+                "key": x.key, "expected": x.expected, "measured": x.measured,
+            })).collect::<Vec<_>>(),
+        })),
+    })
 }
 
 /// Library cases (and variants) allowed to come out worse than the reference restraint, with the most they

@@ -13,7 +13,7 @@
 //!   ±5 m/s, never makes the outcome worse than the reference restraint, nor bottoms out where
 //!   the reference does not.
 
-use e2e_tests::offline::{run, table_row, OfflineConfig, OfflineRun, TABLE_HEADER};
+use e2e_tests::offline::{run, table_header, table_row, OfflineConfig, OfflineRun, NAME_WIDTH};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use world::Scenario;
@@ -45,45 +45,11 @@ fn cfg() -> OfflineConfig {
 /// Problems of one run with its expectations and the judge's verdict; an adaptive airbag may
 /// come up to `late_ms` after its plan (1 ms on the library: plan = fire).
 fn problems(s: &Scenario, r: &OfflineRun, late_ms: f64) -> Vec<String> {
-    let mut bad = Vec::new();
-    let e = &s.expect;
-    let mut check = |what: &str, want: Option<bool>, got: bool| {
-        if want.is_some_and(|w| w != got) {
-            bad.push(format!("{}: {what}: expected {want:?}, got {got}", s.name));
-        }
-    };
-    let pre = r.action("pretensioner_fire").is_some_and(|a| a.0 < 0.0)
-        && r.action("pretensioner_release")
-            .is_none_or(|rel| rel.0 >= 0.0);
-    check("contact", e.contact, r.contact_s.is_some());
-    check(
-        "airbag fires",
-        e.airbag_fires,
-        r.action("airbag_fire").is_some(),
-    );
-    check(
-        "pretensioner before contact",
-        e.pretensioner_before_contact,
-        pre,
-    );
-    check(
-        "pretensioner released",
-        e.pretensioner_released,
-        r.action("pretensioner_release").is_some(),
-    );
-    // After having been Normal: every run starts in ReferenceFallback (and sends the reference
-    // settings) until its inputs are fresh, which would make this check pass for any scenario.
-    check(
-        "reference fallback",
-        e.reference_fallback,
-        e2e_tests::fell_back_after_normal(&r.modes).is_some(),
-    );
-    // Raised after the sensor failed (not the start-up report) and before the contact.
-    check(
-        "accelerometer fault before contact",
-        e.accel_fault_before_contact,
-        e2e_tests::accel_fault_before_contact(s, &r.faults, r.contact_s),
-    );
+    let mut bad: Vec<String> =
+        e2e_tests::expect::check(s, &e2e_tests::expect::Observed::offline(r))
+            .iter()
+            .map(ToString::to_string)
+            .collect();
     if let Some(ev) = &r.evaluated {
         if let Some((max_pct, why)) = e2e_tests::offline::accepted_cost(&s.name) {
             if ev.outcome.change_pct > max_pct {
@@ -115,13 +81,13 @@ fn problems(s: &Scenario, r: &OfflineRun, late_ms: f64) -> Vec<String> {
 #[test]
 fn the_library_meets_its_expectations_and_fires_on_plan() {
     let cfg = cfg();
-    let mut table = format!("{TABLE_HEADER}\n");
+    let mut table = format!("{}\n", table_header(NAME_WIDTH));
     let mut bad = Vec::new();
     let lib = library();
     assert!(lib.len() >= 25, "library: {}", lib.len());
     for s in &lib {
         let r = run(s, &cfg).expect("offline run");
-        table.push_str(&table_row(&r));
+        table.push_str(&table_row(&r, NAME_WIDTH));
         table.push('\n');
         bad.extend(problems(s, &r, 1.0));
     }
@@ -155,7 +121,7 @@ fn misreported(base: &Scenario, true_kg: f64, reported_kg: f64) -> Scenario {
 fn a_misreported_opponent_mass_up_to_1200_kg_is_never_worse_than_the_reference() {
     let cfg = cfg();
     let late_ms = fire_delay_tolerance_ms(&cfg);
-    let mut table = format!("{TABLE_HEADER}\n");
+    let mut table = format!("{}\n", table_header(NAME_WIDTH));
     let mut bad = Vec::new();
     let mut runs = 0;
     for base in [
@@ -175,7 +141,7 @@ fn a_misreported_opponent_mass_up_to_1200_kg_is_never_worse_than_the_reference()
                 let s = misreported(&base, true_kg, reported);
                 let r = run(&s, &cfg).expect("offline run");
                 runs += 1;
-                table.push_str(&table_row(&r));
+                table.push_str(&table_row(&r, NAME_WIDTH));
                 table.push('\n');
                 bad.extend(problems(&s, &r, late_ms));
             }
@@ -190,7 +156,7 @@ fn a_misreported_opponent_mass_up_to_1200_kg_is_never_worse_than_the_reference()
 fn a_misreported_closing_speed_up_to_5_mps_is_never_worse_than_the_reference() {
     let cfg = cfg();
     let late_ms = fire_delay_tolerance_ms(&cfg);
-    let mut table = format!("{TABLE_HEADER}\n");
+    let mut table = format!("{}\n", table_header(NAME_WIDTH));
     let mut bad = Vec::new();
     for base in [
         "taurus-48-48-abs",
@@ -205,7 +171,7 @@ fn a_misreported_closing_speed_up_to_5_mps_is_never_worse_than_the_reference() {
             s.sensor.speed_bias_mps = bias;
             s.expect = Default::default();
             let r = run(&s, &cfg).expect("offline run");
-            table.push_str(&table_row(&r));
+            table.push_str(&table_row(&r, NAME_WIDTH));
             table.push('\n');
             bad.extend(problems(&s, &r, late_ms));
             // Which path confirmed: with the track filter a 5 m/s bias is seen as outliers and
@@ -214,7 +180,7 @@ fn a_misreported_closing_speed_up_to_5_mps_is_never_worse_than_the_reference() {
             // window, and the crash then goes the generic way (restraint README, "Track
             // filter": a speed-bias state is the next step). Either way: never worse.
             if let Some(by) = &r.confirmed_by {
-                let _ = writeln!(table, "  confirmed by {by}");
+                let _ = writeln!(table, "  confirmed by {by:?}");
             }
         }
     }
@@ -230,7 +196,7 @@ fn the_campaigns_scenario_variants_meet_their_expectations_offline() {
     use e2e_tests::faults::{cases, lengthened_scenario, variant_scenario, Fault, CRASH_LEAD_S};
     let dir = std::env::temp_dir().join(format!("offline-variants-{}", std::process::id()));
     let mut bad = Vec::new();
-    let mut table = format!("{TABLE_HEADER}\n");
+    let mut table = format!("{}\n", table_header(NAME_WIDTH));
     let mut n = 0;
     for case in cases() {
         let mut path = root().join(format!("scenarios/{}.toml", case.scenario));
@@ -253,7 +219,11 @@ fn the_campaigns_scenario_variants_meet_their_expectations_offline() {
         }
         let r = run(&s, &cfg).expect("offline run");
         n += 1;
-        table.push_str(&format!("{:<22} {}\n", case.name, table_row(&r)));
+        table.push_str(&format!(
+            "{:<22} {}\n",
+            case.name,
+            table_row(&r, NAME_WIDTH)
+        ));
         bad.extend(
             problems(&s, &r, 1.0)
                 .into_iter()
@@ -315,11 +285,19 @@ fn in_phase_4_khz_ringing_fires_only_without_the_anti_alias_filter() {
     let cfg = cfg();
     let filtered = scenario("misuse-aliased-ringing");
     let r = run(&filtered, &cfg).expect("offline run");
-    assert!(r.action("airbag_fire").is_none(), "{}", table_row(&r));
+    assert!(
+        r.action("airbag_fire").is_none(),
+        "{}",
+        table_row(&r, NAME_WIDTH)
+    );
     let mut ideal = filtered.clone();
     ideal.sensor.accel_lowpass_hz = 0.0;
     let r = run(&ideal, &cfg).expect("offline run");
-    assert!(r.action("airbag_fire").is_some(), "{}", table_row(&r));
+    assert!(
+        r.action("airbag_fire").is_some(),
+        "{}",
+        table_row(&r, NAME_WIDTH)
+    );
 }
 
 #[test]
@@ -374,4 +352,223 @@ fn offline_bench_plots_what_a_pothole_did_to_the_sensors_and_the_decision() {
         u32::from_be_bytes(png[20..24].try_into().unwrap()),
     );
     assert_eq!((w, h), (1200, 1000));
+}
+
+/// `offline-bench` on `files` with `args`: (exit code, stdout, stderr, the JSON it wrote).
+fn offline_bench(files: &[PathBuf], args: &[&str]) -> (i32, String, String, serde_json::Value) {
+    // A file per call: the tests run side by side in one process.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let json =
+        std::env::temp_dir().join(format!("offline-bench-{}-{call}.json", std::process::id()));
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_offline-bench"));
+    for f in files {
+        cmd.arg("--scenario").arg(f);
+    }
+    let out = cmd
+        .arg("--json")
+        .arg(&json)
+        .args(args)
+        .output()
+        .expect("offline-bench runs");
+    let text = std::fs::read_to_string(&json).unwrap_or_else(|_| "null".into());
+    let _ = std::fs::remove_file(&json);
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+        serde_json::from_str(&text).expect("json"),
+    )
+}
+
+/// A library file with `from` replaced by `to`, written to a temporary folder as
+/// `<name>-<tag>.toml`.
+fn edited(name: &str, tag: &str, from: &str, to: &str) -> PathBuf {
+    let text =
+        std::fs::read_to_string(root().join(format!("scenarios/{name}.toml"))).expect("scenario");
+    assert!(text.contains(from), "{name}: no `{from}`");
+    // One folder per tag: the tests run side by side in one process and each removes its own.
+    let dir =
+        std::env::temp_dir().join(format!("offline-bench-edited-{}-{tag}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join(format!("{name}-{tag}.toml"));
+    std::fs::write(&path, text.replacen(from, to, 1)).expect("written");
+    path
+}
+
+#[test]
+fn a_wrong_expectation_fails_offline_bench_and_a_bad_file_does_not_stop_the_others() {
+    // Issue 32 items 1 and 6: a user's regression file can fail; every file is reported.
+    let wrong = edited(
+        "misuse-pothole",
+        "wrong",
+        "airbag_fires = false",
+        "airbag_fires = true",
+    );
+    let broken = edited(
+        "misuse-pothole",
+        "broken",
+        "peak_g = 10.0",
+        "peak_g = \"ten\"",
+    );
+    let good = root().join("scenarios/taurus-48-48-abs.toml");
+    let (code, stdout, stderr, json) =
+        offline_bench(&[wrong.clone(), broken.clone(), good.clone()], &[]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("misuse-pothole: [expect] airbag_fires = true, measured false"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("peak_g"),
+        "the bad file's error names its field: {stderr}"
+    );
+    assert!(
+        stdout.contains("taurus-48-48-abs"),
+        "the good file still ran: {stdout}"
+    );
+    let runs = json.as_array().expect("array");
+    assert_eq!(runs.len(), 3);
+    assert_eq!(runs[0]["expect"]["met"], false);
+    assert_eq!(runs[0]["expect"]["mismatches"][0]["key"], "airbag_fires");
+    assert!(runs[1]["error"]
+        .as_str()
+        .is_some_and(|e| e.contains("peak_g")));
+    assert_eq!(runs[2]["expect"]["met"], true);
+    // --no-expect runs the same files without judging them: only the bad file fails.
+    let (code, _, _, json) = offline_bench(std::slice::from_ref(&wrong), &["--no-expect"]);
+    assert_eq!(code, 0);
+    assert!(json[0]["expect"].is_null());
+    let (code, ..) = offline_bench(&[good], &[]);
+    assert_eq!(code, 0);
+    for f in [&wrong, &broken] {
+        let _ = std::fs::remove_dir_all(f.parent().expect("dir"));
+    }
+}
+
+/// The keys tests/README.md documents for `offline-bench --json` ("offline-bench JSON"): the
+/// top-level keys, and the members of the `{…}` each of `nested`'s rows lists.
+fn documented_json_keys(nested: &[&str]) -> (Vec<String>, Vec<(String, Vec<String>)>) {
+    let readme = std::fs::read_to_string(root().join("tests/README.md")).expect("README");
+    let section = readme
+        .split("### offline-bench JSON")
+        .nth(1)
+        .and_then(|s| s.split("\n#").next())
+        .expect("the JSON section");
+    let mut top = Vec::new();
+    let mut inner = Vec::new();
+    for row in section.lines().filter(|l| l.starts_with("| `")) {
+        let key = row.split('`').nth(1).expect("key").to_owned();
+        if nested.contains(&key.as_str()) {
+            let meaning = row.rsplit(" | ").next().expect("meaning");
+            let members = meaning
+                .split_once('{')
+                .and_then(|(_, rest)| rest.split_once('}'))
+                .map(|(m, _)| m.split(", ").map(|k| k.trim().to_owned()).collect())
+                .expect("members");
+            inner.push((key.clone(), members));
+        }
+        top.push(key);
+    }
+    (top, inner)
+}
+
+#[test]
+fn offline_bench_json_is_what_tests_readme_documents_on_one_time_base() {
+    // Issue 32 item 3: one time base (ms after the scenario start, ms after the contact beside
+    // it), typed fields, the schema next to the tools — checked both ways.
+    let nested = ["crash_mode", "modes", "faults", "actions"];
+    let (top, inner) = documented_json_keys(&nested);
+    let files = [
+        root().join("scenarios/taurus-48-48-abs.toml"),
+        root().join("scenarios/avoided-last-moment.toml"),
+        root().join("scenarios/misuse-pothole.toml"),
+    ];
+    let (code, _, stderr, json) = offline_bench(&files, &[]);
+    assert_eq!(code, 0, "{stderr}");
+    let keys = |v: &serde_json::Value| -> Vec<String> {
+        let mut k: Vec<String> = v.as_object().expect("object").keys().cloned().collect();
+        k.sort();
+        k
+    };
+    let sorted = |mut v: Vec<String>| {
+        v.sort();
+        v
+    };
+    for run in json.as_array().expect("array") {
+        assert_eq!(keys(run), sorted(top.clone()), "{}", run["scenario"]);
+        for (key, members) in &inner {
+            let items: Vec<&serde_json::Value> = match &run[key.as_str()] {
+                serde_json::Value::Array(a) => a.iter().collect(),
+                serde_json::Value::Null => Vec::new(),
+                v => vec![v],
+            };
+            for item in items {
+                assert_eq!(
+                    keys(item),
+                    sorted(members.clone()),
+                    "{key} of {}",
+                    run["scenario"]
+                );
+            }
+        }
+        let contact_ms = run["contact_ms"].as_f64();
+        let mut times = Vec::new();
+        for key in nested {
+            match &run[key] {
+                serde_json::Value::Array(a) => times.extend(a.iter().cloned()),
+                serde_json::Value::Null => {}
+                v => times.push(v.clone()),
+            }
+        }
+        for t in times {
+            let t_ms = t["t_ms"].as_f64().expect("t_ms");
+            match contact_ms {
+                Some(c) => {
+                    let after = t["after_contact_ms"].as_f64().expect("after_contact_ms");
+                    assert!((t_ms - c - after).abs() < 1e-6, "{t}");
+                }
+                None => assert!(t["after_contact_ms"].is_null(), "{t}"),
+            }
+            assert!(t_ms >= 0.0, "{t}");
+        }
+    }
+    // The crash run: confirmed by a typed path, its airbag in the table and the JSON alike.
+    let crash = &json[0];
+    assert!(
+        crash["confirmed_by"]["path"].is_string(),
+        "{}",
+        crash["confirmed_by"]
+    );
+    assert!(crash["crash_mode"]["after_contact_ms"].as_f64().is_some());
+}
+
+#[test]
+fn the_table_shows_every_restraint_action_and_says_when_there_is_no_contact() {
+    // Issue 32 item 2: a run without contact that fires shows it (the rough road's
+    // pretensioner was hidden behind "no fire … no contact"): the action lines carry each
+    // restraint, its kind, source and time, and say "no contact" instead of a contact time.
+    let fired = edited(
+        "misuse-pothole",
+        "fired",
+        "peak_g = 10.0\nduration_ms = 8.0",
+        "peak_g = 25.0\nduration_ms = 80.0",
+    );
+    let (_, stdout, ..) = offline_bench(std::slice::from_ref(&fired), &["--no-expect"]);
+    let _ = std::fs::remove_dir_all(fired.parent().expect("dir"));
+    assert!(stdout.contains("FIRED, no contact"), "{stdout}");
+    assert!(
+        stdout.contains("pretensioner fired (pyrotechnic)") && stdout.contains("airbag fired"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("ms after the start, no contact"),
+        "{stdout}"
+    );
+    let (_, stdout, ..) = offline_bench(&[root().join("scenarios/taurus-48-48-abs.toml")], &[]);
+    assert!(
+        stdout.contains("pretensioner fired (reversible, pre-crash)")
+            && stdout.contains("ms after contact"),
+        "{stdout}"
+    );
 }

@@ -84,3 +84,33 @@ fn paper_cases_meet_at_their_published_speeds() {
         "below the 20 km/h no-fire limit: {e} {o}"
     );
 }
+
+#[test]
+fn the_docs_count_and_list_every_library_file() {
+    // Issue 32: the README said 25 files when there were 33, and scenarios/README's library
+    // table lacked 9. Every file has a row (its name in backticks) and the count is right.
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let table = std::fs::read_to_string(root.join("scenarios/README.md")).expect("README");
+    let table = table
+        .split("## Library")
+        .nth(1)
+        .expect("the library section");
+    let files = library();
+    let missing: Vec<String> = files
+        .iter()
+        .filter_map(|f| f.file_stem().and_then(|x| x.to_str()))
+        .filter(|n| !table.contains(&format!("`{n}`")))
+        .map(str::to_owned)
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "not in scenarios/README.md's library table: {missing:?}"
+    );
+    let readme = std::fs::read_to_string(root.join("README.md")).expect("README");
+    let said = format!("The whole scenario library ({} files", files.len());
+    assert!(
+        readme.contains(&said),
+        "README.md should say \"{said}\" (the library has {} files)",
+        files.len()
+    );
+}

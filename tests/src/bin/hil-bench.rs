@@ -1,6 +1,9 @@
 //! `hil-bench --scenario FILE [--scenario FILE …] [--out DIR]`: runs scenarios through the real
 //! bench processes on a CAN interface that must already exist (run it through
 //! `./vcan-setup.sh --run -- target/release/hil-bench …`). One guest boot, many scenarios.
+//! Every scenario's `[expect]` keys are judged (`e2e_tests::expect`, as `offline-bench` does;
+//! `--no-expect` skips it): a miss is printed (`hil-bench: MISSED <scenario>: [expect] <key> =
+//! <expected>, measured <value>`) and the exit status is 1.
 
 use anyhow::Result;
 use clap::Parser;
@@ -33,6 +36,10 @@ struct Cli {
     /// Print only the one-line verdicts, not the full summaries.
     #[arg(long)]
     brief: bool,
+    /// Do not judge the scenarios' `[expect]` blocks (by default every key is asserted, with
+    /// the judge `offline-bench` uses, and a miss exits 1).
+    #[arg(long)]
+    no_expect: bool,
 }
 
 fn main() -> std::process::ExitCode {
@@ -134,6 +141,20 @@ fn run() -> Result<bool> {
         };
         match run_until_measured(&cfg) {
             Ok((r, retries)) => {
+                let missed = if cli.no_expect {
+                    Vec::new()
+                } else {
+                    match sensor_feeds::Scenario::load(scenario) {
+                        Ok(s) => e2e_tests::expect::check(
+                            &s,
+                            &e2e_tests::expect::Observed::bench(&r.report),
+                        )
+                        .iter()
+                        .map(ToString::to_string)
+                        .collect(),
+                        Err(e) => vec![format!("{e}")],
+                    }
+                };
                 if cli.brief {
                     let verdict = r
                         .report
@@ -171,7 +192,10 @@ fn run() -> Result<bool> {
                 } else {
                     println!("{}", r.summary);
                 }
-                all_ok &= r.problems.is_empty();
+                for m in &missed {
+                    println!("hil-bench: MISSED {m}");
+                }
+                all_ok &= r.problems.is_empty() && missed.is_empty();
             }
             Err(e) => {
                 eprintln!("hil-bench: {}: {e:#}", scenario.display());

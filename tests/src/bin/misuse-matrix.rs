@@ -33,7 +33,10 @@ struct Cli {
     /// Seed of the variant parameters.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Only these families (repeatable).
+    /// Print the families — name, requirement, what each samples — and exit.
+    #[arg(long)]
+    list: bool,
+    /// Only these families (repeatable; `--list` names them).
     #[arg(long = "family")]
     families: Vec<String>,
     /// Repository root (default: where this crate was built).
@@ -42,7 +45,7 @@ struct Cli {
     /// Also write the table and every failing variant as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
-    /// No progress bar.
+    /// The table only: no progress bar, no failing scenarios on stderr (their count stays).
     #[arg(long)]
     quiet: bool,
     /// The suite's gate: families that do not hold yet (`e2e_tests::misuse::OPEN`) are
@@ -299,8 +302,31 @@ fn run_variant(cfg: &OfflineConfig, text: &str) -> Result<Outcome> {
     })
 }
 
+/// `--list`: every family with its requirement and what it samples.
+fn list() {
+    let width = misuse::FAMILIES
+        .iter()
+        .map(|f| f.name.len())
+        .max()
+        .unwrap_or(0);
+    println!("{:<width$}  {:<11}  what its variants sample (× 1.5 = the matrix's margin over each physical bound)", "family", "requirement");
+    for f in misuse::FAMILIES {
+        println!(
+            "{:<width$}  {:<11}  {}",
+            f.name,
+            f.requirement.label(),
+            f.envelope
+        );
+    }
+    println!("requirements: no fire = no airbag and no pyrotechnic pretensioner (a reversible pre-crash one must be released), and a crash phase that fired nothing ends; no airbag = the belt may act; must fire = the airbag fires, its time against \"127 mm − 30 ms\" reported; report only = printed, not judged");
+}
+
 fn main() -> Result<()> {
     let cli = Cli::parse();
+    if cli.list {
+        list();
+        return Ok(());
+    }
     let repo = cli
         .repo
         .clone()
@@ -531,17 +557,22 @@ fn main() -> Result<()> {
         .with_context(|| format!("writing {}", path.display()))?;
     }
     if !failures.is_empty() {
-        for f in failures.iter().take(20) {
-            // --quiet: the first line of each (family, variant, what); the whole scenario
-            // is in --json.
-            let f = if cli.quiet {
-                f.lines().next().unwrap_or("")
-            } else {
-                f
-            };
-            eprintln!("misuse-matrix: FAIL {f}");
+        // --quiet: the table and this count only; every failing variant's scenario is in
+        // --json. Otherwise the first 20 in full.
+        if !cli.quiet {
+            for f in failures.iter().take(20) {
+                eprintln!("misuse-matrix: FAIL {f}");
+            }
         }
-        eprintln!("misuse-matrix: {} failing variants", failures.len());
+        eprintln!(
+            "misuse-matrix: {} failing variants{}",
+            failures.len(),
+            if cli.json.is_some() {
+                ""
+            } else {
+                " (--json FILE writes each one's scenario)"
+            }
+        );
         std::process::exit(1);
     }
     Ok(())

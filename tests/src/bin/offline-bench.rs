@@ -1,18 +1,25 @@
-//! `offline-bench [--scenario FILE …] [--no-lut] [--json FILE] [--cycle-config FILE]`: runs scenarios through the
-//! restraint core under a simulated clock with the real sensor model and the actuator stubs'
-//! judge (`e2e_tests::offline`), and prints the outcome table. No vcan, no processes, no
-//! emulator: deterministic, ≈ 50 ms per scenario. Default: the whole library (`scenarios/`).
+//! `offline-bench [--scenario FILE …] [--no-lut] [--json FILE] [--cycle-config FILE] [--plot DIR]
+//! [--no-expect]`: runs scenarios through the restraint core under a simulated clock with the
+//! real sensor model and the actuator stubs' judge (`e2e_tests::offline`), prints the outcome
+//! table (one line per run, one indented line per restraint action) and judges every
+//! `[expect]` key of every file (`e2e_tests::expect`, the judge `hil-bench` uses too). No vcan,
+//! no processes, no emulator: deterministic, ≈ 50 ms per scenario. Default: the whole library
+//! (`scenarios/`).
 //!
-//! Time bases of `--json` (one array, an object per scenario): `actions[].t_ns` is the ECU's
-//! simulated clock, which starts at 1 s (scenario time + 1 s, so that no time stamp is 0);
-//! `actions[].t_ms` is the same instant in ms after the scenario start; `modes`, `faults` and
-//! `crash_mode_ms` are ms after the true contact (`contact_s`, s after the start), or after
-//! the scenario start when there is no contact. `severity_excess_mps`: the largest crash −
-//! safing sensor Δv over a confirmed event (restraint's severity agreement; `null`: none judged).
+//! Exit status: 0 when every file ran and met its expectations; 1 when a run missed an
+//! expectation or a file did not load or run (each is reported, the others still run);
+//! 2 on a usage or set-up error (table, reference restraint, `--cycle-config`, `--plot`).
+//!
+//! `--json` writes one array, an object per file; its schema is in tests/README.md
+//! ("offline-bench JSON"), checked by `tests/tests/offline.rs`.
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use e2e_tests::offline::{run_traced, table_row, OfflineConfig, Trace, START_NS, TABLE_HEADER};
+use e2e_tests::expect::{check, Observed};
+use e2e_tests::offline::{
+    run_json, run_traced, table_header, table_row, OfflineConfig, Trace, NAME_WIDTH,
+};
+use std::io::Write as _;
 use std::path::PathBuf;
 
 /// Scenario library through the ECU core, offline.
@@ -28,7 +35,8 @@ struct Cli {
     /// Repository root (default: where this crate was built).
     #[arg(long)]
     repo: Option<PathBuf>,
-    /// Also write every run's modes, faults, actions and outcome as JSON.
+    /// Also write every run's modes, faults, actions, outcome and expectations as JSON
+    /// (schema: tests/README.md, "offline-bench JSON").
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
     /// A TOML file of `[cycle]` keys (as in ecu.toml's `[cycle]`, without the header) that
@@ -39,9 +47,25 @@ struct Cli {
     /// boundaries and floors, the ECU's mode and every restraint action (created if missing).
     #[arg(long, value_name = "DIR")]
     plot: Option<PathBuf>,
+    /// Do not judge the files' `[expect]` blocks (by default every key is asserted and a miss
+    /// exits 1).
+    #[arg(long)]
+    no_expect: bool,
 }
 
-fn main() -> Result<()> {
+fn main() -> std::process::ExitCode {
+    match run_all() {
+        Ok(true) => std::process::ExitCode::SUCCESS,
+        Ok(false) => std::process::ExitCode::from(1),
+        Err(e) => {
+            eprintln!("offline-bench: error: {e:#}");
+            std::process::ExitCode::from(2)
+        }
+    }
+}
+
+/// Runs every file; `Ok(false)` when a file failed or missed an expectation.
+fn run_all() -> Result<bool> {
     let cli = Cli::parse();
     let repo = cli.repo.clone().unwrap_or_else(e2e_tests::repo_root);
     let mut files = cli.scenario.clone();
@@ -64,48 +88,70 @@ fn main() -> Result<()> {
     if let Some(dir) = &cli.plot {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    println!("{TABLE_HEADER}");
-    let mut json = Vec::new();
-    for f in &files {
-        let s = sensor_feeds::Scenario::load(f).map_err(|e| anyhow::anyhow!("{e}"))?;
+    // Load every file first: the table's name column fits the longest name.
+    let loaded: Vec<_> = files
+        .iter()
+        .map(|f| (f, sensor_feeds::Scenario::load(f)))
+        .collect();
+    let width = loaded
+        .iter()
+        .filter_map(|(_, s)| s.as_ref().ok().map(|s| s.name.chars().count()))
+        .fold(NAME_WIDTH, usize::max);
+    let mut out = std::io::stdout().lock();
+    // A closed pipe (`| head`) ends the table quietly instead of a panic.
+    let mut say = |line: &str| writeln!(out, "{line}").is_ok();
+    say(&table_header(width));
+    let (mut json, mut failed, mut missed) = (Vec::new(), 0usize, Vec::new());
+    for (file, loaded) in loaded {
+        let file_name = file.display().to_string();
+        let s = match loaded {
+            Ok(s) => s,
+            Err(e) => {
+                eprintln!("offline-bench: {e}");
+                json.push(serde_json::json!({ "file": file_name, "error": e.to_string() }));
+                failed += 1;
+                continue;
+            }
+        };
         let mut trace = Trace::default();
-        let r = run_traced(&s, &cfg, cli.plot.is_some().then_some(&mut trace))?;
+        let r = match run_traced(&s, &cfg, cli.plot.is_some().then_some(&mut trace)) {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("offline-bench: {file_name}: {e:#}");
+                json.push(serde_json::json!({
+                    "file": file_name, "scenario": s.name, "error": format!("{e:#}")
+                }));
+                failed += 1;
+                continue;
+            }
+        };
         if let Some(dir) = &cli.plot {
             e2e_tests::offline_plot::draw(&dir.join(format!("{}.png", r.name)), &r, &trace)
                 .map_err(anyhow::Error::msg)?;
         }
-        println!("{}", table_row(&r));
-        json.push(serde_json::json!({
-            "scenario": r.name,
-            "contact_s": r.contact_s,
-            "crash_mode_ms": r.crash_mode_ms,
-            "confirmed_by": r.confirmed_by,
-            "severity_excess_mps": r.severity_excess_mps,
-            "modes": r.modes,
-            "faults": r.faults,
-            "actions": actions_json(&r.modules.actions)?,
-            "outcome": r.evaluated.as_ref().map(|e| &e.outcome),
-        }));
+        let mismatches = (!cli.no_expect).then(|| check(&s, &Observed::offline(&r)));
+        if !say(&table_row(&r, width)) {
+            return Ok(true);
+        }
+        if let Some(m) = &mismatches {
+            missed.extend(m.iter().map(ToString::to_string));
+        }
+        json.push(run_json(&r, file, mismatches.as_deref()));
     }
-    println!("(! = bottomed out; confirm = first ECU cycle in mode crash; airbag = ms after the true contact, plan = its FireTime; times on the simulated 1 kHz grid, no CAN latency)");
+    say("(! = bottomed out; confirm = first ECU cycle in mode crash; airbag = ms after the true contact, plan = its FireTime; action lines: ms after the true contact, or after the start without one; times on the simulated 1 kHz grid, no CAN latency)");
     if let Some(p) = &cli.json {
         std::fs::write(p, serde_json::to_string_pretty(&json)?)
             .with_context(|| format!("writing {}", p.display()))?;
     }
-    Ok(())
-}
-
-/// The actions as recorded, each with `t_ms` (ms after the scenario start) added.
-fn actions_json<T: serde::Serialize>(actions: &[T]) -> Result<Vec<serde_json::Value>> {
-    actions
-        .iter()
-        .map(|a| {
-            let mut v = serde_json::to_value(a)?;
-            if let Some(t_ns) = v.get("t_ns").and_then(serde_json::Value::as_u64) {
-                let t_ms = t_ns.saturating_sub(START_NS) as f64 * 1e-6;
-                v["t_ms"] = serde_json::json!(t_ms);
-            }
-            Ok(v)
-        })
-        .collect()
+    for m in &missed {
+        eprintln!("offline-bench: {m}");
+    }
+    if failed + missed.len() > 0 {
+        eprintln!(
+            "offline-bench: FAIL: {failed} of {} files did not run, {} expectations missed",
+            files.len(),
+            missed.len()
+        );
+    }
+    Ok(failed == 0 && missed.is_empty())
 }

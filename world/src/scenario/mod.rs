@@ -735,6 +735,92 @@ mass_kg = 75
     }
 
     #[test]
+    fn a_mass_bias_beside_a_reported_mass_is_an_error_that_names_the_winner() {
+        // Issue 32 item 4: `mass_estimate_kg` is the reported mass as given; a bias beside it
+        // was silently ignored.
+        let text = format!("{OK}\n[sensor]\nmass_estimate_kg = 3000\nmass_bias_kg = 500\n");
+        let e = Scenario::parse("x.toml", &text).unwrap_err();
+        assert_eq!(e.field.as_deref(), Some("sensor.mass_bias_kg"), "{e}");
+        assert!(e.message.contains("mass_estimate_kg"), "{e}");
+        assert!(e.line.is_some(), "{e}");
+        let text = format!("{OK}\n[sensor]\nmass_estimate_kg = 3000\nmass_bias_kg = 0\n");
+        Scenario::parse("x.toml", &text).expect("a zero bias changes nothing");
+    }
+
+    /// Every key serde accepts in each table (from its own `deny_unknown_fields` message)
+    /// is documented in scenarios/README.md: the docs are tested against the schema.
+    #[test]
+    fn scenarios_readme_documents_every_key_the_schema_accepts() {
+        let readme = std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/README.md"),
+        )
+        .expect("scenarios/README.md");
+        let schema = readme
+            .split("## Schema")
+            .nth(1)
+            .and_then(|s| s.split("\n## ").next())
+            .expect("the schema section");
+        // A document with one unknown key in `table`: serde lists the keys it knows.
+        let known = |table: &str, prefix: &str| -> Vec<String> {
+            let text = format!("{prefix}{table}bogus_key = 1\n");
+            let msg = match toml::from_str::<Scenario>(&text) {
+                Err(e) => e.message().to_owned(),
+                Ok(_) => panic!("{table}: bogus key accepted"),
+            };
+            let list = msg
+                .split("expected one of ")
+                .nth(1)
+                .or_else(|| msg.split("expected ").nth(1))
+                .unwrap_or_else(|| panic!("{table}: {msg}"));
+            list.split('`')
+                .skip(1)
+                .step_by(2)
+                .map(str::to_owned)
+                .collect()
+        };
+        let top = "name = \"x\"\nduration_s = 1\n";
+        let full = format!(
+            "{top}[ego]\nmass_kg = 1785\nspeed_kph = 50\n[opponent]\nkind = \"barrier\"\n\
+             initial_distance_m = 9\n[occupant]\nmass_kg = 75\n"
+        );
+        let tables = [
+            ("", String::new()),
+            ("[ego]\n", top.to_owned()),
+            (
+                "[ego.braking]\nstart_s = 0\ndecel_mps2 = 1\n",
+                top.to_owned(),
+            ),
+            ("[opponent]\n", top.to_owned()),
+            ("[sensor]\n", full.clone()),
+            ("[occupant]\n", top.to_owned()),
+            ("[expect]\n", full.clone()),
+            (
+                "[[accel_event]]\nkind = \"spike\"\nstart_s = 0\n",
+                full.clone(),
+            ),
+        ];
+        let mut missing = Vec::new();
+        for (table, prefix) in &tables {
+            let keys = known(table, prefix);
+            assert!(keys.len() > 2, "{table}: {keys:?}");
+            for k in keys {
+                // A key in backticks; a table as its header (`[ego]`, `[[accel_event]]`,
+                // `[ego.braking]`).
+                let documented = [format!("`{k}`"), format!("[{k}]"), format!(".{k}]")]
+                    .iter()
+                    .any(|form| schema.contains(form.as_str()));
+                if !documented {
+                    missing.push(format!("{}{k}", table.lines().next().unwrap_or("")));
+                }
+            }
+        }
+        assert!(
+            missing.is_empty(),
+            "keys not in scenarios/README.md: {missing:?}"
+        );
+    }
+
+    #[test]
     fn freeze_windows() {
         let text = format!("{OK}\n[sensor]\nfreezes = [{{ start_s = 0.6, end_s = 0.9 }}]\n");
         let s = Scenario::parse("x.toml", &text).expect("valid");
