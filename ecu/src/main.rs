@@ -21,14 +21,27 @@ fn main() -> std::process::ExitCode {
     }
 }
 
-/// The LUT, or `None` with a clear message: the ECU then runs DEGRADED on the reference
-/// restraint instead of refusing to start (never "no protection").
-fn load_lut(cfg: &EcuConfig) -> Option<diagram::Diagram> {
-    match diagram::Diagram::load_any(&cfg.cycle.lut) {
+/// The LUT, or `None` with a clear message: a table that is there but corrupt leaves the ECU
+/// DEGRADED on the reference restraint (never "no protection"); one that is not there at all is
+/// a set-up mistake and the ECU does not start, unless the user asked for `--no-lut`.
+fn load_lut(cfg: &EcuConfig, no_lut: bool) -> anyhow::Result<Option<diagram::Diagram>> {
+    if no_lut {
+        eprintln!("ecu: lut          none (--no-lut): running DEGRADED on the reference restraint");
+        return Ok(None);
+    }
+    let path = &cfg.cycle.lut;
+    if !path.exists() {
+        anyhow::bail!(
+            "characteristic diagram {} not found (build one with `lut build`, pass --lut FILE, \
+             or --no-lut to run DEGRADED on the reference restraint)",
+            path.display()
+        );
+    }
+    Ok(match diagram::Diagram::load_any(path) {
         Ok(d) => {
             eprintln!(
                 "ecu: lut          {} (id {:#06x}, ego {} kg class {})",
-                cfg.cycle.lut.display(),
+                path.display(),
                 d.lut_id(),
                 d.header().ego.mass_kg,
                 d.header().ego.class
@@ -42,29 +55,30 @@ fn load_lut(cfg: &EcuConfig) -> Option<diagram::Diagram> {
             );
             None
         }
-    }
+    })
 }
 
-/// The SecOC sender, or `None` with a clear message: the ECU then starts without
-/// authenticator frames and reports `FaultConfig` (see `CycleConfig::secoc_keys`) rather than
-/// refusing to start — its commands still go out, the bench sees why the actuators ignore them.
-fn load_secoc(cfg: &EcuConfig) -> Option<bus::secoc::SecOcTx> {
-    match bus::secoc::SecOcKeys::load(&cfg.cycle.secoc_keys) {
-        Ok(keys) => {
-            eprintln!("ecu: secoc keys   {}", cfg.cycle.secoc_keys.display());
-            // Freshness = CLOCK_REALTIME µs per cycle (CycleInfo::sync_time_us): nothing to
-            // agree on with the actuators, nothing to persist across restarts.
-            Some(keys.tx())
-        }
-        Err(e) => {
-            eprintln!(
-                "ecu: error: SecOC keys unusable: {e} — commands are sent WITHOUT \
-                 authenticators (authenticated actuators will ignore them), EcuStatus.FaultConfig \
-                 set (pass --secoc-keys FILE)"
-            );
-            None
-        }
+/// The SecOC sender. Fail closed (issue 22): without usable keys the ECU's fire commands would
+/// go out unauthenticated, so it does not start unless the user asked for that with
+/// `--no-secoc` (then `EcuStatus.FaultConfig` is set and the start-up line says so).
+fn load_secoc(cfg: &EcuConfig, no_secoc: bool) -> anyhow::Result<Option<bus::secoc::SecOcTx>> {
+    if no_secoc {
+        eprintln!(
+            "ecu: secoc keys   none (--no-secoc): commands WITHOUT authenticators, \
+             EcuStatus.FaultConfig set"
+        );
+        return Ok(None);
     }
+    let keys = bus::secoc::SecOcKeys::load(&cfg.cycle.secoc_keys).map_err(|e| {
+        anyhow::anyhow!(
+            "SecOC keys unusable: {e} (pass --secoc-keys FILE, or --no-secoc to send commands \
+             without authenticators)"
+        )
+    })?;
+    eprintln!("ecu: secoc keys   {}", cfg.cycle.secoc_keys.display());
+    // Freshness = CLOCK_REALTIME µs per cycle (CycleInfo::sync_time_us): nothing to agree on
+    // with the actuators, nothing to persist across restarts.
+    Ok(Some(keys.tx()))
 }
 
 fn load_reference(cfg: &EcuConfig) -> anyhow::Result<ReferenceRestraint> {
@@ -79,13 +93,24 @@ fn load_reference(cfg: &EcuConfig) -> anyhow::Result<ReferenceRestraint> {
 
 fn run(cli: &Cli) -> anyhow::Result<()> {
     let layers = Layers::new(cli.run.config.as_deref(), cli.run.clone())?;
-    let cfg = layers.extract()?;
+    let mut cfg = layers.extract()?;
+    layers.resolve_files(&mut cfg);
     if cli.run.show_config {
         print!("{}", layers.show(&cfg));
         return Ok(());
     }
+    // Every output path is checked before the run, not at its end.
+    if let Some(path) = &cfg.report_json {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(path)
+            .map_err(|e| anyhow::anyhow!("--report-json {}: {e}", path.display()))?;
+    }
+    let secoc = load_secoc(&cfg, cli.run.no_secoc)?;
+    let lut = load_lut(&cfg, cli.run.no_lut)?;
     let stop = host::install_stop_signals()?;
-    let lut = load_lut(&cfg);
     let reference = load_reference(&cfg)?;
     let (mut activity, notes) = RestraintCycle::new(
         cfg.cycle.decision.clone(),
@@ -96,7 +121,7 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
     if let Some(m) = notes.lut_rejected {
         eprintln!("ecu: warning: {m}");
     }
-    activity.set_secoc(load_secoc(&cfg));
+    activity.set_secoc(secoc);
     // SocketCAN with the kernel input filter when CAN is on and the interface exists; the
     // shell's CAN decision reports a missing interface (and `--no-can` switches CAN off).
     let can: Option<Box<dyn CanPort>> = if cfg.can.enabled

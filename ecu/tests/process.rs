@@ -265,3 +265,113 @@ fn sigterm_stops_cleanly_with_report() {
     assert!(stdout.contains("stopped by signal"), "{stdout}");
     assert!(stdout.contains("p99.9"), "{stdout}");
 }
+
+/// `ecu --no-can --cycles 3` with `args`, run in `cwd`: (success, stderr).
+fn short_run(cwd: &std::path::Path, tag: &str, args: &[&str]) -> (bool, String) {
+    let pfx = prefix(tag);
+    let out = Command::new(ECU)
+        .current_dir(cwd)
+        .args(["--no-can", "--cycles", "3", "--quiet"])
+        .args([
+            "--service-prefix",
+            &pfx,
+            "--node-name",
+            &format!("{pfx}-ecu"),
+        ])
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn started_from_another_folder_the_ecu_finds_its_table_and_keys() {
+    // Issue 22 item 1: from any folder but the repository's root it ran DEGRADED and sent its
+    // commands without authenticators, exit 0. The defaults now resolve against the
+    // repository, found by walking up from the executable.
+    let (ok, err) = short_run(&tmpdir("elsewhere"), "elsewhere", &[]);
+    assert!(ok, "{err}");
+    assert!(!err.contains("error"), "{err}");
+    let repo = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let lut = repo.join("data/default.lut").canonicalize().unwrap();
+    let keys = repo
+        .join("data/secoc-keys.example.toml")
+        .canonicalize()
+        .unwrap();
+    let named = |p: &std::path::Path| {
+        err.lines().any(|l| {
+            l.split_whitespace()
+                .any(|w| PathBuf::from(w).canonicalize().ok().as_deref() == Some(p))
+        })
+    };
+    assert!(named(&lut), "{err}");
+    assert!(named(&keys), "{err}");
+}
+
+#[test]
+fn missing_keys_or_table_stop_the_ecu_unless_it_is_asked_to_run_without_them() {
+    // Fail closed (issue 22): one clear line naming the file and the flag; exit != 0.
+    let here = tmpdir("failclosed");
+    let (ok, err) = short_run(&here, "nokeys", &["--secoc-keys", "/nonexistent/keys.toml"]);
+    assert!(!ok, "started without keys: {err}");
+    assert!(
+        err.contains("/nonexistent/keys.toml") && err.contains("--no-secoc"),
+        "{err}"
+    );
+    let (ok, err) = short_run(&here, "nolut", &["--lut", "missing.lut"]);
+    assert!(!ok, "started without its table: {err}");
+    assert!(
+        err.contains("missing.lut") && err.contains("--no-lut"),
+        "{err}"
+    );
+    // Asked for explicitly: it runs, and says so.
+    let (ok, err) = short_run(&here, "asked", &["--no-secoc", "--no-lut"]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("--no-secoc") && err.contains("--no-lut"),
+        "{err}"
+    );
+    // A table that is there but corrupt leaves the ECU DEGRADED on the reference restraint
+    // (never no protection; the fault campaign's lut-corrupt case runs it on the bench).
+    let corrupt = here.join("corrupt.lut");
+    std::fs::write(&corrupt, b"not a table").unwrap();
+    let (ok, err) = short_run(&here, "corrupt", &["--lut", corrupt.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(err.contains("DEGRADED"), "{err}");
+}
+
+#[test]
+fn an_output_path_is_checked_before_the_run_and_config_paths_follow_their_file() {
+    let here = tmpdir("paths");
+    let (ok, err) = short_run(
+        &here,
+        "badout",
+        &["--report-json", "/nonexistent/dir/r.json"],
+    );
+    assert!(!ok, "{err}");
+    assert!(err.contains("/nonexistent/dir/r.json"), "{err}");
+    assert!(!err.contains("cycles run"), "it ran first: {err}");
+    // `secoc_keys = "keys.toml"` in a config file means the file beside it, from any folder.
+    let repo = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let conf_dir = tmpdir("conf");
+    std::fs::copy(
+        repo.join("data/secoc-keys.example.toml"),
+        conf_dir.join("keys.toml"),
+    )
+    .unwrap();
+    std::fs::write(
+        conf_dir.join("ecu.toml"),
+        "[cycle]\nsecoc_keys = \"keys.toml\"\n",
+    )
+    .unwrap();
+    let conf = conf_dir.join("ecu.toml");
+    let (ok, err) = short_run(&here, "conf", &["--config", conf.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains(&conf_dir.join("keys.toml").display().to_string()),
+        "{err}"
+    );
+}

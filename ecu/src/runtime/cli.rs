@@ -108,18 +108,27 @@ pub struct RunArgs {
     /// Do not print the start-up summary.
     #[arg(long)]
     pub quiet: bool,
-    /// Characteristic diagram (default data/default.lut). Missing or corrupt: the ECU says
+    /// Characteristic diagram (default: the repository's data/default.lut, found from any
+    /// folder). Not found: the ECU does not start (unless --no-lut); found but corrupt: it says
     /// why and runs DEGRADED on the reference restraint.
-    #[arg(long, value_name = "FILE")]
+    #[arg(long, value_name = "FILE", conflicts_with = "no_lut")]
     pub lut: Option<PathBuf>,
-    /// Reference-restraint file (default data/reference-restraint.toml; missing or corrupt:
-    /// the copy built into the binary).
+    /// Run without a characteristic diagram: DEGRADED on the reference restraint, on purpose.
+    #[arg(long)]
+    pub no_lut: bool,
+    /// Reference-restraint file (default: the repository's data/reference-restraint.toml;
+    /// missing or corrupt: the copy built into the binary).
     #[arg(long, value_name = "FILE")]
     pub reference: Option<PathBuf>,
-    /// SecOC key file (default data/secoc-keys.example.toml; missing or corrupt: the ECU
-    /// starts without authenticator frames and reports FaultConfig).
-    #[arg(long, value_name = "FILE")]
+    /// SecOC key file (default: the repository's data/secoc-keys.example.toml). Missing or
+    /// unusable: the ECU does not start — its fire commands would go out unauthenticated —
+    /// unless --no-secoc.
+    #[arg(long, value_name = "FILE", conflicts_with = "no_secoc")]
     pub secoc_keys: Option<PathBuf>,
+    /// Send commands without SecOC authenticators, on purpose (authenticated actuators ignore
+    /// them; EcuStatus.FaultConfig is set and the start-up line says so).
+    #[arg(long)]
+    pub no_secoc: bool,
 }
 
 impl RunArgs {

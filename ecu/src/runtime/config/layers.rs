@@ -72,6 +72,48 @@ impl Layers {
         Ok(cfg)
     }
 
+    /// Relative file paths resolved as the user meant them (issue 22: the ECU started from
+    /// another folder ran without its table and keys): a path from the `--config` file is
+    /// relative to that file's folder (or the nearest folder above it that holds it); a default (`data/default.lut`, …) to the repository the
+    /// ECU belongs to — the first folder holding it, walking up from the current directory,
+    /// then from the executable's; a flag or environment value to the current directory, as
+    /// typed.
+    pub fn resolve_files(&self, cfg: &mut EcuConfig) {
+        let file_dir = self
+            .file
+            .as_ref()
+            .and_then(|(p, _)| p.parent().map(Path::to_path_buf));
+        let c = &mut cfg.cycle;
+        for (key, path) in [
+            ("cycle.lut", &mut c.lut),
+            ("cycle.reference", &mut c.reference),
+            ("cycle.secoc_keys", &mut c.secoc_keys),
+        ] {
+            if path.is_absolute() {
+                continue;
+            }
+            let metadata = self.figment.find_metadata(key);
+            let from_file = metadata.is_some_and(|m| matches!(m.source, Some(Source::File(_))));
+            let from_user = metadata
+                .is_some_and(|m| m.name == COMMAND_LINE || m.name.contains("environment variable"));
+            if from_file {
+                if let Some(dir) = &file_dir {
+                    // Beside the file, or the nearest folder above it that holds it
+                    // (`ecu/ecu.toml`'s `data/default.lut` is the repository's).
+                    *path = dir
+                        .ancestors()
+                        .map(|a| a.join(&*path))
+                        .find(|p| p.exists())
+                        .unwrap_or_else(|| dir.join(&*path));
+                }
+            } else if !from_user {
+                if let Some(found) = find_upwards(path) {
+                    *path = found;
+                }
+            }
+        }
+    }
+
     /// Where the value of the dotted `key` came from.
     pub fn origin(&self, key: &str) -> String {
         let Some(metadata) = self.figment.find_metadata(key) else {
@@ -156,6 +198,21 @@ fn unset_keys(v: &serde_json::Value, table: &str, out: &mut Vec<(String, String)
             _ => {}
         }
     }
+}
+
+/// `rel` under the first folder that holds it, walking up from the current directory, then
+/// from the executable's folder (`target/release/ecu` finds the repository's `data/`).
+fn find_upwards(rel: &Path) -> Option<PathBuf> {
+    let starts = [
+        std::env::current_dir().ok(),
+        std::env::current_exe()
+            .ok()
+            .and_then(|e| e.parent().map(Path::to_path_buf)),
+    ];
+    starts
+        .into_iter()
+        .flatten()
+        .find_map(|start| start.ancestors().map(|a| a.join(rel)).find(|p| p.exists()))
 }
 
 /// `environment variable ECU_RT__CPU` for `rt.cpu`.

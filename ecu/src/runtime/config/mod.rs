@@ -39,17 +39,19 @@ pub struct EcuConfig {
 /// which rejects unknown keys and reports wrong types at their line as any other table.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CycleSection {
-    /// Characteristic diagram (LUT) file (`--lut`). Missing/corrupt → DEGRADED mode with the
-    /// reference restraint; the ECU still starts.
+    /// Characteristic diagram (LUT) file (`--lut`). Relative paths: from the config file,
+    /// beside it; the default, in the repository the ECU belongs to (found from any folder;
+    /// `Layers::resolve_files`). Not found → the ECU does not start unless `--no-lut` (a
+    /// set-up mistake); found but corrupt → DEGRADED mode with the reference restraint, the
+    /// ECU still starts (a fault it must survive: never "no protection").
     pub lut: PathBuf,
     /// Reference-restraint file (`--reference`). Missing/corrupt → the copy built into the
     /// binary (same file at build time), with a warning.
     pub reference: PathBuf,
     /// SecOC key file (`--secoc-keys`, format in `bus::secoc::SecOcKeys`). Missing/corrupt →
-    /// the ECU still starts and still sends its (E2E-protected) commands, but without
-    /// authenticator frames, and reports `FaultConfig` in `EcuStatus`: an unauthenticated
-    /// command that authenticated actuators ignore is still better than refusing to protect,
-    /// and the fault bit tells the bench why the actuators are not acting.
+    /// the ECU does not start (fail closed, issue 22: its fire commands would go out without
+    /// authenticators), unless `--no-secoc` asks for exactly that; then `EcuStatus` reports
+    /// `FaultConfig` and the start-up line says why.
     pub secoc_keys: PathBuf,
     /// The decision thresholds (same table; unknown keys are rejected by the core's struct).
     #[serde(flatten)]
