@@ -375,3 +375,22 @@ fn an_output_path_is_checked_before_the_run_and_config_paths_follow_their_file()
         "{err}"
     );
 }
+
+#[test]
+fn config_errors_are_one_line_naming_the_field_and_the_os_error_once() {
+    // Issue 22 item 4: `mlockall = "yes"` gave line and column but not the field; a missing
+    // file repeated its OS error.
+    let dir = tmpdir("errstyle");
+    let path = dir.join("typed.toml");
+    std::fs::write(&path, "[rt]\nmlockall = \"yes\"\n").unwrap();
+    let (ok, err) = short_run(&dir, "typed", &["--config", path.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(
+        err.contains(&format!("{}:2:", path.display())) && err.contains("field `rt.mlockall`"),
+        "{err}"
+    );
+    let (ok, err) = short_run(&dir, "nofile", &["--config", "/nonexistent/ecu.toml"]);
+    assert!(!ok);
+    assert_eq!(err.matches("No such file").count(), 1, "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+}

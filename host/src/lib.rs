@@ -4,7 +4,8 @@
 //! * [`clock`] — CLOCK_MONOTONIC (the bench's one time base for timestamps and deadlines,
 //!   shared by every process on the machine), the synchronized time of SecOC freshness
 //!   (CLOCK_REALTIME µs), absolute sleeps, and the simulated clock of deterministic tests;
-//! * [`stop`] — the SIGTERM/SIGINT stop flag.
+//! * [`stop`] — the SIGTERM/SIGINT stop flag (and SIGPIPE's default for the command-line
+//!   tools).
 
 pub mod clock;
 pub mod stop;
@@ -13,4 +14,4 @@ pub use clock::{
     monotonic_ns, realtime_ns, sleep_through_signals_until_ns, sleep_until_ns, sync_time_us, Clock,
     MonotonicClock, SimClock, SleepOutcome,
 };
-pub use stop::install_stop_signals;
+pub use stop::{default_sigpipe, install_stop_signals};

@@ -38,6 +38,15 @@ pub fn install_stop_signals() -> Result<&'static AtomicBool, nix::Error> {
     Ok(&STOP)
 }
 
+/// SIGPIPE back to its default for a command-line tool: a closed pipe (`lut inspect … | head`)
+/// ends the process quietly, as it does any Unix tool, instead of a panic in `println!`
+/// (Rust ignores SIGPIPE, so a write to the closed pipe fails and `println!` panics). Not for
+/// the bench processes: an ECU whose log reader went away must keep running.
+pub fn default_sigpipe() {
+    // SAFETY: installs the default disposition, no handler code runs.
+    let _ = unsafe { nix::sys::signal::signal(Signal::SIGPIPE, SigHandler::SigDfl) };
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

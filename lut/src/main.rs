@@ -63,6 +63,7 @@ enum Command {
 /// Errors are printed as one readable chain (`lut: error: …: …`), never as a Debug dump with a
 /// backtrace (which `main() -> anyhow::Result` prints when RUST_BACKTRACE is set).
 fn main() -> std::process::ExitCode {
+    host::default_sigpipe();
     match run(Cli::parse()) {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {

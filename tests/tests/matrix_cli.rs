@@ -63,3 +63,51 @@ fn quiet_prints_the_table_only() {
         "{stdout}"
     );
 }
+
+/// Runs `bin args`, reads one line of its output and closes the pipe: how `| head -1` ends it.
+fn closed_pipe(bin: &str, args: &[&str]) -> (std::process::ExitStatus, String) {
+    use std::io::{BufRead, BufReader, Read};
+    let mut child = Command::new(bin)
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("runs");
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().expect("stdout"))
+        .read_line(&mut first)
+        .expect("a line");
+    // The reader is dropped here: the pipe is closed.
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .expect("stderr")
+        .read_to_string(&mut err)
+        .expect("stderr");
+    (child.wait().expect("exit"), err)
+}
+
+#[test]
+fn a_closed_pipe_ends_the_tools_quietly() {
+    // Issue 22 item 3: `offline-bench | head -1` and `lut inspect … | head -1` panicked
+    // (exit 101, "failed printing to stdout: Broken pipe").
+    let root = e2e_tests::repo_root();
+    let lut = root.join("data/default.lut");
+    let lut_bin = root.join("target/release/lut");
+    for (bin, args) in [
+        (env!("CARGO_BIN_EXE_offline-bench"), vec![]),
+        (env!("CARGO_BIN_EXE_misuse-matrix"), vec!["--list"]),
+        (
+            lut_bin.to_str().expect("path"),
+            vec!["inspect", lut.to_str().expect("path")],
+        ),
+    ] {
+        if !std::path::Path::new(bin).exists() {
+            panic!("{bin} not built (test.sh builds every binary first)");
+        }
+        let (status, err) = closed_pipe(bin, &args);
+        assert!(!err.contains("panicked"), "{bin}: {err}");
+        assert_ne!(status.code(), Some(101), "{bin}: {err}");
+    }
+}

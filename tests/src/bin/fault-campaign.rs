@@ -90,6 +90,7 @@ enum Cmd {
 }
 
 fn main() -> std::process::ExitCode {
+    host::default_sigpipe();
     match run() {
         Ok(true) => std::process::ExitCode::SUCCESS,
         Ok(false) => std::process::ExitCode::from(1),

@@ -43,6 +43,7 @@ struct Cli {
 }
 
 fn main() -> std::process::ExitCode {
+    host::default_sigpipe();
     match run() {
         Ok(true) => std::process::ExitCode::SUCCESS,
         Ok(false) => std::process::ExitCode::from(1),

@@ -321,7 +321,19 @@ fn list() {
     println!("requirements: no fire = no airbag and no pyrotechnic pretensioner (a reversible pre-crash one must be released), and a crash phase that fired nothing ends; no airbag = the belt may act; must fire = the airbag fires, its time against \"127 mm − 30 ms\" reported; report only = printed, not judged");
 }
 
-fn main() -> Result<()> {
+/// Errors as one line (`misuse-matrix: error: …`), never a Debug dump with a backtrace.
+fn main() -> std::process::ExitCode {
+    host::default_sigpipe();
+    match run_matrix() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("misuse-matrix: error: {e:#}");
+            std::process::ExitCode::from(2)
+        }
+    }
+}
+
+fn run_matrix() -> Result<()> {
     let cli = Cli::parse();
     if cli.list {
         list();

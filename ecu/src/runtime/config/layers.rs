@@ -38,9 +38,9 @@ impl Layers {
         let mut figment = Figment::from(Serialized::defaults(EcuConfig::default()));
         let file = match file {
             Some(path) => {
-                let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+                let text = std::fs::read_to_string(path).map_err(|cause| ConfigError::Read {
                     path: path.to_owned(),
-                    source,
+                    cause,
                 })?;
                 EcuConfig::from_toml_str(&text, path)?;
                 figment = figment.merge(Toml::file_exact(path));

@@ -158,12 +158,12 @@ impl Default for CanConfig {
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
     /// The file could not be read.
-    #[error("{path}: cannot read config file: {source}")]
+    #[error("{path}: cannot read config file: {cause}")]
     Read {
         /// File path.
         path: PathBuf,
-        /// OS error.
-        source: std::io::Error,
+        /// OS error (in the message once: not a `source`, which error chains print again).
+        cause: std::io::Error,
     },
     /// TOML syntax or schema error.
     #[error("{path}:{line}:{column}: {message}")]
@@ -203,11 +203,23 @@ impl EcuConfig {
     pub fn from_toml_str(text: &str, path: &Path) -> Result<Self, ConfigError> {
         let cfg: Self = toml::from_str(text).map_err(|e| {
             let (line, column) = e.span().map_or((1, 1), |s| line_col(text, s.start));
+            // A type error names its value, not its key: say the key too (unknown and missing
+            // keys already name theirs).
+            let message = e.message().trim();
+            let message = match key_at_line(text, line) {
+                Some(key)
+                    if !message
+                        .contains(&format!("`{}`", key.rsplit('.').next().unwrap_or(&key))) =>
+                {
+                    format!("field `{key}`: {message}")
+                }
+                _ => message.to_owned(),
+            };
             ConfigError::Parse {
                 path: path.to_owned(),
                 line,
                 column,
-                message: e.message().trim().to_owned(),
+                message,
             }
         })?;
         cfg.validate(&|key: &str| layers::origin_in_file(text, path, key))?;
@@ -216,9 +228,9 @@ impl EcuConfig {
 
     /// Reads and parses a TOML file.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+        let text = std::fs::read_to_string(path).map_err(|cause| ConfigError::Read {
             path: path.to_owned(),
-            source,
+            cause,
         })?;
         Self::from_toml_str(&text, path)
     }
@@ -275,6 +287,28 @@ impl EcuConfig {
         }
         Ok(())
     }
+}
+
+/// The dotted key set on 1-based `line` of a TOML text (`rt.mlockall` for `mlockall = …`
+/// under `[rt]`), if that line is a plain `key = value`.
+fn key_at_line(text: &str, line: usize) -> Option<String> {
+    let lines: Vec<&str> = text.lines().collect();
+    let this = lines.get(line.checked_sub(1)?)?;
+    let (key, _) = this.split_once('=')?;
+    let key = key.trim().trim_matches('"');
+    if key.is_empty() || key.starts_with('[') || key.starts_with('#') {
+        return None;
+    }
+    let table = lines[..line - 1]
+        .iter()
+        .rev()
+        .map(|l| l.trim())
+        .find(|l| l.starts_with('[') && !l.starts_with("[["))
+        .map(|l| l.trim_matches(|c| c == '[' || c == ']').trim());
+    Some(match table {
+        Some(t) if !t.is_empty() => format!("{t}.{key}"),
+        _ => key.to_owned(),
+    })
 }
 
 #[cfg(test)]
