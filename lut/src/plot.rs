@@ -35,6 +35,12 @@ pub trait Figure {
 /// Renders `figure` into `path` at `size` pixels: SVG when the file name ends in `.svg`
 /// (any case), PNG otherwise. The one place that picks the backend for every plot of `lut`.
 pub fn render(path: &Path, size: (u32, u32), figure: &(impl Figure + ?Sized)) -> Result<()> {
+    // The folder is made and the file opened here, so a bad path is one readable line
+    // (`writing x.png: Permission denied`) rather than the backend's debug text.
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    std::fs::File::create(path).with_context(|| format!("writing {}", path.display()))?;
     let is_svg = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("svg"));

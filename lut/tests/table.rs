@@ -172,3 +172,38 @@ fn shard_ranges_cover_the_grid_exactly_once() {
     assert!(table::shard_range(10, 0, 3).is_err());
     assert!(table::shard_range(10, 4, 3).is_err());
 }
+
+#[test]
+fn plot_makes_its_folder_and_a_bad_path_is_one_readable_line() {
+    // Issue 22 item 2: `lut plot` into a missing folder printed the backend's debug text
+    // (`ImageError(IoError(Os { code: 2, … }))`).
+    let exe = env!("CARGO_BIN_EXE_lut");
+    let table = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/default.lut");
+    let dir = std::env::temp_dir().join(format!("lut-plot-{}", std::process::id()));
+    let out = dir.join("not/yet/there.png");
+    let run = |path: &std::path::Path| {
+        std::process::Command::new(exe)
+            .arg("plot")
+            .arg(&table)
+            .arg("--out")
+            .arg(path)
+            .output()
+            .expect("lut runs")
+    };
+    let ok = run(&out);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    assert!(out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+    let bad = run(std::path::Path::new("/proc/no-such/x.png"));
+    assert!(!bad.status.success());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        err.contains("/proc/no-such") && !err.contains("Os {"),
+        "{err}"
+    );
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+}
