@@ -32,6 +32,12 @@ echo "demo: building the bench (release)…" >&2
 cargo build --release --workspace --bins
 name=$(sed -n 's/^name *= *"\(.*\)".*/\1/p' "$scenario" | head -n1)
 
+# The output folder may be anywhere: the guest routes see the host read-only except the shares,
+# so it is shared read-write too (vcan-setup.sh's VCAN_GUEST_RW).
+mkdir -p "$out"
+out=$(cd "$out" && pwd -P)
+export VCAN_GUEST_RW="$out${VCAN_GUEST_RW:+:$VCAN_GUEST_RW}"
+
 rc=0
 ./vcan-setup.sh --run -- "$target/release/hil-bench" --scenario "$scenario" --out "$out" --repo "$PWD" || rc=$?
 
@@ -43,6 +49,11 @@ if [ -s "$dir/candump.log" ]; then
     grep -m 6 -E "AirbagStageCmd|BeltLimiterCmd" -A 9 "$dir/candump-decoded.txt" | head -n 24 || true
 fi
 echo
+if [ "$rc" != 0 ]; then
+    # A failed run never prints a success summary.
+    echo "demo: FAILED (exit $rc): see the messages above; what the run left is in $dir/" >&2
+    exit "$rc"
+fi
 echo "demo: everything is in $dir/:"
 echo "  summary.txt           the summary above"
 echo "  report.json           actuator stubs: commands, actions, occupant outcome (adaptive vs reference vs ideal)"
