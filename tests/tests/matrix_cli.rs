@@ -111,3 +111,35 @@ fn a_closed_pipe_ends_the_tools_quietly() {
         assert_ne!(status.code(), Some(101), "{bin}: {err}");
     }
 }
+
+#[test]
+fn every_tool_answers_version_with_its_own_name() {
+    // Issue 22 item 5: `budget` and `worst_cycle` lacked `--version`.
+    let release = e2e_tests::repo_root().join("target/release");
+    for tool in [
+        "ecu",
+        "sensor-feeds",
+        "actuator-stubs",
+        "lut",
+        "hil-bench",
+        "offline-bench",
+        "misuse-matrix",
+        "fault-campaign",
+        "bus-inject",
+        "budget",
+        "worst_cycle",
+        "loop-vs-cyclictest",
+    ] {
+        let bin = release.join(tool);
+        assert!(
+            bin.exists(),
+            "{tool} not built (test.sh builds every binary first)"
+        );
+        let out = Command::new(&bin).arg("--version").output().expect("runs");
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success() && text.starts_with(&format!("{tool} ")),
+            "{tool}: {text}"
+        );
+    }
+}

@@ -19,6 +19,8 @@ use std::time::SystemTime;
 
 #[derive(Parser, Debug)]
 #[command(
+    name = "budget",
+    version,
     about = "Run the cycle benches and fail when a budget (benches/budgets.toml) is exceeded"
 )]
 struct Args {

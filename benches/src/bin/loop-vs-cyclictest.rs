@@ -19,7 +19,11 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 #[derive(Parser, Debug)]
-#[command(about = "ECU loop wake-up latency vs cyclictest, same settings, one session")]
+#[command(
+    name = "loop-vs-cyclictest",
+    version,
+    about = "ECU loop wake-up latency vs cyclictest, same settings, one session"
+)]
 struct Args {
     /// Cycles (ECU) = loops (cyclictest).
     #[arg(long, default_value_t = 20_000)]

@@ -18,7 +18,11 @@ use rand_chacha::ChaCha8Rng;
 use std::path::{Path, PathBuf};
 
 #[derive(Parser, Debug)]
-#[command(about = "Search for the ECU cycle with the most instructions")]
+#[command(
+    name = "worst_cycle",
+    version,
+    about = "Search for the ECU cycle with the most instructions"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Cmd,

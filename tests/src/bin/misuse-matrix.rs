@@ -25,7 +25,7 @@ use rayon::prelude::*;
 
 /// The misuse / single-fault / must-fire matrix through the ECU core, offline.
 #[derive(Parser)]
-#[command(version)]
+#[command(name = "misuse-matrix", version)]
 struct Cli {
     /// Number of variants (spread evenly over the families).
     #[arg(long, default_value_t = 100_000)]
