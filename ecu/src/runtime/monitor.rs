@@ -53,17 +53,18 @@ pub fn format_estimate(d: &EcuDiagnostics) -> String {
 pub fn format_line(d: &EcuDiagnostics, rx_rate_hz: f64) -> String {
     let mode = EcuMode::from_u8(d.mode).map_or("?", EcuMode::name);
     format!(
-        "cycle {:>9} {:>7.0} Hz | mode {:<10} | {} | Δv {:>5.1} m/s a_max {:>6.1} m/s² | belt {:>6.0} N pt {:>6.3}s bag st{} {:>6.3}s | wake {:>6.1} µs exec {:>6.1} µs overruns {} | obj#{} acc#{} | degraded {}",
+        "cycle {:>9} {:>7.0} Hz | mode {:<10} | {} | Δv {:>5.1} m/s a_max {:>6.1} m/s² | belt {:>5.2} kN pt {:>+6.1} ms bag st{} {:>+6.1} ms | wake {:>6.1} µs exec {:>6.1} µs overruns {} | obj#{} acc#{} | degraded {}",
         d.cycle_count,
         rx_rate_hz,
         mode,
         format_estimate(d),
         d.predicted_delta_v_mps,
         d.predicted_a_max_mps2,
-        d.belt_force_limit_n,
-        d.pretensioner_time_s,
+        // kN and ms, as the rest of the bench says them (issue 22 item 5).
+        d.belt_force_limit_n / 1e3,
+        d.pretensioner_time_s * 1e3,
         d.airbag_stage,
-        d.airbag_time_s,
+        d.airbag_time_s * 1e3,
         d.wake_latency_ns as f64 / 1e3,
         d.last_exec_ns as f64 / 1e3,
         d.overrun_count,
@@ -159,5 +160,14 @@ mod tests {
         assert!(l.contains("pre-crash"), "{l}");
         assert!(l.contains("wake   12.3 µs"), "{l}");
         assert!(l.contains("overruns 4"), "{l}");
+        d.belt_force_limit_n = 8967.0;
+        d.pretensioner_time_s = 0.010;
+        d.airbag_stage = 2;
+        d.airbag_time_s = -0.0123;
+        let l = format_line(&d, 1000.0);
+        assert!(
+            l.contains("belt  8.97 kN pt  +10.0 ms bag st2  -12.3 ms"),
+            "{l}"
+        );
     }
 }
