@@ -305,29 +305,34 @@ pub fn table_header(width: usize) -> String {
     )
 }
 
-/// What one module action was, in words: (name, kind of restraint).
-fn action_words(what: &str, mode: Option<u8>) -> (&'static str, &'static str) {
+/// The kind of a pretensioner action: `pyrotechnic` (fired in the crash phase) or `reversible`
+/// (fired before it, or released); `None` for other actions. `mode`: the core's mode in the
+/// cycle that sent it.
+pub fn pretensioner_kind(what: &str, mode: Option<u8>) -> Option<&'static str> {
     let crash_phase = mode.is_some_and(|m| {
         m == restraint::EcuMode::Crash as u8 || m == restraint::EcuMode::PostCrash as u8
     });
     match what {
-        "airbag_fire" => ("airbag fired", ""),
-        "airbag_fire_ignored_disarmed" => ("airbag fire ignored (disarmed)", ""),
-        "pretensioner_fire" if crash_phase => ("pretensioner fired", "pyrotechnic"),
-        "pretensioner_fire" => ("pretensioner fired", "reversible, pre-crash"),
-        "pretensioner_release" => ("pretensioner released", "reversible"),
-        _ => ("module action", ""),
+        "pretensioner_fire" if crash_phase => Some("pyrotechnic"),
+        "pretensioner_fire" | "pretensioner_release" => Some("reversible"),
+        _ => None,
     }
 }
 
-/// The kind of a pretensioner fire as the JSON names it: `pyrotechnic` (crash phase) or
-/// `reversible` (pre-crash); `None` for other actions.
-pub fn pretensioner_kind(what: &str, mode: Option<u8>) -> Option<&'static str> {
-    match action_words(what, mode).1 {
-        "pyrotechnic" => Some("pyrotechnic"),
-        "" => None,
-        _ => Some("reversible"),
-    }
+/// What one module action was, in words: (name, kind of restraint for the table).
+fn action_words(what: &str, mode: Option<u8>) -> (&'static str, &'static str) {
+    let name = match what {
+        "airbag_fire" => "airbag fired",
+        "airbag_fire_ignored_disarmed" => "airbag fire ignored (disarmed)",
+        "pretensioner_fire" => "pretensioner fired",
+        "pretensioner_release" => "pretensioner released",
+        _ => "module action",
+    };
+    let kind = match (what, pretensioner_kind(what, mode)) {
+        ("pretensioner_fire", Some("reversible")) => "reversible, pre-crash",
+        (_, k) => k.unwrap_or(""),
+    };
+    (name, kind)
 }
 
 /// One run of the outcome table: the outcome line, then one indented line per restraint

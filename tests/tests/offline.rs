@@ -241,19 +241,9 @@ fn offline_bench_json_actions_carry_ms_after_the_scenario_start() {
     // (the simulated clock, scenario time + 1 s). Checked against the run's own contact-relative
     // times, which come another way (`OfflineRun::action`: ms after the true contact).
     let name = "taurus-48-48-abs";
-    let out = std::env::temp_dir().join(format!("offline-bench-t-ms-{}.json", std::process::id()));
-    let status = std::process::Command::new(env!("CARGO_BIN_EXE_offline-bench"))
-        .arg("--scenario")
-        .arg(root().join(format!("scenarios/{name}.toml")))
-        .arg("--json")
-        .arg(&out)
-        .stdout(std::process::Stdio::null())
-        .status()
-        .expect("offline-bench runs");
-    assert!(status.success());
-    let text = std::fs::read_to_string(&out).expect("json written");
-    let _ = std::fs::remove_file(&out);
-    let json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let (code, _, stderr, json) =
+        offline_bench(&[root().join(format!("scenarios/{name}.toml"))], &[]);
+    assert_eq!(code, 0, "{stderr}");
     let run_json = &json[0];
     let contact_ms = run_json["contact_s"].as_f64().expect("contact") * 1e3;
     let actions = run_json["actions"].as_array().expect("actions");
