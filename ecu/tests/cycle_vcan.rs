@@ -50,7 +50,7 @@ fn worker_body() {
         .spawn()
         .expect("candump (can-utils) must be installed: ./vcan-setup.sh installs it");
     let ecu = Command::new(ECU)
-        .args(["--can-interface", &iface(), "--cycles", "2500", "--quiet"])
+        .args(["--can", &iface(), "--cycles", "2500", "--quiet"])
         .args([
             "--service-prefix",
             &prefix,

@@ -121,7 +121,7 @@ fn a_bad_environment_variable_is_named_in_the_error() {
 #[test]
 fn missing_can_interface_is_an_error_unless_no_can() {
     let out = Command::new(ECU)
-        .args(["--cycles", "1", "--can-interface", "nocan-test0"])
+        .args(["--cycles", "1", "--can", "nocan-test0"])
         .output()
         .unwrap();
     assert!(!out.status.success());
@@ -224,7 +224,7 @@ fn cycles_run_writes_json_report_and_monitor_shows_it() {
     let mon = String::from_utf8_lossy(&monitor.stdout);
     assert_eq!(mon.lines().count(), 3, "{mon}");
     // The restraint cycle without CAN (no occupant data) runs DEGRADED on the reference.
-    assert!(mon.contains("mode degraded"), "{mon}");
+    assert!(mon.contains("mode ReferenceFallback (degraded)"), "{mon}");
     assert!(mon.contains("can-off"), "{mon}");
 }
 

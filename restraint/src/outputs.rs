@@ -17,7 +17,7 @@ use diagram::AirbagStage;
 
 use crate::contract::{CycleInfo, CycleIo};
 use crate::counters::CycleCounters;
-use crate::decision::{Decision, Phase, Pretensioner};
+use crate::decision::{Decision, Pretensioner};
 use crate::estimate::{pulse::PULSE_DT_S, Estimator};
 use crate::inputs::InputMonitor;
 use crate::plan::PlanSource;
@@ -289,12 +289,7 @@ impl Outputs {
                 Err(_) => count(&mut counters.encode_errors),
             }
         }
-        let mode = match d.phase() {
-            Phase::Monitoring | Phase::PreCrash => EcuStatusEcuMode::Normal,
-            Phase::Degraded => EcuStatusEcuMode::ReferenceFallback,
-            Phase::Crash if !d.airbag_fired() => EcuStatusEcuMode::CrashDetected,
-            Phase::Crash | Phase::PostCrash => EcuStatusEcuMode::Deployed,
-        };
+        let mode = d.phase().mode().on_bus(d.airbag_fired());
         let faults = StatusFaults {
             vehicle_input: inputs.vehicle_stale(now),
             occupant_input: inputs.occupant_stale(now),

@@ -138,9 +138,24 @@ impl EcuMode {
         Self::from_repr(v)
     }
 
-    /// Short display name (`pre-crash`, …).
+    /// Short display name (`pre-crash`, …): the decision's phase, finer than the bus's mode.
     pub fn name(self) -> &'static str {
         self.into()
+    }
+
+    /// The mode `EcuStatus` puts on the bus for this diagnostics mode — the one mapping
+    /// between the two vocabularies. The bus has no pre-crash (a preset is `Normal`, its
+    /// settings are on `BeltLimiterCmd`), calls the degraded phase `ReferenceFallback` (what
+    /// the actuators then receive) and splits the crash phase at the airbag's fire.
+    pub fn on_bus(self, airbag_fired: bool) -> bus::codec::EcuStatusEcuMode {
+        use bus::codec::EcuStatusEcuMode as Bus;
+        match self {
+            Self::Startup => Bus::Init,
+            Self::Monitoring | Self::PreCrash => Bus::Normal,
+            Self::Degraded => Bus::ReferenceFallback,
+            Self::Crash if !airbag_fired => Bus::CrashDetected,
+            Self::Crash | Self::PostCrash => Bus::Deployed,
+        }
     }
 }
 

@@ -121,12 +121,24 @@ fn run(cli: &Cli) -> Result<()> {
     }
     let truth =
         Truth::new(&scenario).map_err(|e| anyhow::anyhow!("{}: {e}", cli.scenario.display()))?;
-    eprintln!("sensor-feeds: {}", describe(&truth));
-    for (i, e) in scenario.accel_events.iter().enumerate() {
-        eprintln!("sensor-feeds: {}", describe_event(i, e));
-    }
+    let mut lines = vec![describe(&truth)];
+    lines.extend(
+        scenario
+            .accel_events
+            .iter()
+            .enumerate()
+            .map(|(i, e)| describe_event(i, e)),
+    );
     if cli.check {
+        // The check's verdict is its output: stdout, with a last line a script can test.
+        for l in &lines {
+            println!("{l}");
+        }
+        println!("{}: valid", cli.scenario.display());
         return Ok(());
+    }
+    for l in &lines {
+        eprintln!("sensor-feeds: {l}");
     }
     let contact_s = truth.contact_s;
     let closing_at_contact_mps = truth.closing_speed_at_contact_mps();

@@ -1,6 +1,6 @@
 //! `sensor-feeds --check`: a file with `[[accel_event]]`s is validated like every other key
 //! (the same `file:line: field …` error on stderr, exit status 1) and, when valid, its events
-//! are announced after the true contact. No transport is opened.
+//! are announced after the true contact, on stdout, ending `FILE: valid`. No transport is opened.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -17,10 +17,15 @@ fn check(name: &str, text: &str) -> (bool, String) {
         .output()
         .expect("run sensor-feeds");
     let _ = std::fs::remove_file(&file);
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    // A valid file's verdict is on stdout (issue 22: it was only on stderr); an error on stderr.
+    let printed = if out.status.success() {
+        &out.stdout
+    } else {
+        &out.stderr
+    };
     (
         out.status.success(),
-        stderr.replace(&format!("{}/", dir.display()), ""),
+        String::from_utf8_lossy(printed).replace(&format!("{}/", dir.display()), ""),
     )
 }
 
@@ -37,9 +42,10 @@ fn check_announces_valid_events() {
         "{err}"
     );
     assert!(
-        err.contains("sensor-feeds: accel_event[0]: half_sine 7.5 g × 4 ms from 1.8000 s on all"),
+        err.contains("\naccel_event[0]: half_sine 7.5 g × 4 ms from 1.8000 s on all\n"),
         "{err}"
     );
+    assert!(err.ends_with("c.toml: valid\n"), "{err}");
 }
 
 #[test]

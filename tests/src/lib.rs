@@ -556,7 +556,7 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     let mut ecu = spawn(
         Command::new(bin("ecu"))
             .args([
-                "--can-interface",
+                "--can",
                 &cfg.can,
                 "--service-prefix",
                 &cfg.service_prefix,

@@ -1,8 +1,9 @@
 //! Loop timing harness: the ECU loop's wake-up latency against `cyclictest` (rt-tests), same
 //! machine, same session, same period, policy, priority, CPU, memory locking, PM-QoS and count.
 //!
-//! `cargo run --release -p cycle-benches --bin loop-vs-cyclictest -- --cycles 20000
-//! --period-us 1000 [--fifo 80] [--cpu 1] [--png docs/img/timing-loop-vs-cyclictest.png]`
+//! `target/release/loop-vs-cyclictest --cycles 20000 --period-us 1000 [--sched-fifo 80]
+//! [--cpu 1] [--out DIR] [--png FILE]` (the ECU is the `ecu` built beside it; the PNG and the
+//! raw data go to `--out`, never over the committed docs/img picture unless `--png` says so).
 //!
 //! cyclictest measures the OS floor: a thread that does nothing but sleep to an absolute
 //! deadline (clock_nanosleep TIMER_ABSTIME) and read the clock. The ECU loop does the same plus
@@ -12,7 +13,6 @@
 
 use anyhow::{bail, Context};
 use clap::Parser;
-use cycle_benches::gate;
 use cycle_benches::latency::{CyclictestHistogram, EcuReport, PercentilesUs};
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -31,14 +31,14 @@ struct Args {
     /// Period, µs.
     #[arg(long, default_value_t = 1000)]
     period_us: u64,
-    /// SCHED_FIFO priority for both (absent: SCHED_OTHER for both).
-    #[arg(long)]
+    /// SCHED_FIFO priority for both (absent: SCHED_OTHER for both); as `ecu --sched-fifo`.
+    #[arg(long = "sched-fifo", alias = "fifo", value_name = "PRIO")]
     fifo: Option<u8>,
     /// Pin both to this CPU.
     #[arg(long)]
     cpu: Option<usize>,
-    /// Do not mlockall (default: both lock memory).
-    #[arg(long)]
+    /// Do not mlockall (default: both lock memory); as `ecu --no-mlockall`.
+    #[arg(long = "no-mlockall", alias = "no-mlock")]
     no_mlock: bool,
     /// Do not hold /dev/cpu_dma_latency at 0 (cyclictest `--laptop`, ECU `--no-pm-qos`).
     #[arg(long)]
@@ -46,14 +46,20 @@ struct Args {
     /// cyclictest histogram range, µs (samples above are counted as overflows).
     #[arg(long, default_value_t = 10_000)]
     hist_max_us: u64,
-    /// Output PNG.
-    #[arg(long, default_value = "docs/img/timing-loop-vs-cyclictest.png")]
-    png: PathBuf,
-    /// Directory for the raw cyclictest histogram and the ECU report JSON.
-    #[arg(long, default_value = "target/loop-vs-cyclictest")]
+    /// Output PNG (default: timing-loop-vs-cyclictest.png in --out).
+    #[arg(long, value_name = "FILE")]
+    png: Option<PathBuf>,
+    /// Folder for the plot, the raw cyclictest histogram and the ECU report JSON.
+    #[arg(
+        long = "out",
+        alias = "out-dir",
+        value_name = "DIR",
+        default_value = "target/loop-vs-cyclictest"
+    )]
     out_dir: PathBuf,
-    /// ECU binary (default: build `-p ecu --release` and use it).
-    #[arg(long)]
+    /// ECU binary (default: the `ecu` beside this binary, as `cargo build --release
+    /// --workspace` leaves it).
+    #[arg(long, value_name = "FILE")]
     ecu: Option<PathBuf>,
 }
 
@@ -67,18 +73,19 @@ fn main() {
 fn run() -> anyhow::Result<()> {
     let a = Args::parse();
     std::fs::create_dir_all(&a.out_dir)?;
+    let png = a
+        .png
+        .clone()
+        .unwrap_or_else(|| a.out_dir.join("timing-loop-vs-cyclictest.png"));
     let ecu = match &a.ecu {
         Some(p) => p.clone(),
-        None => {
-            let ok = Command::new(gate::cargo())
-                .args(["build", "--release", "-p", "ecu", "--bin", "ecu"])
-                .status()
-                .context("cannot run cargo build -p ecu")?
-                .success();
-            anyhow::ensure!(ok, "cargo build -p ecu failed");
-            gate::cargo_target_dir()?.join("release/ecu")
-        }
+        None => std::env::current_exe()?.with_file_name("ecu"),
     };
+    anyhow::ensure!(
+        ecu.is_file(),
+        "no ECU binary at {} (build it: cargo build --release -p ecu; or pass --ecu FILE)",
+        ecu.display()
+    );
 
     // --- cyclictest ---------------------------------------------------------------------
     let histfile = a.out_dir.join("cyclictest-hist.txt");
@@ -154,8 +161,8 @@ fn run() -> anyhow::Result<()> {
         .with_context(|| format!("parsing {}", report_path.display()))?;
 
     print!("{}", side_by_side(&a, &ct_hist, &ct_p, &report));
-    plot(&a.png, &ct_hist, &ct_p, &report, a.cycles)?;
-    println!("plot: {}", a.png.display());
+    plot(&png, &ct_hist, &ct_p, &report, a.cycles)?;
+    println!("plot: {}", png.display());
     println!("raw: {} and {}", histfile.display(), report_path.display());
     Ok(())
 }

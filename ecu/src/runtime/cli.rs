@@ -96,8 +96,8 @@ pub struct RunArgs {
     /// Switch the CAN side off (e.g. no SocketCAN on this host); the report says so.
     #[arg(long)]
     pub no_can: bool,
-    /// SocketCAN interface (default vcan0).
-    #[arg(long, value_name = "IF")]
+    /// SocketCAN interface (default vcan0); `--can`, as in every bench tool.
+    #[arg(long = "can", alias = "can-interface", value_name = "IF")]
     pub can_interface: Option<String>,
     /// iceoryx2 service-name prefix.
     #[arg(long, value_name = "PREFIX")]

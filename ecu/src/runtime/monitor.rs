@@ -49,14 +49,27 @@ pub fn format_estimate(d: &EcuDiagnostics) -> String {
     )
 }
 
+/// The mode as `EcuStatus` names it on the bus (the DBC's value table), with the decision's
+/// finer phase in brackets: `Normal (pre-crash)`, `ReferenceFallback (degraded)`.
+pub fn mode_label(d: &EcuDiagnostics) -> String {
+    match EcuMode::from_u8(d.mode) {
+        Some(m) => {
+            let on_bus = u8::from(m.on_bus(d.airbag_fired != 0));
+            let bus_name =
+                bus::value_name(bus::EcuStatus::ECU_MODE_VALUES, i64::from(on_bus)).unwrap_or("?");
+            format!("{bus_name} ({})", m.name())
+        }
+        None => format!("unknown ({})", d.mode),
+    }
+}
+
 /// One status line for a diagnostics record.
 pub fn format_line(d: &EcuDiagnostics, rx_rate_hz: f64) -> String {
-    let mode = EcuMode::from_u8(d.mode).map_or("?", EcuMode::name);
     format!(
-        "cycle {:>9} {:>7.0} Hz | mode {:<10} | {} | Δv {:>5.1} m/s a_max {:>6.1} m/s² | belt {:>5.2} kN pt {:>+6.1} ms bag st{} {:>+6.1} ms | wake {:>6.1} µs exec {:>6.1} µs overruns {} | obj#{} acc#{} | degraded {}",
+        "cycle {:>9} {:>7.0} Hz | mode {:<30} | {} | Δv {:>5.1} m/s a_max {:>6.1} m/s² | belt {:>5.2} kN pt {:>+6.1} ms bag st{} {:>+6.1} ms | wake {:>6.1} µs exec {:>6.1} µs overruns {} | obj#{} acc#{} | degraded {}",
         d.cycle_count,
         rx_rate_hz,
-        mode,
+        mode_label(d),
         format_estimate(d),
         d.predicted_delta_v_mps,
         d.predicted_a_max_mps2,
@@ -157,7 +170,7 @@ mod tests {
             l.contains("ttc 0.250±0.004 s v 25.0±0.1 m/s m 1512±212 kg"),
             "{l}"
         );
-        assert!(l.contains("pre-crash"), "{l}");
+        assert!(l.contains("mode Normal (pre-crash)"), "{l}");
         assert!(l.contains("wake   12.3 µs"), "{l}");
         assert!(l.contains("overruns 4"), "{l}");
         d.belt_force_limit_n = 8967.0;
@@ -169,5 +182,30 @@ mod tests {
             l.contains("belt  8.97 kN pt  +10.0 ms bag st2  -12.3 ms"),
             "{l}"
         );
+    }
+
+    /// The bus's names (bus/restraint.dbc, `VAL_ 272 EcuMode`) for every diagnostics mode,
+    /// the phase in brackets (issue 22: the monitor said `degraded` where the bus says
+    /// `ReferenceFallback`).
+    #[test]
+    fn modes_are_named_as_on_the_bus() {
+        let cases = [
+            (EcuMode::Startup, false, "Init (startup)"),
+            (EcuMode::Monitoring, false, "Normal (monitoring)"),
+            (EcuMode::PreCrash, false, "Normal (pre-crash)"),
+            (EcuMode::Degraded, false, "ReferenceFallback (degraded)"),
+            (EcuMode::Crash, false, "CrashDetected (crash)"),
+            (EcuMode::Crash, true, "Deployed (crash)"),
+            (EcuMode::PostCrash, true, "Deployed (post-crash)"),
+        ];
+        for (mode, fired, want) in cases {
+            let mut d = EcuDiagnostics::ZERO;
+            d.mode = mode as u8;
+            d.airbag_fired = u8::from(fired);
+            assert_eq!(mode_label(&d), want);
+        }
+        let mut d = EcuDiagnostics::ZERO;
+        d.mode = 200;
+        assert_eq!(mode_label(&d), "unknown (200)");
     }
 }

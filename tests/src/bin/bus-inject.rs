@@ -1,6 +1,6 @@
 //! `bus-inject`: a bus attacker / faulty node for the fault campaign (issue 8).
 //!
-//! * `bus-inject mirror --mode crc|counter|replay|delay --id 0x0A0 --epoch-ns N --from-s A --to-s B`
+//! * `bus-inject mirror --mode crc|counter|replay|delay --message EgoVehicleState --epoch-ns N --from-s A --to-s B`
 //!   watches a message on the live bus and, for every genuine frame seen inside the window
 //!   (scenario seconds on the feeds' time base), puts a faulty frame next to it:
 //!   - `crc`: the same payload with the CRC byte inverted (a corrupted frame);
@@ -46,9 +46,10 @@ enum Cmd {
         /// What the copy gets wrong.
         #[arg(long, value_enum)]
         mode: Mode,
-        /// Message id (hex with 0x, or decimal); must be E2E protected in the DBC.
-        #[arg(long, value_parser = parse_id)]
-        id: u32,
+        /// The message to mirror: its DBC name (`EgoVehicleState`), or its id (0x0A0 / 160);
+        /// it must be E2E protected in the DBC.
+        #[arg(long, alias = "id", value_name = "NAME|ID", value_parser = parse_message)]
+        message: u32,
         /// CLOCK_MONOTONIC ns of scenario t = 0 (the feeds' --epoch-ns).
         #[arg(long)]
         epoch_ns: u64,
@@ -84,12 +85,22 @@ enum Mode {
     Delay,
 }
 
-fn parse_id(s: &str) -> Result<u32, String> {
+/// A DBC message name (the bus's one source of truth) or a numeric id, to the message's id.
+fn parse_message(s: &str) -> Result<u32, String> {
+    if let Some(m) = bus::MESSAGES.iter().find(|m| m.name == s) {
+        return Ok(m.id);
+    }
     let r = match s.strip_prefix("0x").or_else(|| s.strip_prefix("0X")) {
         Some(h) => u32::from_str_radix(h, 16),
         None => s.parse(),
     };
-    r.map_err(|e| format!("bad CAN id {s:?}: {e}"))
+    r.map_err(|_| {
+        let names: Vec<&str> = bus::MESSAGES.iter().map(|m| m.name).collect();
+        format!(
+            "{s:?} is neither a DBC message ({}) nor a CAN id",
+            names.join(", ")
+        )
+    })
 }
 
 fn main() -> std::process::ExitCode {
@@ -161,7 +172,7 @@ fn run(cli: Cli) -> Result<()> {
         Cmd::Mirror {
             can,
             mode,
-            id,
+            message: id,
             epoch_ns,
             from_s,
             to_s,
@@ -261,6 +272,15 @@ mod tests {
             let got = checker.check_frame(&bad).err().map(|e| e.reason());
             assert_eq!(got, want, "{mode:?}");
         }
+    }
+
+    #[test]
+    fn messages_are_named_as_in_the_dbc() {
+        assert_eq!(parse_message("EgoVehicleState"), Ok(0x0A0));
+        assert_eq!(parse_message("0x0A0"), Ok(0x0A0));
+        assert_eq!(parse_message("160"), Ok(0x0A0));
+        let e = parse_message("EgoVehicle").unwrap_err();
+        assert!(e.contains("AirbagStageCmd"), "{e}");
     }
 
     #[test]

@@ -713,8 +713,10 @@ impl Disturbance for CaseDisturbance<'_> {
             Fault::Bus { mode, from_s, to_s } => {
                 let child = spawn_piped(
                     Command::new(ctx.bin("bus-inject"))
-                        .args(["mirror", "--can", can, "--mode", mode, "--id"])
-                        .arg(format!("{:#05x}", bus::EgoVehicleState::RAW_ID))
+                        .args(["mirror", "--can", can, "--mode", mode, "--message"])
+                        .arg(
+                            bus::message_info(bus::EgoVehicleState::RAW_ID).map_or("?", |m| m.name),
+                        )
                         .arg("--epoch-ns")
                         .arg(ctx.epoch_ns.to_string())
                         .arg("--from-s")
