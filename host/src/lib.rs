@@ -5,13 +5,16 @@
 //!   shared by every process on the machine), the synchronized time of SecOC freshness
 //!   (CLOCK_REALTIME µs), absolute sleeps, and the simulated clock of deterministic tests;
 //! * [`stop`] — the SIGTERM/SIGINT stop flag (and SIGPIPE's default for the command-line
-//!   tools).
+//!   tools);
+//! * [`files`] — where a tool finds the repository's files from any folder.
 
 pub mod clock;
+pub mod files;
 pub mod stop;
 
 pub use clock::{
     monotonic_ns, realtime_ns, sleep_through_signals_until_ns, sleep_until_ns, sync_time_us, Clock,
     MonotonicClock, SimClock, SleepOutcome,
 };
+pub use files::{find_repo, find_upwards};
 pub use stop::{default_sigpipe, install_stop_signals};

@@ -354,6 +354,21 @@ pub mod harness {
 }
 
 /// The repository root (this crate lives in `<root>/tests`).
+/// The repository a bench tool works on when `--repo` is not given: the checkout the user is
+/// in (walking up from the current folder, then from the tool's own folder), never the folder
+/// the tool was built in (issue 22).
+pub fn repo_or_default(given: Option<PathBuf>) -> Result<PathBuf> {
+    match given {
+        Some(r) => Ok(r),
+        None => host::find_repo().context(
+            "not inside the bench's repository (no bus/restraint.dbc above the current folder \
+             or the tool's): run from the checkout or pass --repo DIR",
+        ),
+    }
+}
+
+/// The repository this crate was built in — for the tests, which cargo builds and runs inside
+/// the checkout; the tools use [`repo_or_default`].
 pub fn repo_root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .parent()

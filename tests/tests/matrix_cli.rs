@@ -227,3 +227,46 @@ fn one_flag_vocabulary_across_tools() {
     let shown = String::from_utf8_lossy(&out.stdout);
     assert!(shown.contains("vcan9"), "{shown}");
 }
+
+#[test]
+fn tools_find_the_repository_they_run_in_not_the_one_they_were_built_in() {
+    // Issue 22 item 1: `--repo` defaulted to the folder the crate was built in. A tool copied
+    // out of the checkout and run outside it now says so (one line, the fix) instead of
+    // silently reading the build folder's files; inside a checkout it finds it by walking up.
+    let release = e2e_tests::repo_root().join("target/release");
+    let outside = std::env::temp_dir().join(format!("repo-walk-{}", std::process::id()));
+    std::fs::create_dir_all(&outside).expect("temp dir");
+    for tool in ["offline-bench", "misuse-matrix"] {
+        let copy = outside.join(tool);
+        std::fs::copy(release.join(tool), &copy).expect("copy the tool");
+        let args: &[&str] = if tool == "offline-bench" {
+            &["--scenario", "x.toml"]
+        } else {
+            &["--variants", "8"]
+        };
+        let out = Command::new(&copy)
+            .args(args)
+            .current_dir(&outside)
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{tool}: {err}");
+        assert!(
+            err.contains("not inside the bench's repository") && err.contains("--repo"),
+            "{tool}: {err}"
+        );
+        assert_eq!(err.trim_end().lines().count(), 1, "{tool}: {err}");
+    }
+    // From a sub-folder of the checkout, the built tool finds it by walking up.
+    let out = Command::new(release.join("misuse-matrix"))
+        .args(["--variants", "4", "--quiet"])
+        .current_dir(e2e_tests::repo_root().join("scenarios"))
+        .output()
+        .expect("runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let _ = std::fs::remove_dir_all(&outside);
+}

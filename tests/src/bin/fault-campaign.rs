@@ -45,7 +45,7 @@ enum Cmd {
         /// Folder of the bench binaries (default: this binary's folder).
         #[arg(long)]
         bin_dir: Option<PathBuf>,
-        /// Repository root (default: where this crate was built).
+        /// Repository root (default: the checkout around the current folder, found by walking up).
         #[arg(long)]
         repo: Option<PathBuf>,
         /// Also print the robustness report with these fuzzing figures.
@@ -68,7 +68,7 @@ enum Cmd {
         /// Folder of the bench binaries (default: this binary's folder).
         #[arg(long)]
         bin_dir: Option<PathBuf>,
-        /// Repository root (default: where this crate was built).
+        /// Repository root (default: the checkout around the current folder, found by walking up).
         #[arg(long)]
         repo: Option<PathBuf>,
     },
@@ -139,7 +139,7 @@ fn run() -> Result<bool> {
                     .or_else(|| std::env::var("VCAN").ok())
                     .unwrap_or_else(|| "vcan0".into()),
                 bin_dir,
-                repo: repo.unwrap_or_else(e2e_tests::repo_root),
+                repo: e2e_tests::repo_or_default(repo)?,
                 ecu_args: [e2e_tests::default_ecu_args(), ecu_arg].concat(),
             };
             let campaign = run_campaign(&cfg, &cases)?;
@@ -167,7 +167,7 @@ fn run() -> Result<bool> {
                     Some(d) => d,
                     None => this_dir()?,
                 },
-                repo: repo.unwrap_or_else(e2e_tests::repo_root),
+                repo: e2e_tests::repo_or_default(repo)?,
                 cpu,
             };
             let h = run_host_timing(&cfg)?;

@@ -30,7 +30,8 @@ struct Cli {
     /// the bench's own `--sched-fifo 80 --mlockall`).
     #[arg(long, allow_hyphen_values = true)]
     ecu_arg: Vec<String>,
-    /// Repository root (the ECU's working directory; default: where this crate was built).
+    /// Repository root (the ECU's working directory; default: the checkout around the current
+    /// folder, found by walking up).
     #[arg(long)]
     repo: Option<PathBuf>,
     /// Print only the one-line verdicts, not the full summaries.
@@ -137,7 +138,7 @@ fn run() -> Result<bool> {
             bin_dir: bin_dir.clone(),
             service_prefix: format!("hil-bench-{}-{i}", std::process::id()),
             ecu_args: [e2e_tests::default_ecu_args(), cli.ecu_arg.clone()].concat(),
-            ecu_cwd: cli.repo.clone().unwrap_or_else(e2e_tests::repo_root),
+            ecu_cwd: e2e_tests::repo_or_default(cli.repo.clone())?,
             stubs_args: e2e_tests::default_stubs_args(),
         };
         match run_until_measured(&cfg) {

@@ -39,7 +39,7 @@ struct Cli {
     /// Only these families (repeatable; `--list` names them).
     #[arg(long = "family")]
     families: Vec<String>,
-    /// Repository root (default: where this crate was built).
+    /// Repository root (default: the checkout around the current folder, found by walking up).
     #[arg(long)]
     repo: Option<PathBuf>,
     /// Also write the table and every failing variant as JSON.
@@ -339,10 +339,7 @@ fn run_matrix() -> Result<()> {
         list();
         return Ok(());
     }
-    let repo = cli
-        .repo
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(".."));
+    let repo = e2e_tests::repo_or_default(cli.repo.clone())?;
     let mut cfg = OfflineConfig::shipped(&repo).context("offline bench configuration")?;
     if let Some(path) = &cli.cycle_config {
         cfg = cfg.with_cycle_file(path)?;

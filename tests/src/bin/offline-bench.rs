@@ -32,7 +32,7 @@ struct Cli {
     /// Run without the characteristic diagram (the ECU then runs on the reference restraint).
     #[arg(long)]
     no_lut: bool,
-    /// Repository root (default: where this crate was built).
+    /// Repository root (default: the checkout around the current folder, found by walking up).
     #[arg(long)]
     repo: Option<PathBuf>,
     /// Also write every run's modes, faults, actions, outcome and expectations as JSON
@@ -68,7 +68,7 @@ fn main() -> std::process::ExitCode {
 /// Runs every file; `Ok(false)` when a file failed or missed an expectation.
 fn run_all() -> Result<bool> {
     let cli = Cli::parse();
-    let repo = cli.repo.clone().unwrap_or_else(e2e_tests::repo_root);
+    let repo = e2e_tests::repo_or_default(cli.repo.clone())?;
     let mut files = cli.scenario.clone();
     if files.is_empty() {
         for e in std::fs::read_dir(repo.join("scenarios")).context("scenarios/")? {

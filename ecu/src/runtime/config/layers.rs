@@ -107,7 +107,7 @@ impl Layers {
                         .unwrap_or_else(|| dir.join(&*path));
                 }
             } else if !from_user {
-                if let Some(found) = find_upwards(path) {
+                if let Some(found) = host::find_upwards(path) {
                     *path = found;
                 }
             }
@@ -198,21 +198,6 @@ fn unset_keys(v: &serde_json::Value, table: &str, out: &mut Vec<(String, String)
             _ => {}
         }
     }
-}
-
-/// `rel` under the first folder that holds it, walking up from the current directory, then
-/// from the executable's folder (`target/release/ecu` finds the repository's `data/`).
-fn find_upwards(rel: &Path) -> Option<PathBuf> {
-    let starts = [
-        std::env::current_dir().ok(),
-        std::env::current_exe()
-            .ok()
-            .and_then(|e| e.parent().map(Path::to_path_buf)),
-    ];
-    starts
-        .into_iter()
-        .flatten()
-        .find_map(|start| start.ancestors().map(|a| a.join(rel)).find(|p| p.exists()))
 }
 
 /// `environment variable ECU_RT__CPU` for `rt.cpu`.
