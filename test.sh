@@ -26,6 +26,11 @@ step "build the bench processes and the tests"
 # (tests/src/lib.rs `harness::build_bench_bins` runs this same command: a no-op here).
 cargo build --workspace --release --features bus/socket --bins --tests --examples
 
+step "docs: every README command run (or its tool and flags checked), every printed number regenerated (≈ 5 s)"
+# A block that differs from what its command prints now fails here; `target/release/docs-check
+# --fix` rewrites it (markers and rules: tests/src/docs.rs).
+target/release/docs-check
+
 step "tests (unit, property, physics oracles, LUT build, real vcan + iceoryx2 end to end)"
 log=$(mktemp); trap 'rm -f "$log"' EXIT
 cargo test --workspace --release --features bus/socket 2>&1 | tee "$log"

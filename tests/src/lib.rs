@@ -7,6 +7,7 @@
 //! produced lands in `OUT/<scenario>/`. Every run uses its own iceoryx2 service prefix, so
 //! leftovers of an earlier (killed) run can never be mistaken for this run's samples.
 
+pub mod docs;
 pub mod expect;
 pub mod faults;
 pub mod host_timing;

@@ -129,6 +129,7 @@ fn every_tool_answers_version_with_its_own_name() {
         "budget",
         "worst_cycle",
         "loop-vs-cyclictest",
+        "docs-check",
     ] {
         let bin = release.join(tool);
         assert!(
@@ -206,6 +207,7 @@ fn one_flag_vocabulary_across_tools() {
         "budget",
         "worst_cycle",
         "loop-vs-cyclictest",
+        "docs-check",
     ] {
         let flags = long_flags(&release.join(tool));
         assert!(
