@@ -141,7 +141,7 @@ fn real_bus_worker_body() {
         .unwrap();
     assert!(status.success());
 
-    let out = Command::new("python3")
+    let out = Command::new(python3())
         .arg(&helper)
         .args(["decode"])
         .arg(&dbc)
@@ -247,7 +247,7 @@ fn real_bus_worker_body() {
     }
     let req_path = dir.join("requests.json");
     std::fs::write(&req_path, serde_json::to_vec(&reqs).unwrap()).unwrap();
-    let out = Command::new("python3")
+    let out = Command::new(python3())
         .arg(&helper)
         .arg("encode")
         .arg(&dbc)
@@ -309,4 +309,15 @@ fn real_bus_worker_body() {
         checker.stats()
     );
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The cantools venv's Python (`tests/setup-host.sh` makes `target/pyenv`), so that `cargo
+/// test` finds cantools without the venv on PATH; plain `python3` where there is none.
+fn python3() -> std::path::PathBuf {
+    let venv = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/pyenv/bin/python3");
+    if venv.exists() {
+        venv
+    } else {
+        "python3".into()
+    }
 }

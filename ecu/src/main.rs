@@ -101,11 +101,7 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
     }
     // Every output path is checked before the run, not at its end.
     if let Some(path) = &cfg.report_json {
-        std::fs::OpenOptions::new()
-            .write(true)
-            .create(true)
-            .truncate(false)
-            .open(path)
+        host::check_output_file(path)
             .map_err(|e| anyhow::anyhow!("--report-json {}: {e}", path.display()))?;
     }
     let secoc = load_secoc(&cfg, cli.run.no_secoc)?;

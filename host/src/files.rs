@@ -29,6 +29,30 @@ pub fn find_repo() -> Option<PathBuf> {
     find_upwards(Path::new(REPO_MARK)).and_then(|dbc| dbc.parent()?.parent().map(Path::to_path_buf))
 }
 
+/// Checks, before a run, that an output file can be written at its end: makes its folder and
+/// opens the file for writing (without truncating; a file the probe created is removed
+/// again). A run that would only fail at its end — after minutes — fails at once instead.
+pub fn check_output_file(path: &Path) -> std::io::Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)?;
+    }
+    let existed = path.exists();
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(path)?;
+    if !existed {
+        let _ = std::fs::remove_file(path);
+    }
+    Ok(())
+}
+
+/// Makes an output folder before a run (and checks it is one).
+pub fn check_output_dir(dir: &Path) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -40,5 +64,22 @@ mod tests {
         assert!(repo.join(REPO_MARK).is_file(), "{}", repo.display());
         assert!(repo.join("host").is_dir(), "{}", repo.display());
         assert_eq!(find_upwards(Path::new("no/such/file-x9")), None);
+    }
+
+    #[test]
+    fn output_files_are_checked_before_the_run() {
+        let dir = std::env::temp_dir().join(format!("host-out-{}", std::process::id()));
+        let file = dir.join("a/b/report.json");
+        check_output_file(&file).expect("folder made");
+        assert!(
+            dir.join("a/b").is_dir() && !file.exists(),
+            "probe left no file"
+        );
+        std::fs::write(&file, "kept").expect("write");
+        check_output_file(&file).expect("existing file");
+        assert_eq!(std::fs::read_to_string(&file).expect("read"), "kept");
+        assert!(check_output_file(Path::new("/proc/no-such-dir/x.json")).is_err());
+        assert!(check_output_file(&dir.join("a/b/report.json/x")).is_err());
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -16,5 +16,5 @@ pub use clock::{
     monotonic_ns, realtime_ns, sleep_through_signals_until_ns, sleep_until_ns, sync_time_us, Clock,
     MonotonicClock, SimClock, SleepOutcome,
 };
-pub use files::{find_repo, find_upwards};
+pub use files::{check_output_dir, check_output_file, find_repo, find_upwards};
 pub use stop::{default_sigpipe, install_stop_signals};

@@ -16,7 +16,7 @@ mod study;
 mod study_fallback;
 mod study_occ;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -64,12 +64,35 @@ enum Command {
 /// backtrace (which `main() -> anyhow::Result` prints when RUST_BACKTRACE is set).
 fn main() -> std::process::ExitCode {
     host::default_sigpipe();
-    match run(Cli::parse()) {
+    let matches = Cli::command().get_matches();
+    let checked = check_outputs(&matches);
+    match checked
+        .and_then(|()| Ok(Cli::from_arg_matches(&matches)?))
+        .and_then(run)
+    {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("lut: error: {e:#}");
             std::process::ExitCode::FAILURE
         }
+    }
+}
+
+/// Every output path of every subcommand (`--out`, `--plot`, `--json`) is checked before the
+/// work — a build or a study takes minutes — not when its result is written: its folder is
+/// made and the file opened for writing (an existing folder is taken as the output folder).
+fn check_outputs(m: &clap::ArgMatches) -> anyhow::Result<()> {
+    for id in ["out", "plot", "json"] {
+        if let Ok(Some(p)) = m.try_get_one::<std::path::PathBuf>(id) {
+            if !p.is_dir() {
+                host::check_output_file(p)
+                    .map_err(|e| anyhow::anyhow!("--{id} {}: {e}", p.display()))?;
+            }
+        }
+    }
+    match m.subcommand() {
+        Some((_, sub)) => check_outputs(sub),
+        None => Ok(()),
     }
 }
 

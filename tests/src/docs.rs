@@ -287,6 +287,14 @@ impl Checker {
         p.is_file().then_some(p)
     }
 
+    /// A prose code span that is a bench-tool command with flags (`ecu --no-can`,
+    /// `target/release/lut plot … --field a_max_g`), not a bare name (`ecu`).
+    fn tool_span(&self, span: &str) -> bool {
+        let mut words = span.split_whitespace();
+        let first = words.next().unwrap_or("");
+        self.tool(first).is_some() && span.contains("--")
+    }
+
     /// Problems of one command not run: each program exists, each flag is known.
     pub fn check_flags(&mut self, cmd: &str) -> Vec<String> {
         let Some(words) = shlex::split(cmd) else {
@@ -420,6 +428,23 @@ impl Checker {
                 return (problems, fixes);
             }
         };
+        // Commands in the prose (`lut plot FILE --field a_max_g …` in a sentence or a table):
+        // each code span that starts with a bench tool has its flags checked.
+        for (line, span) in inline_commands(&text) {
+            if !self.tool_span(&span) {
+                continue;
+            }
+            let cleaned = span.replace("\\|", "|").replace('…', " ");
+            let words: Vec<String> = cleaned.split_whitespace().map(str::to_owned).collect();
+            let mut problems_here = Vec::new();
+            self.check_segment(&words, &mut problems_here);
+            for p in problems_here {
+                problems.push(Problem {
+                    at: format!("{}:{line}", rel.display()),
+                    what: format!("`{span}`: {p}"),
+                });
+            }
+        }
         let all = blocks(&text);
         for (k, b) in all.iter().enumerate() {
             let at = format!("{}:{}", rel.display(), b.line);
@@ -512,6 +537,27 @@ impl Checker {
         }
         (problems, fixes)
     }
+}
+
+/// The code spans of the prose (outside fenced blocks) with their 1-based line.
+pub fn inline_commands(text: &str) -> Vec<(usize, String)> {
+    let mut out = Vec::new();
+    let mut fenced = false;
+    for (i, line) in text.lines().enumerate() {
+        if line.starts_with("```") {
+            fenced = !fenced;
+            continue;
+        }
+        if fenced {
+            continue;
+        }
+        let mut parts = line.split('`');
+        parts.next();
+        while let (Some(code), Some(_)) = (parts.next(), parts.next()) {
+            out.push((i + 1, code.to_owned()));
+        }
+    }
+    out
 }
 
 /// The subcommands a clap `--help` lists under `Commands:`.

@@ -317,20 +317,30 @@ pub mod harness {
 
     /// Runs `vcan-setup.sh --run -- ARGS…` once per argument list, all at once (one guest each),
     /// in the repository root; prints each guest's stdout and stderr under a `--- WHAT, guest k
-    /// of n ---` header and returns their outputs in the same order.
+    /// of n ---` header and returns their outputs in the same order. `out` is the folder the
+    /// runs write under, made here and shared into the guest read-write (`VCAN_GUEST_RW`), as a
+    /// user's `--out` anywhere is (issue 22 item 2).
     pub fn run_in_guests(
         what: &str,
+        out: &Path,
         runs: Vec<Vec<std::ffi::OsString>>,
     ) -> Vec<std::process::Output> {
         let script = super::repo_root().join("vcan-setup.sh");
+        std::fs::create_dir_all(out).expect("output folder");
+        let rw = match std::env::var("VCAN_GUEST_RW") {
+            Ok(more) if !more.is_empty() => format!("{}:{more}", out.display()),
+            _ => out.display().to_string(),
+        };
         let handles: Vec<_> = runs
             .into_iter()
             .map(|args| {
                 let script = script.clone();
+                let rw = rw.clone();
                 std::thread::spawn(move || {
                     Command::new(&script)
                         .args(["--run", "--"])
                         .args(&args)
+                        .env("VCAN_GUEST_RW", rw)
                         .current_dir(super::repo_root())
                         .output()
                         .expect("vcan-setup.sh --run")
@@ -354,7 +364,6 @@ pub mod harness {
     }
 }
 
-/// The repository root (this crate lives in `<root>/tests`).
 /// The repository a bench tool works on when `--repo` is not given: the checkout the user is
 /// in (walking up from the current folder, then from the tool's own folder), never the folder
 /// the tool was built in (issue 22).

@@ -48,7 +48,10 @@ fn bench_run() -> &'static Path {
         harness::build_bench_bins();
         harness::vcan_route();
         let bins = harness::bin_dir();
-        let out = bins.join("e2e-bench-out");
+        // Outside the work tree, as a user's `--out $HOME/runs` (issue 22 item 2: on the guest
+        // routes such a folder was read-only): every test below reads its reports from here.
+        let out = std::env::temp_dir().join(format!("e2e-bench-out-{}", std::process::id()));
+        assert!(!out.starts_with(root()) && !out.starts_with(&bins));
         let _ = std::fs::remove_dir_all(&out);
         // One guest per group of scenarios, side by side where the guests run in virtual time
         // (harness::parallel_guests); each scenario writes OUT/<name>/.
@@ -70,7 +73,7 @@ fn bench_run() -> &'static Path {
                 args
             })
             .collect();
-        let outputs = harness::run_in_guests("hil-bench (all summaries)", runs);
+        let outputs = harness::run_in_guests("hil-bench (all summaries)", &out, runs);
         for (k, o) in outputs.iter().enumerate() {
             assert!(
                 o.status.success(),
@@ -251,12 +254,17 @@ fn candump_log_decodes_with_cantools_and_the_dbc() {
     let text = std::fs::read_to_string(&log).expect("candump.log");
     let lines = text.lines().filter(|l| !l.trim().is_empty()).count();
     assert!(lines > 100, "candump captured {lines} frames");
-    let o = Command::new("python3")
-        .args(["-m", "cantools", "decode", "--single-line"])
-        .arg(root().join("bus/restraint.dbc"))
-        .stdin(std::fs::File::open(&log).expect("open log"))
-        .output()
-        .expect("python3 -m cantools (tests/setup-host.sh installs it; put its venv on PATH)");
+    let venv = root().join("target/pyenv/bin/python3");
+    let o = Command::new(if venv.exists() {
+        venv
+    } else {
+        "python3".into()
+    })
+    .args(["-m", "cantools", "decode", "--single-line"])
+    .arg(root().join("bus/restraint.dbc"))
+    .stdin(std::fs::File::open(&log).expect("open log"))
+    .output()
+    .expect("python3 -m cantools (tests/setup-host.sh installs it; put its venv on PATH)");
     assert!(
         o.status.success(),
         "cantools: {}",

@@ -1,6 +1,7 @@
 //! The docs check catches what issue 22 item 6 found by hand: a README command whose flag does
 //! not exist (`lut plot --field a_max` after the field became `a_max_g`), numbers a command no
-//! longer prints, a command that fails, and a command block nobody checks.
+//! longer prints, a command that fails, a command block nobody checks, and a command in the
+//! prose with a flag its tool does not take.
 
 use std::path::Path;
 use std::time::Duration;
@@ -34,6 +35,8 @@ candump -L vcan0 | sh -c cat
 sensor-feeds --scenario F [--can IF | --no-can]
              [--check]
 ```
+
+In prose: `lut plot FILE [--field F] --out P.png\\|.svg`, `ecu --no-can`, `ecu`, `x --y`.
 ";
 
 const BAD: &str = "\
@@ -66,6 +69,8 @@ ls
 ```sh
 sensor-feeds --scenario F [--can-interface IF | --no-can]
 ```
+
+In prose: `target/release/lut plot data/default.lut --fieldz a_max_g` and `ecu --no-can`.
 ";
 
 fn check(text: &str) -> Vec<String> {
@@ -99,6 +104,7 @@ fn every_kind_of_drift_is_caught_at_its_line() {
         (":17:", "no-such-program-x9: not installed"),
         (":22:", "without a docs marker"),
         (":27:", "no flag --can-interface"),
+        (":31:", "no flag --fieldz"),
     ];
     assert_eq!(p.len(), want.len(), "{p:#?}");
     for (at, what) in want {

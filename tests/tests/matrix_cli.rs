@@ -272,3 +272,38 @@ fn tools_find_the_repository_they_run_in_not_the_one_they_were_built_in() {
     );
     let _ = std::fs::remove_dir_all(&outside);
 }
+
+#[test]
+fn output_paths_are_checked_before_the_work() {
+    // Issue 22 item 1: an output path that cannot be written failed only at the run's end
+    // (after a whole library, a matrix, a table build). Now: at once, naming the flag, with
+    // nothing run (stdout empty).
+    let release = e2e_tests::repo_root().join("target/release");
+    let bad = "/proc/no-such-folder/x.out";
+    for (tool, args) in [
+        ("offline-bench", vec!["--json", bad]),
+        ("offline-bench", vec!["--plot", bad]),
+        ("misuse-matrix", vec!["--variants", "64", "--json", bad]),
+        (
+            "lut",
+            vec!["build", "--grid", "data/default-grid.toml", "--out", bad],
+        ),
+        ("lut", vec!["study", "stiffness", "--plot", bad]),
+        ("worst_cycle", vec!["search", "--out", bad]),
+        ("hil-bench", vec!["--scenario", "x.toml", "--out", bad]),
+    ] {
+        let out = Command::new(release.join(tool))
+            .args(&args)
+            .current_dir(e2e_tests::repo_root())
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{tool} {args:?}");
+        assert!(err.contains(bad), "{tool} {args:?}: {err}");
+        assert!(
+            out.stdout.is_empty(),
+            "{tool} {args:?} ran before failing: {}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+    }
+}

@@ -72,7 +72,7 @@ fn campaign() -> &'static Campaign {
                 args
             })
             .collect();
-        let outputs = run_in_guests("fault-campaign", runs);
+        let outputs = run_in_guests("fault-campaign", &out, runs);
         let mut parts = Vec::new();
         for (o, dir) in outputs.iter().zip(&dirs) {
             let path = dir.join("campaign.json");

@@ -137,6 +137,10 @@ fn search(
     budget: Option<u64>,
     out: Option<&Path>,
 ) -> anyhow::Result<bool> {
+    // The output path is checked before the search, not after it.
+    if let Some(p) = out {
+        host::check_output_file(p).map_err(|e| anyhow::anyhow!("--out {}: {e}", p.display()))?;
+    }
     let dir = std::env::temp_dir();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let population = population.max(4);

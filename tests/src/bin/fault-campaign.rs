@@ -142,8 +142,9 @@ fn run() -> Result<bool> {
                 repo: e2e_tests::repo_or_default(repo)?,
                 ecu_args: [e2e_tests::default_ecu_args(), ecu_arg].concat(),
             };
+            // The output folder is checked before the campaign's minutes, not after them.
+            host::check_output_dir(&out).with_context(|| format!("--out {}", out.display()))?;
             let campaign = run_campaign(&cfg, &cases)?;
-            std::fs::create_dir_all(&out)?;
             let path = out.join("campaign.json");
             std::fs::write(&path, serde_json::to_string_pretty(&campaign)?)?;
             let png = out.join("campaign.png");
@@ -170,8 +171,8 @@ fn run() -> Result<bool> {
                 repo: e2e_tests::repo_or_default(repo)?,
                 cpu,
             };
+            host::check_output_dir(&out).with_context(|| format!("--out {}", out.display()))?;
             let h = run_host_timing(&cfg)?;
-            std::fs::create_dir_all(&out)?;
             let path = out.join("host-timing.json");
             std::fs::write(&path, serde_json::to_string_pretty(&h)?)?;
             println!("{}", host_timing_text(&h));

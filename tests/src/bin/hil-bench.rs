@@ -5,7 +5,7 @@
 //! `--no-expect` skips it): a miss is printed (`hil-bench: MISSED <scenario>: [expect] <key> =
 //! <expected>, measured <value>`) and the exit status is 1.
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::Parser;
 use e2e_tests::{run_scenario, RunConfig};
 use std::path::PathBuf;
@@ -129,6 +129,8 @@ fn run() -> Result<bool> {
         .can
         .or_else(|| std::env::var("VCAN").ok())
         .unwrap_or_else(|| "vcan0".into());
+    // The output folder is checked before the runs, not after them.
+    host::check_output_dir(&cli.out).with_context(|| format!("--out {}", cli.out.display()))?;
     let mut all_ok = true;
     for (i, scenario) in cli.scenario.iter().enumerate() {
         let cfg = RunConfig {

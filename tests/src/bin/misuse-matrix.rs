@@ -340,6 +340,12 @@ fn run_matrix() -> Result<()> {
         return Ok(());
     }
     let repo = e2e_tests::repo_or_default(cli.repo.clone())?;
+    // Every output path is checked before the run, not at its end.
+    for (flag, path) in [("--json", &cli.json), ("--outcomes", &cli.outcomes)] {
+        if let Some(p) = path {
+            host::check_output_file(p).with_context(|| format!("{flag} {}", p.display()))?;
+        }
+    }
     let mut cfg = OfflineConfig::shipped(&repo).context("offline bench configuration")?;
     if let Some(path) = &cli.cycle_config {
         cfg = cfg.with_cycle_file(path)?;

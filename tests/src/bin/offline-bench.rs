@@ -86,8 +86,12 @@ fn run_all() -> Result<bool> {
     if cli.no_lut {
         cfg.lut = None;
     }
+    // Every output path is checked before the run, not at its end.
     if let Some(dir) = &cli.plot {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        host::check_output_dir(dir).with_context(|| format!("--plot {}", dir.display()))?;
+    }
+    if let Some(p) = &cli.json {
+        host::check_output_file(p).with_context(|| format!("--json {}", p.display()))?;
     }
     // Load every file first: the table's name column fits the longest name.
     let loaded: Vec<_> = files
