@@ -441,6 +441,12 @@ fn generate_meta(dbc: &Dbc) -> String {
     writeln!(head, "pub const E2E_MESSAGE_COUNT: usize = {e2e_slot};").unwrap();
     writeln!(
         head,
+        "/// Names of the E2E CRC and alive-counter signals in every protected message.
+pub const E2E_SIGNALS: (&str, &str) = ({CRC_SIGNAL:?}, {COUNTER_SIGNAL:?});"
+    )
+    .unwrap();
+    writeln!(
+        head,
         "/// E2E fields of a decoded message, `None` for unprotected frames (generated).
 pub(crate) fn e2e_view(m: &Messages) -> Option<E2eView<'_>> {{
     match m {{

@@ -36,9 +36,12 @@ mod meta {
 pub use strum::{EnumCount, VariantArray};
 
 pub use meta::{
-    encode_values, message_name, signal_values, signals_of, E2E_MESSAGE_COUNT, MESSAGES,
+    encode_values, message_name, signal_values, signals_of, E2E_MESSAGE_COUNT, E2E_SIGNALS,
+    MESSAGES,
 };
 
+#[cfg(feature = "socket")]
+pub mod candump;
 #[cfg(feature = "socket")]
 pub mod socket;
 
@@ -248,6 +251,85 @@ impl RawFrame {
     pub fn payload(&self) -> &[u8] {
         let len = usize::from(self.len).min(8);
         self.data.get(..len).unwrap_or(&[])
+    }
+
+    /// The E2E layout of this frame's message from the DBC: data id, CRC signal, counter
+    /// signal; `None` for a frame without E2E protection.
+    fn e2e_layout(&self) -> Option<(u16, &'static SignalInfo, &'static SignalInfo)> {
+        let data_id = message_info(self.id)?.e2e_data_id?;
+        let signals = signals_of(self.id)?;
+        let find = |name: &str| signals.iter().find(|s| s.name == name);
+        Some((data_id, find(E2E_SIGNALS.0)?, find(E2E_SIGNALS.1)?))
+    }
+
+    /// The alive counter of an E2E-protected frame (positions from the DBC).
+    #[must_use]
+    pub fn e2e_counter(&self) -> Option<u8> {
+        let (_, _, counter) = self.e2e_layout()?;
+        let raw = intel_raw(
+            le_word(self.payload()),
+            counter.start_bit,
+            counter.size,
+            false,
+        );
+        u8::try_from(raw).ok()
+    }
+
+    /// Writes `counter` (cut to the signal's width) into the alive counter and re-seals the
+    /// CRC, as a node whose counter jumped would send it; `false` for an unprotected frame.
+    /// For the bench's attackers and fuzzers: nothing outside `bus` types a byte position.
+    pub fn set_e2e_counter(&mut self, counter: u8) -> bool {
+        let Some((_, _, c)) = self.e2e_layout() else {
+            return false;
+        };
+        let w = with_intel_raw(
+            le_word(self.payload()),
+            c.start_bit,
+            c.size,
+            i64::from(counter),
+        );
+        let len = usize::from(self.len).min(8);
+        self.data[..len].copy_from_slice(&w.to_le_bytes()[..len]);
+        self.reseal()
+    }
+
+    /// Recomputes the E2E CRC over the frame as it now is; `false` for an unprotected frame.
+    pub fn reseal(&mut self) -> bool {
+        let Some((data_id, crc, _)) = self.e2e_layout() else {
+            return false;
+        };
+        let byte = (crc.start_bit / 8) as usize;
+        let value = e2e_crc(data_id, byte, self.payload());
+        match self.data.get_mut(byte) {
+            Some(b) if byte < usize::from(self.len) => {
+                *b = value;
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// Whether the E2E CRC matches the frame (positions from the DBC); `None` for an
+    /// unprotected frame. An oracle for fuzzers that does not go through the checker.
+    #[must_use]
+    pub fn e2e_crc_ok(&self) -> Option<bool> {
+        let mut resealed = *self;
+        resealed.reseal().then(|| resealed.data == self.data)
+    }
+
+    /// Inverts the CRC byte (a corrupted frame); `false` for an unprotected frame.
+    pub fn corrupt_crc(&mut self) -> bool {
+        let Some((_, crc, _)) = self.e2e_layout() else {
+            return false;
+        };
+        let byte = (crc.start_bit / 8) as usize;
+        match self.data.get_mut(byte) {
+            Some(b) if byte < usize::from(self.len) => {
+                *b = !*b;
+                true
+            }
+            _ => false,
+        }
     }
 
     /// Frame of a generated message, unchanged (E2E fields as they are).
@@ -715,5 +797,41 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The raw-frame editors (for attackers and fuzzers, positions from the DBC's signal
+    /// table) agree with the typed path (`E2eProtector` through the generated impls): a
+    /// counter set on a raw frame and resealed is the frame the protector sends with that
+    /// counter; a corrupted CRC is what the checker rejects as one.
+    #[test]
+    fn raw_frame_e2e_editors_agree_with_the_protector() {
+        let mut p = E2eProtector::new();
+        let v = [0.0, 0.0, 0.0, 0.0, 9.0, 10.0]; // Crc, AliveCounter, Pretensioner, Source, kN, ms
+        let msg = || {
+            let f = encode_values(BeltLimiterCmd::RAW_ID, &v).expect("encode");
+            BeltLimiterCmd::try_from(f.payload()).expect("typed")
+        };
+        let first = p.seal(msg());
+        assert_eq!(first.e2e_counter(), Some(0));
+        assert_eq!(first.e2e_crc_ok(), Some(true));
+        for _ in 0..4 {
+            p.seal(msg());
+        }
+        let fifth = p.seal(msg());
+        let mut edited = first;
+        assert!(edited.set_e2e_counter(5));
+        assert_eq!(edited, fifth);
+        let mut bad = fifth;
+        assert!(bad.corrupt_crc());
+        assert_eq!(bad.e2e_crc_ok(), Some(false));
+        let mut rx = E2eChecker::new();
+        assert_eq!(
+            rx.check_frame(&bad).err().map(|e| e.reason()),
+            Some(RejectReason::CrcMismatch)
+        );
+        // Unprotected frames are left alone.
+        let mut auth = RawFrame::new(AirbagStageAuth::RAW_ID, &[1, 2, 3, 4, 5, 6, 7, 8]);
+        assert!(!auth.reseal() && !auth.corrupt_crc() && !auth.set_e2e_counter(1));
+        assert_eq!((auth.e2e_counter(), auth.e2e_crc_ok()), (None, None));
     }
 }

@@ -126,23 +126,12 @@ fn worker_body() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "ecu failed:\n{stdout}\n{stderr}");
 
-    // Parse candump -L: "(sec.usec) vcan0 040#0011223344556677".
-    let text = std::fs::read_to_string(&log).unwrap();
+    let log = bus::candump::CandumpLog::read(&log).unwrap();
     let mut rx = bus::E2eChecker::with_max_lost(15);
     let (mut belts, mut adaptive_belts, mut bags, mut status) = (0, 0, 0, 0);
     let mut lut_id_seen = None;
-    for line in text.lines() {
-        let Some(frame) = line.split_whitespace().nth(2) else {
-            continue;
-        };
-        let Some((id, data)) = frame.split_once('#') else {
-            continue;
-        };
-        let id = u32::from_str_radix(id, 16).unwrap();
-        let bytes: Vec<u8> = (0..data.len() / 2)
-            .map(|i| u8::from_str_radix(&data[2 * i..2 * i + 2], 16).unwrap())
-            .collect();
-        match rx.check(id, &bytes) {
+    for f in log.frames.iter().map(|l| &l.frame) {
+        match rx.check(f.id, f.payload()) {
             Ok(bus::Messages::BeltLimiterCmd(m)) => {
                 belts += 1;
                 if m.cmd_source() == BeltLimiterCmdCmdSource::Adaptive {
@@ -161,12 +150,19 @@ fn worker_body() {
             Ok(_) => {}
             Err(e) => {
                 // Only the ECU's frames must be E2E-valid; ours are checked the same way.
-                panic!("E2E-invalid frame on the bus: {line}: {e}");
+                panic!(
+                    "E2E-invalid frame on the bus: {}: {e}",
+                    bus::candump::cansend_arg(f)
+                );
             }
         }
     }
     eprintln!("candump: belt {belts} (adaptive {adaptive_belts}), airbag {bags}, status {status}");
-    assert!(belts >= 20, "BeltLimiterCmd frames: {belts}\n{text}");
+    assert!(
+        belts >= 20,
+        "BeltLimiterCmd frames: {belts} of {} in the log",
+        log.frames.len()
+    );
     assert!(
         adaptive_belts >= 1,
         "pre-crash preset never reached the bus\n{stdout}\n{stderr}"

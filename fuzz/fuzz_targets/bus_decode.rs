@@ -29,9 +29,9 @@ fuzz_target!(|data: &[u8]| {
     };
     let info = bus::message_info(id).expect("accepted id is in the DBC");
     assert_eq!(payload.len(), info.size);
-    if let Some(data_id) = info.e2e_data_id {
-        // Every E2E frame of this DBC carries its CRC in byte 0.
-        assert_eq!(bus::e2e_crc(data_id, 0, payload), payload[0]);
+    if info.e2e_data_id.is_some() {
+        // A decoded E2E frame carries a valid CRC (positions from the DBC).
+        assert_eq!(bus::RawFrame::new(id, payload).e2e_crc_ok(), Some(true));
     }
     let mut vals = [0f64; 16];
     let n = bus::signal_values(&msg, &mut vals).expect("16 slots suffice");

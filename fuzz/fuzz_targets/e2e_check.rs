@@ -51,8 +51,9 @@ fuzz_target!(|data: &[u8]| {
         let info = bus::message_info(id);
         let crc_ok = info.is_some_and(|i| {
             payload.len() == i.size
-                && i.e2e_data_id
-                    .is_none_or(|d| bus::e2e_crc(d, 0, payload) == payload[0])
+                && bus::RawFrame::new(id, payload)
+                    .e2e_crc_ok()
+                    .unwrap_or(true)
         });
         match &r {
             Ok(_) => {

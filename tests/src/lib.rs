@@ -401,12 +401,8 @@ pub(crate) fn terminate(
     }
     let pid = nix::unistd::Pid::from_raw(child.id() as i32);
     let _ = nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGTERM);
-    let until = Instant::now() + grace;
-    while Instant::now() < until {
-        if let Some(st) = child.try_wait()? {
-            return Ok(st);
-        }
-        std::thread::sleep(Duration::from_millis(10));
+    if let Some(st) = wait_timeout::ChildExt::wait_timeout(child, grace)? {
+        return Ok(st);
     }
     let _ = child.kill();
     let st = child.wait()?;
@@ -462,16 +458,6 @@ fn wait_ready(ready: std::sync::mpsc::Receiver<()>, child: &mut Child, what: &st
     bail!("{what} did not get ready within 30 s")
 }
 
-fn wait_timeout(child: &mut Child, timeout: Duration) -> Result<Option<std::process::ExitStatus>> {
-    let until = Instant::now() + timeout;
-    while Instant::now() < until {
-        if let Some(st) = child.try_wait()? {
-            return Ok(Some(st));
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    Ok(None)
-}
 
 /// The sensor-feeds command of a run: CAN or `--no-can`, the run's services, and the time
 /// base (`None`: the feeds choose it and announce it).
@@ -657,7 +643,7 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
         } else {
             Duration::from_secs(5)
         };
-        if wait_timeout(&mut p.child, grace)?.is_none() {
+        if wait_timeout::ChildExt::wait_timeout(&mut p.child, grace)?.is_none() {
             terminate(&mut p.child, &p.name, Duration::from_secs(2))?;
         }
     }

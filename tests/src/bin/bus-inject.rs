@@ -16,8 +16,8 @@
 //!   followed by an `AirbagStageAuth` with freshness `F` and a MAC the attacker has to guess —
 //!   exactly what someone with the public DBC but without the key can put on the bus.
 //!
-//! E2E positions come from the DBC (`bus::message_info`): CRC in byte 0, alive counter in the
-//! low nibble of byte 1.
+//! E2E positions come from the DBC, through `bus::RawFrame`'s `corrupt_crc`,
+//! `set_e2e_counter` and `reseal`: nothing here types a byte position.
 
 use anyhow::{bail, Context, Result};
 use bus::RawFrame;
@@ -113,21 +113,18 @@ fn main() -> std::process::ExitCode {
     }
 }
 
-/// `ID#HEX` as `cansend` takes it.
-fn cansend_arg(f: &RawFrame) -> String {
-    let hex: String = f.payload().iter().map(|b| format!("{b:02X}")).collect();
-    format!("{:03X}#{hex}", f.id)
-}
+use bus::candump::cansend_arg;
 
 /// The faulty copy of a genuine E2E frame for `mode` (`delay`/`replay`: the frame itself).
-fn faulty_copy(mode: Mode, data_id: u16, genuine: &RawFrame) -> RawFrame {
+fn faulty_copy(mode: Mode, genuine: &RawFrame) -> RawFrame {
     let mut f = *genuine;
     match mode {
-        Mode::Crc => f.data[0] = !f.data[0],
+        Mode::Crc => {
+            f.corrupt_crc();
+        }
         Mode::Counter => {
-            let c = (f.data[1] & 0x0F).wrapping_add(5) & 0x0F;
-            f.data[1] = (f.data[1] & 0xF0) | c;
-            f.data[0] = bus::e2e_crc(data_id, 0, f.payload());
+            let c = f.e2e_counter().unwrap_or(0).wrapping_add(5);
+            f.set_e2e_counter(c);
         }
         Mode::Replay | Mode::Delay => {}
     }
@@ -146,10 +143,7 @@ fn forge_fire(counter: u8, freshness: u32, mac: u64) -> Result<(RawFrame, RawFra
         &[0.0, f64::from(counter), 1.0, 1.0, 0.0, 3.0, 6.0, 0.0],
     )
     .map_err(|e| anyhow::anyhow!("encoding the forged command: {e:?}"))?;
-    let data_id = bus::message_info(bus::AirbagStageCmd::RAW_ID)
-        .and_then(|i| i.e2e_data_id)
-        .context("AirbagStageCmd has an E2E data id in the DBC")?;
-    cmd.data[0] = bus::e2e_crc(data_id, 0, cmd.payload());
+    anyhow::ensure!(cmd.reseal(), "AirbagStageCmd has E2E protection in the DBC");
     let auth = bus::encode_values(
         bus::AirbagStageAuth::RAW_ID,
         &[f64::from(freshness), mac as f64],
@@ -181,9 +175,10 @@ fn run(cli: Cli) -> Result<()> {
             if !(from_s.is_finite() && to_s.is_finite() && to_s > from_s && from_s >= 0.0) {
                 bail!("window must satisfy 0 <= from_s < to_s");
             }
-            let data_id = bus::message_info(id)
-                .and_then(|i| i.e2e_data_id)
-                .with_context(|| format!("0x{id:03X} is not an E2E-protected DBC message"))?;
+            anyhow::ensure!(
+                bus::message_info(id).is_some_and(|i| i.e2e_data_id.is_some()),
+                "0x{id:03X} is not an E2E-protected DBC message"
+            );
             let mut sock = bus::socket::BusSocket::open(&can, &[id])
                 .with_context(|| format!("opening {can}"))?;
             let at = |s: f64| epoch_ns.saturating_add((s * 1e9) as u64);
@@ -202,7 +197,7 @@ fn run(cli: Cli) -> Result<()> {
                     }
                     seen += 1;
                     let due = if mode == Mode::Delay { t + delay_ns } else { t };
-                    queue.push_back((due, faulty_copy(mode, data_id, &rx.frame)));
+                    queue.push_back((due, faulty_copy(mode, &rx.frame)));
                 }
                 while queue.front().is_some_and(|(due, _)| *due <= now) {
                     if let Some((_, f)) = queue.pop_front() {
@@ -246,21 +241,18 @@ mod tests {
     use super::*;
 
     /// A genuine EgoVehicleState with alive counter 3 and a correct CRC.
-    fn genuine() -> (u16, RawFrame) {
-        let data_id = bus::message_info(bus::EgoVehicleState::RAW_ID)
-            .and_then(|i| i.e2e_data_id)
-            .expect("E2E id");
+    fn genuine() -> RawFrame {
         // Crc, AliveCounter, BrakeState, EgoSpeed, EgoLongAccel.
         let mut f = bus::encode_values(bus::EgoVehicleState::RAW_ID, &[0.0, 3.0, 0.0, 13.0, 0.0])
             .expect("encode");
-        f.data[0] = bus::e2e_crc(data_id, 0, f.payload());
-        (data_id, f)
+        assert!(f.reseal());
+        f
     }
 
     #[test]
     fn each_fault_is_rejected_for_its_own_reason() {
         use bus::RejectReason as R;
-        let (data_id, g) = genuine();
+        let g = genuine();
         for (mode, want) in [
             (Mode::Crc, Some(R::CrcMismatch)),
             (Mode::Counter, Some(R::CounterSkipped)),
@@ -268,7 +260,7 @@ mod tests {
         ] {
             let mut checker = bus::E2eChecker::new();
             checker.check_frame(&g).expect("genuine frame accepted");
-            let bad = faulty_copy(mode, data_id, &g);
+            let bad = faulty_copy(mode, &g);
             let got = checker.check_frame(&bad).err().map(|e| e.reason());
             assert_eq!(got, want, "{mode:?}");
         }

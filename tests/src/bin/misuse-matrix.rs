@@ -136,9 +136,9 @@ fn matrix_args(cli: &Cli, repo: &std::path::Path) -> Result<Vec<String>> {
     Ok(a)
 }
 
-/// Single-quoted for bash.
+/// Quoted for the batch script's shell.
 fn sh_quote(s: &str) -> String {
-    format!("'{}'", s.replace('\'', "'\\''"))
+    shlex::try_quote(s).map_or_else(|_| format!("'{s}'"), |q| q.into_owned())
 }
 
 /// Runs the matrix as a Slurm array of `n` tasks and returns every variant's outcome.

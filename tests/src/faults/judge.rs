@@ -127,26 +127,20 @@ fn counter(ecu: Option<&serde_json::Value>, name: &str) -> u64 {
 /// and occupant frames of the feeds (a random frame with one of those two ids is counted as
 /// the feeds'; 2 of 2048 ids).
 fn flood_frames(run: &RunResult) -> u64 {
-    let Ok(text) = std::fs::read_to_string(run.dir.join("candump.log")) else {
+    let Ok(log) = bus::candump::CandumpLog::read(&run.dir.join("candump.log")) else {
         return 0;
     };
-    let (mut total, mut feeds) = (0u64, 0u64);
-    for l in text.lines() {
-        // Only frame lines count: `(time) iface ID#DATA`.
-        let Some(frame) = l
-            .starts_with('(')
-            .then(|| l.split_whitespace().nth(2))
-            .flatten()
-            .filter(|f| f.contains('#'))
-        else {
-            continue;
-        };
-        total += 1;
-        if frame.starts_with("0A0#") || frame.starts_with("0C0#") {
-            feeds += 1;
-        }
-    }
-    total.saturating_sub(feeds + counter(run.ecu_report.as_ref(), "can_tx"))
+    let feeds = log
+        .frames
+        .iter()
+        .filter(|f| {
+            matches!(
+                f.frame.id,
+                bus::EgoVehicleState::RAW_ID | bus::OccupantClassification::RAW_ID
+            )
+        })
+        .count() as u64;
+    (log.frames.len() as u64).saturating_sub(feeds + counter(run.ecu_report.as_ref(), "can_tx"))
 }
 
 /// Frames on the SecOC command and authenticator ids that the ECU did not send: what the stubs

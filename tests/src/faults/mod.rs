@@ -997,33 +997,20 @@ pub fn lengthened_scenario(src: &Path, dir: &Path, extra_s: f64) -> Result<PathB
 
 /// The first Fire command of a candump log and the authenticator after it, as cansend args.
 pub fn recorded_fire_pair(candump_log: &Path) -> Result<(String, String)> {
-    let text = std::fs::read_to_string(candump_log)
+    let log = bus::candump::CandumpLog::read(candump_log)
         .with_context(|| format!("reading {}", candump_log.display()))?;
-    let mut fire: Option<String> = None;
-    for line in text.lines() {
-        // "(1700000000.123456) vcan0 030#0011223344556677"
-        let Some(frame) = line.split_whitespace().nth(2) else {
-            continue;
-        };
-        let Some((id, hex)) = frame.split_once('#') else {
-            continue;
-        };
-        let bytes: Option<Vec<u8>> = (0..hex.len() / 2)
-            .map(|i| u8::from_str_radix(hex.get(2 * i..2 * i + 2)?, 16).ok())
-            .collect();
-        let (Ok(id), Some(bytes)) = (u32::from_str_radix(id, 16), bytes) else {
-            continue;
-        };
-        match (id, &fire) {
+    let mut fire: Option<&bus::RawFrame> = None;
+    for f in log.frames.iter().map(|l| &l.frame) {
+        match (f.id, fire) {
             (bus::AirbagStageCmd::RAW_ID, None) => {
-                if let Ok(bus::Messages::AirbagStageCmd(m)) = bus::decode(id, &bytes) {
+                if let Ok(bus::Messages::AirbagStageCmd(m)) = bus::decode(f.id, f.payload()) {
                     if matches!(m.fire(), bus::codec::AirbagStageCmdFire::Fire) {
-                        fire = Some(frame.to_owned());
+                        fire = Some(f);
                     }
                 }
             }
             (bus::AirbagStageAuth::RAW_ID, Some(cmd)) => {
-                return Ok((cmd.clone(), frame.to_owned()))
+                return Ok((bus::candump::cansend_arg(cmd), bus::candump::cansend_arg(f)))
             }
             _ => {}
         }
@@ -1174,12 +1161,8 @@ mod tests {
             ],
         )
         .expect("encode");
-        let data_id = bus::message_info(bus::AirbagStageCmd::RAW_ID)
-            .and_then(|i| i.e2e_data_id)
-            .expect("id");
-        f.data[0] = bus::e2e_crc(data_id, 0, f.payload());
-        let hex: String = f.payload().iter().map(|b| format!("{b:02X}")).collect();
-        format!("030#{hex}")
+        assert!(f.reseal());
+        bus::candump::cansend_arg(&f)
     }
 
     #[test]
