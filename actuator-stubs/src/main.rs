@@ -341,12 +341,14 @@ fn build_report(
             .iter()
             .map(|a| TimedAction {
                 action: a.clone(),
-                t_ms: rel_ms(a.t_ns),
+                t_ms: since_start_s(a.t_ns).map_or(0.0, |s| s * 1e3),
+                after_contact_ms: rel_ms(a.t_ns),
             })
             .collect(),
         first_armed_ms: modules.first_armed_ns.and_then(rel_ms),
         first_reference_cmd_ms: modules.first_reference_cmd_ns.and_then(rel_ms),
         first_reference_cmd_s: modules.first_reference_cmd_ns.and_then(since_start_s),
+        modes_relative_to: if contact_ns != 0 { "contact" } else { "start" }.to_owned(),
         ecu_modes: modules
             .ecu_modes
             .iter()

@@ -52,14 +52,17 @@ pub struct Judged {
     pub excursion_trace_mm: Vec<f64>,
 }
 
-/// An action with its time relative to the true contact.
+/// An action with its time on the run's two time bases — the same two keys, with the same
+/// meaning, as `offline-bench --json` (issue 32).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct TimedAction {
     /// The action.
     #[serde(flatten)]
     pub action: Action,
-    /// Time relative to true contact [ms] (None without contact).
-    pub t_ms: Option<f64>,
+    /// Time after the scenario's start (the feeds' t = 0) [ms].
+    pub t_ms: f64,
+    /// Time relative to the true contact [ms] (None without contact).
+    pub after_contact_ms: Option<f64>,
 }
 
 /// The outcome comparison (contact only).
@@ -122,7 +125,12 @@ pub struct Report {
     pub first_reference_cmd_ms: Option<f64>,
     /// First command from the reference restraint [s after scenario start].
     pub first_reference_cmd_s: Option<f64>,
-    /// ECU mode changes from EcuStatus: (ms rel. contact or since start, mode name).
+    /// What the times of `ecu_modes`, `ecu_faults` and `ecu_diag_modes` count from:
+    /// `"contact"` (ms relative to the true contact) or, in a run without one, `"start"` (ms
+    /// after the scenario's start).
+    #[serde(default)]
+    pub modes_relative_to: String,
+    /// ECU mode changes from EcuStatus: (ms, see `modes_relative_to`; mode name as in the DBC).
     pub ecu_modes: Vec<(f64, String)>,
     /// ECU fault-flag changes from EcuStatus (why it degraded): (ms rel. contact or since
     /// start, flags set, named as in [`crate::status::ecu_fault_names`]; empty = no fault).

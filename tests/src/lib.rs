@@ -458,7 +458,6 @@ fn wait_ready(ready: std::sync::mpsc::Receiver<()>, child: &mut Child, what: &st
     bail!("{what} did not get ready within 30 s")
 }
 
-
 /// The sensor-feeds command of a run: CAN or `--no-can`, the run's services, and the time
 /// base (`None`: the feeds choose it and announce it).
 pub fn feeds_command(cfg: &RunConfig, epoch_ns: Option<u64>) -> Command {
@@ -734,7 +733,7 @@ pub fn summarise(
         let _ = writeln!(
             s,
             "  pretensioner fire                                {}  (planned {:+.1} ms, limiter {:.2} kN, {})",
-            ms(a.t_ms),
+            ms(a.after_contact_ms),
             a.action.planned_ms,
             a.action.level_kn,
             a.action.source
@@ -759,12 +758,12 @@ pub fn summarise(
         let _ = writeln!(
             s,
             "  airbag fire                                      {}  (planned {:+.1} ms, level {:.2} kN, {})",
-            ms(a.t_ms),
+            ms(a.after_contact_ms),
             a.action.planned_ms,
             a.action.level_kn,
             a.action.source
         );
-        if let Some(t) = a.t_ms {
+        if let Some(t) = a.after_contact_ms {
             let _ = writeln!(
                 s,
                 "  command latency: airbag command received {:+.1} ms after its planned time",
@@ -782,7 +781,7 @@ pub fn summarise(
         let _ = writeln!(
             s,
             "  pretensioner release                             {}",
-            ms(a.t_ms)
+            ms(a.after_contact_ms)
         );
     }
     if r.first_reference_cmd_s.is_some() {

@@ -310,7 +310,7 @@ pub fn starved_run(
         }
     }
     if let Some(a) = r.action("airbag_fire") {
-        if let Some(t) = a.t_ms {
+        if let Some(t) = a.after_contact_ms {
             let late = t - a.action.planned_ms;
             if late > crate::FIRE_LATE_ALLOWANCE_MS {
                 why.push(format!(

@@ -143,7 +143,7 @@ fn pre_crash_cases_preset_before_contact_and_fire_at_the_planned_time() {
         let p = r
             .action("pretensioner_fire")
             .unwrap_or_else(|| panic!("{}: pretensioner never fired", s.name));
-        let pt = p.t_ms.expect("contact");
+        let pt = p.after_contact_ms.expect("contact");
         assert!(pt < 0.0, "{}: pretensioner at {pt:+.1} ms", s.name);
         // Whether the bag fires is the table's decision (declared per scenario where fixed);
         // when it fires, it must fire at its planned time.
@@ -156,7 +156,7 @@ fn pre_crash_cases_preset_before_contact_and_fire_at_the_planned_time() {
             eprintln!("{}: preset {preset:+.1} ms, pretensioner {pt:+.1} ms, airbag: no fire (table's choice)", s.name);
             continue;
         };
-        let at = a.t_ms.expect("contact");
+        let at = a.after_contact_ms.expect("contact");
         let planned = a.action.planned_ms;
         eprintln!("{}: preset {preset:+.1} ms, pretensioner {pt:+.1} ms (planned {:+.1}), airbag {at:+.1} ms (planned {planned:+.1})", s.name, p.action.planned_ms);
         assert!(
@@ -171,6 +171,43 @@ fn pre_crash_cases_preset_before_contact_and_fire_at_the_planned_time() {
         );
     }
     assert!(checked >= 3, "the library has pre-crash cases");
+}
+
+#[test]
+fn report_times_use_the_offline_benchs_two_time_bases() {
+    // Issue 32: the stubs' `t_ms` meant "after contact" where offline-bench's means "after the
+    // start". Now both: `t_ms` after the start, `after_contact_ms` after the contact, and the
+    // two differ by the contact's own time after the start for every action of every run.
+    for (s, r) in all() {
+        let contact_after_start_ms =
+            (r.contact_ns != 0).then_some((r.contact_ns as f64 - r.start_ns as f64) * 1e-6);
+        assert_eq!(
+            r.modes_relative_to,
+            if contact_after_start_ms.is_some() {
+                "contact"
+            } else {
+                "start"
+            },
+            "{}",
+            s.name
+        );
+        for a in &r.actions {
+            assert!(a.t_ms >= 0.0, "{}: {a:?}", s.name);
+            match (a.after_contact_ms, contact_after_start_ms) {
+                (Some(rel), Some(c)) => assert!(
+                    (a.t_ms - rel - c).abs() < 1e-3,
+                    "{}: t_ms {} − after_contact_ms {rel} ≠ contact {c}",
+                    s.name,
+                    a.t_ms
+                ),
+                (None, None) => {}
+                other => panic!(
+                    "{}: contact and after_contact_ms disagree: {other:?}",
+                    s.name
+                ),
+            }
+        }
+    }
 }
 
 #[test]
@@ -240,7 +277,7 @@ fn dropout_degrades_to_the_reference_restraint_within_the_documented_time() {
         .action("airbag_fire")
         .expect("still protected: airbag fired");
     assert_eq!(a.action.source, "reference", "{a:?}");
-    let t = a.t_ms.expect("contact");
+    let t = a.after_contact_ms.expect("contact");
     assert!(
         (0.0..=10.0 + FIRE_LATE_ALLOWANCE_MS).contains(&t),
         "reference fire at {t:+.1} ms (reference time 10 ms)"

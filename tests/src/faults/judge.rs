@@ -53,7 +53,7 @@ fn starved_inputs_at_fire(
     ecu_faults: &[(f64, Vec<String>)],
 ) -> Option<String> {
     let fire = fire?;
-    let t = fire.t_ms?;
+    let t = fire.after_contact_ms?;
     if fire.action.source != "reference" {
         return None;
     }
@@ -275,11 +275,11 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
             format!("expected {want}, fired {}", r.airbag_fired),
         );
     }
-    let late = fire.and_then(|a| a.t_ms.map(|t| t - a.action.planned_ms));
+    let late = fire.and_then(|a| a.after_contact_ms.map(|t| t - a.action.planned_ms));
     if let (Some(a), Some(l)) = (fire, late) {
         checks.check(
             "fire command on time",
-            (-1.0..=FIRE_LATE_ALLOWANCE_MS).contains(&l) && a.t_ms.is_some_and(|t| t >= 0.0),
+            (-1.0..=FIRE_LATE_ALLOWANCE_MS).contains(&l) && a.after_contact_ms.is_some_and(|t| t >= 0.0),
             format!(
                 "received {:+.1} ms after its planned {:+.1} ms (allowance {FIRE_LATE_ALLOWANCE_MS} ms)",
                 l, a.action.planned_ms
@@ -375,7 +375,9 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
         dir: run.dir.display().to_string(),
         contact_s: (r.contact_ns != 0 && r.start_ns != 0)
             .then_some((r.contact_ns as f64 - r.start_ns as f64) * 1e-9),
-        fire_s: fire.and_then(|a| a.t_ms).map(|t| scenario_s(r, t)),
+        fire_s: fire
+            .and_then(|a| a.after_contact_ms)
+            .map(|t| scenario_s(r, t)),
         fault_s: window,
         duration_s: played.as_ref().map_or(0.0, |s| s.duration_s),
     }
@@ -940,7 +942,7 @@ fn describe_reaction(
                 s,
                 "airbag fired ({}) at {:+.1} ms",
                 a.action.source,
-                a.t_ms.unwrap_or(f64::NAN)
+                a.after_contact_ms.unwrap_or(f64::NAN)
             );
         }
         None => s.push_str("airbag not fired"),
@@ -1118,7 +1120,8 @@ mod tests {
                 planned_ms: 10.0,
                 source: source.into(),
             },
-            t_ms: Some(14.0),
+            t_ms: 1814.0,
+            after_contact_ms: Some(14.0),
         };
         let faults = |names: &[&str]| -> Vec<(f64, Vec<String>)> {
             vec![
