@@ -364,7 +364,7 @@ mod tests {
             .expect("scenario")
     }
 
-    const FIRE_AT_7: &str = r#"{"t_ns": 9, "what": "airbag_fire", "level_kn": 4.5, "planned_ms": 3.0, "source": "adaptive", "t_ms": 7.0}"#;
+    const FIRE_AT_7: &str = r#"{"t_ns": 9, "what": "airbag_fire", "level_kn": 4.5, "planned_ms": 3.0, "source": "adaptive", "t_ms": 1699.0, "after_contact_ms": 7.0}"#;
 
     #[test]
     fn a_no_crash_run_is_judged_up_to_its_end_and_its_injected_sensor_faults_are_its_own() {
@@ -408,7 +408,7 @@ mod tests {
             why.contains("-894 ms") && why.contains("object_input"),
             "{why}"
         );
-        let late = FIRE_AT_7.replace(r#""t_ms": 7.0"#, r#""t_ms": 19.9"#);
+        let late = FIRE_AT_7.replace(r#""after_contact_ms": 7.0"#, r#""after_contact_ms": 19.9"#);
         let why = starved_run(&s, &report(clean, &late)).expect("late fire");
         assert!(why.contains("+16.9 ms after its plan"), "{why}");
         // a scenario that injects a dropout owns its input faults
