@@ -8,7 +8,7 @@
 //!   configuration, the iceoryx2 com layer and the `monitor` command. It knows nothing about
 //!   restraints: it runs any [`restraint::Activity`] through [`restraint::CycleIo`].
 //! * [`can_port`] — the SocketCAN [`runtime::CanPort`] over `bus::socket::BusSocket`.
-//! * [`lut_input`], [`reference_input`] — what the shell loaded, handed to the core as a
+//! * [`lut_input`] — what the shell loaded, handed to the core as a
 //!   borrowed view and plain numbers.
 
 pub mod runtime;
@@ -23,15 +23,5 @@ pub fn lut_input(d: &diagram::Diagram) -> restraint::Lut<'_> {
         id: d.lut_id(),
         ego_mass_kg: d.header().ego.mass_kg,
         ego_class: d.header().ego.class,
-    }
-}
-
-/// The reference-restraint file's settings as the core takes them.
-pub fn reference_input(r: &physics::reference::ReferenceSettings) -> restraint::ReferenceSettings {
-    restraint::ReferenceSettings {
-        belt_limiter_kn: r.belt_limiter_kn,
-        airbag_level_kn: r.airbag_level_kn,
-        pretensioner_time_ms: r.pretensioner_time_ms,
-        airbag_time_ms: r.airbag_time_ms,
     }
 }

@@ -111,7 +111,7 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
     let (mut activity, notes) = RestraintCycle::new(
         cfg.cycle.decision.clone(),
         lut.as_ref().map(ecu::lut_input),
-        &ecu::reference_input(&reference.restraint),
+        &reference.restraint,
     )
     .map_err(|e| anyhow::anyhow!("{e}"))?;
     if let Some(m) = notes.lut_rejected {

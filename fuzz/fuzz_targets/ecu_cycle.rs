@@ -420,7 +420,7 @@ fuzz_target!(|data: &[u8]| {
     let fx = fixture();
     let with_lut = flags & 1 != 0;
     let lut = with_lut.then(|| ecu::lut_input(&fx.lut));
-    let reference = ecu::reference_input(&fx.reference);
+    let reference = fx.reference;
     let Ok((mut cycle, notes)) = RestraintCycle::new(CycleConfig::default(), lut, &reference)
     else {
         panic!("default cycle config must build");

@@ -32,6 +32,7 @@ pub mod occupant;
 pub mod paper;
 #[cfg(feature = "std")]
 pub mod reference;
+pub mod reference_settings;
 pub mod stiffness;
 
 pub use collision::{
@@ -44,6 +45,7 @@ pub use occupant::{
     ideal_constant_force_decel_mps2, simulate_occupant, simulate_occupant_observed, OccupantInput,
     OccupantOutcome, RestraintHardware, RestraintSettings,
 };
+pub use reference_settings::ReferenceSettings;
 pub use stiffness::{class_for_mass_kg, CombinedSpring, Curve, MassClass};
 
 /// Convert an acceleration in m/s² to multiples of standard gravity.

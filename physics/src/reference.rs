@@ -17,20 +17,7 @@ use std::path::Path;
 use std::string::{String, ToString};
 use std::vec::Vec;
 
-/// The reference restraint setting (file units: kN, ms; times relative to first contact).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ReferenceSettings {
-    /// Belt load-limiter level [kN].
-    pub belt_limiter_kn: f64,
-    /// Airbag + column force level [kN].
-    pub airbag_level_kn: f64,
-    /// Pretensioner trigger time after contact [ms] (a conventional system has no pre-crash
-    /// sensing, so this is ≥ 0 in practice; the bounds allow the optimiser's full range).
-    pub pretensioner_time_ms: f64,
-    /// Airbag trigger time after contact [ms] (paper: 10 ms).
-    pub airbag_time_ms: f64,
-}
+pub use crate::reference_settings::ReferenceSettings;
 
 /// Predicted occupant outcome of the reference setting in one load case (documentation of
 /// what the optimiser achieved; not read back by anything safety-relevant).

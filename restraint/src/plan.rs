@@ -3,18 +3,9 @@
 use diagram::{AirbagStage, AirbagThresholds, Lookup};
 
 /// The conventional reference restraint as numbers (the shell reads them from
-/// `data/reference-restraint.toml`; levels kN, times ms relative to first contact).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ReferenceSettings {
-    /// Belt load-limiter level, kN.
-    pub belt_limiter_kn: f64,
-    /// Airbag + column force level, kN.
-    pub airbag_level_kn: f64,
-    /// Pretensioner trigger time after contact, ms.
-    pub pretensioner_time_ms: f64,
-    /// Airbag trigger time after contact, ms.
-    pub airbag_time_ms: f64,
-}
+/// `data/reference-restraint.toml`; levels kN, times ms relative to first contact): physics'
+/// one type, the file's own.
+pub use physics::ReferenceSettings;
 
 /// Where the settings of a plan came from (sent as `CmdSource` on CAN).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -210,7 +210,7 @@ pub fn run_traced(
     let truth = Truth::new(scenario).map_err(|e| anyhow!("{}: {e}", scenario.name))?;
     let contact_s = truth.contact_s;
     let lut = cfg.lut.as_ref().map(ecu::lut_input);
-    let reference = ecu::reference_input(&cfg.reference.restraint);
+    let reference = cfg.reference.restraint;
     let (mut ecu, _) = RestraintCycle::new(cfg.cycle.clone(), lut, &reference)
         .map_err(|e| anyhow!("cycle config: {e}"))?;
     let mut io = SimIo::new();

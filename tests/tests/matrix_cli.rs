@@ -112,25 +112,28 @@ fn a_closed_pipe_ends_the_tools_quietly() {
     }
 }
 
+/// Every command-line tool of the bench (the binaries `./test.sh` builds).
+const TOOLS: [&str; 13] = [
+    "ecu",
+    "sensor-feeds",
+    "actuator-stubs",
+    "lut",
+    "hil-bench",
+    "offline-bench",
+    "misuse-matrix",
+    "fault-campaign",
+    "bus-inject",
+    "budget",
+    "worst_cycle",
+    "loop-vs-cyclictest",
+    "docs-check",
+];
+
 #[test]
 fn every_tool_answers_version_with_its_own_name() {
     // Issue 22 item 5: `budget` and `worst_cycle` lacked `--version`.
     let release = e2e_tests::repo_root().join("target/release");
-    for tool in [
-        "ecu",
-        "sensor-feeds",
-        "actuator-stubs",
-        "lut",
-        "hil-bench",
-        "offline-bench",
-        "misuse-matrix",
-        "fault-campaign",
-        "bus-inject",
-        "budget",
-        "worst_cycle",
-        "loop-vs-cyclictest",
-        "docs-check",
-    ] {
+    for tool in TOOLS {
         let bin = release.join(tool);
         assert!(
             bin.exists(),
@@ -194,21 +197,7 @@ fn one_flag_vocabulary_across_tools() {
     ];
     let release = e2e_tests::repo_root().join("target/release");
     let mut wrong = Vec::new();
-    for tool in [
-        "ecu",
-        "sensor-feeds",
-        "actuator-stubs",
-        "lut",
-        "hil-bench",
-        "offline-bench",
-        "misuse-matrix",
-        "fault-campaign",
-        "bus-inject",
-        "budget",
-        "worst_cycle",
-        "loop-vs-cyclictest",
-        "docs-check",
-    ] {
+    for tool in TOOLS {
         let flags = long_flags(&release.join(tool));
         assert!(
             flags.iter().any(|(_, f)| f == "--help"),
