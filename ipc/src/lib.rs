@@ -16,8 +16,8 @@
 //! open a service whose static settings are incompatible with the ones requested, so every
 //! opener must request the same ones.
 //!
-//! The ECU's records are the restraint core's types (re-exported here), carried in a
-//! transport wrapper so the core never depends on iceoryx2. The subscriber wrappers are
+//! The ECU's records are the `signals` crate's types (re-exported here), carried in a
+//! transport wrapper so the core never depends on iceoryx2 and the transport never on the core. The subscriber wrappers are
 //! poll-only (`receive()` every cycle, no event waits) and their hot-path methods neither
 //! allocate nor block; errors on the hot path are counted, not formatted.
 
@@ -30,7 +30,7 @@ pub mod port;
 pub use names::*;
 pub use payload::{BenchTruth, Shm, ShmRecord, SCENARIO_NAME_CAPACITY};
 pub use port::*;
-pub use restraint::signals::{
+pub use signals::{
     CrashAccelSample, Degraded, EcuDiagnostics, EcuMode, ObjectState, ACCEL_BATCH_CAPACITY,
     PULSE_POINTS, VALID,
 };

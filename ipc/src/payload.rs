@@ -1,11 +1,11 @@
 //! What travels over shared memory. The ECU's records (object state, accelerometer batch,
-//! diagnostics) are the restraint core's types, carried in the [`Shm`] transport wrapper so the
+//! diagnostics) are the `signals` crate's types, carried in the [`Shm`] transport wrapper so the
 //! core never sees iceoryx2; the bench-only [`BenchTruth`] is defined here.
 
 use core::fmt;
 
 use iceoryx2::prelude::ZeroCopySend;
-use restraint::{CrashAccelSample, EcuDiagnostics, ObjectState};
+use signals::{CrashAccelSample, EcuDiagnostics, ObjectState};
 
 /// The core's plain records that may live in shared memory: `#[repr(C)]`, `Copy`,
 /// pointer-free, every bit pattern of every field valid (flags are `u8`). Sealed: only the
@@ -14,9 +14,9 @@ pub trait ShmRecord: Copy + fmt::Debug + 'static + sealed::Sealed {}
 
 mod sealed {
     pub trait Sealed {}
-    impl Sealed for restraint::ObjectState {}
-    impl Sealed for restraint::CrashAccelSample {}
-    impl Sealed for restraint::EcuDiagnostics {}
+    impl Sealed for signals::ObjectState {}
+    impl Sealed for signals::CrashAccelSample {}
+    impl Sealed for signals::EcuDiagnostics {}
 }
 
 impl ShmRecord for ObjectState {}

@@ -7,7 +7,7 @@ use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubFactory;
-use restraint::{CrashAccelSample, EcuDiagnostics, ObjectState};
+use signals::{CrashAccelSample, EcuDiagnostics, ObjectState};
 
 use crate::names::{
     PortSettings, ServiceNames, BENCH_TRUTH_PORTS, CRASH_ACCEL_PORTS, DIAGNOSTICS_PORTS,
@@ -377,7 +377,7 @@ pub type BenchTruthPublisher = ZeroCopyPublisher<BenchTruthTopic>;
 mod tests {
     use super::*;
     use crate::names::CRASH_ACCEL_PORTS;
-    use restraint::VALID;
+    use signals::VALID;
 
     fn unique_prefix(tag: &str) -> String {
         format!("ipc-test-{}-{tag}", std::process::id())

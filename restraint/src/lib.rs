@@ -57,7 +57,8 @@ pub mod plan;
 pub mod roughness;
 pub mod safing;
 pub mod settings;
-pub mod signals;
+/// The records shared with the transport: the `signals` crate, under the core's name for it.
+pub use ::signals;
 pub mod sim;
 
 pub use config::{CycleConfig, TrackConfig, MAX_E2E_BURST};
@@ -71,6 +72,7 @@ pub use estimate::{
     equivalent_barrier_speed_kph, time_to_contact, Contact, Lut, LutMismatch, Situation,
 };
 pub use inputs::{input_can_ids, Occupant};
+pub use outputs::bus_mode;
 pub use plan::{PlanSource, ReferenceSettings, RestraintPlan};
 pub use settings::{ConfigError, G_MPS2};
 pub use signals::{

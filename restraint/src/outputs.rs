@@ -21,7 +21,22 @@ use crate::decision::{Decision, Pretensioner};
 use crate::estimate::{pulse::PULSE_DT_S, Estimator};
 use crate::inputs::InputMonitor;
 use crate::plan::PlanSource;
-use crate::signals::{Degraded, EcuDiagnostics};
+use crate::signals::{Degraded, EcuDiagnostics, EcuMode};
+
+/// The mode `EcuStatus` puts on the bus for a diagnostics mode — the one mapping between the
+/// two vocabularies. The bus has no pre-crash (a preset is `Normal`, its settings are on
+/// `BeltLimiterCmd`), calls the degraded phase `ReferenceFallback` (what the actuators then
+/// receive) and splits the crash phase at the airbag's fire.
+pub fn bus_mode(mode: EcuMode, airbag_fired: bool) -> EcuStatusEcuMode {
+    use EcuStatusEcuMode as Bus;
+    match mode {
+        EcuMode::Startup => Bus::Init,
+        EcuMode::Monitoring | EcuMode::PreCrash => Bus::Normal,
+        EcuMode::Degraded => Bus::ReferenceFallback,
+        EcuMode::Crash if !airbag_fired => Bus::CrashDetected,
+        EcuMode::Crash | EcuMode::PostCrash => Bus::Deployed,
+    }
+}
 
 /// Contents of a belt-limiter command (for change detection).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -289,7 +304,7 @@ impl Outputs {
                 Err(_) => count(&mut counters.encode_errors),
             }
         }
-        let mode = d.phase().mode().on_bus(d.airbag_fired());
+        let mode = bus_mode(d.phase().mode(), d.airbag_fired());
         let faults = StatusFaults {
             vehicle_input: inputs.vehicle_stale(now),
             occupant_input: inputs.occupant_stale(now),

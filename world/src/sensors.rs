@@ -19,7 +19,7 @@ use bus::codec::{
 use bus::{EgoVehicleState, EncodeError, OccupantClassification};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use restraint::ObjectState;
+use signals::ObjectState;
 
 /// Tracker id of the opponent (one tracked object).
 pub const OPPONENT_OBJECT_ID: u32 = 7;
@@ -108,7 +108,7 @@ impl SensorModelSim {
         o.opponent_mass_kg = mass.max(1.0) as f32;
         o.opponent_mass_sigma_kg = s.mass_sigma_kg as f32;
         o.confidence = s.confidence as f32;
-        o.valid = restraint::VALID;
+        o.valid = signals::VALID;
         Some(o)
     }
 

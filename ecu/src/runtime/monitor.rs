@@ -54,7 +54,7 @@ pub fn format_estimate(d: &EcuDiagnostics) -> String {
 pub fn mode_label(d: &EcuDiagnostics) -> String {
     match EcuMode::from_u8(d.mode) {
         Some(m) => {
-            let on_bus = u8::from(m.on_bus(d.airbag_fired != 0));
+            let on_bus = u8::from(restraint::bus_mode(m, d.airbag_fired != 0));
             let bus_name =
                 bus::value_name(bus::EcuStatus::ECU_MODE_VALUES, i64::from(on_bus)).unwrap_or("?");
             format!("{bus_name} ({})", m.name())

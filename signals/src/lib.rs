@@ -1,5 +1,16 @@
+//! The records that cross shared memory between the bench's processes and the ECU core —
+//! the one interface both sides compile against, so that the transport (`ipc`), the sensor
+//! feeds and the actuator stubs need not link the restraint core, and the core never links
+//! the transport. `no_std`, no allocation, no dependency beyond `bitflags` and `strum`.
+//!
 //! What the cycle reads and writes besides CAN: the opponent object, the crash accelerometer
 //! and the diagnostics record, plus the mode and degraded-reason vocabulary they use.
+
+#![no_std]
+#![warn(missing_docs)]
+// Every method here is a few instructions on the ECU cycle's path, called from another crate:
+// `#[inline]` lets the core inline them as it did while they were its own module (the budget
+// gate's instruction counts are the check).
 //!
 //! Plain `#[repr(C)]`, `Copy`, pointer-free records: the shell carries them over iceoryx2
 //! shared memory (the `ipc` crate wraps each in its transport type), a microcontroller port
@@ -54,6 +65,7 @@ impl ObjectState {
     };
 
     /// True if the producer flagged the track valid (does not check the values).
+    #[inline]
     pub fn is_valid(&self) -> bool {
         self.valid == VALID
     }
@@ -97,6 +109,7 @@ impl CrashAccelSample {
     };
 
     /// The valid samples; a corrupt `count` is clamped, so this never panics.
+    #[inline]
     pub fn samples(&self) -> &[f32] {
         let n = (self.count as usize).min(ACCEL_BATCH_CAPACITY);
         self.accel_mps2.get(..n).unwrap_or(&[])
@@ -134,28 +147,16 @@ pub enum EcuMode {
 
 impl EcuMode {
     /// Decodes a raw mode byte; unknown values map to `None`.
+    #[inline]
     pub fn from_u8(v: u8) -> Option<Self> {
         Self::from_repr(v)
     }
 
-    /// Short display name (`pre-crash`, …): the decision's phase, finer than the bus's mode.
+    /// Short display name (`pre-crash`, …): the decision's phase, finer than the bus's mode
+    /// (`restraint::bus_mode` maps one to the other).
+    #[inline]
     pub fn name(self) -> &'static str {
         self.into()
-    }
-
-    /// The mode `EcuStatus` puts on the bus for this diagnostics mode — the one mapping
-    /// between the two vocabularies. The bus has no pre-crash (a preset is `Normal`, its
-    /// settings are on `BeltLimiterCmd`), calls the degraded phase `ReferenceFallback` (what
-    /// the actuators then receive) and splits the crash phase at the airbag's fire.
-    pub fn on_bus(self, airbag_fired: bool) -> bus::codec::EcuStatusEcuMode {
-        use bus::codec::EcuStatusEcuMode as Bus;
-        match self {
-            Self::Startup => Bus::Init,
-            Self::Monitoring | Self::PreCrash => Bus::Normal,
-            Self::Degraded => Bus::ReferenceFallback,
-            Self::Crash if !airbag_fired => Bus::CrashDetected,
-            Self::Crash | Self::PostCrash => Bus::Deployed,
-        }
     }
 }
 
@@ -309,6 +310,7 @@ impl EcuDiagnostics {
     };
 
     /// The degraded reasons as a set (unknown bits dropped).
+    #[inline]
     pub fn degraded(&self) -> Degraded {
         Degraded::from_bits_truncate(self.degraded_reasons)
     }
