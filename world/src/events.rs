@@ -296,7 +296,7 @@ fn rough_road(rng: &mut ChaCha8Rng, length_s: f64, rms_mps2: f64) -> Vec<f64> {
     let n = (length_s.max(0.0) * ROUGH_ROAD_GRID_HZ).ceil() as usize + 2;
     let mut filter = BandPass::new(ROUGH_ROAD_BAND_HZ, ROUGH_ROAD_GRID_HZ);
     let mut track: Vec<f64> = (0..n)
-        .map(|_| filter.step(crate::sensors::gauss(rng)))
+        .map(|_| filter.step(crate::noise::gauss(rng)))
         .collect();
     // The rms over the window's own points (j / grid < length).
     let inside = ((length_s.max(0.0) * ROUGH_ROAD_GRID_HZ).ceil() as usize).clamp(1, n);

@@ -12,6 +12,7 @@
 
 pub mod events;
 pub mod lowpass;
+mod noise;
 pub mod scenario;
 pub mod sensors;
 pub mod truth;

@@ -17,7 +17,9 @@ use bus::codec::{
     OccupantClassificationOccupantClass,
 };
 use bus::{EgoVehicleState, EncodeError, OccupantClassification};
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
+
+use crate::noise::gauss;
 use rand_chacha::ChaCha8Rng;
 use signals::ObjectState;
 
@@ -37,13 +39,6 @@ pub struct SensorModelSim {
     /// The anti-alias filters of the crash and the safing accelerometer.
     lowpass: [AntiAlias; 2],
     object_sequence: u64,
-}
-
-/// A standard normal draw (Box–Muller; two uniforms per draw keeps the stream simple).
-pub(crate) fn gauss(rng: &mut ChaCha8Rng) -> f64 {
-    let u1: f64 = rng.gen_range(f64::MIN_POSITIVE..1.0);
-    let u2: f64 = rng.gen::<f64>();
-    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
 }
 
 impl SensorModelSim {
