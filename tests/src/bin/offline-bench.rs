@@ -11,7 +11,7 @@
 //! 2 on a usage or set-up error (table, reference restraint, `--cycle-config`, `--plot`).
 //!
 //! `--json` writes one array, an object per file; its schema is in tests/README.md
-//! ("offline-bench JSON"), checked by `tests/tests/offline.rs`.
+//! ("offline-bench JSON"), checked by `tests/tests/tools/offline.rs`.
 
 use anyhow::{Context, Result};
 use clap::Parser;
