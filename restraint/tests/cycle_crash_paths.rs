@@ -6,9 +6,7 @@
 
 mod cycle_support;
 
-use bus::codec::{
-    AirbagStageCmdCmdSource, AirbagStageCmdFire, BeltLimiterCmdPretensionerCmd, EcuStatusEcuMode,
-};
+use bus::codec::{AirbagStageCmdCmdSource, AirbagStageCmdFire, EcuStatusEcuMode};
 use cycle_support::*;
 use restraint::crash::ConfirmKind;
 use restraint::crash_match::{MatchState, Mismatch};
@@ -24,9 +22,7 @@ fn no_airbag_fired(b: &Bench) -> bool {
 }
 
 fn first_fire(b: &Bench) -> Option<(u64, bus::AirbagStageCmd)> {
-    b.airbag_frames()
-        .into_iter()
-        .find(|(_, f)| f.fire() == AirbagStageCmdFire::Fire)
+    b.first_airbag_fire()
 }
 
 /// First step time from `from` on at which the diagnostics carry `reason`.
@@ -48,11 +44,6 @@ fn first_accel_fault_on_bus(b: &Bench, from: u64) -> Option<u64> {
                 && s.ecu_mode() == EcuStatusEcuMode::ReferenceFallback
         })
         .map(|(t, _)| t)
-}
-
-/// Quiet running: "no track" objects every 10 ms, live accelerometer.
-fn idle_until(b: &mut Bench, end: u64) {
-    run_scenario(b, end, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
 }
 
 // --- Path 1: the prediction-matched crash -------------------------------------------------
@@ -262,12 +253,7 @@ fn the_conventional_airbags_must_fire_fires_the_pretensioner_at_the_same_instant
         &|_| 12.0,
     );
     let (bag, _) = first_fire(&b).expect("reference airbag");
-    let pretensioner = b
-        .belt_frames()
-        .into_iter()
-        .find(|(_, f)| f.pretensioner_cmd() == BeltLimiterCmdPretensionerCmd::Fire)
-        .map(|(t, _)| t)
-        .expect("pretensioner");
+    let (pretensioner, _) = b.first_pretensioner_fire().expect("pretensioner");
     let own_floor_ns = C + (cfg.pretensioner_min_dv_mps / (12.0 * f64::from(G)) * 1e9) as u64;
     assert_eq!(pretensioner, bag);
     assert!(bag < own_floor_ns, "{} ms", (bag - C) as f64 * 1e-6);

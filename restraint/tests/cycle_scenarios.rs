@@ -235,11 +235,7 @@ fn stale_object_data_degrades_after_the_timeout_and_the_reference_fires() {
     let d = &b.diagnostics[400];
     assert_ne!(d.degraded_reasons & Degraded::OBJECT_STALE.bits(), 0);
     // Reference: pretensioner and airbag 10 ms after the measured contact, reference levels.
-    let bag = b
-        .airbag_frames()
-        .into_iter()
-        .find(|(_, f)| f.fire() == AirbagStageCmdFire::Fire)
-        .expect("reference airbag fired");
+    let bag = b.first_airbag_fire().expect("reference airbag fired");
     assert_eq!(bag.0, crash + 10 * MS);
     assert_eq!(bag.1.force_level(), 12.0);
     assert_eq!(bag.1.stage(), AirbagStageCmdStage::BothStages);
@@ -275,11 +271,7 @@ fn crash_without_pre_crash_detection_fires_the_reference() {
     );
     assert_eq!(b.first_mode(EcuMode::PreCrash), None);
     assert_eq!(b.first_mode(EcuMode::Degraded), None);
-    let bag = b
-        .airbag_frames()
-        .into_iter()
-        .find(|(_, f)| f.fire() == AirbagStageCmdFire::Fire)
-        .expect("fired");
+    let bag = b.first_airbag_fire().expect("fired");
     assert_eq!(bag.0, crash + 10 * MS);
     assert_eq!(bag.1.cmd_source(), AirbagStageCmdCmdSource::Reference);
 }
@@ -303,11 +295,7 @@ fn sensor_dropout_before_pre_crash_then_crash_fires_the_reference() {
         b.first_mode(EcuMode::Degraded),
         Some(C - 410 * MS + 101 * MS)
     );
-    let bag = b
-        .airbag_frames()
-        .into_iter()
-        .find(|(_, f)| f.fire() == AirbagStageCmdFire::Fire)
-        .expect("fired");
+    let bag = b.first_airbag_fire().expect("fired");
     assert_eq!(bag.0, C + 10 * MS);
     assert_eq!(bag.1.force_level(), 12.0);
 }
@@ -401,11 +389,7 @@ fn missing_lut_runs_degraded_from_the_start_and_fires_the_reference() {
         0
     );
     assert_eq!(b.first_mode(EcuMode::PreCrash), None);
-    let bag = b
-        .airbag_frames()
-        .into_iter()
-        .find(|(_, f)| f.fire() == AirbagStageCmdFire::Fire)
-        .expect("fired");
+    let bag = b.first_airbag_fire().expect("fired");
     assert_eq!(bag.0, C + 10 * MS);
     assert_eq!(bag.1.cmd_source(), AirbagStageCmdCmdSource::Reference);
     let st = b.status_frames();

@@ -5,7 +5,6 @@
 
 mod cycle_support;
 
-use bus::codec::{AirbagStageCmdFire, BeltLimiterCmdPretensionerCmd};
 use cycle_support::*;
 use restraint::{Degraded, Pretensioner};
 
@@ -13,20 +12,11 @@ use restraint::{Degraded, Pretensioner};
 const C: u64 = T0 + 1_000 * MS;
 
 fn airbag_fired(b: &Bench) -> bool {
-    b.airbag_frames()
-        .iter()
-        .any(|(_, f)| f.fire() == AirbagStageCmdFire::Fire)
+    b.first_airbag_fire().is_some()
 }
 
 fn pretensioner_fired(b: &Bench) -> bool {
-    b.belt_frames()
-        .iter()
-        .any(|(_, f)| f.pretensioner_cmd() == BeltLimiterCmdPretensionerCmd::Fire)
-}
-
-/// Normal driving with "no track" objects every 10 ms until `end`.
-fn drive(b: &mut Bench, end: u64) {
-    run_scenario(b, end, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
+    b.first_pretensioner_fire().is_some()
 }
 
 /// A rectangular deceleration the whole car feels (both sensors), `g` × `dur_ms`.
@@ -63,15 +53,15 @@ fn reproduction_1_a_spike_then_a_bump_fires_nothing() {
     for spike_g in [15.0f32, 25.0, 40.0, 60.0] {
         for both_sensors in [false, true] {
             let mut b = Bench::new(Some(test_lut()));
-            drive(&mut b, T0 + 500 * MS);
+            idle_until(&mut b, T0 + 500 * MS);
             if both_sensors {
                 b.push_accel(-spike_g * G);
             } else {
                 b.push_crash_sensor_fault(-spike_g * G);
             }
-            drive(&mut b, T0 + 1_000 * MS);
+            idle_until(&mut b, T0 + 1_000 * MS);
             bump(&mut b, 4.5, 40); // Δv 1.77 m/s = 6.4 km/h
-            drive(&mut b, T0 + 1_300 * MS);
+            idle_until(&mut b, T0 + 1_300 * MS);
             let what = format!("{spike_g} g spike (both sensors: {both_sensors})");
             assert!(!airbag_fired(&b), "{what}: airbag fired");
             assert!(!pretensioner_fired(&b), "{what}: pretensioner fired");
@@ -94,7 +84,7 @@ fn reproduction_2_a_prediction_plus_a_kerb_strike_at_the_predicted_contact_fires
             b.push_object_none();
             b.step();
         }
-        drive(&mut b, C + 300 * MS);
+        idle_until(&mut b, C + 300 * MS);
         let what = format!("{closing} m/s, {peak_g} g × {ramp_ms} ms");
         assert!(!airbag_fired(&b), "{what}: airbag fired");
         // The reversible pre-crash pretensioner fired on the prediction and is released.
@@ -114,13 +104,13 @@ fn one_faulty_crash_accelerometer_alone_fires_nothing() {
     ];
     for (name, reading) in faults {
         let mut b = Bench::new(Some(test_lut()));
-        drive(&mut b, T0 + 500 * MS);
+        idle_until(&mut b, T0 + 500 * MS);
         for k in 0..1_000u64 {
             b.push_crash_sensor_fault(reading(k));
             b.push_object_none();
             b.step();
         }
-        drive(&mut b, T0 + 1_700 * MS);
+        idle_until(&mut b, T0 + 1_700 * MS);
         assert!(!airbag_fired(&b), "{name}: airbag fired");
         assert!(!pretensioner_fired(&b), "{name}: pretensioner fired");
         if name != "25 g burst" {
@@ -134,17 +124,17 @@ fn one_faulty_crash_accelerometer_alone_fires_nothing() {
 #[test]
 fn one_faulty_safing_accelerometer_alone_fires_nothing_and_is_flagged() {
     let mut b = Bench::new(Some(test_lut()));
-    drive(&mut b, T0 + 500 * MS);
+    idle_until(&mut b, T0 + 500 * MS);
     for k in 0..200u64 {
         b.push_safing_sensor_fault(if k < 100 { -30.0 * G } else { -5.0 * G });
         b.push_object_none();
         b.step();
     }
-    drive(&mut b, T0 + 900 * MS);
+    idle_until(&mut b, T0 + 900 * MS);
     assert!(!airbag_fired(&b) && !pretensioner_fired(&b));
     // A dead safing sensor is on the bus within its timeout + one status period.
     b.safing_live = false;
-    drive(&mut b, T0 + 1_000 * MS);
+    idle_until(&mut b, T0 + 1_000 * MS);
     assert!(b.ecu.degraded_reasons().contains(Degraded::SAFING_STALE));
     assert!(!b.ecu.degraded_reasons().intersects(Degraded::DEGRADING));
     let flagged = b
@@ -163,7 +153,7 @@ fn a_real_crash_with_a_dead_safing_sensor_fires_when_the_vehicle_deceleration_ag
     // second agreement: the reference airbag fires once a vehicle frame shows ≥ 2 g.
     let mut b = Bench::new(Some(test_lut()));
     b.safing_live = false;
-    drive(&mut b, C);
+    idle_until(&mut b, C);
     b.ego_long_accel_mps2 = -15.0 * G;
     run_scenario(
         &mut b,
@@ -175,18 +165,14 @@ fn a_real_crash_with_a_dead_safing_sensor_fires_when_the_vehicle_deceleration_ag
         Some(C),
         &|_| 20.0,
     );
-    let (t, _) = b
-        .airbag_frames()
-        .into_iter()
-        .find(|(_, f)| f.fire() == AirbagStageCmdFire::Fire)
-        .expect("the airbag fires");
+    let (t, _) = b.first_airbag_fire().expect("the airbag fires");
     // The reference fire time is contact + 10 ms; the vehicle frame at C (sent every 10 ms
     // from T0) already shows the deceleration, so the substitute agrees in time.
     assert_eq!(t, C + 10 * MS);
     // Without any second agreement (vehicle frame shows only braking) nothing fires.
     let mut b = Bench::new(Some(test_lut()));
     b.safing_live = false;
-    drive(&mut b, C);
+    idle_until(&mut b, C);
     b.ego_long_accel_mps2 = -G; // 1 g of braking
     run_scenario(
         &mut b,
@@ -210,7 +196,7 @@ fn fault_inside_event(case: &str, tolerance_dv_mps: f64) -> Bench {
         ..ideal_sensor_config()
     };
     let mut b = Bench::with_config(cfg, Some(test_lut()));
-    drive(&mut b, T0 + 500 * MS);
+    idle_until(&mut b, T0 + 500 * MS);
     for k in 0..400u64 {
         let t_s = k as f64 * 1e-3;
         match case {
@@ -246,7 +232,7 @@ fn fault_inside_event(case: &str, tolerance_dv_mps: f64) -> Bench {
         b.push_object_none();
         b.step();
     }
-    drive(&mut b, T0 + 1_500 * MS);
+    idle_until(&mut b, T0 + 1_500 * MS);
     b
 }
 
@@ -279,7 +265,7 @@ fn pothole_while_braking(compensate: bool) -> (Bench, f64) {
     };
     let mut b = Bench::with_config(cfg, Some(test_lut()));
     b.accel_dither = false;
-    drive(&mut b, T0 + 300 * MS);
+    idle_until(&mut b, T0 + 300 * MS);
     b.abs_braking = true;
     b.ego_long_accel_mps2 = -G;
     let mut dv = f64::NAN;
@@ -341,11 +327,11 @@ fn rough_road_run(roughness_k: f64) -> Bench {
         ..ideal_sensor_config()
     };
     let mut b = Bench::with_config(cfg, Some(test_lut()));
-    drive(&mut b, T0 + 500 * MS);
+    idle_until(&mut b, T0 + 500 * MS);
     // Each backward half carries 8 g × 30 ms = 2.35 m/s since its onset: past the
     // pretensioner's boundary (1.53 m/s at 20 ms) and its 1.5 m/s floor.
     swings(&mut b, 8.0, 30, 4);
-    drive(&mut b, T0 + 1_000 * MS);
+    idle_until(&mut b, T0 + 1_000 * MS);
     b
 }
 
@@ -382,13 +368,10 @@ fn a_crash_on_a_smooth_road_is_not_delayed_by_the_roughness_measure() {
             ..ideal_sensor_config()
         };
         let mut b = Bench::with_config(cfg, Some(test_lut()));
-        drive(&mut b, T0 + 500 * MS);
+        idle_until(&mut b, T0 + 500 * MS);
         bump(&mut b, 20.0, 80); // a 20 g × 80 ms barrier-like pulse: Δv 15.7 m/s
-        drive(&mut b, T0 + 700 * MS);
-        b.airbag_frames()
-            .into_iter()
-            .find(|(_, f)| f.fire() == AirbagStageCmdFire::Fire)
-            .map(|(t, _)| t)
+        idle_until(&mut b, T0 + 700 * MS);
+        b.first_airbag_fire().map(|(t, _)| t)
     };
     let with = fire_at(restraint::CycleConfig::default().roughness_k);
     assert!(with.is_some(), "the crash fired no airbag");

@@ -15,15 +15,24 @@ use std::path::Path;
 const BEFORE_MS: f64 = 60.0;
 const AFTER_MS: f64 = 120.0;
 
-/// The time window [ms after start] the picture shows.
-fn window(run: &OfflineRun, trace: &Trace) -> (f64, f64) {
-    let end = trace.cycles.last().map_or(1.0, |c| c.t_ms).max(1.0);
-    let mut marks: Vec<f64> = run
-        .modules
+/// Each module action at its time [ms after start], labelled `what (source)`.
+fn timed_actions(run: &OfflineRun) -> Vec<(f64, String)> {
+    run.modules
         .actions
         .iter()
-        .map(|a| a.t_ns.saturating_sub(START_NS) as f64 * 1e-6)
-        .collect();
+        .map(|a| {
+            (
+                a.t_ns.saturating_sub(START_NS) as f64 * 1e-6,
+                format!("{} ({})", a.what, a.source),
+            )
+        })
+        .collect()
+}
+
+/// The time window [ms after start] the picture shows.
+fn window(run: &OfflineRun, trace: &Trace, actions: &[(f64, String)]) -> (f64, f64) {
+    let end = trace.cycles.last().map_or(1.0, |c| c.t_ms).max(1.0);
+    let mut marks: Vec<f64> = actions.iter().map(|(t, _)| *t).collect();
     marks.extend(run.contact_s.map(|c| c * 1e3));
     marks.extend(
         trace
@@ -54,7 +63,8 @@ fn mode_label(m: u8) -> &'static str {
 /// The file cannot be written (the message names it).
 pub fn draw(path: &Path, run: &OfflineRun, trace: &Trace) -> Result<(), String> {
     let err = |e: &dyn std::fmt::Display| format!("plot {}: {e}", path.display());
-    let (t0, t1) = window(run, trace);
+    let all_actions = timed_actions(run);
+    let (t0, t1) = window(run, trace, &all_actions);
     let inside = |t: f64| t >= t0 && t <= t1;
     let root = BitMapBackend::new(path, (1200, 1000)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
@@ -62,16 +72,8 @@ pub fn draw(path: &Path, run: &OfflineRun, trace: &Trace) -> Result<(), String> 
         .titled(&run.name, ("sans-serif", 22))
         .map_err(|e| err(&e))?;
     let areas = root.split_by_breakpoints::<i32, i32, _, _>([], [360, 700]);
-    let actions: Vec<(f64, String)> = run
-        .modules
-        .actions
-        .iter()
-        .map(|a| {
-            (
-                a.t_ns.saturating_sub(START_NS) as f64 * 1e-6,
-                format!("{} ({})", a.what, a.source),
-            )
-        })
+    let actions: Vec<(f64, String)> = all_actions
+        .into_iter()
         .filter(|(t, _)| inside(*t))
         .collect();
     let contact_ms = run.contact_s.map(|c| c * 1e3).filter(|t| inside(*t));

@@ -346,6 +346,20 @@ impl Bench {
             .collect()
     }
 
+    /// The first AirbagStageCmd that fires, with its time.
+    pub fn first_airbag_fire(&self) -> Option<(u64, bus::AirbagStageCmd)> {
+        self.airbag_frames()
+            .into_iter()
+            .find(|(_, f)| f.fire() == bus::codec::AirbagStageCmdFire::Fire)
+    }
+
+    /// The first BeltLimiterCmd that fires the pretensioner, with its time.
+    pub fn first_pretensioner_fire(&self) -> Option<(u64, bus::BeltLimiterCmd)> {
+        self.belt_frames()
+            .into_iter()
+            .find(|(_, f)| f.pretensioner_cmd() == bus::codec::BeltLimiterCmdPretensionerCmd::Fire)
+    }
+
     pub fn status_frames(&self) -> Vec<(u64, bus::EcuStatus)> {
         self.decoded()
             .into_iter()
@@ -374,6 +388,11 @@ impl Bench {
             .find(|(d, _)| d.mode == mode as u8)
             .map(|(_, t)| *t)
     }
+}
+
+/// Quiet running until `end`: "no track" objects every 10 ms, a live accelerometer, no crash.
+pub fn idle_until(b: &mut Bench, end: u64) {
+    run_scenario(b, end, u64::MAX, 0, 0.0, u64::MAX, None, &|_| 0.0);
 }
 
 /// Runs until `end`: every 10 ms an object sample (approach towards `contact` from
