@@ -231,7 +231,11 @@ impl Checker {
 
     /// Runs `cmd` with `sh -c` from the repository root: (exit code, stdout, stderr, seconds).
     pub fn run(&self, cmd: &str) -> Result<(Option<i32>, String, String, f64)> {
-        let dir = std::env::temp_dir().join(format!("docs-check-{}", std::process::id()));
+        // One folder per run: checkers in several threads of one process (the tests) must not
+        // share (or delete) each other's output files.
+        static RUNS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let n = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!("docs-check-{}-{n}", std::process::id()));
         std::fs::create_dir_all(&dir)?;
         let (out_path, err_path) = (dir.join("stdout"), dir.join("stderr"));
         let t0 = Instant::now();
