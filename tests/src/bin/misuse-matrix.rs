@@ -141,7 +141,31 @@ fn sh_quote(s: &str) -> String {
     shlex::try_quote(s).map_or_else(|_| format!("'{s}'"), |q| q.into_owned())
 }
 
+/// What a `--slurm` work directory computes (`spec.json`): the matrix's own arguments and the
+/// number of tasks. Shard files are kept only for the spec they were computed under.
+#[derive(serde::Serialize, serde::Deserialize, PartialEq, Debug)]
+struct SlurmSpec {
+    args: Vec<String>,
+    tasks: u32,
+}
+
+/// The last submission of a work directory (`state.json`).
+#[derive(serde::Serialize, serde::Deserialize, Default)]
+struct SlurmState {
+    job: Option<String>,
+}
+
+/// The outcomes of shard `k`, if its file is there and whole.
+fn read_shard(work: &std::path::Path, k: u32) -> Option<Vec<ShardRow>> {
+    let text = std::fs::read_to_string(work.join(format!("shard-{k}.json"))).ok()?;
+    serde_json::from_str(&text).ok()
+}
+
 /// Runs the matrix as a Slurm array of `n` tasks and returns every variant's outcome.
+///
+/// Running the same command again **resumes**, as `lut build --slurm` does: with the same
+/// arguments and N, a job still queued is watched rather than submitted twice, and otherwise
+/// only the tasks without a whole shard file are submitted; other arguments start afresh.
 fn run_on_slurm(
     cli: &Cli,
     repo: &std::path::Path,
@@ -155,39 +179,89 @@ fn run_on_slurm(
     std::fs::create_dir_all(work.join("logs"))
         .with_context(|| format!("creating {}", work.display()))?;
     let work = std::fs::canonicalize(&work)?;
-    for k in 0..n {
-        let _ = std::fs::remove_file(work.join(format!("shard-{k}.json")));
+    let spec = SlurmSpec {
+        args: matrix_args(cli, repo)?,
+        tasks: n,
+    };
+    let (spec_path, state_path) = (work.join("spec.json"), work.join("state.json"));
+    let same_spec = std::fs::read_to_string(&spec_path)
+        .ok()
+        .and_then(|t| serde_json::from_str::<SlurmSpec>(&t).ok())
+        .is_some_and(|old| old == spec);
+    if !same_spec {
+        for e in std::fs::read_dir(&work)?.flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if name.starts_with("shard-") && name.ends_with(".json") {
+                std::fs::remove_file(e.path())?;
+            }
+        }
+        let _ = std::fs::remove_file(&state_path);
+        std::fs::write(&spec_path, serde_json::to_string_pretty(&spec)?)?;
     }
-    let exe = std::env::current_exe()?;
-    let mut line = vec![sh_quote(&exe.display().to_string())];
-    line.extend(matrix_args(cli, repo)?.iter().map(|a| sh_quote(a)));
-    line.push(format!("--shard \"$SLURM_ARRAY_TASK_ID/{n}\""));
-    line.push(format!(
-        "--outcomes {}/shard-\"$SLURM_ARRAY_TASK_ID\".json",
-        sh_quote(&work.display().to_string())
-    ));
-    let script = work.join("task.sh");
-    std::fs::write(
-        &script,
-        format!(
-            "#!/bin/bash\n# misuse-matrix --slurm {n}: one array task\nexec {}\n",
-            line.join(" ")
-        ),
-    )?;
-    let id = lut::slurm::sbatch(&lut::slurm::Submit {
-        job_name: "misuse-matrix".into(),
-        array: Some(format!("0-{}", n - 1)),
-        cpus_per_task: cli.cpus_per_task,
-        output: work.join("logs/shard-%a.log"),
-        chdir: work.clone(),
-        after_ok: None,
-        extra: cli.sbatch_args.clone(),
-        script,
-    })?;
-    eprintln!(
-        "misuse-matrix: Slurm job array {id}, {n} tasks, work directory {}",
-        work.display()
-    );
+    let state: SlurmState = std::fs::read_to_string(&state_path)
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or_default();
+    let queued = match &state.job {
+        Some(id) => !lut::slurm::squeue(std::slice::from_ref(id))?.is_empty(),
+        None => false,
+    };
+    let mut ids = Vec::new();
+    if let (true, Some(id)) = (queued, &state.job) {
+        eprintln!(
+            "misuse-matrix: Slurm job {id} of this work directory is still queued; watching it"
+        );
+        ids.push(id.clone());
+    } else {
+        let missing: Vec<u32> = (0..n).filter(|k| read_shard(&work, *k).is_none()).collect();
+        if missing.is_empty() {
+            eprintln!(
+                "misuse-matrix: all {n} tasks already done in {} (same arguments)",
+                work.display()
+            );
+        } else {
+            let exe = std::env::current_exe()?;
+            let mut line = vec![sh_quote(&exe.display().to_string())];
+            line.extend(spec.args.iter().map(|a| sh_quote(a)));
+            line.push(format!("--shard \"$SLURM_ARRAY_TASK_ID/{n}\""));
+            line.push(format!(
+                "--outcomes {}/shard-\"$SLURM_ARRAY_TASK_ID\".json",
+                sh_quote(&work.display().to_string())
+            ));
+            let script = work.join("task.sh");
+            std::fs::write(
+                &script,
+                format!(
+                    "#!/bin/bash\n# misuse-matrix --slurm {n}: one array task\nexec {}\n",
+                    line.join(" ")
+                ),
+            )?;
+            let list: Vec<String> = missing.iter().map(u32::to_string).collect();
+            let id = lut::slurm::sbatch(&lut::slurm::Submit {
+                job_name: "misuse-matrix".into(),
+                array: Some(list.join(",")),
+                cpus_per_task: cli.cpus_per_task,
+                output: work.join("logs/shard-%a.log"),
+                chdir: work.clone(),
+                after_ok: None,
+                extra: cli.sbatch_args.clone(),
+                script,
+            })?;
+            std::fs::write(
+                &state_path,
+                serde_json::to_string(&SlurmState {
+                    job: Some(id.clone()),
+                })?,
+            )?;
+            eprintln!(
+                "misuse-matrix: Slurm job array {id}, tasks {} of {n} ({} already done), work directory {}",
+                list.join(","),
+                n as usize - missing.len(),
+                work.display()
+            );
+            ids.push(id);
+        }
+    }
     let bar = if cli.quiet {
         ProgressBar::hidden()
     } else {
@@ -196,12 +270,9 @@ fn run_on_slurm(
     bar.set_style(ProgressStyle::with_template(
         "{bar:40} {pos}/{len} tasks, {elapsed}",
     )?);
-    let ids = [id];
     loop {
         let queued = lut::slurm::squeue(&ids)?;
-        let done = (0..n)
-            .filter(|k| work.join(format!("shard-{k}.json")).exists())
-            .count();
+        let done = (0..n).filter(|k| read_shard(&work, *k).is_some()).count();
         bar.set_position(done as u64);
         if queued.is_empty() {
             break;
@@ -211,16 +282,13 @@ fn run_on_slurm(
     bar.finish_and_clear();
     let mut results = Vec::new();
     for k in 0..n {
-        let path = work.join(format!("shard-{k}.json"));
-        let text = std::fs::read_to_string(&path).with_context(|| {
+        let rows = read_shard(&work, k).with_context(|| {
             format!(
-                "task {k} left no outcomes ({}); its log: {}",
-                path.display(),
+                "task {k} left no whole outcomes file ({}); its log: {} (run the same command again to resubmit only the missing tasks)",
+                work.join(format!("shard-{k}.json")).display(),
                 work.join(format!("logs/shard-{k}.log")).display()
             )
         })?;
-        let rows: Vec<ShardRow> =
-            serde_json::from_str(&text).with_context(|| format!("{}", path.display()))?;
         results.extend(rows.into_iter().map(|r| {
             let o = match (r.outcome, r.error) {
                 (Some(o), _) => Ok(o),

@@ -1,6 +1,7 @@
 //! `misuse-matrix --slurm N` on a real scheduler (issue 30 item 4): a one-node Slurm cluster
 //! (`tests/slurm-cluster.sh`, `lut::slurm::OneNodeCluster`) runs the matrix as a job array and
-//! the table it prints is the local run's, row for row. The cluster must start: if it cannot
+//! the table it prints is the local run's, row for row; run again, it resubmits only the
+//! tasks without a whole outcomes file. The cluster must start: if it cannot
 //! (not root, packages missing and not installable), the test fails with the script's output.
 //! It never skips.
 
@@ -66,6 +67,44 @@ fn the_matrix_on_a_slurm_job_array_prints_the_local_table() {
             "task {k}\n{logs}"
         );
     }
+    // The same command again resumes (issue 30's leftover): one task's file lost, one cut
+    // short → only those two are submitted, and the table is the same.
+    std::fs::remove_file(work.join("shard-1.json")).unwrap();
+    std::fs::write(work.join("shard-2.json"), "[{\"family\": 0").unwrap();
+    let again = || {
+        matrix()
+            .args(["--slurm", "3", "--cpus-per-task", "1", "--work-dir"])
+            .arg(&work)
+            .env("SLURM_CONF", cluster.conf())
+            .output()
+            .expect("misuse-matrix --slurm")
+    };
+    let resumed = again();
+    let said = String::from_utf8_lossy(&resumed.stderr);
+    assert!(said.contains("tasks 1,2 of 3 (1 already done)"), "{said}");
+    assert_eq!(a, table(&resumed), "{said}");
+    // Everything done: nothing is submitted.
+    let done = again();
+    let said = String::from_utf8_lossy(&done.stderr);
+    assert!(said.contains("all 3 tasks already done"), "{said}");
+    assert_eq!(a, table(&done), "{said}");
+    // Other arguments start afresh.
+    let other = matrix()
+        .args([
+            "--family",
+            "pothole",
+            "--slurm",
+            "3",
+            "--cpus-per-task",
+            "1",
+            "--work-dir",
+        ])
+        .arg(&work)
+        .env("SLURM_CONF", cluster.conf())
+        .output()
+        .expect("misuse-matrix --slurm");
+    let said = String::from_utf8_lossy(&other.stderr);
+    assert!(said.contains("tasks 0,1,2 of 3 (0 already done)"), "{said}");
     drop(cluster);
     let _ = std::fs::remove_dir_all(&tmp);
 }
