@@ -13,7 +13,13 @@ venv_bin=$(tests/setup-host.sh --disk-gb 4 | tail -n1)
 export PATH="$venv_bin:$PATH"
 export CARGO_TERM_COLOR=${CARGO_TERM_COLOR:-never}
 
-step() { printf '\n=== %s ===\n' "$*"; }
+# Where the suite's time goes: each step's wall time, printed at the end.
+times=() last_name="set-up (packages, venv, vcan route, disk check)" last_t=0
+step() {
+  times+=("$(printf '%5d s  %s' $((SECONDS - last_t)) "$last_name")")
+  last_name=${1%% (*}; last_name=${last_name%%:*}; last_t=$SECONDS
+  printf '\n=== %s ===\n' "$*"
+}
 
 step "format and lints"
 cargo fmt --all --check
@@ -62,6 +68,9 @@ step "robustness report (fault campaign of the tests above + fuzz smoke)"
 target/release/fault-campaign report --campaign target/robustness/campaign.json \
   --fuzz target/robustness/fuzz.json --host-timing target/robustness/host-timing.json
 
+step "done"
 echo
 echo "test.sh: all steps passed"
 echo "cargo tests: $totals"
+echo "where the time went ($SECONDS s in all):"
+printf '  %s\n' "${times[@]}"
