@@ -147,4 +147,29 @@ mod tests {
         assert!(!auth.reseal() && !auth.corrupt_crc() && !auth.set_e2e_counter(1));
         assert_eq!((auth.e2e_counter(), auth.e2e_crc_ok()), (None, None));
     }
+
+    /// The reasons are the receive errors' own variants (strum), in declaration order, with
+    /// the report names the fault campaign and the stubs' reports use.
+    #[test]
+    fn reject_reasons_are_the_errors_variants_with_their_report_names() {
+        let names: Vec<&str> = RejectReason::VARIANTS.iter().map(|r| r.name()).collect();
+        assert_eq!(
+            names,
+            [
+                "unknown_id",
+                "wrong_dlc",
+                "crc_mismatch",
+                "counter_repeated",
+                "counter_skipped",
+                "out_of_range"
+            ]
+        );
+        assert_eq!(RejectReason::COUNT, 6);
+        let e = RxError::CrcMismatch {
+            computed: 1,
+            received: 2,
+        };
+        assert_eq!(e.reason(), RejectReason::CrcMismatch);
+        assert_eq!(RejectReason::CounterSkipped as usize, 4);
+    }
 }

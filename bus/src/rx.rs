@@ -7,7 +7,25 @@ use crate::{e2e_crc, message_info, meta, RawFrame, E2E_MESSAGE_COUNT};
 use strum::EnumCount;
 
 /// Why a received frame was rejected.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+///
+/// Its details stripped, it is a [`RejectReason`] (derived by strum: one list of reasons,
+/// not a mirrored enum), for counting rejections by reason: `COUNT`, `VARIANTS` (index order)
+/// and the report names (`name`: `crc_mismatch`, …).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, strum::EnumDiscriminants)]
+#[strum_discriminants(
+    name(RejectReason),
+    vis(pub),
+    derive(
+        Hash,
+        PartialOrd,
+        Ord,
+        strum::EnumCount,
+        strum::VariantArray,
+        strum::IntoStaticStr
+    ),
+    strum(serialize_all = "snake_case"),
+    doc = "[`RxError`] without its details."
+)]
 pub enum RxError {
     /// The id is not in `restraint.dbc` (or is a 29-bit id).
     UnknownId(u32),
@@ -39,38 +57,6 @@ pub enum RxError {
     OutOfRange(&'static str),
 }
 
-/// [`RxError`] without its details, for counting rejections by reason. `COUNT`,
-/// `VARIANTS` (index order) and the report names (`name`) are derived (strum).
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Hash,
-    PartialOrd,
-    Ord,
-    strum::EnumCount,
-    strum::VariantArray,
-    strum::IntoStaticStr,
-)]
-#[strum(serialize_all = "snake_case")]
-#[repr(u8)]
-pub enum RejectReason {
-    /// [`RxError::UnknownId`]
-    UnknownId = 0,
-    /// [`RxError::WrongDlc`]
-    WrongDlc = 1,
-    /// [`RxError::CrcMismatch`]
-    CrcMismatch = 2,
-    /// [`RxError::CounterRepeated`]
-    CounterRepeated = 3,
-    /// [`RxError::CounterSkipped`]
-    CounterSkipped = 4,
-    /// [`RxError::OutOfRange`]
-    OutOfRange = 5,
-}
-
 impl RejectReason {
     /// Stable short name for reports (`crc_mismatch`, …).
     #[must_use]
@@ -82,15 +68,8 @@ impl RejectReason {
 impl RxError {
     /// The reason without details.
     #[must_use]
-    pub const fn reason(&self) -> RejectReason {
-        match self {
-            Self::UnknownId(_) => RejectReason::UnknownId,
-            Self::WrongDlc { .. } => RejectReason::WrongDlc,
-            Self::CrcMismatch { .. } => RejectReason::CrcMismatch,
-            Self::CounterRepeated { .. } => RejectReason::CounterRepeated,
-            Self::CounterSkipped { .. } => RejectReason::CounterSkipped,
-            Self::OutOfRange(_) => RejectReason::OutOfRange,
-        }
+    pub fn reason(&self) -> RejectReason {
+        self.into()
     }
 }
 
