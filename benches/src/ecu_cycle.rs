@@ -92,14 +92,7 @@ pub fn quiet_accel(now_ns: u64) -> CrashAccelSample {
 
 /// Cycle info of the cycle at `now_ns` (on time).
 pub fn info(now_ns: u64) -> CycleInfo {
-    CycleInfo {
-        cycle: now_ns / MS,
-        slot: now_ns / MS,
-        period_ns: MS,
-        deadline_ns: now_ns,
-        now_ns,
-        ..CycleInfo::default()
-    }
+    CycleInfo::on_time(now_ns / MS, MS, now_ns)
 }
 
 /// E2E-sealed input frames: (`EgoVehicleState`, `OccupantClassification`) of a buckled

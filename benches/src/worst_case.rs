@@ -507,15 +507,7 @@ impl Feed<'_> {
 }
 
 fn info_at(now: u64, cycle: u64) -> CycleInfo {
-    CycleInfo {
-        cycle,
-        slot: cycle,
-        period_ns: MS,
-        deadline_ns: now,
-        now_ns: now,
-        sync_time_us: 1_750_000_000_000_000 + now / 1_000,
-        ..CycleInfo::default()
-    }
+    CycleInfo::on_time(cycle, MS, now).with_sync_time_us(1_750_000_000_000_000 + now / 1_000)
 }
 
 /// Runs the case's prefix through a fresh cycle and queues the measured cycle's inputs.

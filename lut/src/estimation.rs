@@ -306,14 +306,7 @@ pub fn simulate(
             }
         }
         let now = T0_NS + cycle * MS;
-        let info = CycleInfo {
-            cycle,
-            slot: cycle,
-            period_ns: MS,
-            deadline_ns: now,
-            now_ns: now,
-            ..CycleInfo::default()
-        };
+        let info = CycleInfo::on_time(cycle, MS, now);
         ecu.step(&info, &mut io);
         io.can_tx.clear();
         let fresh = t - last_sample_s <= timeout_s;

@@ -40,6 +40,37 @@ pub struct CycleInfo {
     pub sync_time_us: u64,
 }
 
+impl CycleInfo {
+    /// Cycle `cycle` of a simulated loop with period `period_ns`, started on time at `now_ns`
+    /// (slot = cycle, deadline = now, no latency, no overrun, no skipped slot): how the offline
+    /// bench, the studies, the benches, the fuzz target and the tests drive the core. The
+    /// synchronized time is 0 unless [`with_sync_time_us`](Self::with_sync_time_us) sets it.
+    #[must_use]
+    pub const fn on_time(cycle: u64, period_ns: u64, now_ns: u64) -> Self {
+        Self {
+            cycle,
+            slot: cycle,
+            period_ns,
+            deadline_ns: now_ns,
+            now_ns,
+            wake_latency_ns: 0,
+            last_exec_ns: 0,
+            overruns: 0,
+            skipped_slots: 0,
+            sync_time_us: 0,
+        }
+    }
+
+    /// The same cycle with the synchronized time (SecOC freshness) set, µs.
+    #[must_use]
+    pub const fn with_sync_time_us(self, sync_time_us: u64) -> Self {
+        Self {
+            sync_time_us,
+            ..self
+        }
+    }
+}
+
 /// Why an output could not be written (hot path: `Copy`, no text).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum IoError {

@@ -91,15 +91,8 @@ fn no_allocation_in_precrash_and_crash_cycles() {
         if ms.is_multiple_of(100) {
             io.push_can(bench.occupant_frame());
         }
-        let info = CycleInfo {
-            cycle: k,
-            slot: k,
-            period_ns: MS,
-            deadline_ns: now,
-            now_ns: now,
-            sync_time_us: cycle_support::sync_time_us(now),
-            ..CycleInfo::default()
-        };
+        let info =
+            CycleInfo::on_time(k, MS, now).with_sync_time_us(cycle_support::sync_time_us(now));
         if k == 1_000 {
             predictions_before = ecu.counters().predictions;
         }

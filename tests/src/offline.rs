@@ -235,15 +235,7 @@ pub fn run_traced(
                 .for_each(|b| t.safing_g.extend(batch_g(b)));
         }
         let now = START_NS + tick * MS + cfg.ecu_phase_ns;
-        let info = CycleInfo {
-            cycle: tick,
-            slot: tick,
-            period_ns: MS,
-            deadline_ns: now,
-            now_ns: now,
-            sync_time_us: now / 1_000,
-            ..CycleInfo::default()
-        };
+        let info = CycleInfo::on_time(tick, MS, now).with_sync_time_us(now / 1_000);
         let before = io.can_tx_total;
         ecu.step(&info, &mut io);
         let m = io.diagnostics.mode;

@@ -257,13 +257,8 @@ impl Bench {
             ));
         }
         let info = CycleInfo {
-            cycle: self.cycle,
-            slot: self.cycle,
-            period_ns: MS,
             deadline_ns: self.deadline.take().unwrap_or(self.now),
-            now_ns: self.now,
-            sync_time_us: sync_time_us(self.now),
-            ..CycleInfo::default()
+            ..CycleInfo::on_time(self.cycle, MS, self.now).with_sync_time_us(sync_time_us(self.now))
         };
         let before = self.io.can_tx_total;
         self.ecu.step(&info, &mut self.io);
