@@ -521,9 +521,9 @@ impl Checker {
                     let flags = flags_in(&text);
                     let mut seg = vec![tool.to_owned()];
                     seg.extend(flags);
-                    for p in self.check_flags(
-                        &shlex::try_join(seg.iter().map(String::as_str)).unwrap_or_default(),
-                    ) {
+                    let mut found = Vec::new();
+                    self.check_segment(&seg, &mut found);
+                    for p in found {
                         fail(format!("synopsis: {p}"));
                     }
                     if self.tool(tool).is_none() {
@@ -565,7 +565,7 @@ pub fn inline_commands(text: &str) -> Vec<(usize, String)> {
 }
 
 /// The subcommands a clap `--help` lists under `Commands:`.
-fn subcommands(help: &str) -> Vec<String> {
+pub fn subcommands(help: &str) -> Vec<String> {
     help.lines()
         .skip_while(|l| !l.starts_with("Commands:"))
         .skip(1)

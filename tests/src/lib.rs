@@ -232,6 +232,21 @@ pub fn repo_or_default(given: Option<PathBuf>) -> Result<PathBuf> {
     }
 }
 
+/// The scenario library: every `*.toml` of the repository's `scenarios/`, sorted by name (the
+/// offline bench's default and what the library tests run).
+pub fn library_files(repo: &Path) -> Result<Vec<PathBuf>> {
+    let dir = repo.join("scenarios");
+    let mut files = Vec::new();
+    for e in std::fs::read_dir(&dir).with_context(|| dir.display().to_string())? {
+        let p = e?.path();
+        if p.extension().is_some_and(|x| x == "toml") {
+            files.push(p);
+        }
+    }
+    files.sort();
+    Ok(files)
+}
+
 /// The repository this crate was built in — for the tests, which cargo builds and runs inside
 /// the checkout; the tools use [`repo_or_default`].
 pub fn repo_root() -> PathBuf {

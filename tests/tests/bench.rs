@@ -32,13 +32,7 @@ fn root() -> PathBuf {
 }
 
 fn library() -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("scenarios"))
-        .expect("scenarios/")
-        .map(|e| e.expect("entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    v.sort();
-    v
+    e2e_tests::library_files(&root()).expect("scenarios/")
 }
 
 /// Runs the library once; returns the output root.

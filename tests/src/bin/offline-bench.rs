@@ -71,13 +71,7 @@ fn run_all() -> Result<bool> {
     let repo = e2e_tests::repo_or_default(cli.repo.clone())?;
     let mut files = cli.scenario.clone();
     if files.is_empty() {
-        for e in std::fs::read_dir(repo.join("scenarios")).context("scenarios/")? {
-            let p = e?.path();
-            if p.extension().is_some_and(|x| x == "toml") {
-                files.push(p);
-            }
-        }
-        files.sort();
+        files = e2e_tests::library_files(&repo)?;
     }
     let mut cfg = OfflineConfig::shipped(&repo)?;
     if let Some(path) = &cli.cycle_config {

@@ -156,16 +156,10 @@ fn long_flags(bin: &std::path::Path) -> Vec<(String, String)> {
     };
     let top = help(&["--help"]);
     let mut pages = vec![(String::new(), top.clone())];
-    let subcommands = top
-        .lines()
-        .skip_while(|l| !l.starts_with("Commands:"))
-        .skip(1)
-        .take_while(|l| !l.trim().is_empty())
-        .filter_map(|l| l.split_whitespace().next())
-        .filter(|s| *s != "help")
-        .map(str::to_owned)
-        .collect::<Vec<_>>();
-    for s in subcommands {
+    for s in e2e_tests::docs::subcommands(&top)
+        .into_iter()
+        .filter(|s| s != "help")
+    {
         let page = help(&[&s, "--help"]);
         pages.push((s, page));
     }

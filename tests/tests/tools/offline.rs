@@ -23,13 +23,9 @@ fn root() -> PathBuf {
 }
 
 fn library() -> Vec<Scenario> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("scenarios"))
+    e2e_tests::library_files(&root())
         .expect("scenarios/")
-        .map(|e| e.expect("entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    v.sort();
-    v.iter()
+        .iter()
         .map(|p| Scenario::load(p).unwrap_or_else(|e| panic!("{e}")))
         .collect()
 }
