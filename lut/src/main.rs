@@ -3,18 +3,14 @@
 //! Each sub-command lives in its own module; add new ones by adding a variant to [`Command`]
 //! and a module with `run(args)`.
 
-mod cmd_estimation;
 mod cmd_optim;
-mod cmd_robustness;
 mod cmd_simulate;
 mod cmd_slurm;
 mod cmd_stiffness;
+mod cmd_study;
 mod cmd_table;
 mod heatmap;
 mod plot;
-mod study;
-mod study_fallback;
-mod study_occ;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
@@ -35,7 +31,7 @@ enum Command {
     Simulate(cmd_simulate::SimulateArgs),
     /// Parameter studies of the paper.
     #[command(subcommand)]
-    Study(study::StudyCommand),
+    Study(cmd_study::StudyCommand),
     /// Stiffness-class tools.
     #[command(subcommand)]
     Stiffness(cmd_stiffness::StiffnessCommand),
@@ -109,7 +105,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     }
     match cli.command {
         Command::Simulate(args) => cmd_simulate::run(&args),
-        Command::Study(cmd) => study::run(&cmd),
+        Command::Study(cmd) => cmd_study::run(&cmd),
         Command::Stiffness(cmd) => cmd_stiffness::run(&cmd),
         Command::Reference(args) => cmd_optim::run_reference(&args),
         Command::Optimise(args) => cmd_optim::run_optimise(&args),

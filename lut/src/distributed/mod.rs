@@ -19,180 +19,25 @@
 //! valid file are submitted. A complete, valid shard is never recomputed.
 
 use crate::progress::{read_progress_file, Progress};
-use crate::robustness::RobustnessJob;
 use crate::shard::{short, ShardHeader};
 use crate::slurm::{self, Queued, Record, Submit};
-use crate::table::{self, Grid, GridFile};
 use anyhow::{anyhow, bail, Context, Result};
-use diagram::Diagram;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::{Deserialize, Serialize};
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+use std::time::{Duration, SystemTime, UNIX_EPOCH};
+
+mod job;
+mod status;
+mod watch;
+
+pub use job::{Job, TableJob};
+pub use status::{CollectStatus, ShardState, ShardStatus, Status};
+pub use watch::watch;
 
 /// Spec file name in the work directory.
 pub const SPEC_FILE: &str = "spec.json";
 /// State file name in the work directory.
 pub const STATE_FILE: &str = "state.json";
-
-/// What a distributed run computes.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-pub enum Job {
-    /// The characteristic diagram of a grid.
-    Table(TableJob),
-    /// The Monte-Carlo robustness study of one cell.
-    Robustness(RobustnessJob),
-}
-
-/// A table build: the grid and how the merged table is spot-checked.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct TableJob {
-    /// The grid (a copy: editing the grid file during a run changes nothing).
-    pub grid: GridFile,
-    /// Cells re-optimised by the collect job's check (like `lut verify --cells`).
-    pub verify_cells: usize,
-    /// Seed of that check.
-    pub verify_seed: u64,
-}
-
-impl TableJob {
-    fn grid(&self) -> Result<Grid> {
-        Grid::from_spec("grid of the distributed build", self.grid.clone())
-    }
-
-    /// Merge, check (checksum, every cell, the grid's identity, spot re-optimisation), write.
-    fn collect(&self, identity: &str, shards: &[(String, Vec<u8>)], out: &Path) -> Result<String> {
-        let decoded = shards
-            .iter()
-            .map(|(o, b)| Ok((o.clone(), table::read_shard(o, b)?)))
-            .collect::<Result<Vec<_>>>()?;
-        let d = table::merge_shards(&decoded, Some(identity))?;
-        let name = out.display().to_string();
-        let bytes = d.to_bytes();
-        let back = Diagram::from_bytes(&name, &bytes).map_err(|e| anyhow!("merged table: {e}"))?;
-        if back.checksum() != d.checksum() || back.cells().len() != self.grid()?.axes.cell_count() {
-            bail!("merged table does not survive its own file format (checksum or cell count)");
-        }
-        if table::table_identity(back.header(), back.axes())? != identity {
-            bail!("merged table's header and axes are not those of the grid");
-        }
-        let rows = table::verify(&back, self.verify_cells, self.verify_seed)?;
-        let bad: Vec<String> = rows
-            .iter()
-            .filter(|r| !r.ok)
-            .map(|r| format!("cell {}: {}", r.index, r.problem.as_deref().unwrap_or("?")))
-            .collect();
-        if !bad.is_empty() {
-            bail!(
-                "merged table fails the spot re-optimisation: {}",
-                bad.join("; ")
-            );
-        }
-        diagram::write_atomically(out, &bytes).map_err(|e| anyhow!("{e}"))?;
-        Ok(format!(
-            "table {name}: {} cells, LUT id 0x{:04x}, CRC-32C 0x{:08x}; {} cells re-optimised, all within tolerance",
-            back.cells().len(),
-            back.lut_id(),
-            back.checksum(),
-            rows.len()
-        ))
-    }
-
-    fn output_matches(out: &Path, identity: &str) -> bool {
-        Diagram::load(out).is_ok_and(|d| {
-            table::table_identity(d.header(), d.axes()).is_ok_and(|id| id == identity)
-        })
-    }
-}
-
-impl Job {
-    /// Kind tag (shard files, job names).
-    pub fn kind(&self) -> &'static str {
-        match self {
-            Job::Table(_) => table::TABLE_SHARD_KIND,
-            Job::Robustness(_) => crate::robustness::SHARD_KIND,
-        }
-    }
-
-    /// What an item is called.
-    pub fn unit(&self) -> &'static str {
-        match self {
-            Job::Table(_) => "cells",
-            Job::Robustness(_) => "samples",
-        }
-    }
-
-    /// Identity of the inputs.
-    pub fn identity(&self) -> Result<String> {
-        match self {
-            Job::Table(t) => t.grid()?.identity(),
-            Job::Robustness(r) => r.identity(),
-        }
-    }
-
-    /// Items in total.
-    pub fn items(&self) -> Result<usize> {
-        match self {
-            Job::Table(t) => Ok(t.grid()?.axes.cell_count()),
-            Job::Robustness(r) => Ok(r.samples()),
-        }
-    }
-
-    /// Compute shard `k` of `n`; the encoded shard file.
-    pub fn compute_shard(
-        &self,
-        k: usize,
-        n: usize,
-        threads: Option<usize>,
-        progress: &Progress,
-    ) -> Result<Vec<u8>> {
-        match self {
-            Job::Table(t) => {
-                let (s, stats) = table::build_shard(&t.grid()?, k, n, threads, progress)?;
-                eprintln!(
-                    "{} cells in {:.1} s: {:.2} cells/s, {} occupant simulations",
-                    stats.cells,
-                    stats.wall.as_secs_f64(),
-                    stats.cells as f64 / stats.wall.as_secs_f64().max(1e-9),
-                    stats.occupant_simulations
-                );
-                s.to_bytes()
-            }
-            Job::Robustness(r) => r.compute_shard(k, n, threads, progress),
-        }
-    }
-
-    /// Read and check one shard file on its own; its header.
-    pub fn read_shard(&self, origin: &str, bytes: &[u8]) -> Result<ShardHeader> {
-        match self {
-            Job::Table(_) => Ok(table::read_shard(origin, bytes)?.header),
-            Job::Robustness(_) => crate::robustness::read_shard(origin, bytes).map(|s| s.header),
-        }
-    }
-
-    /// Combine all shards into the checked output, written atomically to `out`; a summary.
-    pub fn collect(
-        &self,
-        identity: &str,
-        shards: &[(String, Vec<u8>)],
-        out: &Path,
-    ) -> Result<String> {
-        match self {
-            Job::Table(t) => t.collect(identity, shards, out),
-            Job::Robustness(r) => r.collect(identity, shards, out),
-        }
-    }
-
-    /// `out` holds this job's complete output.
-    pub fn output_matches(&self, out: &Path, identity: &str) -> bool {
-        match self {
-            Job::Table(_) => TableJob::output_matches(out, identity),
-            Job::Robustness(_) => crate::robustness::output_matches(out, identity),
-        }
-    }
-}
 
 /// The work directory's description of the run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -295,9 +140,11 @@ pub fn default_work_dir(out: &Path) -> PathBuf {
     PathBuf::from(s)
 }
 
-/// Single-quote for sh.
-fn sh_quote(s: &str) -> String {
-    format!("'{}'", s.replace('\'', r"'\''"))
+/// Quoted for sh (shlex; a path cannot hold the NUL byte it refuses).
+fn sh_quote(s: &str) -> Result<String> {
+    Ok(shlex::try_quote(s)
+        .map_err(|e| anyhow!("{s:?}: {e}"))?
+        .into_owned())
 }
 
 impl Work {
@@ -424,8 +271,8 @@ impl Work {
     }
 
     fn write_scripts(&self) -> Result<()> {
-        let lut = sh_quote(&self.spec.lut.display().to_string());
-        let dir = sh_quote(&self.dir.display().to_string());
+        let lut = sh_quote(&self.spec.lut.display().to_string())?;
+        let dir = sh_quote(&self.dir.display().to_string())?;
         let shard = format!(
             "#!/bin/sh\n# Written by lut: array task K computes shard K of {} of the run in this directory.\nexec {lut} slurm shard {dir} \"$SLURM_ARRAY_TASK_ID\"\n",
             self.spec.n
@@ -585,278 +432,6 @@ impl Work {
     }
 }
 
-/// State of one shard.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum ShardState {
-    /// A valid shard file is there.
-    Done,
-    /// Its array task runs.
-    Running,
-    /// Its array task waits in the queue.
-    Pending,
-    /// Its array task of the latest submission ended without a valid shard file.
-    Failed,
-    /// A file is there but it is not a valid shard of this run.
-    Invalid,
-    /// Not computed and not submitted.
-    Missing,
-}
-
-/// One shard's status.
-#[derive(Clone, Debug, Serialize)]
-pub struct ShardStatus {
-    /// K.
-    pub k: u32,
-    /// State.
-    pub state: ShardState,
-    /// Items of the shard.
-    pub items: usize,
-    /// Items done (running: from its progress file).
-    pub done: usize,
-    /// Queue state, or why it failed / is invalid.
-    pub detail: String,
-}
-
-/// The collect job of the latest submission.
-#[derive(Clone, Debug, Serialize)]
-pub struct CollectStatus {
-    /// Job id.
-    pub job: String,
-    /// Queue state if still queued.
-    pub queued: Option<String>,
-    /// Its log file.
-    pub log: PathBuf,
-}
-
-/// Where a run stands.
-#[derive(Clone, Debug, Serialize)]
-pub struct Status {
-    /// Work directory.
-    pub dir: PathBuf,
-    /// Output file.
-    pub out: PathBuf,
-    /// Item name.
-    pub unit: String,
-    /// Items in total.
-    pub items: u64,
-    /// Shards.
-    pub n: u32,
-    /// The output is complete and of this run.
-    pub output_complete: bool,
-    /// Any job of the latest submission is still queued.
-    pub jobs_queued: bool,
-    /// Per shard.
-    pub shards: Vec<ShardStatus>,
-    /// The latest collect job.
-    pub collect: Option<CollectStatus>,
-    /// Submissions so far.
-    pub submissions: usize,
-}
-
-impl Status {
-    /// Shards in `s`.
-    pub fn count(&self, s: ShardState) -> usize {
-        self.shards.iter().filter(|x| x.state == s).count()
-    }
-
-    /// Items done (complete shards plus running tasks' progress).
-    pub fn items_done(&self) -> usize {
-        self.shards.iter().map(|s| s.done).sum()
-    }
-
-    /// Shards that need computing (no valid file and not queued).
-    pub fn to_submit(&self) -> Vec<u32> {
-        self.shards
-            .iter()
-            .filter(|s| {
-                matches!(
-                    s.state,
-                    ShardState::Failed | ShardState::Invalid | ShardState::Missing
-                )
-            })
-            .map(|s| s.k)
-            .collect()
-    }
-
-    /// One line: shards done/running/pending/failed and items.
-    pub fn summary(&self) -> String {
-        format!(
-            "shards {}/{} done, {} running, {} pending, {} failed; {}/{} {}",
-            self.count(ShardState::Done),
-            self.n,
-            self.count(ShardState::Running),
-            self.count(ShardState::Pending),
-            self.count(ShardState::Failed) + self.count(ShardState::Invalid),
-            self.items_done(),
-            self.items,
-            self.unit
-        )
-    }
-
-    /// Multi-line report (for `lut slurm status`).
-    pub fn report(&self) -> String {
-        let mut s = format!(
-            "work dir {}\noutput   {} ({})\n{}\n",
-            self.dir.display(),
-            self.out.display(),
-            if self.output_complete {
-                "complete"
-            } else {
-                "not written yet"
-            },
-            self.summary()
-        );
-        for sh in &self.shards {
-            s.push_str(&format!(
-                "  shard {:>3}: {:<8} {:>6}/{:<6} {}\n",
-                sh.k,
-                format!("{:?}", sh.state).to_lowercase(),
-                sh.done,
-                sh.items,
-                sh.detail
-            ));
-        }
-        if let Some(c) = &self.collect {
-            s.push_str(&format!(
-                "  collect job {}: {} (log {})\n",
-                c.job,
-                c.queued.as_deref().unwrap_or("not queued"),
-                c.log.display()
-            ));
-        }
-        s
-    }
-}
-
-/// Shows a watched run: an indicatif bar on a terminal, a line on every change of the shards'
-/// states (and every 10 s) otherwise.
-struct Watcher {
-    bar: Option<ProgressBar>,
-    start: Instant,
-    done0: Option<usize>,
-    last_line: Instant,
-    last_summary: String,
-}
-
-impl Watcher {
-    fn new(items: u64, unit: &str) -> Self {
-        let bar = std::io::stderr().is_terminal().then(|| {
-            let b = ProgressBar::with_draw_target(Some(items), ProgressDrawTarget::stderr());
-            if let Ok(st) = ProgressStyle::with_template(&format!(
-                "slurm [{{elapsed_precise}}] {{wide_bar}} {{pos}}/{{len}} {unit} {{msg}}"
-            )) {
-                b.set_style(st);
-            }
-            b
-        });
-        let now = Instant::now();
-        Watcher {
-            bar,
-            start: now,
-            done0: None,
-            last_line: now,
-            last_summary: String::new(),
-        }
-    }
-
-    fn update(&mut self, st: &Status) {
-        let done = st.items_done();
-        let done0 = *self.done0.get_or_insert(done);
-        let el = self.start.elapsed().as_secs_f64();
-        let rate = if el > 0.5 && done > done0 {
-            format!("{:.2} {}/s", (done - done0) as f64 / el, st.unit)
-        } else {
-            format!("– {}/s", st.unit)
-        };
-        let shards = format!(
-            "shards {}/{} done, {} running, {} pending, {} failed",
-            st.count(ShardState::Done),
-            st.n,
-            st.count(ShardState::Running),
-            st.count(ShardState::Pending),
-            st.count(ShardState::Failed) + st.count(ShardState::Invalid)
-        );
-        match &self.bar {
-            Some(b) => {
-                b.set_position(done as u64);
-                b.set_message(format!("{shards}, {rate}"));
-            }
-            None => {
-                if shards != self.last_summary
-                    || self.last_line.elapsed() >= Duration::from_secs(10)
-                {
-                    eprintln!(
-                        "slurm: {shards}; {done}/{} {}, {rate}, {el:.0} s",
-                        st.items, st.unit
-                    );
-                    self.last_summary = shards;
-                    self.last_line = Instant::now();
-                }
-            }
-        }
-    }
-
-    fn finish(&self) {
-        if let Some(b) = &self.bar {
-            b.finish();
-        }
-    }
-}
-
-/// Watch until nothing of the latest submission is queued: `Ok` when the output is complete,
-/// otherwise an error naming the failed shards (or the failed collect job) and their logs.
-pub fn watch(work: &Work, poll: Duration) -> Result<()> {
-    let mut w = Watcher::new(work.spec.items, work.spec.job.unit());
-    loop {
-        let st = work.status(false)?;
-        w.update(&st);
-        if !st.jobs_queued {
-            w.finish();
-            if st.output_complete {
-                eprintln!("slurm: {} written", work.spec.out.display());
-                return Ok(());
-            }
-            let st = work.status(true)?;
-            let failed: Vec<String> = st
-                .shards
-                .iter()
-                .filter(|s| s.state != ShardState::Done)
-                .map(|s| format!("shard {}/{} ({:?}): {}", s.k, st.n, s.state, s.detail))
-                .collect();
-            if !failed.is_empty() {
-                bail!(
-                    "distributed run failed: {} of {} shards missing or failed (re-run the same command to resume: only these are re-submitted):\n  {}",
-                    failed.len(),
-                    st.n,
-                    failed.join("\n  ")
-                );
-            }
-            let c = st.collect.as_ref();
-            let rec = match c {
-                Some(c) => slurm::scontrol_show(&c.job)?
-                    .first()
-                    .map_or("no record".into(), Record::describe),
-                None => "never submitted".into(),
-            };
-            let tail = c
-                .and_then(|c| std::fs::read_to_string(&c.log).ok())
-                .map(|t| {
-                    let lines: Vec<&str> = t.lines().collect();
-                    lines[lines.len().saturating_sub(6)..].join("\n    ")
-                })
-                .unwrap_or_default();
-            bail!(
-                "every shard is done but the collect job {} did not write {} ({rec}); log {}:\n    {tail}",
-                c.map_or("?", |c| c.job.as_str()),
-                work.spec.out.display(),
-                c.map_or_else(String::new, |c| c.log.display().to_string())
-            );
-        }
-        std::thread::sleep(poll);
-    }
-}
-
 /// Submit (or resume, or attach to) a distributed run of `job` writing `out`, then wait unless
 /// `opts.no_wait`. See the module docs for the resume rules.
 pub fn run(job: Job, out: &Path, work_dir: &Path, opts: &RunOptions) -> Result<()> {
@@ -966,7 +541,10 @@ mod tests {
 
     #[test]
     fn quoting_and_default_dir() {
-        assert_eq!(sh_quote("a'b c"), r"'a'\''b c'");
+        assert_eq!(
+            shlex::split(&sh_quote("a'b c $HOME").unwrap()).unwrap(),
+            ["a'b c $HOME"]
+        );
         assert_eq!(
             default_work_dir(Path::new("x/t.lut")),
             PathBuf::from("x/t.lut.slurm")

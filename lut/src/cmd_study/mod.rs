@@ -1,4 +1,4 @@
-//! `lut study ...`: the paper's parameter studies.
+//! `lut study ...`: the paper's parameter studies and the bench's own (robustness, fallback, estimation), one file per study beyond Table 5.
 
 use crate::{cmd_simulate::vehicle_json, plot};
 use anyhow::Result;
@@ -10,25 +10,30 @@ use physics::{
 use serde_json::json;
 use std::path::PathBuf;
 
+mod estimation;
+mod fallback;
+mod occupant;
+mod robustness;
+
 #[derive(Subcommand, Debug)]
 pub enum StudyCommand {
     /// Table 5: symmetric 1785 kg vs 1785 kg at 108 km/h for each stiffness class, beside the
     /// paper's published vehicle results.
     Stiffness(StiffnessStudyArgs),
     /// Adaptive occupant loading over opponent mass 800..3000 kg (200 kg steps).
-    OpponentMass(crate::study_occ::OpponentMassArgs),
+    OpponentMass(occupant::OpponentMassArgs),
     /// Closing speed × occupant mass: reference restraint vs adaptive optimum, reductions in %.
-    Reduction(crate::study_occ::ReductionArgs),
+    Reduction(occupant::ReductionArgs),
     /// Monte-Carlo: the pre-crash estimate's errors (payload, speed, distance) → spread of the
     /// occupant's outcome in one cell; locally or as a Slurm job array (--slurm N).
-    Robustness(crate::cmd_robustness::RobustnessArgs),
+    Robustness(robustness::RobustnessArgs),
     /// The ECU's accelerometer-only airbag algorithm over a sweep of barrier and car-to-car
     /// crashes: no-fire and must-fire lines, fire times against the occupant's deadline;
     /// `--derive` calibrates its boundary.
-    Fallback(crate::study_fallback::FallbackArgs),
+    Fallback(fallback::FallbackArgs),
     /// The ECU's track filter against the newest sample alone over the scenario library and
     /// noisier sensors: errors at contact, occupant outcome, a plot of one case.
-    Estimation(crate::cmd_estimation::EstimationArgs),
+    Estimation(estimation::EstimationArgs),
 }
 
 #[derive(Args, Debug)]
@@ -44,11 +49,11 @@ pub struct StiffnessStudyArgs {
 pub fn run(cmd: &StudyCommand) -> Result<()> {
     match cmd {
         StudyCommand::Stiffness(args) => stiffness_study(args),
-        StudyCommand::OpponentMass(args) => crate::study_occ::opponent_mass(args),
-        StudyCommand::Reduction(args) => crate::study_occ::reduction(args),
-        StudyCommand::Robustness(args) => crate::cmd_robustness::run(args),
-        StudyCommand::Fallback(args) => crate::study_fallback::run(args),
-        StudyCommand::Estimation(args) => crate::cmd_estimation::run(args),
+        StudyCommand::OpponentMass(args) => occupant::opponent_mass(args),
+        StudyCommand::Reduction(args) => occupant::reduction(args),
+        StudyCommand::Robustness(args) => robustness::run(args),
+        StudyCommand::Fallback(args) => fallback::run(args),
+        StudyCommand::Estimation(args) => estimation::run(args),
     }
 }
 
@@ -79,10 +84,10 @@ fn stiffness_study(args: &StiffnessStudyArgs) -> Result<()> {
             "class": p.class,
             "vehicle": vehicle_json(v, s.contact_duration_s),
             // Occupant: adaptive optimum for the 75 kg occupant at 300 mm in this class's pulse.
-            "occupant": crate::study_occ::stiffness_occupant(&buf.ego_pulse())?,
+            "occupant": occupant::stiffness_occupant(&buf.ego_pulse())?,
             "paper": {
                 "vehicle": { "crush_mm": p.crush_mm, "a_max_g": p.a_max_g, "a_mean_g": p.a_mean_g },
-                "occupant": { "a_mean_g_approx": crate::study_occ::PAPER_TABLE5_OCCUPANT_MEAN_G },
+                "occupant": { "a_mean_g_approx": occupant::PAPER_TABLE5_OCCUPANT_MEAN_G },
             },
             "error_pct": {
                 "crush_mm": pct(v.crush_m * 1e3, p.crush_mm),
