@@ -576,11 +576,16 @@ impl Scenario {
     /// Parses and validates scenario text; `file` names the source in errors.
     pub fn parse(file: &str, text: &str) -> Result<Self, ScenarioError> {
         let scenario: Scenario = toml::from_str(text).map_err(|e| {
-            let (line, column) = e.span().map(|s| location::line_col(text, s.start)).unzip();
+            let (line, column) = e
+                .span()
+                .map(|s| toml_location::line_col(text, s.start))
+                .unzip();
             let message = e.message().to_owned();
             // Unknown/missing field errors name the key themselves; others (types, ranges
             // of integers) get the key of the offending line.
-            let field = e.span().and_then(|s| location::field_at(text, s.start));
+            let field = e
+                .span()
+                .and_then(|s| toml_location::field_at(text, s.start));
             ScenarioError {
                 file: file.to_owned(),
                 line,
@@ -593,7 +598,7 @@ impl Scenario {
             .validate()
             .map_err(|(field, message)| ScenarioError {
                 file: file.to_owned(),
-                line: location::line_of_field(text, &field),
+                line: toml_location::line_of_field(text, &field),
                 column: None,
                 field: Some(field),
                 message,

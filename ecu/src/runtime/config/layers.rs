@@ -17,8 +17,9 @@ use std::path::{Path, PathBuf};
 use figment::providers::{Env, Format, Serialized, Toml};
 use figment::{Figment, Provider, Source};
 
-use super::{line_col, ConfigError, EcuConfig};
+use super::{ConfigError, EcuConfig};
 use crate::runtime::cli::COMMAND_LINE;
+use toml_location::line_of_key;
 
 /// Prefix of the environment layer's variables.
 pub const ENV_PREFIX: &str = "ECU_";
@@ -211,20 +212,8 @@ fn env_origin(key: &str) -> String {
 /// `path:line` of the dotted `key` (from the span `toml_edit` keeps for it), or `path` when
 /// the file does not set it.
 pub(super) fn origin_in_file(text: &str, path: &Path, key: &str) -> String {
-    let line = toml_edit::ImDocument::parse(text).ok().and_then(|doc| {
-        let mut table: &dyn toml_edit::TableLike = doc.as_table();
-        let mut parts = key.split('.').peekable();
-        while let Some(part) = parts.next() {
-            let (k, item) = table.get_key_value(part)?;
-            if parts.peek().is_none() {
-                return k.span().or_else(|| item.span());
-            }
-            table = item.as_table_like()?;
-        }
-        None
-    });
-    match line {
-        Some(span) => format!("{}:{}", path.display(), line_col(text, span.start).0),
+    match line_of_key(text, key) {
+        Some(line) => format!("{}:{line}", path.display()),
         None => path.display().to_string(),
     }
 }

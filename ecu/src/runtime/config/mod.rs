@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
+use toml_location::{field_at, line_col};
 
 use super::cli::RunArgs;
 
@@ -190,14 +191,6 @@ pub enum ConfigError {
     },
 }
 
-/// 1-based (line, column) of byte `offset` in `text`.
-pub(super) fn line_col(text: &str, offset: usize) -> (usize, usize) {
-    let before = text.get(..offset.min(text.len())).unwrap_or(text);
-    let line = before.matches('\n').count() + 1;
-    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-    (line, column)
-}
-
 impl EcuConfig {
     /// Parses TOML text; errors name `path:line:column`.
     pub fn from_toml_str(text: &str, path: &Path) -> Result<Self, ConfigError> {
@@ -206,7 +199,7 @@ impl EcuConfig {
             // A type error names its value, not its key: say the key too (unknown and missing
             // keys already name theirs).
             let message = e.message().trim();
-            let message = match key_at_line(text, line) {
+            let message = match e.span().and_then(|s| field_at(text, s.start)) {
                 Some(key)
                     if !message
                         .contains(&format!("`{}`", key.rsplit('.').next().unwrap_or(&key))) =>
@@ -287,28 +280,6 @@ impl EcuConfig {
         }
         Ok(())
     }
-}
-
-/// The dotted key set on 1-based `line` of a TOML text (`rt.mlockall` for `mlockall = …`
-/// under `[rt]`), if that line is a plain `key = value`.
-fn key_at_line(text: &str, line: usize) -> Option<String> {
-    let lines: Vec<&str> = text.lines().collect();
-    let this = lines.get(line.checked_sub(1)?)?;
-    let (key, _) = this.split_once('=')?;
-    let key = key.trim().trim_matches('"');
-    if key.is_empty() || key.starts_with('[') || key.starts_with('#') {
-        return None;
-    }
-    let table = lines[..line - 1]
-        .iter()
-        .rev()
-        .map(|l| l.trim())
-        .find(|l| l.starts_with('[') && !l.starts_with("[["))
-        .map(|l| l.trim_matches(|c| c == '[' || c == ']').trim());
-    Some(match table {
-        Some(t) if !t.is_empty() => format!("{t}.{key}"),
-        _ => key.to_owned(),
-    })
 }
 
 #[cfg(test)]
