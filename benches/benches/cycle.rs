@@ -14,9 +14,7 @@
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use cycle_benches::ecu_cycle::{self, DecisionOnly, WorstCasePreCrash};
 use cycle_benches::worst_case;
-use restraint::Activity;
 use restraint::Phase;
-use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 fn bench_cycle(c: &mut Criterion) {
@@ -46,8 +44,8 @@ fn bench_cycle(c: &mut Criterion) {
     g.bench_function("crash_confirmation", |b| {
         b.iter_batched(
             || ecu_cycle::crash_confirmation_setup().expect("set-up"),
-            |(mut ecu, mut io, now)| {
-                ecu.step(black_box(&ecu_cycle::info(now)), &mut io);
+            |(mut ecu, mut io, mut clock)| {
+                clock.step(&mut ecu, &mut io);
                 assert!(matches!(ecu.phase(), Phase::Crash | Phase::PostCrash));
                 ecu
             },

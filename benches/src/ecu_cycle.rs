@@ -24,8 +24,8 @@ use bus::codec::{
 };
 use bus::RawFrame;
 use restraint::{
-    Activity, CrashAccelSample, CycleConfig, CycleInfo, ObjectState, Phase, ReferenceSettings,
-    RestraintCycle, SimIo, VALID,
+    CrashAccelSample, CycleConfig, ObjectState, Phase, ReferenceSettings, RestraintCycle, SimIo,
+    SimLoop, VALID,
 };
 
 /// One cycle period, ns.
@@ -90,10 +90,8 @@ pub fn quiet_accel(now_ns: u64) -> CrashAccelSample {
     }
 }
 
-/// Cycle info of the cycle at `now_ns` (on time).
-pub fn info(now_ns: u64) -> CycleInfo {
-    CycleInfo::on_time(now_ns / MS, MS, now_ns)
-}
+/// When the benches' simulated loops start (1 s: the sensors' time stamps are past zero).
+pub const START_NS: u64 = 1_000 * MS;
 
 /// E2E-sealed input frames: (`EgoVehicleState`, `OccupantClassification`) of a buckled
 /// mid-adult at 15 m/s ego speed.
@@ -132,7 +130,7 @@ fn bench_lut() -> restraint::Lut<'static> {
 /// # Errors
 /// Cycle construction failed or it is not in PRE-CRASH afterwards.
 pub fn precrash(
-    now_ns: &mut u64,
+    clock: &mut SimLoop,
     io: &mut SimIo,
     tx: &mut bus::E2eProtector,
 ) -> anyhow::Result<RestraintCycle<'static>> {
@@ -141,10 +139,9 @@ pub fn precrash(
     for k in 0..50u64 {
         let [e, o] = can_inputs(tx)?;
         io.push_can(if k.is_multiple_of(2) { e } else { o });
-        io.push_object(object(*now_ns));
-        io.push_both_accel(quiet_accel(*now_ns));
-        ecu.step(&info(*now_ns), io);
-        *now_ns += MS;
+        io.push_object(object(clock.now_ns()));
+        io.push_both_accel(quiet_accel(clock.now_ns()));
+        clock.step(&mut ecu, io);
     }
     anyhow::ensure!(
         ecu.phase() == Phase::PreCrash,
@@ -185,7 +182,7 @@ pub struct WorstCasePreCrash {
     ecu: RestraintCycle<'static>,
     io: SimIo,
     can: CanReplay,
-    now_ns: u64,
+    clock: SimLoop,
     k: u64,
     predictions_before: u64,
     lookups_before: u64,
@@ -204,10 +201,10 @@ impl WorstCasePreCrash {
     /// # Errors
     /// See [`precrash`].
     pub fn new() -> anyhow::Result<Self> {
-        let mut now_ns = 1_000 * MS;
+        let mut clock = SimLoop::new(START_NS, MS);
         let mut io = SimIo::new();
         let mut tx = bus::E2eProtector::new();
-        let ecu = precrash(&mut now_ns, &mut io, &mut tx)?;
+        let ecu = precrash(&mut clock, &mut io, &mut tx)?;
         let can = CanReplay::new(&mut tx)?;
         let c = ecu.counters();
         Ok(Self {
@@ -218,7 +215,7 @@ impl WorstCasePreCrash {
             ecu,
             io,
             can,
-            now_ns,
+            clock,
             k: 0,
         })
     }
@@ -226,16 +223,14 @@ impl WorstCasePreCrash {
     /// One measured cycle: new object sample (+ a CAN input every 8th cycle), then `step`.
     pub fn step(&mut self) {
         self.k += 1;
-        self.io.push_object(object(self.now_ns));
-        self.io.push_both_accel(quiet_accel(self.now_ns));
+        self.io.push_object(object(self.clock.now_ns()));
+        self.io.push_both_accel(quiet_accel(self.clock.now_ns()));
         if self.k.is_multiple_of(CAN_EVERY) {
             if let Some(f) = self.can.next() {
                 self.io.push_can(f);
             }
         }
-        self.ecu
-            .step(std::hint::black_box(&info(self.now_ns)), &mut self.io);
-        self.now_ns += MS;
+        self.clock.step(&mut self.ecu, &mut self.io);
     }
 
     /// Checks that every measured cycle stayed in PRE-CRASH and ran the track filter and the
@@ -279,7 +274,7 @@ pub struct DecisionOnly {
     ecu: RestraintCycle<'static>,
     io: SimIo,
     can: CanReplay,
-    now_ns: u64,
+    clock: SimLoop,
     k: u64,
 }
 
@@ -289,16 +284,16 @@ impl DecisionOnly {
     /// # Errors
     /// See [`precrash`].
     pub fn new() -> anyhow::Result<Self> {
-        let mut now_ns = 1_000 * MS;
+        let mut clock = SimLoop::new(START_NS, MS);
         let mut io = SimIo::new();
         let mut tx = bus::E2eProtector::new();
-        let ecu = precrash(&mut now_ns, &mut io, &mut tx)?;
+        let ecu = precrash(&mut clock, &mut io, &mut tx)?;
         let can = CanReplay::new(&mut tx)?;
         Ok(Self {
             ecu,
             io,
             can,
-            now_ns,
+            clock,
             k: 0,
         })
     }
@@ -308,23 +303,20 @@ impl DecisionOnly {
     pub fn refresh_if_due(&mut self) {
         self.k += 1;
         if self.k.is_multiple_of(CAN_EVERY) {
-            self.io.push_object(object(self.now_ns));
-            self.io.push_both_accel(quiet_accel(self.now_ns));
+            self.io.push_object(object(self.clock.now_ns()));
+            self.io.push_both_accel(quiet_accel(self.clock.now_ns()));
             if let Some(f) = self.can.next() {
                 self.io.push_can(f);
             }
-            self.ecu.step(&info(self.now_ns), &mut self.io);
-            self.now_ns += MS;
+            self.clock.step(&mut self.ecu, &mut self.io);
         }
     }
 
     /// One measured cycle without new object or CAN inputs (the accelerometer's batch, as
     /// every cycle).
     pub fn step(&mut self) {
-        self.io.push_both_accel(quiet_accel(self.now_ns));
-        self.ecu
-            .step(std::hint::black_box(&info(self.now_ns)), &mut self.io);
-        self.now_ns += MS;
+        self.io.push_both_accel(quiet_accel(self.clock.now_ns()));
+        self.clock.step(&mut self.ecu, &mut self.io);
     }
 
     /// The measured cycles stayed in PRE-CRASH.
@@ -338,23 +330,22 @@ impl DecisionOnly {
 }
 
 /// A PRE-CRASH cycle after two sub-threshold accelerometer batches, with the third (which
-/// confirms: 3 × 0.2 m/s ≥ 0.5 m/s) queued: the next `step(&info(now), &mut io)` is the crash
-/// confirmation cycle. Returns `(cycle, io, now_ns)`.
+/// confirms: 3 × 0.2 m/s ≥ 0.5 m/s) queued: the next `clock.step(&mut ecu, &mut io)` is the
+/// crash confirmation cycle. Returns `(cycle, io, clock)`.
 ///
 /// # Errors
 /// See [`precrash`].
-pub fn crash_confirmation_setup() -> anyhow::Result<(RestraintCycle<'static>, SimIo, u64)> {
-    let mut now_ns = 1_000 * MS;
+pub fn crash_confirmation_setup() -> anyhow::Result<(RestraintCycle<'static>, SimIo, SimLoop)> {
+    let mut clock = SimLoop::new(START_NS, MS);
     let mut io = SimIo::new();
     let mut tx = bus::E2eProtector::new();
-    let mut ecu = precrash(&mut now_ns, &mut io, &mut tx).context("crash confirmation")?;
+    let mut ecu = precrash(&mut clock, &mut io, &mut tx).context("crash confirmation")?;
     for _ in 0..2 {
-        io.push_both_accel(accel(now_ns));
-        ecu.step(&info(now_ns), &mut io);
-        now_ns += MS;
+        io.push_both_accel(accel(clock.now_ns()));
+        clock.step(&mut ecu, &mut io);
     }
-    io.push_both_accel(accel(now_ns));
-    Ok((ecu, io, now_ns))
+    io.push_both_accel(accel(clock.now_ns()));
+    Ok((ecu, io, clock))
 }
 
 /// The crash phase of a predicted crash, cycle by cycle (`icount_crash`): a cycle driven into
@@ -369,7 +360,7 @@ pub struct CrashPhase {
     can: CanReplay,
     crash: physics::ExactCollision,
     contact_ns: u64,
-    now_ns: u64,
+    clock: SimLoop,
 }
 
 impl CrashPhase {
@@ -381,15 +372,16 @@ impl CrashPhase {
     /// # Errors
     /// Cycle construction failed, or it is not in PRE-CRASH 5 ms before the contact.
     pub fn new() -> anyhow::Result<Self> {
-        let mut now_ns = 1_000 * MS;
-        let contact_ns = now_ns + 400 * MS;
+        let mut clock = SimLoop::new(START_NS, MS);
+        let contact_ns = START_NS + 400 * MS;
         let mut io = SimIo::new();
         let mut tx = bus::E2eProtector::new();
         let (mut ecu, _) =
             RestraintCycle::new(CycleConfig::default(), Some(bench_lut()), &REFERENCE)
                 .map_err(|e| anyhow::anyhow!("RestraintCycle::new: {e}"))?;
         let mut can = CanReplay::new(&mut tx)?;
-        while now_ns < contact_ns - 5 * MS {
+        while clock.now_ns() < contact_ns - 5 * MS {
+            let now_ns = clock.now_ns();
             if (now_ns / MS).is_multiple_of(10) {
                 let mut o = object(now_ns);
                 o.closing_speed_mps = Self::CLOSING_MPS;
@@ -403,8 +395,7 @@ impl CrashPhase {
                 }
             }
             io.push_both_accel(quiet_accel(now_ns));
-            ecu.step(&info(now_ns), &mut io);
-            now_ns += MS;
+            clock.step(&mut ecu, &mut io);
         }
         anyhow::ensure!(
             ecu.phase() == Phase::PreCrash,
@@ -428,13 +419,13 @@ impl CrashPhase {
             can,
             crash,
             contact_ns,
-            now_ns,
+            clock,
         })
     }
 
     /// One cycle with the accelerometer batch of the last ms (the pulse from the contact on).
     pub fn step(&mut self) {
-        let mut a = quiet_accel(self.now_ns);
+        let mut a = quiet_accel(self.clock.now_ns());
         for (i, s) in a.accel_mps2.iter_mut().enumerate() {
             let t = a.first_timestamp_ns + i as u64 * 125_000;
             if t >= self.contact_ns {
@@ -443,14 +434,12 @@ impl CrashPhase {
             }
         }
         self.io.push_both_accel(a);
-        if (self.now_ns / MS).is_multiple_of(CAN_EVERY) {
+        if (self.clock.now_ns() / MS).is_multiple_of(CAN_EVERY) {
             if let Some(f) = self.can.next() {
                 self.io.push_can(f);
             }
         }
-        self.ecu
-            .step(std::hint::black_box(&info(self.now_ns)), &mut self.io);
-        self.now_ns += MS;
+        self.clock.step(&mut self.ecu, &mut self.io);
     }
 
     /// The cycle (its phase, how the crash was confirmed, whether the airbag fired).
@@ -498,9 +487,9 @@ mod tests {
 
     #[test]
     fn crash_confirmation_setup_confirms_on_the_next_cycle() {
-        let (mut ecu, mut io, now) = crash_confirmation_setup().unwrap();
+        let (mut ecu, mut io, mut clock) = crash_confirmation_setup().unwrap();
         assert_eq!(ecu.phase(), Phase::PreCrash);
-        ecu.step(&info(now), &mut io);
+        clock.step(&mut ecu, &mut io);
         assert!(matches!(ecu.phase(), Phase::Crash | Phase::PostCrash));
     }
 }

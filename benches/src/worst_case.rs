@@ -37,7 +37,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use restraint::{
     Activity, CrashAccelSample, CycleConfig, CycleInfo, ObjectState, Phase, ReferenceSettings,
-    RestraintCycle, SimIo, VALID,
+    RestraintCycle, SimIo, SimLoop, VALID,
 };
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -506,9 +506,9 @@ impl Feed<'_> {
     }
 }
 
-fn info_at(now: u64, cycle: u64) -> CycleInfo {
-    CycleInfo::on_time(cycle, MS, now).with_sync_time_us(1_750_000_000_000_000 + now / 1_000)
-}
+/// Synchronized time at simulated time 0 (`host::SimClock::SYNC_EPOCH_US`): SecOC freshness
+/// values of a plausible date.
+const SYNC_EPOCH_US: u64 = 1_750_000_000_000_000;
 
 /// Runs the case's prefix through a fresh cycle and queues the measured cycle's inputs.
 ///
@@ -546,22 +546,20 @@ pub fn prepare(case: &CycleCase) -> anyhow::Result<Prepared> {
     };
     let start = T_MEASURED - (case.tracked_ms.ceil() as u64 + 200) * MS;
     let mut io = SimIo::new();
-    let mut now = start;
-    let mut cycle = 0;
-    while now < T_MEASURED {
-        feed.prefix_inputs(now, start, &mut io)?;
-        ecu.step(&info_at(now, cycle), &mut io);
+    let mut clock = SimLoop::new(start, MS).with_sync_epoch_us(SYNC_EPOCH_US);
+    while clock.now_ns() < T_MEASURED {
+        feed.prefix_inputs(clock.now_ns(), start, &mut io)?;
+        clock.step(&mut ecu, &mut io);
         io.can_tx.clear();
-        now += MS;
-        cycle += 1;
     }
+    let now = clock.now_ns();
     feed.measured_inputs(now, &mut io)?;
     let late = u64::from(case.late_us) * 1_000;
     let info = CycleInfo {
         deadline_ns: now - late,
         wake_latency_ns: late,
         overruns: u64::from(case.overruns),
-        ..info_at(now, cycle)
+        ..clock.next_info()
     };
     Ok(Prepared { ecu, io, info })
 }

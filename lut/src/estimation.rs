@@ -34,9 +34,7 @@ use diagram::Diagram;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
-use restraint::{
-    Activity, CycleConfig, CycleInfo, ObjectState, ReferenceSettings, RestraintCycle, SimIo,
-};
+use restraint::{CycleConfig, ObjectState, ReferenceSettings, RestraintCycle, SimIo, SimLoop};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use world::{scenario::OpponentKind, Scenario, SensorModelSim, Truth};
@@ -252,6 +250,7 @@ pub fn simulate(
     let (mut ecu, _) = RestraintCycle::new(cfg, None, &REFERENCE)
         .map_err(|e| anyhow!("RestraintCycle::new: {e}"))?;
     let mut io = SimIo::new();
+    let mut clock = SimLoop::new(T0_NS, MS);
     let mut next_pub_s = 0.0;
     let (mut raw, mut last_sample_s, mut samples) = (None, f64::NEG_INFINITY, 0u64);
     let mut out = Run {
@@ -305,9 +304,7 @@ pub fn simulate(
                 raw = None;
             }
         }
-        let now = T0_NS + cycle * MS;
-        let info = CycleInfo::on_time(cycle, MS, now);
-        ecu.step(&info, &mut io);
+        clock.step(&mut ecu, &mut io);
         io.can_tx.clear();
         let fresh = t - last_sample_s <= timeout_s;
         let filtered = ecu.situation().map(|s| held_of(&s));

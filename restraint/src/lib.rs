@@ -25,7 +25,7 @@
 //! | [`outputs`] | command, status and diagnostics encoding, clock-timed cyclic sends |
 //! | [`contract`] | the activity contract a shell runs the cycle through |
 //! | [`signals`] | the non-CAN inputs and outputs (object, accelerometer, diagnostics) |
-//! | [`sim`] | the in-memory I/O of tests, benches and fuzz targets |
+//! | [`sim`] | the in-memory I/O of tests, benches and fuzz targets, and the virtual-time loop that drives the core through it |
 //!
 //! **The rule this crate enforces**: no `std`, no `alloc`, no operating system. It gets a
 //! [`diagram::DiagramView`], the reference restraint as numbers, SecOC keys as bytes and time as
@@ -79,4 +79,4 @@ pub use signals::{
     CrashAccelSample, Degraded, EcuDiagnostics, EcuMode, ObjectState, ACCEL_BATCH_CAPACITY,
     PULSE_POINTS, VALID,
 };
-pub use sim::SimIo;
+pub use sim::{SimIo, SimLoop};

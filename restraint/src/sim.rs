@@ -9,7 +9,7 @@
 use bus::RawFrame;
 use heapless::{Deque, HistoryBuf};
 
-use crate::contract::{CycleIo, IoError, ReceiveErrors};
+use crate::contract::{Activity, CycleInfo, CycleIo, IoError, ReceiveErrors};
 use crate::signals::{CrashAccelSample, EcuDiagnostics, ObjectState};
 
 /// Capacity of every queue of [`SimIo`].
@@ -184,6 +184,102 @@ impl CycleIo for SimIo {
     }
 }
 
+/// The one virtual-time loop: an [`Activity`] run cycle after cycle on a simulated grid, every
+/// cycle on time (cycle k starts at `start_ns + k · period_ns`, deadline = start, no latency,
+/// no overrun). The offline bench, lut's estimation study, the benches and the core's tests
+/// drive the core through it, so "cycle k at time t" means the same everywhere; the shell's
+/// real-time loop (`ecu::runtime::run_activity`) is the other way to run an activity, on a
+/// real or a simulated clock with late and skipped cycles.
+///
+/// It owns only time: the activity and the [`SimIo`] stay the caller's, who pushes each
+/// cycle's inputs into the I/O before [`SimLoop::step`] and reads what the cycle sent with
+/// [`SimLoop::sent`] after it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SimLoop {
+    start_ns: u64,
+    period_ns: u64,
+    /// Synchronized time (µs) at simulated time 0; `None`: the cycles get 0 (no SecOC).
+    sync_epoch_us: Option<u64>,
+    cycle: u64,
+    /// [`SimIo::can_tx_total`] before the last step.
+    sent_before: u64,
+}
+
+impl SimLoop {
+    /// A loop whose first cycle starts at `start_ns`, one cycle every `period_ns`.
+    #[must_use]
+    pub const fn new(start_ns: u64, period_ns: u64) -> Self {
+        Self {
+            start_ns,
+            period_ns,
+            sync_epoch_us: None,
+            cycle: 0,
+            sent_before: 0,
+        }
+    }
+
+    /// Hands every cycle the synchronized time `epoch_us + now_ns / 1000` (SecOC freshness),
+    /// as the shell's simulated clock does (`host::SimClock::SYNC_EPOCH_US`).
+    #[must_use]
+    pub const fn with_sync_epoch_us(self, epoch_us: u64) -> Self {
+        Self {
+            sync_epoch_us: Some(epoch_us),
+            ..self
+        }
+    }
+
+    /// Index of the next cycle (= cycles run so far).
+    #[must_use]
+    pub const fn cycle(&self) -> u64 {
+        self.cycle
+    }
+
+    /// Start time of the next cycle, ns.
+    #[must_use]
+    pub const fn now_ns(&self) -> u64 {
+        self.start_ns
+            .saturating_add(self.cycle.saturating_mul(self.period_ns))
+    }
+
+    /// What the next cycle will be told.
+    #[must_use]
+    pub const fn next_info(&self) -> CycleInfo {
+        let now = self.now_ns();
+        let info = CycleInfo::on_time(self.cycle, self.period_ns, now);
+        match self.sync_epoch_us {
+            Some(epoch) => info.with_sync_time_us(epoch.saturating_add(now / 1_000)),
+            None => info,
+        }
+    }
+
+    /// Runs the next cycle of `activity` on `io`; its [`CycleInfo`].
+    #[inline]
+    pub fn step<A: Activity + ?Sized>(&mut self, activity: &mut A, io: &mut SimIo) -> CycleInfo {
+        self.step_with(activity, io, |info| info)
+    }
+
+    /// [`SimLoop::step`] with the cycle's info edited first (a late deadline, a skipped slot):
+    /// the tests of the core's timing checks.
+    #[inline]
+    pub fn step_with<A: Activity + ?Sized>(
+        &mut self,
+        activity: &mut A,
+        io: &mut SimIo,
+        edit: impl FnOnce(CycleInfo) -> CycleInfo,
+    ) -> CycleInfo {
+        let info = edit(self.next_info());
+        self.sent_before = io.can_tx_total;
+        activity.step(&info, io);
+        self.cycle += 1;
+        info
+    }
+
+    /// The frames the last step sent (as far as `io` still keeps them).
+    pub fn sent<'io>(&self, io: &'io SimIo) -> impl Iterator<Item = &'io RawFrame> {
+        io.sent_since(self.sent_before)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -221,6 +317,88 @@ mod tests {
         assert_eq!(
             io.send_can(&RawFrame::new(1, &[])),
             Err(IoError::CanDisabled)
+        );
+    }
+
+    /// Sends one frame per cycle carrying the cycle index and the synchronized time's low
+    /// byte, so a test sees what each cycle was told.
+    struct Echo;
+
+    impl Activity for Echo {
+        fn name(&self) -> &'static str {
+            "echo"
+        }
+        fn startup(
+            &mut self,
+            _now_ns: u64,
+            _io: &mut dyn CycleIo,
+        ) -> Result<(), crate::contract::StartupError> {
+            Ok(())
+        }
+        fn step(&mut self, info: &CycleInfo, io: &mut dyn CycleIo) {
+            let _ = io.send_can(&RawFrame::new(
+                0x100,
+                &[info.cycle as u8, info.sync_time_us as u8],
+            ));
+            if info.cycle % 2 == 1 {
+                let _ = io.send_can(&RawFrame::new(0x101, &[]));
+            }
+        }
+        fn shutdown(&mut self, _now_ns: u64, _io: &mut dyn CycleIo) {}
+    }
+
+    #[test]
+    fn the_virtual_loop_runs_every_cycle_on_its_grid() {
+        let mut io = SimIo::new();
+        let mut clock = SimLoop::new(5_000, 1_000_000).with_sync_epoch_us(7_000);
+        for k in 0..5u64 {
+            assert_eq!(clock.cycle(), k);
+            assert_eq!(clock.now_ns(), 5_000 + k * 1_000_000);
+            let info = clock.step(&mut Echo, &mut io);
+            assert_eq!(
+                (info.cycle, info.slot, info.now_ns, info.deadline_ns),
+                (k, k, 5_000 + k * 1_000_000, 5_000 + k * 1_000_000)
+            );
+            assert_eq!(info.sync_time_us, 7_000 + info.now_ns / 1_000);
+            assert_eq!(
+                (info.wake_latency_ns, info.overruns, info.skipped_slots),
+                (0, 0, 0)
+            );
+            // What this cycle sent, not what the earlier ones did.
+            let sent: heapless::Vec<u32, 4> = clock.sent(&io).map(|f| f.id).collect();
+            let want: &[u32] = if k % 2 == 1 {
+                &[0x100, 0x101]
+            } else {
+                &[0x100]
+            };
+            assert_eq!(sent.as_slice(), want);
+            assert_eq!(
+                clock.sent(&io).next().map(|f| f.payload()[0]),
+                Some(k as u8)
+            );
+        }
+        // Without an epoch the cycles carry no synchronized time.
+        assert_eq!(SimLoop::new(0, 1_000_000).next_info().sync_time_us, 0);
+    }
+
+    #[test]
+    fn a_step_can_be_told_it_is_late() {
+        let mut io = SimIo::new();
+        let mut clock = SimLoop::new(0, 1_000_000);
+        clock.step(&mut Echo, &mut io);
+        let info = clock.step_with(&mut Echo, &mut io, |i| CycleInfo {
+            deadline_ns: i.now_ns - 300_000,
+            wake_latency_ns: 300_000,
+            ..i
+        });
+        assert_eq!(
+            (info.cycle, info.now_ns, info.deadline_ns),
+            (1, 1_000_000, 700_000)
+        );
+        assert_eq!(
+            clock.now_ns(),
+            2_000_000,
+            "the grid does not move with a late cycle"
         );
     }
 }

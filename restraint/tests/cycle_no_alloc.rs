@@ -16,7 +16,7 @@ mod cycle_support;
 use cycle_support::{MS, REFERENCE, T0};
 use physics::{CombinedSpring, ExactCollision, MassClass};
 use restraint::crash::ConfirmKind;
-use restraint::{Activity, CrashAccelSample, CycleConfig, CycleInfo, Phase, RestraintCycle, SimIo};
+use restraint::{CrashAccelSample, CycleConfig, Phase, RestraintCycle, SimIo, SimLoop};
 
 #[test]
 fn no_allocation_in_precrash_and_crash_cycles() {
@@ -33,7 +33,7 @@ fn no_allocation_in_precrash_and_crash_cycles() {
     let mut bench = cycle_support::Bench::new(None); // only for its sealed CAN frames
     let mut io = SimIo::new();
     let mut auth_tx = 0u64;
-    let mut now = T0;
+    let mut clock = SimLoop::new(T0, MS).with_sync_epoch_us(cycle_support::SYNC_EPOCH_US);
     let mut allocations = 0u64;
     let mut precrash_cycles = 0u64;
     let mut crash_cycles = 0u64;
@@ -55,6 +55,7 @@ fn no_allocation_in_precrash_and_crash_cycles() {
     .unwrap();
     let contact_ns = T0 + crash_from * MS;
     for k in 0..total {
+        let now = clock.now_ns();
         let ms = k;
         if ms < crash_from && ms.is_multiple_of(10) {
             // Contact always 250 ms ahead, and in the last 250 ms at `contact_ns`.
@@ -91,20 +92,17 @@ fn no_allocation_in_precrash_and_crash_cycles() {
         if ms.is_multiple_of(100) {
             io.push_can(bench.occupant_frame());
         }
-        let info =
-            CycleInfo::on_time(k, MS, now).with_sync_time_us(cycle_support::sync_time_us(now));
         if k == 1_000 {
             predictions_before = ecu.counters().predictions;
         }
         let count = k >= 1_000;
         set_counting(count);
         let before = allocations_here();
-        let sent_before = io.can_tx_total;
-        ecu.step(&info, &mut io);
+        clock.step(&mut ecu, &mut io);
         allocations += allocations_here() - before;
         set_counting(false);
-        auth_tx += io
-            .sent_since(sent_before)
+        auth_tx += clock
+            .sent(&io)
             .filter(|f| bus::secoc::SecOcStream::for_auth_id(f.id).is_some())
             .count() as u64;
         if count {
@@ -114,7 +112,6 @@ fn no_allocation_in_precrash_and_crash_cycles() {
                 _ => {}
             }
         }
-        now += MS;
     }
     assert_eq!(allocations, 0, "heap allocations in the cycle");
     assert!(

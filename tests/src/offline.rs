@@ -17,7 +17,7 @@ use actuator_stubs::commands::{decode, Modules};
 use actuator_stubs::outcome::{evaluate, Evaluated};
 use actuator_stubs::status::{ecu_fault_names, ecu_mode_name};
 use anyhow::{anyhow, Result};
-use restraint::{Activity, CycleConfig, CycleInfo, RestraintCycle, SimIo};
+use restraint::{CycleConfig, RestraintCycle, SimIo, SimLoop};
 use sensor_feeds::{Player, TickOutput};
 use world::{Scenario, Truth};
 
@@ -214,6 +214,8 @@ pub fn run_traced(
     let (mut ecu, _) = RestraintCycle::new(cfg.cycle.clone(), lut, &reference)
         .map_err(|e| anyhow!("cycle config: {e}"))?;
     let mut io = SimIo::new();
+    // The feeds play from START_NS; the ECU's cycles run `ecu_phase_ns` after their ticks.
+    let mut clock = SimLoop::new(START_NS + cfg.ecu_phase_ns, MS).with_sync_epoch_us(0);
     let mut player = Player::new(truth, START_NS, 1.0, 0);
     let mut out = TickOutput::default();
     let mut modules = Modules::default();
@@ -234,12 +236,9 @@ pub fn run_traced(
                 .iter()
                 .for_each(|b| t.safing_g.extend(batch_g(b)));
         }
-        let now = START_NS + tick * MS + cfg.ecu_phase_ns;
-        let info = CycleInfo::on_time(tick, MS, now).with_sync_time_us(now / 1_000);
-        let before = io.can_tx_total;
-        ecu.step(&info, &mut io);
+        let now = clock.step(&mut ecu, &mut io).now_ns;
         let m = io.diagnostics.mode;
-        for f in io.sent_since(before) {
+        for f in clock.sent(&io) {
             if let Ok(msg) = bus::decode(f.id, f.payload()) {
                 modules.apply(now, &decode(&msg));
             }
