@@ -13,6 +13,7 @@
 
 pub mod runtime;
 
+#[cfg(feature = "shell")]
 pub mod can_port;
 
 /// The loaded characteristic diagram as the core takes it: the borrowed view plus the header

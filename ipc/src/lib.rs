@@ -20,15 +20,23 @@
 //! transport wrapper so the core never depends on iceoryx2 and the transport never on the core. The subscriber wrappers are
 //! poll-only (`receive()` every cycle, no event waits) and their hot-path methods neither
 //! allocate nor block; errors on the hot path are counted, not formatted.
+//!
+//! Without the default `transport` feature the crate is [`names`] only (no iceoryx2): what the
+//! ECU's configuration needs for its defaults where the transport is not built (fuzz).
 
+#[cfg(feature = "transport")]
 pub use iceoryx2;
 
 pub mod names;
+#[cfg(feature = "transport")]
 pub mod payload;
+#[cfg(feature = "transport")]
 pub mod port;
 
 pub use names::*;
+#[cfg(feature = "transport")]
 pub use payload::{BenchTruth, Shm, ShmRecord, SCENARIO_NAME_CAPACITY};
+#[cfg(feature = "transport")]
 pub use port::*;
 pub use signals::{
     CrashAccelSample, Degraded, EcuDiagnostics, EcuMode, ObjectState, ACCEL_BATCH_CAPACITY,
