@@ -7,7 +7,7 @@
 //! On a host without SocketCAN the visible test re-runs the `#[ignore]`d worker inside the
 //! QEMU guest of `vcan-setup.sh --run`; with no route it FAILS (never skipped).
 
-#[path = "../../restraint/tests/cycle_support/mod.rs"]
+#[path = "../../restraint/tests/cycle/cycle_support/mod.rs"]
 mod cycle_support;
 #[path = "../../bus/tests/support/vcan_rerun.rs"]
 mod vcan_rerun;

@@ -11,6 +11,7 @@
 mod alloc_counter;
 
 use alloc_counter::{allocations_here, set_counting};
+#[path = "cycle/cycle_support/mod.rs"]
 mod cycle_support;
 
 use cycle_support::{MS, REFERENCE, T0};

@@ -4,9 +4,7 @@
 //! gave mean 10.596 ms, median 10.577 ms, p99 11.757 ms: every late wake-up pushed all later
 //! repetitions back.)
 
-mod cycle_support;
-
-use cycle_support::{Bench, MS, T0};
+use crate::cycle_support::{Bench, MS, T0};
 
 /// Deterministic xorshift for the scripted jitter (no test depends on the host's timing).
 fn next(state: &mut u64) -> u64 {

@@ -1,9 +1,7 @@
 //! The cycle writes every field of its diagnostics record, so an I/O may hand it the
 //! previous record's buffer without clearing it (the shell's triple buffer, `SimIo`).
 
-mod cycle_support;
-
-use cycle_support::{Bench, MS, T0};
+use crate::cycle_support::{Bench, MS, T0};
 use restraint::{Activity as _, EcuDiagnostics, PULSE_POINTS};
 
 /// A record whose every field differs from anything the cycle writes in these runs.
@@ -45,7 +43,7 @@ fn garbage() -> EcuDiagnostics {
 /// Runs the same scenario from a zeroed and from a garbage record before every step.
 fn records(with_prediction: bool) -> (Vec<EcuDiagnostics>, Vec<EcuDiagnostics>) {
     let run = |dirty: bool| {
-        let mut b = Bench::new(Some(cycle_support::test_lut()));
+        let mut b = Bench::new(Some(crate::cycle_support::test_lut()));
         let contact = T0 + 250 * MS;
         for k in 0..60 {
             if with_prediction && k % 10 == 0 {
@@ -82,7 +80,7 @@ fn every_field_is_written_with_and_without_a_prediction() {
     }
 }
 
-fn counter(b: &cycle_support::Bench, name: &str) -> u64 {
+fn counter(b: &crate::cycle_support::Bench, name: &str) -> u64 {
     let mut v = None;
     b.ecu.report_counters(&mut |n, x| {
         if n == name {
@@ -97,7 +95,7 @@ fn counter(b: &cycle_support::Bench, name: &str) -> u64 {
 /// default object timeout (100 ms): a 400 ms silence after fresh objects is ≈ 300 lost cycles.
 #[test]
 fn object_lost_cycles_count_dropouts_not_the_start_up_wait() {
-    let mut b = Bench::new(Some(cycle_support::test_lut()));
+    let mut b = Bench::new(Some(crate::cycle_support::test_lut()));
     b.run_ms(300);
     let startup_stale = counter(&b, "object_stale_cycles");
     assert!((299..=300).contains(&startup_stale), "{startup_stale}");

@@ -3,19 +3,17 @@
 //! Expected times and values are closed form: the test LUT's cells are linear in closing
 //! speed and opponent mass (multilinear interpolation reproduces them exactly), objects move
 //! at constant speed (TTC = d / v; the track filter reproduces such noise-free samples
-//! exactly, see `cycle_support::oracle_config`), and the crash pulse is either the onset ramp
+//! exactly, see `crate::cycle_support::oracle_config`), and the crash pulse is either the onset ramp
 //! of the predicted collision (slope k·v/m_ego, k the series stiffness of the two fronts'
 //! first segments: the prediction-matched path) or a constant deceleration (Δv after n
 //! samples = (n − ½)·a·1 ms, trapezoidal from rest: the generic confirmation and the
 //! accelerometer-only algorithm). Every command is decoded with the bus crate (CRC checked).
 
-mod cycle_support;
-
+use crate::cycle_support::*;
 use bus::codec::{
     AirbagStageCmdArm, AirbagStageCmdCmdSource, AirbagStageCmdFire, AirbagStageCmdStage,
     BeltLimiterCmdCmdSource, BeltLimiterCmdPretensionerCmd, EcuStatusEcuMode,
 };
-use cycle_support::*;
 use restraint::crash::ConfirmKind;
 use restraint::{Degraded, EcuMode, ObjectState, Phase, Pretensioner};
 
@@ -151,7 +149,7 @@ fn avoided_collision_releases_pretensioner_and_never_fires_the_airbag() {
     let mut t_avoid = b.now;
     for k in 0..max_outliers {
         assert_eq!(b.ecu.phase(), Phase::PreCrash, "sample {k}");
-        let mut o = cycle_support::object(b.now, -2.0, 1500.0, 100.0);
+        let mut o = crate::cycle_support::object(b.now, -2.0, 1500.0, 100.0);
         o.distance_m = 3.0 + 0.02 * k as f32;
         b.io.push_object(o);
         t_avoid = b.now;
@@ -459,7 +457,7 @@ fn nan_object_fields_degrade_until_a_valid_sample_arrives() {
         None,
         &|_| 0.0,
     );
-    let mut o = cycle_support::object(b.now, f32::NAN, 1500.0, 100.0);
+    let mut o = crate::cycle_support::object(b.now, f32::NAN, 1500.0, 100.0);
     o.distance_m = f32::INFINITY;
     b.io.push_object(o);
     let t_bad = b.now;

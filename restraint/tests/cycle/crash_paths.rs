@@ -2,12 +2,10 @@
 //! cases each is tested against (README "Decision table"), the in-crash severity re-estimate,
 //! and the crash accelerometer's faults — detected, reported on the bus within their limits,
 //! before a crash that follows. Expected values are closed form (linear test LUT, onset ramps
-//! k·v·t / m_ego, constant pulses), as in `cycle_scenarios.rs`.
+//! k·v·t / m_ego, constant pulses), as in `cycle/scenarios.rs`.
 
-mod cycle_support;
-
+use crate::cycle_support::*;
 use bus::codec::{AirbagStageCmdCmdSource, AirbagStageCmdFire, EcuStatusEcuMode};
-use cycle_support::*;
 use restraint::crash::ConfirmKind;
 use restraint::crash_match::{MatchState, Mismatch};
 use restraint::{Degraded, EcuMode, Phase};

@@ -141,7 +141,7 @@ pub fn sync_time_us(now_ns: u64) -> u64 {
 /// (`mass_sigma_correlation = 1`), so the conservative mass is m + σ. The filter of
 /// noise-free samples on the motion model's own trajectory (constant closing acceleration)
 /// reproduces them exactly — every innovation is zero — so the estimate is the closed form.
-/// The knobs themselves are tested in `cycle_estimate.rs` and the filter's unit tests.
+/// The knobs themselves are tested in `cycle/estimate.rs` and the filter's unit tests.
 /// The benches' accelerometer samples are ideal (no anti-alias filter), so their onset is
 /// the contact: `accel_delay_ms = 0` (`ideal_sensor_config`).
 pub fn oracle_config() -> CycleConfig {

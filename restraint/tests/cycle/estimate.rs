@@ -1,9 +1,7 @@
 //! The track filter inside the cycle: what its outputs do to the decision, the LUT query and
 //! the diagnostics record (the filter's own oracles are in `track_filter.rs`).
 
-mod cycle_support;
-
-use cycle_support::*;
+use crate::cycle_support::*;
 use physics::{CollisionInput, CombinedSpring, ExactCollision, MassClass};
 use restraint::{EcuMode, ObjectState, PULSE_POINTS};
 

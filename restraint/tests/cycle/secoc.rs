@@ -2,11 +2,9 @@
 //! (`CycleInfo::sync_time_us`) as freshness, and a receiver on the same time base accepts
 //! every one of them — while a pair recorded from an earlier session is rejected.
 
-mod cycle_support;
-
+use crate::cycle_support::{sync_time_us, Bench, MS};
 use bus::secoc::{SecOcConfig, SecOcError, SecOcKeys, SecOcStream, SecOcVerifier};
 use bus::RawFrame;
-use cycle_support::{sync_time_us, Bench, MS};
 
 fn keys() -> SecOcKeys {
     let p =
@@ -16,7 +14,7 @@ fn keys() -> SecOcKeys {
 
 /// A monitoring ECU run for `ms`; returns the frames it sent with their send time.
 fn session(keys: &SecOcKeys, start_ns: u64, ms: u64) -> Vec<(u64, RawFrame)> {
-    let mut b = Bench::new(Some(cycle_support::test_lut()));
+    let mut b = Bench::new(Some(crate::cycle_support::test_lut()));
     b.now = start_ns;
     b.ecu.set_secoc(Some(keys.tx()));
     b.run_ms(ms);
@@ -29,7 +27,7 @@ fn session(keys: &SecOcKeys, start_ns: u64, ms: u64) -> Vec<(u64, RawFrame)> {
 #[test]
 fn every_authenticator_carries_the_cycle_time_and_verifies() {
     let keys = keys();
-    let frames = session(&keys, cycle_support::T0, 500);
+    let frames = session(&keys, crate::cycle_support::T0, 500);
     let mut rx = SecOcStream::ALL.map(|s| keys.verifier(s, SecOcConfig::default()));
     let mut accepted = 0;
     for (t_ns, f) in &frames {
@@ -58,8 +56,8 @@ fn every_authenticator_carries_the_cycle_time_and_verifies() {
 fn authenticators_of_an_earlier_ecu_session_are_rejected() {
     let keys = keys();
     // Session 1 recorded; session 2 starts 3 s later (bench: next scenario) with a new ECU.
-    let recorded = session(&keys, cycle_support::T0, 50);
-    let later_ns = cycle_support::T0 + 3_000 * MS;
+    let recorded = session(&keys, crate::cycle_support::T0, 50);
+    let later_ns = crate::cycle_support::T0 + 3_000 * MS;
     let live = session(&keys, later_ns, 50);
     let mut rx: SecOcVerifier = keys.verifier(SecOcStream::AirbagStage, SecOcConfig::default());
     let stream = SecOcStream::AirbagStage;

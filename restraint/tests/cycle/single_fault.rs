@@ -3,9 +3,7 @@
 //! and the safing channel's single faults, under the simulated 1 kHz clock. The seeded matrix
 //! over thousands of variants is `misuse-matrix` (e2e-tests crate).
 
-mod cycle_support;
-
-use cycle_support::*;
+use crate::cycle_support::*;
 use restraint::{Degraded, Pretensioner};
 
 /// Contact of the standard approach.

@@ -4,10 +4,8 @@
 //! timing (jumps, standstill, time running backwards), with and without a LUT.
 //! Outputs stay well-formed: every frame sent decodes with the bus crate.
 
-mod cycle_support;
-
+use crate::cycle_support::{Bench, MS};
 use bus::RawFrame;
-use cycle_support::{Bench, MS};
 use proptest::prelude::*;
 use restraint::{Activity, CrashAccelSample, CycleInfo, ObjectState};
 
@@ -116,10 +114,10 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
     #[test]
     fn cycle_never_panics(events in prop::collection::vec(event(), 1..200), with_lut: bool) {
-        let mut b = Bench::new(with_lut.then(cycle_support::test_lut));
+        let mut b = Bench::new(with_lut.then(crate::cycle_support::test_lut));
         b.send_vehicle = false;
         b.send_occupant = false;
-        let mut now = cycle_support::T0;
+        let mut now = crate::cycle_support::T0;
         for (i, e) in events.into_iter().enumerate() {
             match e {
                 Event::Object(mut o, ts_now) => {
