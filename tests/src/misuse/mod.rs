@@ -1,0 +1,346 @@
+//! The misuse / single-fault / must-fire catalogue of `misuse-matrix` (issues 20, 30, 31):
+//! seeded families of scenarios, each built in code from the documented scenario schema and
+//! judged by what its family requires.
+//!
+//! ## Misuse as physics makes it (issue 30)
+//! A mechanical event changes the car's speed by the impulse its contact can carry,
+//! Δv = J / m (J = ∫F dt); what the tunnel-mounted ECU measures on top is zero-mean structural
+//! ringing, which can be large while its integral is zero. Each misuse family is therefore a
+//! `ringing` `[[accel_event]]` (`world::events`: zero-mean ringing over a rigid-body pulse that
+//! carries exactly `net_dv_mps`) with its envelope below, and every variant is drawn up to
+//! **1.5 × the envelope's bounds** (Δv, rigid-body peak, ringing amplitude; durations and
+//! frequencies over the envelope's range). S = from a published source, D = derived from the
+//! stated physics (`../shared/misuse-envelopes.md` has the derivations and links).
+//!
+//! | family | net Δv bound (× 1.5 sampled) | rigid-body peak | ringing | duration | source |
+//! |---|---|---|---|---|---|
+//! | pothole (30–110 km/h) | 0.8 m/s, both front wheels (1.2) | 5 g (7.5) | 10 g at 10–300 Hz (15) | 10–30 ms, rear axle again a wheelbase / v later | D: wheel-centre force ≈ 4.5 × static corner load (23 kN typical, 45 kN worst) over 10–30 ms |
+//! | kerb-strike (climbed, 10–50 km/h) | 0.8 m/s (1.2) | 7 g (10.5) | 10 g at 20–300 Hz (15) | 10–30 ms | D: the edge force leans back by θ, tan θ ≈ 1.0–1.5 for a 100–150 mm kerb |
+//! | door-slam (standing) | 0.01 m/s (0.015) | — | 40 g at 125–250 Hz, lobes of 2–4 ms (60) | 20–100 ms | D: 30 kg door at ≤ 3 m/s; the ringing amplitude is issue 31's (15–40 g), above the table's 0.5–3 g |
+//! | hood-slam (standing) | 0.06 m/s (0.09) | — | 3 g at 20–300 Hz (4.5) | 20–100 ms | D: hood / boot mass × closing speed |
+//! | hammer-blow (standing) | 0.01 m/s (0.015) | — | 1 000 g at 1–10 kHz (1 500) | 0.2–2 ms | D: 1 kg head at ≤ 10 m/s; S: ISO 16750-3 shock is at the door, not the tunnel |
+//! | rough-road (driving) | ≈ 0 (zero-mean band-limited) | crest factor 3 (13.5 g at 4.5 g rms) | 3 g rms (4.5), 5–40 Hz, from rest | 0.3–5 s | issue 30 fixes ≥ 3 g rms for up to 5 s (≈ 10 × the table's 0.3 g); S: random-vibration drive signals are clipped at 3σ (IEC 60068-2-64 asks for a crest factor ≥ 2.5); D: a 4σ lobe at 4.5 g rms is 300 kN through the wheels |
+//! | speed-bump (30–80 km/h) | 0.3 m/s per axle (0.45), net ≈ 0 | 3 g (4.5) | 3 g at 10–100 Hz (4.5) | 20–60 ms per axle, two bursts a wheelbase / v apart | D |
+//! | jump-landing (30–110 km/h) | 0.6 m/s (0.9) | 5 g (7.5) | 5 g at 10–100 Hz (7.5) | 20–80 ms | D: x as the sensor sees a vertical landing |
+//! | animal-strike (roe deer, 40–110 km/h) | 0.4 m/s (0.6) | one-signed | 5 g at 20–200 Hz (7.5) | 20–60 ms | D: 25 kg at 100 km/h, v·m_a/(m_a + m_car)·(1+e) |
+//!
+//! The one-signed half-sine sweep of issue 20 (the whole area a velocity change of the car:
+//! a 15 g × 20 ms "pothole" is Δv 1.87 m/s, a 260 kN longitudinal peak) stays as the
+//! **beyond-physics** report: printed, where each floor sits, not a gate.
+//!
+//! ## Single faults inside real events (issue 31)
+//! | family | what | requirement |
+//! |---|---|---|
+//! | stuck-crash-sensor-in-door-slam | door slam (as above) on a standing car while the crash sensor sticks for 100 ms | no fire |
+//! | spike-in-pothole | one 150–199 g crash-sensor sample inside a 0.6–0.8 m/s pothole with rebound | no fire |
+//! | offset-with-pothole | a +8 g crash-sensor offset (0.1–0.5 s) starting with a 0.3 m/s pothole | no fire |
+//! | misreported-low-speed | a crash below the no-fire line with one object fault: 14.5 + 14.5 km/h equal cars reported 4 000 kg; 16 + 16 km/h reported 2 800 kg; 1 000–1 300 kg opponents reported 3 000–4 000 kg at an EBS of 13–16 km/h; a 15.5 km/h barrier with the speed reported 5 m/s high | no airbag |
+//! | aliased-ringing | zero-mean ringing near 4 kHz in phase with the samples (±30–49 g × 1.5, 3–4 ms), at 3.95–4.05 kHz (±30–45 g × 1.5, 20–30 ms), or at a multiple of either sampling rate (2, 4, 8, 12, 16 kHz) | no fire |
+//! | low-speed-crash-and-kerb | a 12–16 km/h barrier or 12 + 12 to 15 + 15 km/h cars, tracked, with a kerb strike of 0.5–0.8 m/s (× 1.5) 0–10 ms after contact | no airbag |
+//! | braking-and-pothole | ABS braking at 0.6–1 g with a 0.72–0.76 m/s pothole with rebound (× 1.5: up to 1.14), or with a 0.5–1.3 g crash-sensor offset | no fire |
+//! | near-miss | closing 40–110 km/h (and 30 + 30), the opponent evading 1–50 ms before the predicted contact, a 0.4–0.8 m/s pothole (× 1.5) within ±20 ms of it; also: the ECU must not stay in CrashDetected | no fire, back to Normal |
+//!
+//! ## Faults and must-fire crashes (issue 20)
+//! Spikes, offsets, dead / stuck / noisy sensors, crashes below the no-fire line and must-fire
+//! crashes (with a misreported opponent, with a dead safing sensor) keep their ranges of issue 20
+//! (table in [`FAMILIES`]' docs).
+//!
+//! Required fire time of a must-fire crash: the classic "127 mm − 30 ms" criterion — the
+//! instant a free-flying (unbelted) occupant has moved 127 mm relative to the compartment in
+//! the TRUE pulse, minus 30 ms.
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+mod crashes;
+mod events;
+mod faults;
+mod text;
+
+use crashes::*;
+use events::*;
+use faults::*;
+
+/// What a family requires.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum Requirement {
+    /// No restraint may fire (airbag, pyrotechnic pretensioner), and the ECU returns from a
+    /// crash phase that fired nothing.
+    NoFire,
+    /// The airbag must not fire (a crash below the no-fire line; the belt may act).
+    NoAirbag,
+    /// The airbag must fire.
+    MustFire,
+    /// Printed, not judged: the beyond-physics sweep (where each floor sits).
+    Report,
+}
+
+impl Requirement {
+    /// The requirement in words (`misuse-matrix --list`).
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::NoFire => "no fire",
+            Self::NoAirbag => "no airbag",
+            Self::MustFire => "must fire",
+            Self::Report => "report only",
+        }
+    }
+}
+
+/// One family of the matrix.
+pub struct Family {
+    /// Its name (`--family`).
+    pub name: &'static str,
+    /// What its variants sample (`misuse-matrix --list`; the sources are in the module docs).
+    pub envelope: &'static str,
+    /// What it requires.
+    pub requirement: Requirement,
+    /// The scenario file text of one variant, from its own random stream.
+    make: fn(&mut ChaCha8Rng, &str, u64) -> String,
+}
+
+/// 1.5 × the envelope: every physical bound is sampled up to this multiple (issue 30).
+pub const MARGIN: f64 = 1.5;
+const G: f64 = 9.806_65;
+/// Ego wheelbase [m] (the rear axle meets an edge a wheelbase / v after the front).
+const WHEELBASE_M: f64 = 2.7;
+
+/// Every family, gate families first.
+pub const FAMILIES: &[Family] = &[
+    Family {
+        name: "pothole",
+        envelope: "driving 30–110 km/h; front axle then rear a wheelbase / v later: net Δv ≤ 0.8 m/s, rigid-body ≤ 5 g, ringing ≤ 10 g at 10–300 Hz, 10–30 ms (each × 1.5)",
+        requirement: Requirement::NoFire,
+        make: pothole,
+    },
+    Family {
+        name: "kerb-strike",
+        envelope: "climbing a kerb at 10–50 km/h: net Δv ≤ 0.8 m/s, rigid-body ≤ 7 g, ringing ≤ 10 g at 20–300 Hz, 10–30 ms (each × 1.5)",
+        requirement: Requirement::NoFire,
+        make: kerb_strike,
+    },
+    Family {
+        name: "door-slam",
+        envelope: "standing car: ringing 0.5–60 g at 125–250 Hz for 20–100 ms, net Δv ≤ 0.015 m/s",
+        requirement: Requirement::NoFire,
+        make: door_slam,
+    },
+    Family {
+        name: "hood-slam",
+        envelope: "standing car: ringing 0.5–4.5 g at 20–300 Hz for 20–100 ms, net Δv ≤ 0.09 m/s",
+        requirement: Requirement::NoFire,
+        make: hood_slam,
+    },
+    Family {
+        name: "hammer-blow",
+        envelope: "standing car: ringing 100–1 500 g at 1–10 kHz for 0.2–2 ms, net Δv ≤ 0.015 m/s",
+        requirement: Requirement::NoFire,
+        make: hammer_blow,
+    },
+    Family {
+        name: "rough-road",
+        envelope: "driving 30–110 km/h: 0.5–4.5 g rms, 5–40 Hz from rest, crest factor 3, for 0.3–5 s, both sensors",
+        requirement: Requirement::NoFire,
+        make: rough_road,
+    },
+    Family {
+        name: "speed-bump",
+        envelope: "30–80 km/h, each axle: net Δv ≤ 0.3 m/s, rigid-body ≤ 3 g, ringing ≤ 3 g at 10–100 Hz, 20–60 ms (each × 1.5)",
+        requirement: Requirement::NoFire,
+        make: speed_bump,
+    },
+    Family {
+        name: "jump-landing",
+        envelope: "driving 30–110 km/h: net Δv ≤ 0.6 m/s, rigid-body ≤ 5 g, ringing ≤ 5 g at 10–100 Hz, 20–80 ms (each × 1.5)",
+        requirement: Requirement::NoFire,
+        make: jump_landing,
+    },
+    Family {
+        name: "animal-strike",
+        envelope: "roe deer at 40–110 km/h: net Δv ≤ v·25/(25 + 1 785)·1.3, ringing ≤ 5 g at 20–200 Hz, 20–60 ms (each × 1.5)",
+        requirement: Requirement::NoFire,
+        make: animal_strike,
+    },
+    Family {
+        name: "kerb-at-predicted-contact",
+        envelope: "a tracked object (20–55 km/h each, 1 000–2 500 kg) evading 1 ms before the predicted contact, a kerb strike (as kerb-strike) at it",
+        requirement: Requirement::NoFire,
+        make: kerb_at_predicted_contact,
+    },
+    Family {
+        name: "ghost-object-and-pothole",
+        envelope: "a tracked object evading 1–300 ms before the predicted contact, a pothole (as pothole) from 100 ms before the evasion to 50 ms after the contact",
+        requirement: Requirement::NoFire,
+        make: ghost_object_and_pothole,
+    },
+    Family {
+        name: "spike",
+        envelope: "one sample of 10–200 g on the crash, the safing or both sensors, driving",
+        requirement: Requirement::NoFire,
+        make: spike,
+    },
+    Family {
+        name: "crash-sensor-offset",
+        envelope: "the crash sensor offset by ±2–20 g for 50–500 ms, driving",
+        requirement: Requirement::NoFire,
+        make: crash_sensor_offset,
+    },
+    Family {
+        name: "safing-sensor-offset",
+        envelope: "the safing sensor offset by ±2–20 g for 50–500 ms, driving",
+        requirement: Requirement::NoFire,
+        make: safing_sensor_offset,
+    },
+    Family {
+        name: "crash-sensor-dead",
+        envelope: "the crash sensor stops publishing and stays dead, driving",
+        requirement: Requirement::NoFire,
+        make: crash_sensor_dead,
+    },
+    Family {
+        name: "safing-sensor-dead",
+        envelope: "the safing sensor stops publishing and stays dead, driving",
+        requirement: Requirement::NoFire,
+        make: safing_sensor_dead,
+    },
+    Family {
+        name: "sensor-stuck",
+        envelope: "the crash or safing sensor stuck or saturated for 50–500 ms, driving",
+        requirement: Requirement::NoFire,
+        make: sensor_stuck,
+    },
+    Family {
+        name: "sensor-noisy",
+        envelope: "one sensor (crash or safing) noisy: 1–10 g rms for 0.1–0.5 s, the other quiet",
+        requirement: Requirement::NoFire,
+        make: sensor_noisy,
+    },
+    Family {
+        name: "stuck-crash-sensor-in-door-slam",
+        envelope: "a door slam (as door-slam) while the crash sensor sticks for 100 ms",
+        requirement: Requirement::NoFire,
+        make: stuck_in_door_slam,
+    },
+    Family {
+        name: "spike-in-pothole",
+        envelope: "one 150–199 g crash-sensor sample inside a 0.9–1.2 m/s pothole with rebound",
+        requirement: Requirement::NoFire,
+        make: spike_in_pothole,
+    },
+    Family {
+        name: "offset-with-pothole",
+        envelope: "a crash-sensor offset of 3–12 g for 0.1–0.5 s starting with a 0.15–0.45 m/s pothole",
+        requirement: Requirement::NoFire,
+        make: offset_with_pothole,
+    },
+    Family {
+        name: "aliased-ringing",
+        envelope: "zero-mean ringing near 4 kHz in phase with the samples (45–73.5 g, 3–4 ms), at 3.95–4.05 kHz (45–67.5 g, 20–30 ms), or at 2–16 kHz multiples (15–75 g, 3–30 ms)",
+        requirement: Requirement::NoFire,
+        make: aliased_ringing,
+    },
+    Family {
+        name: "braking-and-pothole",
+        envelope: "ABS braking at 0.6–1 g, 50–110 km/h, with a 1.08–1.14 m/s pothole with rebound or a 0.75–1.95 g crash-sensor offset",
+        requirement: Requirement::NoFire,
+        make: braking_and_pothole,
+    },
+    Family {
+        name: "near-miss",
+        envelope: "closing 30–110 km/h, the opponent evading 1–50 ms before the predicted contact, a 0.6–1.2 m/s pothole within ±20 ms of it; also back to Normal",
+        requirement: Requirement::NoFire,
+        make: near_miss,
+    },
+    Family {
+        name: "no-fire-crash",
+        envelope: "barrier 8–16 km/h, objects live or dead",
+        requirement: Requirement::NoAirbag,
+        make: no_fire_crash,
+    },
+    Family {
+        name: "misreported-low-speed",
+        envelope: "below the no-fire line with one object fault: 14.5 + 14.5 km/h reported 4 000 kg, 16 + 16 km/h reported 2 800 kg, 1 000–1 300 kg opponents reported 3 000–4 000 kg (EBS 13–16 km/h), a 15.5 km/h barrier reported 5 m/s faster",
+        requirement: Requirement::NoAirbag,
+        make: misreported_low_speed,
+    },
+    Family {
+        name: "low-speed-crash-and-kerb",
+        envelope: "barrier 12–16 km/h or 12 + 12 to 15 + 15 km/h cars, tracked, a 0.75–1.2 m/s kerb strike 0–10 ms after contact",
+        requirement: Requirement::NoAirbag,
+        make: low_speed_crash_and_kerb,
+    },
+    Family {
+        name: "must-fire-crash",
+        envelope: "barrier 35–56 km/h, objects live or dead; fire − required (127 mm − 30 ms) reported",
+        requirement: Requirement::MustFire,
+        make: must_fire_crash,
+    },
+    Family {
+        name: "must-fire-car",
+        envelope: "equal cars 35 + 35 to 56 + 56 km/h",
+        requirement: Requirement::MustFire,
+        make: must_fire_car,
+    },
+    Family {
+        name: "must-fire-misreported",
+        envelope: "1 000–2 800 kg opponents at an ego EBS of 35–56 km/h, the mass reported ±1 200 kg off or the closing speed ±5 m/s",
+        requirement: Requirement::MustFire,
+        make: must_fire_misreported,
+    },
+    Family {
+        name: "must-fire-safing-dead",
+        envelope: "barrier 35–56 km/h with the safing sensor dead",
+        requirement: Requirement::MustFire,
+        make: must_fire_safing_dead,
+    },
+    Family {
+        name: "beyond-physics-half-sine",
+        envelope: "one-signed half-sine 3–15 g × 5–20 ms on both sensors (its whole area a Δv of the car): where each floor sits, printed, not judged",
+        requirement: Requirement::Report,
+        make: beyond_physics,
+    },
+];
+
+/// Families that do not hold yet: `misuse-matrix --gate` prints them and does not fail on
+/// them, so the suite gates everything that holds while the rest is open work. Empty since
+/// issues 30/31 closed their last families (rough road: the floors' roughness lift); a family
+/// found failing goes here, with its counts (500 variants, seed 7, as the gate runs them) and
+/// a README note, until it holds.
+pub const OPEN: &[&str] = &[];
+
+/// The family called `name`.
+pub fn family(name: &str) -> Option<&'static Family> {
+    FAMILIES.iter().find(|f| f.name == name)
+}
+
+/// The names of every family, for an error message.
+pub fn names() -> Vec<&'static str> {
+    FAMILIES.iter().map(|f| f.name).collect()
+}
+
+impl Family {
+    /// The scenario text of variant `i` under `seed` (reproducible: the same text every time).
+    pub fn variant(&self, i: u64, seed: u64) -> String {
+        let mut r = ChaCha8Rng::seed_from_u64(seed ^ i.wrapping_mul(0x9E37_79B9_7F4A_7C15));
+        (self.make)(&mut r, &format!("{}-{i}", self.name), i)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every family's variants parse and validate against the documented schema, and are
+    /// reproducible.
+    #[test]
+    fn every_variant_is_a_valid_scenario() {
+        for f in FAMILIES {
+            for i in 0..40 {
+                let text = f.variant(i, 7);
+                assert_eq!(text, f.variant(i, 7));
+                world::Scenario::parse(f.name, &text)
+                    .unwrap_or_else(|e| panic!("{}: {e}\n{text}", f.name));
+            }
+        }
+    }
+}
