@@ -1,0 +1,441 @@
+//! One bench run: the processes of a scenario (candump, stubs, ECU, feeds), started in order,
+//! disturbed if the caller asks, stopped, and what they left.
+
+use super::*;
+use actuator_stubs::report::Report;
+use anyhow::{bail, Context, Result};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// What one run needs.
+#[derive(Clone, Debug)]
+pub struct RunConfig {
+    /// Scenario file.
+    pub scenario: PathBuf,
+    /// Output root (the run writes `out/<scenario name>/`).
+    pub out: PathBuf,
+    /// CAN interface ("" = no CAN: only the host-timing runs, which have no stubs).
+    pub can: String,
+    /// Folder with the `ecu`, `sensor-feeds` and `actuator-stubs` binaries.
+    pub bin_dir: PathBuf,
+    /// iceoryx2 service prefix for this run.
+    pub service_prefix: String,
+    /// Extra arguments for the ECU.
+    pub ecu_args: Vec<String>,
+    /// Working directory of the ECU (its config paths `data/default.lut`,
+    /// `data/reference-restraint.toml` are relative to the repository root).
+    pub ecu_cwd: PathBuf,
+    /// Extra arguments for the actuator stubs (see [`default_stubs_args`]).
+    pub stubs_args: Vec<String>,
+}
+
+/// The ECU as it is meant to run: SCHED_FIFO 80 and locked memory. Without the privileges
+/// it says so on stderr and in its report (`rt`) and runs on. In the guest (PREEMPT_RT kernel)
+/// as on a real bench, this is what keeps a busy neighbour (candump writing a flooded bus to
+/// disk) from delaying the cycle.
+pub fn default_ecu_args() -> Vec<String> {
+    ["--sched-fifo", "80", "--mlockall"]
+        .map(str::to_owned)
+        .to_vec()
+}
+
+/// A fire command may arrive this much after its planned time: crash confirmation needs a few
+/// accelerometer samples (≈ 5.5 ms after contact), plus the ECU cycle and the CAN hop.
+pub const FIRE_LATE_ALLOWANCE_MS: f64 = 15.0;
+
+/// The stubs' bench arguments: receive until stopped after the ECU, so every command it sent
+/// is received and counted. The SecOC windows are the defaults on every route (10 ms pairing,
+/// 100 ms freshness): the QEMU guest's real kernel delivers in time (see [`route`]).
+pub fn default_stubs_args() -> Vec<String> {
+    vec!["--until-signal".to_owned()]
+}
+
+/// What a run needs to know to disturb it (fault campaign).
+pub struct RunCtx<'a> {
+    /// The run's configuration.
+    pub cfg: &'a RunConfig,
+    /// The scenario being played.
+    pub scenario: &'a world::Scenario,
+    /// The run's output folder.
+    pub dir: PathBuf,
+    /// CLOCK_MONOTONIC ns of scenario t = 0 (the feeds' `--epoch-ns`).
+    pub epoch_ns: u64,
+}
+
+impl RunCtx<'_> {
+    /// Path of a bench binary.
+    pub fn bin(&self, name: &str) -> PathBuf {
+        self.cfg.bin_dir.join(name)
+    }
+
+    /// The sensor-feeds command of this run (on the run's epoch, so a restart resumes).
+    pub fn feeds_command(&self) -> Command {
+        feeds_command(self.cfg, Some(self.epoch_ns))
+    }
+
+    /// Sleeps until scenario time `t_s`.
+    pub fn sleep_until_s(&self, t_s: f64) {
+        sensor_feeds::sleep_until_ns(self.epoch_ns + (t_s * 1e9) as u64);
+    }
+}
+
+/// Something done to a run: before it, beside it, or to its sensor feeds. The plain bench run
+/// is [`Undisturbed`].
+pub trait Disturbance {
+    /// Before any bench process starts (e.g. leave a stale iceoryx2 service behind).
+    fn prepare(&mut self, _cfg: &RunConfig, _dir: &Path) -> Result<()> {
+        Ok(())
+    }
+    /// Processes started once the feeds have fixed the time base (bus injectors, floods),
+    /// stdout piped. After the feeds, the ECU is stopped; then each is given 5 s to end by
+    /// itself (or stopped at once if it runs until stopped), then SIGTERM; their stdout is
+    /// returned in [`RunResult::disturbance_output`].
+    fn start(&mut self, _ctx: &RunCtx) -> Result<Vec<SideProcess>> {
+        Ok(Vec::new())
+    }
+    /// While the feeds play (`feeds` is running); the default waits for them to finish.
+    fn feeds_running(
+        &mut self,
+        _ctx: &RunCtx,
+        feeds: &mut Child,
+    ) -> Result<std::process::ExitStatus> {
+        feeds.wait().context("waiting for sensor-feeds")
+    }
+}
+
+/// A process a [`Disturbance`] runs beside the bench.
+pub struct SideProcess {
+    /// Name for messages and [`RunResult::disturbance_output`].
+    pub name: String,
+    /// The process (stdout piped if its output matters).
+    pub child: Child,
+    /// Runs until stopped (e.g. `cangen`): SIGTERM as soon as the feeds are done.
+    pub until_stopped: bool,
+}
+
+/// The plain bench run.
+pub struct Undisturbed;
+
+impl Disturbance for Undisturbed {}
+
+/// What one run produced.
+#[derive(Debug)]
+pub struct RunResult {
+    /// Scenario name.
+    pub name: String,
+    /// Output folder.
+    pub dir: PathBuf,
+    /// The stubs' report.
+    pub report: Report,
+    /// The ECU's JSON report (if it wrote one).
+    pub ecu_report: Option<serde_json::Value>,
+    /// Readable summary (also in summary.txt).
+    pub summary: String,
+    /// Process problems (non-zero exits), empty when all went well.
+    pub problems: Vec<String>,
+    /// CLOCK_MONOTONIC ns of scenario t = 0.
+    pub epoch_ns: u64,
+    /// The scenario file played.
+    pub scenario: PathBuf,
+    /// What the disturbance processes printed, by name.
+    pub disturbance_output: Vec<(String, String)>,
+}
+
+fn spawn(cmd: &mut Command, what: &str) -> Result<Child> {
+    cmd.spawn()
+        .with_context(|| format!("starting {what} ({cmd:?})"))
+}
+
+pub(crate) fn terminate(
+    child: &mut Child,
+    what: &str,
+    grace: Duration,
+) -> Result<std::process::ExitStatus> {
+    if let Ok(Some(st)) = child.try_wait() {
+        return Ok(st);
+    }
+    let pid = nix::unistd::Pid::from_raw(child.id() as i32);
+    let _ = nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGTERM);
+    if let Some(st) = wait_timeout::ChildExt::wait_timeout(child, grace)? {
+        return Ok(st);
+    }
+    let _ = child.kill();
+    let st = child.wait()?;
+    eprintln!("hil-bench: {what} did not stop on SIGTERM within {grace:?}; killed");
+    Ok(st)
+}
+
+/// Forwards a child's piped stderr to ours line by line (and to `log` if given); if `ready`
+/// is given, the returned receiver gets a message when a line starting with it was seen.
+fn forward_stderr(
+    child: &mut Child,
+    log: Option<PathBuf>,
+    ready: Option<&'static str>,
+) -> (
+    Option<std::thread::JoinHandle<()>>,
+    std::sync::mpsc::Receiver<()>,
+) {
+    let (tx, rx) = std::sync::mpsc::channel();
+    let thread = child.stderr.take().map(|pipe| {
+        std::thread::spawn(move || {
+            use std::io::{BufRead, Write};
+            let mut file = log.and_then(|p| std::fs::File::create(p).ok());
+            for line in std::io::BufReader::new(pipe).lines().map_while(Result::ok) {
+                eprintln!("{line}");
+                if let Some(f) = file.as_mut() {
+                    let _ = writeln!(f, "{line}");
+                }
+                if ready.is_some_and(|r| line.starts_with(r)) {
+                    let _ = tx.send(());
+                }
+            }
+        })
+    });
+    (thread, rx)
+}
+
+/// Waits for a child's ready line (see [`forward_stderr`]); an error if it exits first or
+/// takes longer than a slow start in an emulated guest on a busy host could explain.
+fn wait_ready(ready: std::sync::mpsc::Receiver<()>, child: &mut Child, what: &str) -> Result<()> {
+    let until = Instant::now() + Duration::from_secs(30);
+    while Instant::now() < until {
+        match ready.recv_timeout(Duration::from_millis(20)) {
+            Ok(()) => return Ok(()),
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                bail!("{what} exited before it was ready: {:?}", child.wait()?)
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+        }
+        if let Some(st) = child.try_wait()? {
+            bail!("{what} exited before it was ready: {st}");
+        }
+    }
+    bail!("{what} did not get ready within 30 s")
+}
+
+/// The sensor-feeds command of a run: CAN or `--no-can`, the run's services, and the time
+/// base (`None`: the feeds choose it and announce it).
+pub fn feeds_command(cfg: &RunConfig, epoch_ns: Option<u64>) -> Command {
+    let mut c = Command::new(cfg.bin_dir.join("sensor-feeds"));
+    c.arg("--scenario").arg(&cfg.scenario);
+    if cfg.can.is_empty() {
+        c.arg("--no-can");
+    } else {
+        c.args(["--can", &cfg.can]);
+    }
+    c.args(["--service-prefix", &cfg.service_prefix]);
+    if let Some(e) = epoch_ns {
+        c.arg("--epoch-ns").arg(e.to_string());
+    }
+    c
+}
+
+/// Reads the feeds' "epoch_ns N" line (their first line on stdout).
+pub fn read_epoch(feeds: &mut Child) -> Result<u64> {
+    use std::io::BufRead;
+    let out = feeds.stdout.take().context("sensor-feeds stdout")?;
+    let mut line = String::new();
+    std::io::BufReader::new(out)
+        .read_line(&mut line)
+        .context("reading sensor-feeds' epoch")?;
+    line.trim()
+        .strip_prefix("epoch_ns ")
+        .and_then(|n| n.parse().ok())
+        .with_context(|| format!("sensor-feeds did not announce its epoch (got {line:?})"))
+}
+
+/// Runs one scenario through the real processes.
+pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
+    run_disturbed(cfg, &mut Undisturbed)
+}
+
+/// Runs one scenario through the real processes, disturbed by `dist`.
+pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunResult> {
+    let scenario = world::Scenario::load(&cfg.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let dir = cfg.out.join(&scenario.name);
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    for stale in [
+        "report.json",
+        "ecu-report.json",
+        "ecu-stderr.txt",
+        "candump.log",
+        "commands.jsonl",
+        "outcome.png",
+        "summary.txt",
+    ] {
+        let _ = std::fs::remove_file(dir.join(stale));
+    }
+    let bin = |name: &str| cfg.bin_dir.join(name);
+    for b in ["ecu", "sensor-feeds", "actuator-stubs"] {
+        if !bin(b).exists() {
+            bail!(
+                "{} missing: build with `cargo build --release --workspace --bins`",
+                bin(b).display()
+            );
+        }
+    }
+    let mut problems = Vec::new();
+    // Absolute paths: the ECU runs in the repository root.
+    let dir = std::path::absolute(&dir)?;
+    dist.prepare(cfg, &dir)?;
+    let candump_log = std::fs::File::create(dir.join("candump.log"))?;
+    let mut candump = spawn(
+        // An 8 MiB receive queue like the stubs': with the default one candump drops frames
+        // under the campaign's flood (it recorded ~ 1/4 of them), and its log is what the
+        // flood and the recorded fire pair are counted from.
+        Command::new("candump")
+            .args(["-L", "-r", "8388608", &cfg.can])
+            .stdout(candump_log)
+            .stderr(Stdio::inherit()),
+        "candump (install can-utils)",
+    )?;
+    let mut stubs = spawn(
+        Command::new(bin("actuator-stubs"))
+            .arg("--scenario")
+            .arg(&cfg.scenario)
+            .args([
+                "--can",
+                &cfg.can,
+                "--service-prefix",
+                &cfg.service_prefix,
+                "--timeout-s",
+            ])
+            .arg(format!("{}", scenario.duration_s + 30.0))
+            .arg("--out")
+            .arg(&dir)
+            .args(&cfg.stubs_args)
+            .stderr(Stdio::piped()),
+        "actuator-stubs",
+    )?;
+    // The ECU starts only once the stubs listen on the bus: its first commands would otherwise
+    // go out before the receiver's socket exists (under load, or in an emulated guest where a
+    // process takes up to a second to start, that was several cycles of commands).
+    let (stubs_stderr, stubs_ready) =
+        forward_stderr(&mut stubs, None, Some(actuator_stubs::READY_PREFIX));
+    if let Err(e) = wait_ready(stubs_ready, &mut stubs, "actuator-stubs") {
+        let _ = terminate(&mut stubs, "actuator-stubs", Duration::from_secs(2));
+        let _ = terminate(&mut candump, "candump", Duration::from_secs(2));
+        return Err(e);
+    }
+    let ecu_log = std::fs::File::create(dir.join("ecu-stdout.txt"))?;
+    let mut ecu = spawn(
+        Command::new(bin("ecu"))
+            .args([
+                "--can",
+                &cfg.can,
+                "--service-prefix",
+                &cfg.service_prefix,
+                "--quiet",
+            ])
+            .arg("--node-name")
+            .arg(format!("ecu-{}", std::process::id()))
+            .arg("--report-json")
+            .arg(dir.join("ecu-report.json"))
+            .args(&cfg.ecu_args)
+            .current_dir(&cfg.ecu_cwd)
+            .stdout(ecu_log)
+            .stderr(Stdio::piped()),
+        "ecu",
+    )?;
+    // The ECU's start-up messages (LUT/keys accepted or rejected) go to the console as before
+    // and into ecu-stderr.txt, where the fault campaign reads them.
+    // The scenario starts once the ECU receives (its ports open, its loop running): the feeds'
+    // first samples are not lost, and no fixed wait (400 ms of each run before) is spent.
+    let (ecu_stderr, ecu_ready) = forward_stderr(
+        &mut ecu,
+        Some(dir.join("ecu-stderr.txt")),
+        Some(ecu::runtime::app::READY_LINE),
+    );
+    if let Err(e) = wait_ready(ecu_ready, &mut ecu, "ecu") {
+        problems.push(format!("{e:#}"));
+    }
+    // The feeds fix scenario t = 0 when they are ready and print it ("epoch_ns N").
+    let mut feeds = spawn(
+        feeds_command(cfg, None).stdout(Stdio::piped()),
+        "sensor-feeds",
+    )?;
+    let epoch_ns = match read_epoch(&mut feeds) {
+        Ok(e) => e,
+        Err(e) => {
+            let _ = feeds.kill();
+            let _ = feeds.wait();
+            let _ = terminate(&mut ecu, "ecu", Duration::from_secs(5));
+            let _ = terminate(&mut stubs, "actuator-stubs", Duration::from_secs(5));
+            let _ = terminate(&mut candump, "candump", Duration::from_secs(2));
+            return Err(e);
+        }
+    };
+    let ctx = RunCtx {
+        cfg,
+        scenario: &scenario,
+        dir: dir.clone(),
+        epoch_ns,
+    };
+    let mut side = match dist.start(&ctx) {
+        Ok(s) => s,
+        Err(e) => {
+            problems.push(format!("disturbance: {e:#}"));
+            Vec::new()
+        }
+    };
+    match dist.feeds_running(&ctx, &mut feeds) {
+        Ok(st) if st.success() => {}
+        Ok(st) => problems.push(format!("sensor-feeds: {st}")),
+        Err(e) => problems.push(format!("sensor-feeds: {e:#}")),
+    }
+    // The ECU stops first, then the side processes, then the stubs (which read everything the
+    // ECU sent before they judge: --until-signal).
+    let st = terminate(&mut ecu, "ecu", Duration::from_secs(5))?;
+    if !st.success() {
+        problems.push(format!("ecu: {st}"));
+    }
+    let _ = ecu_stderr.map(std::thread::JoinHandle::join);
+    let mut disturbance_output = Vec::new();
+    for p in side.iter_mut() {
+        let grace = if p.until_stopped {
+            Duration::ZERO
+        } else {
+            Duration::from_secs(5)
+        };
+        if wait_timeout::ChildExt::wait_timeout(&mut p.child, grace)?.is_none() {
+            terminate(&mut p.child, &p.name, Duration::from_secs(2))?;
+        }
+    }
+    for p in side {
+        let o = p.child.wait_with_output()?;
+        disturbance_output.push((p.name, String::from_utf8_lossy(&o.stdout).into_owned()));
+    }
+    // The ECU is gone, so everything it sent is queued at the stubs: stop them (with
+    // --until-signal they read the queue first and judge).
+    let st = terminate(&mut stubs, "actuator-stubs", Duration::from_secs(20))?;
+    if !st.success() {
+        problems.push(format!("actuator-stubs: {st}"));
+    }
+    let _ = stubs_stderr.map(std::thread::JoinHandle::join);
+    std::thread::sleep(Duration::from_millis(50));
+    let _ = terminate(&mut candump, "candump", Duration::from_secs(2))?;
+
+    let report_path = dir.join("report.json");
+    let report: Report = serde_json::from_str(
+        &std::fs::read_to_string(&report_path)
+            .with_context(|| format!("reading {}", report_path.display()))?,
+    )
+    .with_context(|| format!("parsing {}", report_path.display()))?;
+    let ecu_report = std::fs::read_to_string(dir.join("ecu-report.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok());
+    let summary = summarise(&scenario, &report, ecu_report.as_ref(), &dir, &problems);
+    std::fs::write(dir.join("summary.txt"), &summary)?;
+    Ok(RunResult {
+        name: scenario.name,
+        dir,
+        report,
+        ecu_report,
+        summary,
+        problems,
+        epoch_ns,
+        scenario: cfg.scenario.clone(),
+        disturbance_output,
+    })
+}
