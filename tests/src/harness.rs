@@ -5,6 +5,42 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
+/// The Python of the independent checks: `target/pyenv` (tests/setup-host.sh installs cantools
+/// and mcap there), else `python3` from PATH (then the check says what is missing).
+pub fn python3() -> PathBuf {
+    let venv = crate::repo_root().join("target/pyenv/bin/python3");
+    if venv.exists() {
+        venv
+    } else {
+        "python3".into()
+    }
+}
+
+/// Runs `record/check_mcap.py` (Foxglove's `mcap` reader and cantools, no project code) on a
+/// run folder — with `full`, the folder of a whole bench run (the stubs' files there, log times
+/// on CLOCK_MONOTONIC); its report, or what failed.
+pub fn check_recording(run_dir: &Path, full: bool) -> Result<String, String> {
+    let o = Command::new(python3())
+        .arg(crate::repo_root().join("record/check_mcap.py"))
+        .arg(run_dir)
+        .arg(crate::repo_root().join("bus/restraint.dbc"))
+        .args(full.then_some("--full"))
+        .output()
+        .map_err(|e| {
+            format!("python3 record/check_mcap.py: {e} (tests/setup-host.sh installs its venv)")
+        })?;
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    if o.status.success() {
+        Ok(text)
+    } else {
+        Err(text)
+    }
+}
+
 /// target/<profile>/ of the running test binary (it lives in target/<profile>/deps/).
 pub fn bin_dir() -> PathBuf {
     let exe = std::env::current_exe().expect("current exe");

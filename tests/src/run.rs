@@ -4,6 +4,7 @@
 use super::*;
 use actuator_stubs::report::Report;
 use anyhow::{bail, Context, Result};
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -425,7 +426,31 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     let ecu_report = std::fs::read_to_string(dir.join("ecu-report.json"))
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok());
-    let summary = summarise(&scenario, &report, ecu_report.as_ref(), &dir, &problems);
+    // The run's recording (record crate): everything above on one clock, for Foxglove and
+    // any MCAP reader. A run that cannot be recorded is a problem of the run, not lost silently.
+    let route = crate::Route::current();
+    let recorded = record::write_run(
+        &dir,
+        &dir.join(record::RUN_MCAP),
+        &record::RunMeta {
+            route: route.name().to_owned(),
+            timing_emulated: Some(route.timing_emulated()),
+        },
+    );
+    if let Err(e) = &recorded {
+        problems.push(format!("recording: {e:#}"));
+    }
+    let mut summary = summarise(&scenario, &report, ecu_report.as_ref(), &dir, &problems);
+    if let Ok(s) = &recorded {
+        let _ = writeln!(
+            summary,
+            "recording: {} ({} messages on {} topics, {:.0} kB; open in Foxglove, README \"Recordings\")",
+            dir.join(record::RUN_MCAP).display(),
+            s.messages.values().sum::<u64>(),
+            s.messages.len(),
+            s.bytes as f64 / 1e3
+        );
+    }
     std::fs::write(dir.join("summary.txt"), &summary)?;
     Ok(RunResult {
         name: scenario.name,

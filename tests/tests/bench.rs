@@ -285,17 +285,12 @@ fn candump_log_decodes_with_cantools_and_the_dbc() {
     let text = std::fs::read_to_string(&log).expect("candump.log");
     let lines = text.lines().filter(|l| !l.trim().is_empty()).count();
     assert!(lines > 100, "candump captured {lines} frames");
-    let venv = root().join("target/pyenv/bin/python3");
-    let o = Command::new(if venv.exists() {
-        venv
-    } else {
-        "python3".into()
-    })
-    .args(["-m", "cantools", "decode", "--single-line"])
-    .arg(root().join("bus/restraint.dbc"))
-    .stdin(std::fs::File::open(&log).expect("open log"))
-    .output()
-    .expect("python3 -m cantools (tests/setup-host.sh installs it; put its venv on PATH)");
+    let o = Command::new(harness::python3())
+        .args(["-m", "cantools", "decode", "--single-line"])
+        .arg(root().join("bus/restraint.dbc"))
+        .stdin(std::fs::File::open(&log).expect("open log"))
+        .output()
+        .expect("python3 -m cantools (tests/setup-host.sh installs it; put its venv on PATH)");
     assert!(
         o.status.success(),
         "cantools: {}",
@@ -322,6 +317,33 @@ fn candump_log_decodes_with_cantools_and_the_dbc() {
     assert!(
         decoded.contains("Fire: 'Fire'") || decoded.contains("Fire: Fire"),
         "the fire command is on the bus"
+    );
+}
+
+/// Every run of the library leaves a `run.mcap` that readers independent of the project accept
+/// (record/check_mcap.py: Foxglove's `mcap` package and cantools): every candump frame with its
+/// bytes and time, every DBC message decoded as cantools decodes it, the stubs' commands,
+/// actions and verdict — on the bench's CLOCK_MONOTONIC (the offset measured from the run) and
+/// ≤ 20 MB (issue 23).
+#[test]
+fn every_run_leaves_a_recording_that_independent_readers_accept() {
+    let out = bench_run();
+    let mut failed = Vec::new();
+    for s in library() {
+        let name = Scenario::load(&s).expect("scenario").name;
+        let dir = out.join(&name);
+        let mcap = dir.join("run.mcap");
+        let bytes = std::fs::metadata(&mcap).map(|m| m.len()).unwrap_or(0);
+        match harness::check_recording(&dir, true) {
+            Ok(_) if bytes > 0 && bytes <= 20_000_000 => {}
+            Ok(_) => failed.push(format!("{name}: run.mcap is {bytes} bytes")),
+            Err(text) => failed.push(format!("{name}: {text}")),
+        }
+    }
+    assert!(
+        failed.is_empty(),
+        "recordings failed:\n{}",
+        failed.join("\n")
     );
 }
 

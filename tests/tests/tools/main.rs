@@ -7,3 +7,4 @@ mod docs_check;
 mod matrix_cli;
 mod matrix_slurm;
 mod offline;
+mod recording;

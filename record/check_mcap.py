@@ -1,0 +1,156 @@
+#!/usr/bin/env python3
+"""Checks a run's run.mcap against the run folder with readers independent of the project's
+code: Foxglove's `mcap` package reads the file, `cantools` decodes the frames with the DBC.
+
+    check_mcap.py RUN_DIR DBC [--mcap FILE] [--full]
+
+--full: the folder is a whole bench run: commands.jsonl and report.json must be there and the
+file must be on CLOCK_MONOTONIC (a realtime − monotonic offset measured from the run).
+
+Checked:
+  * every frame of candump.log is on /can/raw, in order, with the same id and bytes and a
+    publish time equal to candump's stamp (±1 µs);
+  * every frame's log time is its publish time minus the file's realtime − monotonic offset
+    (metadata `bench`), the same for every frame;
+  * every frame of a DBC message is on /can/<name> with the same times, and each signal's value
+    equals cantools' decode of the same bytes (scaled, no value-table names);
+  * with commands.jsonl: every record is on /stubs/commands unchanged, at its rx_mono_ns;
+  * with report.json: one /stubs/actions message per action, one /stubs/verdict.
+Prints one line per check and exits 1 on the first failure.
+"""
+
+import argparse
+import json
+import math
+import pathlib
+import re
+import sys
+
+import cantools
+from mcap.reader import make_reader
+
+LINE = re.compile(r"^\((\d+)\.(\d{6})\)\s+(\S+)\s+([0-9A-Fa-f]+)#([0-9A-Fa-f]*)\s*$")
+
+
+def fail(msg):
+    print(f"check_mcap: FAIL: {msg}")
+    sys.exit(1)
+
+
+def candump_frames(path):
+    frames = []
+    for line in path.read_text().splitlines():
+        m = LINE.match(line)
+        if not m:
+            continue  # remote / error / FD frames: not data frames of this bus
+        sec, usec, iface, ident, data = m.groups()
+        frames.append(
+            {
+                "t_ns": (int(sec) * 1_000_000 + int(usec)) * 1000,
+                "iface": iface,
+                "id": int(ident, 16),
+                "extended": len(ident) == 8,
+                "data": bytes.fromhex(data),
+            }
+        )
+    return frames
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("run_dir", type=pathlib.Path)
+    ap.add_argument("dbc", type=pathlib.Path)
+    ap.add_argument("--mcap", type=pathlib.Path)
+    ap.add_argument("--full", action="store_true")
+    a = ap.parse_args()
+    mcap_path = a.mcap or a.run_dir / "run.mcap"
+    db = cantools.database.load_file(str(a.dbc))
+
+    topics = {}
+    with open(mcap_path, "rb") as f:
+        reader = make_reader(f)
+        meta = {m.name: m.metadata for m in reader.iter_metadata()}
+        for schema, channel, message in reader.iter_messages(log_time_order=False):
+            topics.setdefault(channel.topic, []).append(
+                (message.log_time, message.publish_time, json.loads(message.data), schema)
+            )
+    bench = meta.get("bench")
+    if bench is None:
+        fail("no `bench` metadata")
+    offset = int(bench["realtime_minus_monotonic_ns"]) if bench.get("realtime_minus_monotonic_ns") else 0
+    if a.full:
+        for f in ("commands.jsonl", "report.json"):
+            if not (a.run_dir / f).exists():
+                fail(f"--full: no {f} in {a.run_dir}")
+        if not bench.get("realtime_minus_monotonic_ns") or "MONOTONIC" not in bench.get("log_time_clock", ""):
+            fail(f"--full: log times are not on CLOCK_MONOTONIC ({bench.get('log_time_clock')})")
+    print(f"check_mcap: {mcap_path}: {sum(map(len, topics.values()))} messages, "
+          f"route {bench.get('route')}, timing {bench.get('timing')}, offset {offset} ns")
+
+    frames = candump_frames(a.run_dir / "candump.log")
+    raw = topics.get("/can/raw", [])
+    if len(raw) != len(frames):
+        fail(f"/can/raw has {len(raw)} frames, candump.log {len(frames)}")
+    for i, (fr, (log_t, pub_t, msg, _)) in enumerate(zip(frames, raw)):
+        if msg["id"] != fr["id"] or bytes(msg["data"]) != fr["data"] or msg["dlc"] != len(fr["data"]):
+            fail(f"frame {i}: {msg} is not candump's {fr['id']:x}#{fr['data'].hex()}")
+        if abs(pub_t - fr["t_ns"]) > 1000:
+            fail(f"frame {i}: publish time {pub_t} vs candump {fr['t_ns']} ns")
+        if log_t != pub_t - offset:
+            fail(f"frame {i}: log time {log_t} is not publish time − offset ({pub_t - offset})")
+    print(f"check_mcap: /can/raw: all {len(frames)} frames of candump.log, bytes and times (±1 µs) equal")
+
+    decoded = 0
+    by_id = {}
+    for fr in frames:
+        try:
+            m = db.get_message_by_frame_id(fr["id"])
+        except KeyError:
+            continue
+        if fr["extended"] != m.is_extended_frame or len(fr["data"]) != m.length:
+            continue
+        by_id.setdefault(m.name, []).append((fr, m))
+    for name, items in by_id.items():
+        got = topics.get(f"/can/{name}", [])
+        if len(got) != len(items):
+            fail(f"/can/{name}: {len(got)} messages, candump.log has {len(items)} frames")
+        for (fr, m), (log_t, pub_t, msg, _) in zip(items, got):
+            if abs(pub_t - fr["t_ns"]) > 1000 or log_t != pub_t - offset:
+                fail(f"/can/{name}: times {log_t}/{pub_t} vs candump {fr['t_ns']}")
+            want = m.decode(fr["data"], decode_choices=False, scaling=True)
+            if set(want) != set(msg):
+                fail(f"/can/{name}: signals {sorted(msg)} vs cantools {sorted(want)}")
+            for sig, v in want.items():
+                if not math.isclose(float(msg[sig]), float(v), rel_tol=1e-9, abs_tol=1e-9):
+                    fail(f"/can/{name}.{sig}: {msg[sig]} vs cantools {v} ({fr['data'].hex()})")
+            decoded += 1
+    print(f"check_mcap: /can/<message>: {decoded} frames of {len(by_id)} DBC messages, every signal equals cantools' decode")
+
+    cmd_path = a.run_dir / "commands.jsonl"
+    if cmd_path.exists():
+        want = [json.loads(l) for l in cmd_path.read_text().splitlines() if l.strip()]
+        got = topics.get("/stubs/commands", [])
+        if len(got) != len(want):
+            fail(f"/stubs/commands: {len(got)} vs {len(want)} records")
+        for w, (log_t, _, msg, _) in zip(want, got):
+            if msg != w or log_t != w["rx_mono_ns"]:
+                fail(f"/stubs/commands: {msg} at {log_t} vs {w}")
+        print(f"check_mcap: /stubs/commands: all {len(want)} records unchanged at their rx_mono_ns")
+
+    rep_path = a.run_dir / "report.json"
+    if rep_path.exists():
+        rep = json.loads(rep_path.read_text())
+        acts = topics.get("/stubs/actions", [])
+        if len(acts) != len(rep["actions"]):
+            fail(f"/stubs/actions: {len(acts)} vs {len(rep['actions'])} actions")
+        for w, (log_t, _, msg, _) in zip(rep["actions"], acts):
+            if msg["what"] != w["what"] or abs(log_t - (rep["start_ns"] + w["t_ms"] * 1e6)) > 1:
+                fail(f"/stubs/actions: {msg} at {log_t} vs {w}")
+        if len(topics.get("/stubs/verdict", [])) != 1:
+            fail("/stubs/verdict: not exactly one message")
+        print(f"check_mcap: /stubs/actions: {len(acts)} actions at start + t_ms; one verdict")
+    print("check_mcap: OK")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,31 @@
+//! Recordings of bench runs in the formats of the field's measurement tools: one MCAP file per
+//! run (`run.mcap`, for Foxglove and every MCAP reader), written from what the run left in its
+//! folder.
+//!
+//! | topic | from | one message per |
+//! |---|---|---|
+//! | `/can/raw` | `candump.log` | frame: id, extended, dlc, data bytes, interface, DBC name |
+//! | `/can/<DBC message>` | `candump.log` + `bus/restraint.dbc` | frame of that id: every signal's physical value |
+//! | `/stubs/commands` | `commands.jsonl` | frame the actuator stubs received, with its E2E / SecOC verdict |
+//! | `/stubs/actions` | `report.json` | action of a module (airbag fire, pretensioner fire / release …) |
+//! | `/stubs/verdict` | `report.json` | run: the occupant outcome and the modes |
+//!
+//! **One clock.** Every message's `log_time` is CLOCK_MONOTONIC of the bench, ns — the clock
+//! of the ECU's cycles, the stubs' receive times and the diagnostics. candump stamps frames
+//! with the kernel's CLOCK_REALTIME arrival time; a frame's `publish_time` keeps that stamp
+//! exactly (µs → ns) and its `log_time` is it minus the realtime − monotonic offset, which
+//! is measured from the run itself: the stubs log the same kernel arrival time of every
+//! command frame on CLOCK_MONOTONIC (`commands.jsonl`), so the offset is the median of
+//! candump − stubs over the frames both saw. The file's `bench` metadata names the clock, the
+//! offset, the route and whether the timing is emulated.
+//!
+//! Message encoding is JSON; every schema is a JSON Schema, the CAN ones generated from the
+//! DBC's signal tables (`bus::signals_of`), never typed by hand.
+
+pub mod schema;
+pub mod write;
+
+pub use write::{write_run, RunMeta, WriteSummary};
+
+/// File name of a run's recording in its folder.
+pub const RUN_MCAP: &str = "run.mcap";

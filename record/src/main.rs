@@ -1,0 +1,74 @@
+//! `record` — recordings of bench runs.
+//!
+//! `record mcap DIR` writes `DIR/run.mcap` from the run folder a bench run left (`hil-bench`,
+//! `demo.sh`, the fault campaign write it themselves after every run).
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use record::{write_run, RunMeta, RUN_MCAP};
+use std::path::PathBuf;
+
+#[derive(Parser, Debug)]
+#[command(name = "record", version, about = "Recordings of bench runs (MCAP)")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Write the run folder's recording: CAN frames raw and decoded by the DBC, the stubs'
+    /// commands, actions and verdict, on the bench's CLOCK_MONOTONIC.
+    Mcap {
+        /// The run folder (holds candump.log; commands.jsonl and report.json when the stubs ran).
+        dir: PathBuf,
+        /// Output file [default: DIR/run.mcap].
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+        /// The vcan route the run took, for the file's metadata.
+        #[arg(long, default_value = "unknown")]
+        route: String,
+        /// Whether the route's timing was emulated (a virtual CPU's) or real.
+        #[arg(long, value_parser = ["emulated", "real"])]
+        timing: Option<String>,
+    },
+}
+
+fn main() -> Result<()> {
+    host::stop::default_sigpipe();
+    match Cli::parse().command {
+        Command::Mcap {
+            dir,
+            out,
+            route,
+            timing,
+        } => {
+            let out = out.unwrap_or_else(|| dir.join(RUN_MCAP));
+            host::files::check_output_file(&out)?;
+            let s = write_run(
+                &dir,
+                &out,
+                &RunMeta {
+                    route,
+                    timing_emulated: timing.map(|t| t == "emulated"),
+                },
+            )
+            .with_context(|| format!("recording {}", dir.display()))?;
+            let total: u64 = s.messages.values().sum();
+            println!(
+                "{}: {total} messages on {} topics, {:.1} kB; log time {}",
+                out.display(),
+                s.messages.len(),
+                s.bytes as f64 / 1e3,
+                s.realtime_minus_monotonic_ns.map_or(
+                    "CLOCK_REALTIME (no frame seen by both candump and the stubs)".to_owned(),
+                    |o| format!("CLOCK_MONOTONIC (realtime − monotonic = {o} ns)")
+                )
+            );
+            for (topic, n) in &s.messages {
+                println!("  {topic:<28} {n}");
+            }
+            Ok(())
+        }
+    }
+}

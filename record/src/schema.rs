@@ -1,0 +1,151 @@
+//! JSON Schemas and JSON messages of the CAN topics, from the DBC's generated tables.
+
+use bus::{MessageInfo, RawFrame, SignalInfo, CAN_EFF_FLAG};
+use serde_json::{json, Map, Value};
+
+/// Schema name of `/can/raw`.
+pub const RAW_FRAME_SCHEMA: &str = "restraint_bench.CanFrame";
+
+/// JSON Schema of a raw frame on `/can/raw`.
+pub fn raw_frame_schema() -> Value {
+    json!({
+        "title": RAW_FRAME_SCHEMA,
+        "description": "One classic CAN data frame as candump logged it",
+        "type": "object",
+        "properties": {
+            "interface": { "type": "string", "description": "CAN interface it was logged on" },
+            "id": { "type": "integer", "description": "identifier (without the extended flag)" },
+            "extended": { "type": "boolean", "description": "29-bit identifier" },
+            "dlc": { "type": "integer", "minimum": 0, "maximum": 8 },
+            "data": { "type": "array", "items": { "type": "integer", "minimum": 0, "maximum": 255 } },
+            "message": { "type": ["string", "null"], "description": "DBC message name of the id" }
+        },
+        "required": ["interface", "id", "extended", "dlc", "data", "message"]
+    })
+}
+
+/// A raw frame as a `/can/raw` message.
+pub fn raw_frame(interface: &str, f: &RawFrame) -> Value {
+    let extended = f.id & CAN_EFF_FLAG != 0;
+    let id = f.id & !CAN_EFF_FLAG;
+    let message = (!extended)
+        .then(|| bus::message_info(id))
+        .flatten()
+        .map(|m| m.name);
+    json!({
+        "interface": interface,
+        "id": id,
+        "extended": extended,
+        "dlc": f.payload().len(),
+        "data": f.payload(),
+        "message": message,
+    })
+}
+
+/// Schema name of `/can/<message>`.
+pub fn message_schema_name(m: &MessageInfo) -> String {
+    format!("restraint_bench.dbc.{}", m.name)
+}
+
+/// JSON Schema of a DBC message's topic: one number per signal (its physical value), described
+/// by unit, range and bit layout.
+pub fn message_schema(m: &MessageInfo, signals: &[SignalInfo]) -> Value {
+    let mut props = Map::new();
+    for s in signals {
+        let mut p = Map::new();
+        // Integral steps without offset decode to integers, as cantools gives them.
+        let integral = s.factor.fract() == 0.0 && s.offset.fract() == 0.0;
+        p.insert(
+            "type".into(),
+            json!(if integral { "integer" } else { "number" }),
+        );
+        p.insert(
+            "description".into(),
+            json!(format!(
+                "{}{}[{} … {}], bits {}+{}{}, phys = raw × {} + {}",
+                s.unit,
+                if s.unit.is_empty() { "" } else { ", " },
+                s.min,
+                s.max,
+                s.start_bit,
+                s.size,
+                if s.signed { " signed" } else { "" },
+                s.factor,
+                s.offset
+            )),
+        );
+        props.insert(s.name.into(), Value::Object(p));
+    }
+    json!({
+        "title": message_schema_name(m),
+        "description": format!(
+            "DBC message {} (id {:#05x}, {} bytes, sent by {}), decoded from bus/restraint.dbc",
+            m.name, m.id, m.size, m.transmitter
+        ),
+        "type": "object",
+        "properties": props,
+        "required": signals.iter().map(|s| s.name).collect::<Vec<_>>(),
+    })
+}
+
+/// A frame's signals as its topic's message: every signal as the bits lie (forged and damaged
+/// frames included: the recording shows what was on the bus, the verdicts are on
+/// `/stubs/commands`).
+pub fn message_values(signals: &[SignalInfo], payload: &[u8]) -> Value {
+    let mut o = Map::new();
+    for s in signals {
+        let integral = s.factor.fract() == 0.0 && s.offset.fract() == 0.0;
+        let v = if integral {
+            json!(s.raw(payload) * s.factor as i64 + s.offset as i64)
+        } else {
+            json!(s.value(payload))
+        };
+        o.insert(s.name.into(), v);
+    }
+    Value::Object(o)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_dbc_message_has_a_schema_naming_each_signal() {
+        for m in bus::MESSAGES {
+            let sigs = bus::signals_of(m.id).unwrap();
+            let s = message_schema(m, sigs);
+            let props = s["properties"].as_object().unwrap();
+            assert_eq!(props.len(), sigs.len(), "{}", m.name);
+            for sig in sigs {
+                assert!(props.contains_key(sig.name), "{}.{}", m.name, sig.name);
+            }
+        }
+    }
+
+    #[test]
+    fn a_frame_decodes_to_the_values_it_was_encoded_from() {
+        let m = bus::message_info(bus::EgoVehicleState::RAW_ID).unwrap();
+        let sigs = bus::signals_of(m.id).unwrap();
+        let vals: Vec<f64> = sigs
+            .iter()
+            .map(|s| {
+                // a raw value inside the range, as a physical value
+                let raw = (s.raw_min + s.raw_max) / 2;
+                raw as f64 * s.factor + s.offset
+            })
+            .collect();
+        let f = bus::encode_values(m.id, &vals).unwrap();
+        let msg = message_values(sigs, f.payload());
+        for (s, v) in sigs.iter().zip(&vals) {
+            let got = msg[s.name].as_f64().unwrap();
+            assert!(
+                (got - v).abs() <= 1e-9 * v.abs().max(1.0),
+                "{}: {got} vs {v}",
+                s.name
+            );
+        }
+        let raw = raw_frame("vcan0", &f);
+        assert_eq!(raw["message"], "EgoVehicleState");
+        assert_eq!(raw["dlc"], m.size);
+    }
+}

@@ -1,0 +1,322 @@
+//! `run.mcap` from a run folder (module docs of the crate: topics and clock).
+
+use crate::schema;
+use actuator_stubs::report::Report;
+use anyhow::{bail, Context, Result};
+use bus::candump::CandumpLog;
+use mcap::records::MessageHeader;
+use mcap::write::{Metadata, Writer};
+use serde_json::{json, Value};
+use std::collections::{BTreeMap, HashMap};
+use std::io::BufWriter;
+use std::path::Path;
+
+/// What the folder cannot say about the run: where it ran.
+#[derive(Clone, Debug, Default)]
+pub struct RunMeta {
+    /// The vcan route (`host-vcan`, `qemu-kvm`, `qemu-tcg`, …).
+    pub route: String,
+    /// Whether the route's timing is emulated (a virtual CPU's), not the host's (`None`: not
+    /// known, e.g. a folder recorded after the fact).
+    pub timing_emulated: Option<bool>,
+}
+
+/// What was written.
+#[derive(Clone, Debug)]
+pub struct WriteSummary {
+    /// Messages per topic.
+    pub messages: BTreeMap<String, u64>,
+    /// CLOCK_REALTIME − CLOCK_MONOTONIC used for candump's stamps, ns (`None`: no frame seen by
+    /// both candump and the stubs; log times are then candump's realtime stamps).
+    pub realtime_minus_monotonic_ns: Option<i64>,
+    /// File size, bytes.
+    pub bytes: u64,
+}
+
+/// One JSON topic of the file.
+struct Topic {
+    channel: u16,
+    sequence: u32,
+}
+
+/// The file being written: topics by name, schemas added on first use.
+struct Recording<W: std::io::Write + std::io::Seek> {
+    w: Writer<W>,
+    topics: HashMap<String, Topic>,
+    counts: BTreeMap<String, u64>,
+}
+
+impl<W: std::io::Write + std::io::Seek> Recording<W> {
+    fn topic(&mut self, name: &str, schema_name: &str, schema: &Value) -> Result<u16> {
+        if let Some(t) = self.topics.get(name) {
+            return Ok(t.channel);
+        }
+        let schema_id = self.w.add_schema(
+            schema_name,
+            "jsonschema",
+            serde_json::to_string(schema)?.as_bytes(),
+        )?;
+        let channel = self
+            .w
+            .add_channel(schema_id, name, "json", &BTreeMap::new())?;
+        self.topics.insert(
+            name.to_owned(),
+            Topic {
+                channel,
+                sequence: 0,
+            },
+        );
+        Ok(channel)
+    }
+
+    fn write(
+        &mut self,
+        topic: &str,
+        schema_name: &str,
+        schema: &Value,
+        log_time: u64,
+        publish_time: u64,
+        msg: &Value,
+    ) -> Result<()> {
+        let channel_id = self.topic(topic, schema_name, schema)?;
+        let t = self.topics.get_mut(topic).expect("added above");
+        t.sequence = t.sequence.wrapping_add(1);
+        self.w.write_to_known_channel(
+            &MessageHeader {
+                channel_id,
+                sequence: t.sequence,
+                log_time,
+                publish_time,
+            },
+            serde_json::to_string(msg)?.as_bytes(),
+        )?;
+        *self.counts.entry(topic.to_owned()).or_default() += 1;
+        Ok(())
+    }
+}
+
+/// candump's realtime stamps against the stubs' monotonic times of the same frames: the median
+/// difference, ns (module docs).
+fn clock_offset_ns(log: &CandumpLog, commands: &[Value]) -> Option<i64> {
+    let mut by_frame: HashMap<(u32, String), Vec<u64>> = HashMap::new();
+    for f in &log.frames {
+        let hex: String = f
+            .frame
+            .payload()
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect();
+        by_frame
+            .entry((f.frame.id, hex))
+            .or_default()
+            .push(f.t_us * 1_000);
+    }
+    let mut diffs: Vec<i64> = Vec::new();
+    for c in commands {
+        let (Some(id), Some(hex), Some(mono)) = (
+            c["id"].as_u64(),
+            c["data_hex"].as_str(),
+            c["rx_mono_ns"].as_u64(),
+        ) else {
+            continue;
+        };
+        let Ok(id) = u32::try_from(id) else { continue };
+        // Only payloads candump logged once: the E2E counter and CRC make nearly every command
+        // frame unique, and a repeated payload could pair with the wrong stamp.
+        if let Some([stamp]) = by_frame.get(&(id, hex.to_owned())).map(Vec::as_slice) {
+            diffs.push(*stamp as i64 - mono as i64);
+        }
+    }
+    if diffs.is_empty() {
+        return None;
+    }
+    diffs.sort_unstable();
+    Some(diffs[diffs.len() / 2])
+}
+
+fn read_jsonl(path: &Path) -> Result<Vec<Value>> {
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    text.lines()
+        .filter(|l| !l.trim().is_empty())
+        .enumerate()
+        .map(|(i, l)| {
+            serde_json::from_str(l).with_context(|| format!("{}:{}", path.display(), i + 1))
+        })
+        .collect()
+}
+
+/// Writes `out` (normally `DIR/run.mcap`) from the run folder `dir`. `candump.log` is required;
+/// `commands.jsonl` and `report.json` are recorded when present.
+///
+/// # Errors
+/// A file that cannot be read or parsed, or the MCAP cannot be written.
+pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary> {
+    let candump_path = dir.join("candump.log");
+    let log = CandumpLog::read(&candump_path)
+        .with_context(|| format!("reading {}", candump_path.display()))?;
+    let commands_path = dir.join("commands.jsonl");
+    let commands = if commands_path.exists() {
+        read_jsonl(&commands_path)?
+    } else {
+        Vec::new()
+    };
+    let report_path = dir.join("report.json");
+    let report: Option<Report> = if report_path.exists() {
+        let text = std::fs::read_to_string(&report_path)
+            .with_context(|| report_path.display().to_string())?;
+        Some(
+            serde_json::from_str(&text)
+                .with_context(|| format!("{}: invalid", report_path.display()))?,
+        )
+    } else {
+        None
+    };
+    let offset = clock_offset_ns(&log, &commands);
+
+    let file = std::fs::File::create(out).with_context(|| out.display().to_string())?;
+    let mut rec = Recording {
+        w: Writer::new(BufWriter::new(file))?,
+        topics: HashMap::new(),
+        counts: BTreeMap::new(),
+    };
+    let mut bench = BTreeMap::from([
+        ("route".to_owned(), meta.route.clone()),
+        (
+            "timing".to_owned(),
+            match meta.timing_emulated {
+                Some(true) => "emulated (a virtual CPU's; measure real timing on the host)",
+                Some(false) => "real",
+                None => "unknown",
+            }
+            .to_owned(),
+        ),
+        (
+            "log_time_clock".to_owned(),
+            if offset.is_some() {
+                "CLOCK_MONOTONIC of the bench, ns".to_owned()
+            } else {
+                "CLOCK_REALTIME (candump's stamps; no frame seen by both candump and the stubs)"
+                    .to_owned()
+            },
+        ),
+        (
+            "can_publish_time".to_owned(),
+            "candump's kernel arrival stamp, CLOCK_REALTIME ns".to_owned(),
+        ),
+        (
+            "realtime_minus_monotonic_ns".to_owned(),
+            offset.map_or_else(String::new, |o| o.to_string()),
+        ),
+        ("dbc".to_owned(), "bus/restraint.dbc".to_owned()),
+        ("can_frames".to_owned(), log.frames.len().to_string()),
+        ("candump_lines_skipped".to_owned(), log.skipped.to_string()),
+    ]);
+    if let Some(r) = &report {
+        bench.insert("scenario".to_owned(), r.scenario.clone());
+        bench.insert("start_ns".to_owned(), r.start_ns.to_string());
+        bench.insert("contact_ns".to_owned(), r.contact_ns.to_string());
+    }
+    rec.w.write_metadata(&Metadata {
+        name: "bench".to_owned(),
+        metadata: bench,
+    })?;
+
+    let to_mono = |realtime_ns: u64| -> u64 {
+        offset.map_or(realtime_ns, |o| {
+            u64::try_from(realtime_ns as i64 - o).unwrap_or_default()
+        })
+    };
+    let raw_schema = schema::raw_frame_schema();
+    let mut msg_schemas: HashMap<u32, (String, String, Value)> = HashMap::new();
+    for m in bus::MESSAGES {
+        let sigs = bus::signals_of(m.id).unwrap_or(&[]);
+        msg_schemas.insert(
+            m.id,
+            (
+                format!("/can/{}", m.name),
+                schema::message_schema_name(m),
+                schema::message_schema(m, sigs),
+            ),
+        );
+    }
+    for f in &log.frames {
+        let publish = f.t_us * 1_000;
+        let log_time = to_mono(publish);
+        rec.write(
+            "/can/raw",
+            schema::RAW_FRAME_SCHEMA,
+            &raw_schema,
+            log_time,
+            publish,
+            &schema::raw_frame(&f.device, &f.frame),
+        )?;
+        if let (Some((topic, name, sch)), Some(sigs)) =
+            (msg_schemas.get(&f.frame.id), bus::signals_of(f.frame.id))
+        {
+            if f.frame.payload().len() == bus::message_info(f.frame.id).map_or(0, |m| m.size) {
+                let v = schema::message_values(sigs, f.frame.payload());
+                rec.write(topic, name, sch, log_time, publish, &v)?;
+            }
+        }
+    }
+
+    let any = json!({ "type": "object" });
+    for c in &commands {
+        let t = c["rx_mono_ns"].as_u64().unwrap_or_default();
+        rec.write(
+            "/stubs/commands",
+            "restraint_bench.StubsCommand",
+            &any,
+            t,
+            t,
+            c,
+        )?;
+    }
+    if let Some(r) = &report {
+        let report_json = serde_json::to_value(r)?;
+        for (a, v) in r.actions.iter().zip(
+            report_json["actions"]
+                .as_array()
+                .map(Vec::as_slice)
+                .unwrap_or(&[]),
+        ) {
+            let t = r.start_ns.saturating_add((a.t_ms * 1e6).round() as u64);
+            rec.write(
+                "/stubs/actions",
+                "restraint_bench.StubsAction",
+                &any,
+                t,
+                t,
+                v,
+            )?;
+        }
+        let end = log
+            .frames
+            .last()
+            .map_or(r.start_ns, |f| to_mono(f.t_us * 1_000));
+        let mut verdict = report_json;
+        if let Some(o) = verdict.as_object_mut() {
+            o.remove("actions");
+        }
+        rec.write(
+            "/stubs/verdict",
+            "restraint_bench.StubsReport",
+            &any,
+            end,
+            end,
+            &verdict,
+        )?;
+    }
+    rec.w.finish()?;
+    let counts = rec.counts;
+    drop(rec.w);
+    let bytes = std::fs::metadata(out)?.len();
+    if counts.get("/can/raw").copied().unwrap_or(0) != log.frames.len() as u64 {
+        bail!("not every frame of {} was recorded", candump_path.display());
+    }
+    Ok(WriteSummary {
+        messages: counts,
+        realtime_minus_monotonic_ns: offset,
+        bytes,
+    })
+}
