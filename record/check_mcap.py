@@ -15,7 +15,10 @@ Checked:
   * every frame of a DBC message is on /can/<name> with the same times, and each signal's value
     equals cantools' decode of the same bytes (scaled, no value-table names);
   * with commands.jsonl: every record is on /stubs/commands unchanged, at its rx_mono_ns;
-  * with report.json: one /stubs/actions message per action, one /stubs/verdict.
+  * with report.json: one /stubs/actions message per action, one /stubs/verdict;
+  * with diagnostics.postcard: /ecu/diagnostics holds as many records as the metadata says,
+    each at its own timestamp_ns, with the schema's fields, cycle counts rising; the records
+    the stubs missed are at most the gaps in those counts.
 Prints one line per check and exits 1 on the first failure.
 """
 
@@ -149,6 +152,33 @@ def main():
         if len(topics.get("/stubs/verdict", [])) != 1:
             fail("/stubs/verdict: not exactly one message")
         print(f"check_mcap: /stubs/actions: {len(acts)} actions at start + t_ms; one verdict")
+    if (a.run_dir / "diagnostics.postcard").exists():
+        diag = topics.get("/ecu/diagnostics", [])
+        n = int(bench.get("diagnostics_records", -1))
+        if len(diag) != n or n <= 0:
+            fail(f"/ecu/diagnostics: {len(diag)} records, metadata says {n}")
+        fields = None
+        last = -1
+        gaps = 0
+        for log_t, pub_t, msg, schema in diag:
+            if fields is None:
+                fields = set(json.loads(schema.data)["properties"])
+            if set(msg) != fields:
+                fail(f"/ecu/diagnostics: fields {sorted(set(msg) ^ fields)} differ from the schema")
+            if log_t != msg["timestamp_ns"] or pub_t != log_t:
+                fail(f"/ecu/diagnostics: log time {log_t} vs timestamp_ns {msg['timestamp_ns']}")
+            if msg["cycle_count"] <= last:
+                fail(f"/ecu/diagnostics: cycle_count {msg['cycle_count']} after {last}")
+            if last >= 0:
+                gaps += msg["cycle_count"] - last - 1
+            last = msg["cycle_count"]
+        if gaps != int(bench.get("diagnostics_missed", -1)):
+            fail(f"/ecu/diagnostics: {gaps} cycles missing, metadata says {bench.get('diagnostics_missed')}")
+        print(f"check_mcap: /ecu/diagnostics: {len(diag)} records at their timestamps, {gaps} cycles the stubs missed")
+        if a.full and not diag:
+            fail("--full: no diagnostics")
+    elif a.full:
+        fail("--full: no diagnostics.postcard")
     print("check_mcap: OK")
 
 

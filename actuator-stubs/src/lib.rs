@@ -23,3 +23,7 @@ pub mod status;
 /// receive: an orchestrator (the e2e harness, `hil-bench`) starts the ECU only after it, so the
 /// ECU's first commands are not sent before anyone listens.
 pub const READY_PREFIX: &str = "actuator-stubs: listening on";
+
+/// The diagnostics records the stubs saw on iceoryx2, as postcard records back to back (the
+/// run's recording reads them: `record`, topic `/ecu/diagnostics`).
+pub const DIAGNOSTICS_LOG: &str = "diagnostics.postcard";

@@ -135,10 +135,17 @@ fn run(cli: &Cli) -> Result<()> {
     let names = ServiceNames::with_prefix(&cli.service_prefix);
     let (node, _) = ipc::create_node(&format!("actuator-stubs-{}", std::process::id()), false)?;
     let mut truth_sub = BenchTruthSubscriber::new(&node, &names)?;
-    // ECU diagnostics: only for the timeline (when the ECU entered pre-crash); the judgement
-    // uses nothing but the bus.
+    // ECU diagnostics: for the timeline (when the ECU entered pre-crash) and logged as seen
+    // for the run's recording (`record`: /ecu/diagnostics); the judgement uses nothing but the
+    // bus.
     let mut diag_sub = ipc::DiagnosticsSubscriber::new(&node, &names)?;
     let mut diag_modes: Vec<(u64, u8)> = Vec::new();
+    let diag_path = cli.out.join(actuator_stubs::DIAGNOSTICS_LOG);
+    let mut diag_log = std::io::BufWriter::new(
+        std::fs::File::create(&diag_path)
+            .with_context(|| format!("creating {}", diag_path.display()))?,
+    );
+    let mut diag_log_error: Option<String> = None;
     let log_path = cli.out.join("commands.jsonl");
     let mut log = std::io::BufWriter::new(
         std::fs::File::create(&log_path)
@@ -226,6 +233,13 @@ fn run(cli: &Cli) -> Result<()> {
             if diag_modes.last().map(|m| m.1) != Some(d.mode) {
                 diag_modes.push((d.timestamp_ns, d.mode));
             }
+            // postcard is self-delimiting for a fixed record: the log is the records back to
+            // back. A write error is reported once at the end, never aborts the judging.
+            if diag_log_error.is_none() {
+                if let Err(e) = postcard::to_io(d, &mut diag_log) {
+                    diag_log_error = Some(e.to_string());
+                }
+            }
         });
         if let Some(t) = truth_sub.latest() {
             truth = t;
@@ -242,6 +256,12 @@ fn run(cli: &Cli) -> Result<()> {
         }
     };
     log.flush()?;
+    if let Err(e) = diag_log.flush() {
+        diag_log_error.get_or_insert(e.to_string());
+    }
+    if let Some(e) = &diag_log_error {
+        eprintln!("actuator-stubs: {} incomplete: {e}", diag_path.display());
+    }
     let report = build_report(
         cli,
         &scenario,

@@ -2,6 +2,7 @@
 
 use bus::{MessageInfo, RawFrame, SignalInfo, CAN_EFF_FLAG};
 use serde_json::{json, Map, Value};
+use signals::{Degraded, EcuDiagnostics, EcuMode};
 
 /// Schema name of `/can/raw`.
 pub const RAW_FRAME_SCHEMA: &str = "restraint_bench.CanFrame";
@@ -105,6 +106,61 @@ pub fn message_values(signals: &[SignalInfo], payload: &[u8]) -> Value {
     Value::Object(o)
 }
 
+/// Schema name of `/ecu/diagnostics`.
+pub const DIAGNOSTICS_SCHEMA: &str = "restraint_bench.EcuDiagnostics";
+
+/// A diagnostics record as published on iceoryx2, field by field (serde of the record itself),
+/// with the mode's and the degraded reasons' names beside their numbers.
+pub fn diagnostics(d: &EcuDiagnostics) -> Value {
+    let mut v = serde_json::to_value(d).unwrap_or(Value::Null);
+    if let Some(o) = v.as_object_mut() {
+        o.insert(
+            "mode_name".into(),
+            json!(EcuMode::from_u8(d.mode).map_or("unknown", EcuMode::name)),
+        );
+        o.insert(
+            "degraded".into(),
+            json!(Degraded::from_bits_truncate(d.degraded_reasons)
+                .iter_names()
+                .map(|(n, _)| n.to_ascii_lowercase())
+                .collect::<Vec<_>>()),
+        );
+    }
+    v
+}
+
+/// JSON Schema of `/ecu/diagnostics`, derived from the record's own serialization (so a field
+/// added to the record appears here without an edit).
+pub fn diagnostics_schema() -> Value {
+    let mut s = schema_of(&diagnostics(&EcuDiagnostics::ZERO));
+    if let Some(o) = s.as_object_mut() {
+        o.insert("title".into(), json!(DIAGNOSTICS_SCHEMA));
+        o.insert(
+            "description".into(),
+            json!("The ECU's diagnostics record of one cycle, as published on iceoryx2 (signals::EcuDiagnostics); units in the field names"),
+        );
+    }
+    s
+}
+
+/// The JSON Schema of a value's shape.
+fn schema_of(v: &Value) -> Value {
+    match v {
+        Value::Null => json!({}),
+        Value::Bool(_) => json!({ "type": "boolean" }),
+        Value::Number(n) if n.is_f64() => json!({ "type": ["number", "null"] }),
+        Value::Number(_) => json!({ "type": "integer" }),
+        Value::String(_) => json!({ "type": "string" }),
+        Value::Array(a) => {
+            json!({ "type": "array", "items": a.first().map_or(json!({}), schema_of) })
+        }
+        Value::Object(o) => json!({
+            "type": "object",
+            "properties": o.iter().map(|(k, v)| (k.clone(), schema_of(v))).collect::<Map<_, _>>(),
+        }),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -147,5 +203,22 @@ mod tests {
         let raw = raw_frame("vcan0", &f);
         assert_eq!(raw["message"], "EgoVehicleState");
         assert_eq!(raw["dlc"], m.size);
+    }
+
+    #[test]
+    fn the_diagnostics_schema_names_every_field_of_the_record() {
+        let s = diagnostics_schema();
+        let props = s["properties"].as_object().unwrap();
+        for f in [
+            "timestamp_ns",
+            "mode",
+            "mode_name",
+            "degraded",
+            "pulse_accel_mps2",
+            "opponent_mass_sigma_kg",
+        ] {
+            assert!(props.contains_key(f), "{f}");
+        }
+        assert_eq!(props["pulse_accel_mps2"]["type"], "array");
     }
 }

@@ -7,6 +7,7 @@ use bus::candump::CandumpLog;
 use mcap::records::MessageHeader;
 use mcap::write::{Metadata, Writer};
 use serde_json::{json, Value};
+use signals::EcuDiagnostics;
 use std::collections::{BTreeMap, HashMap};
 use std::io::BufWriter;
 use std::path::Path;
@@ -134,6 +135,38 @@ fn clock_offset_ns(log: &CandumpLog, commands: &[Value]) -> Option<i64> {
     Some(diffs[diffs.len() / 2])
 }
 
+/// The stubs' diagnostics log: postcard records back to back (a run killed mid-write leaves a
+/// partial last record: its bytes are counted, not an error).
+fn read_diagnostics(path: &Path) -> Result<(Vec<EcuDiagnostics>, usize)> {
+    let bytes = std::fs::read(path).with_context(|| path.display().to_string())?;
+    let mut rest = bytes.as_slice();
+    let mut out = Vec::new();
+    while !rest.is_empty() {
+        match postcard::take_from_bytes::<EcuDiagnostics>(rest) {
+            Ok((d, r)) => {
+                out.push(d);
+                rest = r;
+            }
+            Err(_) => break,
+        }
+    }
+    Ok((out, rest.len()))
+}
+
+/// Cycles whose record is not in the log (gaps in `cycle_count`). The ECU publishes from a
+/// helper thread the newest record of its triple buffer (the cycle never waits for iceoryx2), so
+/// a record overwritten before that thread ran was never published: ≈ 5 % of the cycles in the
+/// emulated guest, single records; a stall of the stubs beyond their queue would add more.
+fn missed_cycles(d: &[EcuDiagnostics]) -> u64 {
+    d.windows(2)
+        .map(|w| {
+            w[1].cycle_count
+                .saturating_sub(w[0].cycle_count)
+                .saturating_sub(1)
+        })
+        .sum()
+}
+
 fn read_jsonl(path: &Path) -> Result<Vec<Value>> {
     let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
     text.lines()
@@ -170,6 +203,12 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         )
     } else {
         None
+    };
+    let diag_path = dir.join(actuator_stubs::DIAGNOSTICS_LOG);
+    let diagnostics = if diag_path.exists() {
+        read_diagnostics(&diag_path)?
+    } else {
+        (Vec::new(), 0)
     };
     let offset = clock_offset_ns(&log, &commands);
 
@@ -209,6 +248,18 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         ),
         ("dbc".to_owned(), "bus/restraint.dbc".to_owned()),
         ("can_frames".to_owned(), log.frames.len().to_string()),
+        (
+            "diagnostics_records".to_owned(),
+            diagnostics.0.len().to_string(),
+        ),
+        (
+            "diagnostics_missed".to_owned(),
+            missed_cycles(&diagnostics.0).to_string(),
+        ),
+        (
+            "diagnostics_log_trailing_bytes".to_owned(),
+            diagnostics.1.to_string(),
+        ),
         ("candump_lines_skipped".to_owned(), log.skipped.to_string()),
     ]);
     if let Some(r) = &report {
@@ -258,6 +309,18 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
                 rec.write(topic, name, sch, log_time, publish, &v)?;
             }
         }
+    }
+
+    let diag_schema = schema::diagnostics_schema();
+    for d in &diagnostics.0 {
+        rec.write(
+            "/ecu/diagnostics",
+            schema::DIAGNOSTICS_SCHEMA,
+            &diag_schema,
+            d.timestamp_ns,
+            d.timestamp_ns,
+            &schema::diagnostics(d),
+        )?;
     }
 
     let any = json!({ "type": "object" });

@@ -208,8 +208,11 @@ impl Degraded {
 }
 
 /// ECU diagnostics, published every cycle (predicted pulse, chosen settings, mode, timing).
+/// With the `serde` feature it (de)serializes field by field: how the actuator stubs log the
+/// records they see and the `record` crate reads them back into a run's recording.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct EcuDiagnostics {
     /// CLOCK_MONOTONIC time of the cycle that produced this record, ns.
     pub timestamp_ns: u64,
@@ -253,6 +256,7 @@ pub struct EcuDiagnostics {
     /// Time between consecutive `pulse_accel_mps2` points, s.
     pub pulse_dt_s: f32,
     /// Predicted pulse, ego acceleration m/s², from contact on.
+    #[cfg_attr(feature = "serde", serde(with = "serde_big_array::BigArray"))]
     pub pulse_accel_mps2: [f32; PULSE_POINTS],
     /// Number of valid pulse points.
     pub pulse_points: u32,
