@@ -65,6 +65,7 @@ def main():
     ap.add_argument("dbc", type=pathlib.Path)
     ap.add_argument("--mcap", type=pathlib.Path)
     ap.add_argument("--full", action="store_true")
+    ap.add_argument("--layout", type=pathlib.Path, help="a Foxglove layout whose every path must resolve in the file")
     a = ap.parse_args()
     mcap_path = a.mcap or a.run_dir / "run.mcap"
     db = cantools.database.load_file(str(a.dbc))
@@ -179,6 +180,20 @@ def main():
             fail("--full: no diagnostics")
     elif a.full:
         fail("--full: no diagnostics.postcard")
+    if a.layout:
+        layout = json.loads(a.layout.read_text())
+        paths = []
+        for cfg in layout["configById"].values():
+            paths += [p["value"] for p in cfg.get("paths", [])]
+            if "topicPath" in cfg:
+                paths.append(cfg["topicPath"])
+        for p in paths:
+            topic, _, field = p.partition(".")
+            if topic not in topics:
+                fail(f"layout: topic {topic} is not in the file")
+            if field and field not in topics[topic][0][2]:
+                fail(f"layout: {topic} has no field {field}")
+        print(f"check_mcap: layout {a.layout.name}: all {len(paths)} paths resolve")
     print("check_mcap: OK")
 
 

@@ -18,13 +18,16 @@ pub fn python3() -> PathBuf {
 
 /// Runs `record/check_mcap.py` (Foxglove's `mcap` reader and cantools, no project code) on a
 /// run folder — with `full`, the folder of a whole bench run (the stubs' files there, log times
-/// on CLOCK_MONOTONIC); its report, or what failed.
+/// on CLOCK_MONOTONIC, every path of `record/foxglove-layout.json` in the file); its report, or
+/// what failed.
 pub fn check_recording(run_dir: &Path, full: bool) -> Result<String, String> {
     let o = Command::new(python3())
         .arg(crate::repo_root().join("record/check_mcap.py"))
         .arg(run_dir)
         .arg(crate::repo_root().join("bus/restraint.dbc"))
         .args(full.then_some("--full"))
+        .args(full.then_some("--layout"))
+        .args(full.then(|| crate::repo_root().join("record/foxglove-layout.json")))
         .output()
         .map_err(|e| {
             format!("python3 record/check_mcap.py: {e} (tests/setup-host.sh installs its venv)")
