@@ -17,8 +17,9 @@ Checked:
   * with commands.jsonl: every record is on /stubs/commands unchanged, at its rx_mono_ns;
   * with report.json: one /stubs/actions message per action, one /stubs/verdict;
   * with diagnostics.postcard: /ecu/diagnostics holds as many records as the metadata says,
-    each at its own timestamp_ns, with the schema's fields, cycle counts rising; the records
-    the stubs missed are at most the gaps in those counts.
+    each at its own timestamp_ns, with the schema's fields, cycle counts rising, the gaps as
+    counted in the metadata; /ecu/predicted_pulse at diagnostics times, each pulse as long as
+    its pulse_points.
 Prints one line per check and exits 1 on the first failure.
 """
 
@@ -175,7 +176,13 @@ def main():
             last = msg["cycle_count"]
         if gaps != int(bench.get("diagnostics_missed", -1)):
             fail(f"/ecu/diagnostics: {gaps} cycles missing, metadata says {bench.get('diagnostics_missed')}")
-        print(f"check_mcap: /ecu/diagnostics: {len(diag)} records at their timestamps, {gaps} cycles the stubs missed")
+        pulses = topics.get("/ecu/predicted_pulse", [])
+        if not pulses or any(len(m["pulse_accel_mps2"]) != m["pulse_points"] for _, _, m, _ in pulses):
+            fail("/ecu/predicted_pulse: missing, or a pulse whose length is not its pulse_points")
+        stamps = {t for t, _, _, _ in diag}
+        if any(t not in stamps for t, _, _, _ in pulses):
+            fail("/ecu/predicted_pulse: a pulse at a time no diagnostics record has")
+        print(f"check_mcap: /ecu/diagnostics: {len(diag)} records at their timestamps, {gaps} cycles never published; {len(pulses)} predicted pulses")
         if a.full and not diag:
             fail("--full: no diagnostics")
     elif a.full:

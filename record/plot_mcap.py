@@ -9,8 +9,7 @@ Panels, all on the recording's one clock (ms after the true contact when the fil
   2. the estimate: closing speed ± σ and time to contact (diagnostics);
   3. planned fire times on the bus (AirbagStageCmd.FireTime, BeltLimiterCmd.PretensionerFireTime)
      and the stubs' actions (airbag / pretensioner fired);
-  4. the predicted pulse of the last pre-crash record (diagnostics) against nothing else: the
-     ECU's own view;
+  4. the predicted pulse the ECU held at the end of pre-crash (/ecu/predicted_pulse);
   5. frames per 100 ms on the bus, by message.
 """
 
@@ -82,14 +81,15 @@ def main():
     ax[2].legend(loc="lower left", fontsize=8)
 
     # 4. predicted pulse of the last record before the crash phase
-    pre_crash = [d for _, d in diag if d["mode_name"] == "pre-crash" and d["pulse_points"] > 0]
-    if pre_crash:
-        d = pre_crash[-1]
+    pre_crash_until = max((t for t, d in diag if d["mode_name"] == "pre-crash"), default=None)
+    pulses = [d for t, d in topics["/ecu/predicted_pulse"] if pre_crash_until is not None and t <= pre_crash_until and d["pulse_points"] > 0]
+    if pulses:
+        d = pulses[-1]
         n, dt = d["pulse_points"], d["pulse_dt_s"]
         ax[3].plot([i * dt * 1e3 for i in range(n)], [-a / 9.80665 for a in d["pulse_accel_mps2"][:n]])
         ax[3].set_xlabel("ms after the predicted contact")
         ax[3].set_ylabel("deceleration [g]")
-    ax[3].set_title("predicted crash pulse, last pre-crash record (diagnostics)")
+    ax[3].set_title("predicted crash pulse at the end of pre-crash (/ecu/predicted_pulse)")
 
     # 5. bus load
     counts = collections.defaultdict(collections.Counter)

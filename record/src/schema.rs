@@ -109,11 +109,46 @@ pub fn message_values(signals: &[SignalInfo], payload: &[u8]) -> Value {
 /// Schema name of `/ecu/diagnostics`.
 pub const DIAGNOSTICS_SCHEMA: &str = "restraint_bench.EcuDiagnostics";
 
-/// A diagnostics record as published on iceoryx2, field by field (serde of the record itself),
-/// with the mode's and the degraded reasons' names beside their numbers.
+/// Schema name of `/ecu/predicted_pulse`.
+pub const PULSE_SCHEMA: &str = "restraint_bench.PredictedPulse";
+
+/// The record's predicted pulse: a message of its own, written when it changes (it changes
+/// with each prediction, not each cycle, and is 64 of the record's ~100 numbers).
+pub fn predicted_pulse(d: &EcuDiagnostics) -> Value {
+    let n = (d.pulse_points as usize).min(d.pulse_accel_mps2.len());
+    json!({
+        "pulse_dt_s": d.pulse_dt_s,
+        "pulse_points": d.pulse_points,
+        "pulse_accel_mps2": &d.pulse_accel_mps2[..n],
+        "predicted_contact_time_s": d.predicted_contact_time_s,
+        "predicted_delta_v_mps": d.predicted_delta_v_mps,
+        "predicted_a_max_mps2": d.predicted_a_max_mps2,
+        "predicted_a_mean_mps2": d.predicted_a_mean_mps2,
+    })
+}
+
+/// JSON Schema of `/ecu/predicted_pulse`.
+pub fn predicted_pulse_schema() -> Value {
+    let mut z = EcuDiagnostics::ZERO;
+    z.pulse_points = 1;
+    let mut s = schema_of(&predicted_pulse(&z));
+    if let Some(o) = s.as_object_mut() {
+        o.insert("title".into(), json!(PULSE_SCHEMA));
+        o.insert(
+            "description".into(),
+            json!("The ECU's predicted crash pulse (ego acceleration, m/s², from the predicted contact on, every pulse_dt_s), written when it changes"),
+        );
+    }
+    s
+}
+
+/// A diagnostics record as published on iceoryx2, field by field (serde of the record itself)
+/// but for the predicted pulse's points (on `/ecu/predicted_pulse`), with the mode's and the
+/// degraded reasons' names beside their numbers.
 pub fn diagnostics(d: &EcuDiagnostics) -> Value {
     let mut v = serde_json::to_value(d).unwrap_or(Value::Null);
     if let Some(o) = v.as_object_mut() {
+        o.remove("pulse_accel_mps2");
         o.insert(
             "mode_name".into(),
             json!(EcuMode::from_u8(d.mode).map_or("unknown", EcuMode::name)),
@@ -214,11 +249,18 @@ mod tests {
             "mode",
             "mode_name",
             "degraded",
-            "pulse_accel_mps2",
+            "pulse_points",
             "opponent_mass_sigma_kg",
         ] {
             assert!(props.contains_key(f), "{f}");
         }
-        assert_eq!(props["pulse_accel_mps2"]["type"], "array");
+        assert!(
+            !props.contains_key("pulse_accel_mps2"),
+            "the pulse has its own topic"
+        );
+        assert_eq!(
+            predicted_pulse_schema()["properties"]["pulse_accel_mps2"]["type"],
+            "array"
+        );
     }
 }

@@ -312,7 +312,21 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
     }
 
     let diag_schema = schema::diagnostics_schema();
+    let pulse_schema = schema::predicted_pulse_schema();
+    let mut last_pulse: Option<Value> = None;
     for d in &diagnostics.0 {
+        let pulse = schema::predicted_pulse(d);
+        if last_pulse.as_ref() != Some(&pulse) {
+            rec.write(
+                "/ecu/predicted_pulse",
+                schema::PULSE_SCHEMA,
+                &pulse_schema,
+                d.timestamp_ns,
+                d.timestamp_ns,
+                &pulse,
+            )?;
+            last_pulse = Some(pulse);
+        }
         rec.write(
             "/ecu/diagnostics",
             schema::DIAGNOSTICS_SCHEMA,
