@@ -133,7 +133,20 @@ def main():
 
     cmd_path = a.run_dir / "commands.jsonl"
     if cmd_path.exists():
-        want = [json.loads(l) for l in cmd_path.read_text().splitlines() if l.strip()]
+        want, unreadable = [], 0
+        for l in cmd_path.read_text().splitlines():
+            if not l.strip():
+                continue
+            try:
+                v = json.loads(l)
+            except ValueError:
+                v = None
+            if isinstance(v, dict):
+                want.append(v)
+            else:
+                unreadable += 1
+        if unreadable != int(bench.get("commands_lines_unreadable", 0)):
+            fail(f"commands.jsonl: {unreadable} unreadable lines, metadata says {bench.get('commands_lines_unreadable')}")
         got = topics.get("/stubs/commands", [])
         if len(got) != len(want):
             fail(f"/stubs/commands: {len(got)} vs {len(want)} records")

@@ -167,15 +167,23 @@ fn missed_cycles(d: &[EcuDiagnostics]) -> u64 {
         .sum()
 }
 
-fn read_jsonl(path: &Path) -> Result<Vec<Value>> {
+/// A JSON-lines log and how many of its lines were no JSON object (a process killed mid-line
+/// leaves a partial last line: counted in the metadata, the rest recorded).
+fn read_jsonl(path: &Path) -> Result<(Vec<Value>, usize)> {
     let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-    text.lines()
+    let mut bad = 0;
+    let values = text
+        .lines()
         .filter(|l| !l.trim().is_empty())
-        .enumerate()
-        .map(|(i, l)| {
-            serde_json::from_str(l).with_context(|| format!("{}:{}", path.display(), i + 1))
+        .filter_map(|l| match serde_json::from_str::<Value>(l) {
+            Ok(v) if v.is_object() => Some(v),
+            _ => {
+                bad += 1;
+                None
+            }
         })
-        .collect()
+        .collect();
+    Ok((values, bad))
 }
 
 /// Writes `out` (normally `DIR/run.mcap`) from the run folder `dir`. `candump.log` is required;
@@ -188,10 +196,10 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
     let log = CandumpLog::read(&candump_path)
         .with_context(|| format!("reading {}", candump_path.display()))?;
     let commands_path = dir.join("commands.jsonl");
-    let commands = if commands_path.exists() {
+    let (commands, commands_unreadable) = if commands_path.exists() {
         read_jsonl(&commands_path)?
     } else {
-        Vec::new()
+        (Vec::new(), 0)
     };
     let report_path = dir.join("report.json");
     let report: Option<Report> = if report_path.exists() {
@@ -248,6 +256,10 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         ),
         ("dbc".to_owned(), "bus/restraint.dbc".to_owned()),
         ("can_frames".to_owned(), log.frames.len().to_string()),
+        (
+            "commands_lines_unreadable".to_owned(),
+            commands_unreadable.to_string(),
+        ),
         (
             "diagnostics_records".to_owned(),
             diagnostics.0.len().to_string(),

@@ -90,7 +90,12 @@ fn log_times_are_on_the_monotonic_clock_the_stubs_measured() {
         );
     }
     assert!(lines.lines().count() > 100);
-    std::fs::write(dir.join("commands.jsonl"), &lines).unwrap();
+    // A stubs process killed mid-line leaves a partial last line: recorded up to it.
+    std::fs::write(
+        dir.join("commands.jsonl"),
+        format!("{lines}{{\"rx_mono_ns\":12"),
+    )
+    .unwrap();
     let s = record::write_run(&dir, &dir.join("run.mcap"), &meta()).unwrap();
     assert_eq!(s.realtime_minus_monotonic_ns, Some(OFFSET_NS));
     assert_eq!(s.messages["/stubs/commands"], lines.lines().count() as u64);
