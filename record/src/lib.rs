@@ -22,6 +22,7 @@
 //! Message encoding is JSON; every schema is a JSON Schema, the CAN ones generated from the
 //! DBC's signal tables (`bus::signals_of`), never typed by hand.
 
+pub mod latency;
 pub mod schema;
 pub mod write;
 

@@ -1,7 +1,8 @@
 //! `record` — recordings of bench runs.
 //!
 //! `record mcap DIR` writes `DIR/run.mcap` from the run folder a bench run left (`hil-bench`,
-//! `demo.sh`, the fault campaign write it themselves after every run).
+//! `demo.sh`, the fault campaign write it themselves after every run); `record latency
+//! run.mcap` measures cycle → bus latency from it.
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
@@ -31,6 +32,12 @@ enum Command {
         /// Whether the route's timing was emulated (a virtual CPU's) or real.
         #[arg(long, value_parser = ["emulated", "real"])]
         timing: Option<String>,
+    },
+    /// How long after the start of the ECU cycle that sent it each command frame reached the
+    /// bus (p50 / p99 / max per message, and every fire), from the recording's own times.
+    Latency {
+        /// A run's recording (run.mcap).
+        file: PathBuf,
     },
 }
 
@@ -68,6 +75,10 @@ fn main() -> Result<()> {
             for (topic, n) in &s.messages {
                 println!("  {topic:<28} {n}");
             }
+            Ok(())
+        }
+        Command::Latency { file } => {
+            print!("{}", record::latency::latency(&file)?.table());
             Ok(())
         }
     }

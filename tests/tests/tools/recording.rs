@@ -121,3 +121,107 @@ fn a_damaged_log_is_recorded_as_far_as_it_goes_and_a_missing_one_is_a_clear_erro
     let e = record::write_run(&empty, &empty.join("run.mcap"), &meta()).unwrap_err();
     assert!(format!("{e:#}").contains("candump.log"), "{e:#}");
 }
+
+/// `record latency` against a run built to known figures: 200 cycles 1 ms apart (cycle 50's
+/// diagnostics record never published), an AirbagStageCmd 20 + (k mod 7) µs after each cycle's
+/// start (Fire from cycle 150 on), an EcuStatus 40 µs after every tenth; candump's stamps on
+/// CLOCK_REALTIME, the stubs' on CLOCK_MONOTONIC. The report must give exactly those
+/// latencies' percentiles (nearest rank), computed here from the construction.
+#[test]
+fn latency_is_measured_from_the_cycle_that_sent_each_frame() {
+    const OFFSET_NS: i64 = 1_700_000_000_000_000_000;
+    const T0: u64 = 5_000_000_000;
+    let dir = std::env::temp_dir().join(format!("record-latency-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let (mut candump, mut commands, mut diag) = (String::new(), String::new(), Vec::new());
+    let (mut cmd_lat, mut status_lat, mut fire_lat) = (Vec::new(), Vec::new(), Vec::new());
+    let mut frame = |mono: u64, f: &bus::RawFrame, name: &str| {
+        let hex: String = f.payload().iter().map(|b| format!("{b:02x}")).collect();
+        let rt = mono as i64 + OFFSET_NS;
+        candump += &format!(
+            "({}.{:06}) vcan0 {}\n",
+            rt / 1_000_000_000,
+            (rt % 1_000_000_000) / 1_000,
+            bus::candump::cansend_arg(f)
+        );
+        commands += &format!(
+            "{{\"rx_mono_ns\":{mono},\"id\":{},\"message\":\"{name}\",\"data_hex\":\"{hex}\",\"e2e\":\"ok\"}}\n",
+            f.id
+        );
+    };
+    let bag = bus::message_info(bus::AirbagStageCmd::RAW_ID).unwrap();
+    let status = bus::message_info(bus::EcuStatus::RAW_ID).unwrap();
+    for k in 1..=200u64 {
+        let start = T0 + k * 1_000_000;
+        if k != 50 {
+            let mut d = signals::EcuDiagnostics::ZERO;
+            d.timestamp_ns = start;
+            d.cycle_count = k;
+            diag.extend(postcard::to_stdvec(&d).unwrap());
+        }
+        // Whole µs: candump's stamps have µs resolution.
+        let lat_us = 20 + k % 7;
+        let sigs = bus::signals_of(bag.id).unwrap();
+        let vals: Vec<f64> = sigs
+            .iter()
+            .map(|s| match s.name {
+                "Fire" | "Arm" => f64::from(u8::from(k >= 150)),
+                // Unique payloads: the clock offset pairs frames by their bytes.
+                "FireTime" => k as f64 * 0.1,
+                _ => 0.0,
+            })
+            .collect();
+        let f = bus::encode_values(bag.id, &vals).unwrap();
+        frame(start + lat_us * 1_000, &f, bag.name);
+        cmd_lat.push(lat_us as f64);
+        if k >= 150 {
+            fire_lat.push(lat_us as f64);
+        }
+        if k % 10 == 0 {
+            let sigs = bus::signals_of(status.id).unwrap();
+            let f = bus::encode_values(status.id, &vec![0.0; sigs.len()]).unwrap();
+            frame(start + 40_000, &f, status.name);
+            status_lat.push(40.0);
+        }
+    }
+    std::fs::write(dir.join("candump.log"), candump).unwrap();
+    std::fs::write(dir.join("commands.jsonl"), commands).unwrap();
+    std::fs::write(dir.join(actuator_stubs::DIAGNOSTICS_LOG), diag).unwrap();
+    let s = record::write_run(&dir, &dir.join("run.mcap"), &meta()).unwrap();
+    assert_eq!(s.realtime_minus_monotonic_ns, Some(OFFSET_NS));
+    python_check(&dir, false);
+    let l = record::latency::latency(&dir.join("run.mcap")).unwrap();
+    let nearest = |v: &mut Vec<f64>, p: f64| {
+        v.sort_by(f64::total_cmp);
+        v[((p / 100.0 * v.len() as f64).ceil() as usize).max(1) - 1]
+    };
+    let row = |what: &str| {
+        l.rows
+            .iter()
+            .find(|r| r.what == what)
+            .unwrap_or_else(|| panic!("no row {what}: {}", l.table()))
+            .clone()
+    };
+    for (what, v) in [
+        ("AirbagStageCmd (every frame)", &mut cmd_lat),
+        ("EcuStatus (every frame)", &mut status_lat),
+        ("airbag fire (every frame)", &mut fire_lat),
+    ] {
+        let r = row(what);
+        assert_eq!(r.n, v.len(), "{what}");
+        for (got, want) in [
+            (r.p50_us, nearest(v, 50.0)),
+            (r.p99_us, nearest(v, 99.0)),
+            (r.max_us, nearest(v, 100.0)),
+        ] {
+            assert!(
+                (got - want).abs() < 1e-6,
+                "{what}: {got} vs {want}\n{}",
+                l.table()
+            );
+        }
+    }
+    // The first fire frame: cycle 150's, 20 + 150 mod 7 = 23 µs.
+    assert!((row("airbag fire (first frame)").p50_us - 23.0).abs() < 1e-6);
+}
