@@ -75,6 +75,8 @@ def main():
     with open(mcap_path, "rb") as f:
         reader = make_reader(f)
         meta = {m.name: m.metadata for m in reader.iter_metadata()}
+        summary = reader.get_summary()
+        channels = {c.topic for c in summary.channels.values()} if summary else set()
         for schema, channel, message in reader.iter_messages(log_time_order=False):
             topics.setdefault(channel.topic, []).append(
                 (message.log_time, message.publish_time, json.loads(message.data), schema)
@@ -209,10 +211,12 @@ def main():
                 paths.append(cfg["topicPath"])
         for p in paths:
             topic, _, field = p.partition(".")
-            if topic not in topics:
+            if topic not in channels:
                 fail(f"layout: topic {topic} is not in the file")
-            if field and field not in topics[topic][0][2]:
+            if field and topic in topics and field not in topics[topic][0][2]:
                 fail(f"layout: {topic} has no field {field}")
+            if field and topic not in topics:
+                fail(f"layout: {topic} has no message to show {field}")
         print(f"check_mcap: layout {a.layout.name}: all {len(paths)} paths resolve")
     print("check_mcap: OK")
 

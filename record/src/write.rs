@@ -362,6 +362,9 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         )?;
     }
     if let Some(r) = &report {
+        // The channel exists in a run without actions too (no fire is an outcome; a layout's
+        // panel then shows an empty topic, not a missing one).
+        rec.topic("/stubs/actions", "restraint_bench.StubsAction", &any)?;
         let report_json = serde_json::to_value(r)?;
         for (a, v) in r.actions.iter().zip(
             report_json["actions"]
