@@ -15,7 +15,9 @@ Checked:
   * every frame of a DBC message is on /can/<name> with the same times, and each signal's value
     equals cantools' decode of the same bytes (scaled, no value-table names);
   * with commands.jsonl: every record is on /stubs/commands unchanged, at its rx_mono_ns;
-  * with report.json: one /stubs/actions message per action, one /stubs/verdict;
+  * with report.json: one /stubs/actions message per action, one /stubs/verdict; /truth/world
+    (required with --full) every ms from the report's start, its contact (distance 0) within
+    1 ms of the report's contact time;
   * with diagnostics.postcard: /ecu/diagnostics holds as many records as the metadata says,
     each at its own timestamp_ns, with the schema's fields, cycle counts rising, the gaps as
     counted in the metadata; /ecu/predicted_pulse at diagnostics times, each pulse as long as
@@ -169,6 +171,18 @@ def main():
         if len(topics.get("/stubs/verdict", [])) != 1:
             fail("/stubs/verdict: not exactly one message")
         print(f"check_mcap: /stubs/actions: {len(acts)} actions at start + t_ms; one verdict")
+        truth = topics.get("/truth/world", [])
+        if a.full and not truth:
+            fail("--full: no /truth/world")
+        if truth:
+            times = [t for t, _, _, _ in truth]
+            if times[0] != rep["start_ns"] or any(b - a_ != 1_000_000 for a_, b in zip(times, times[1:])):
+                fail("/truth/world: not every ms from the scenario start")
+            if rep.get("contact_ns"):
+                first_contact = next((t for t, _, m, _ in truth if m["distance_m"] <= 0.0), None)
+                if first_contact is None or abs(first_contact - rep["contact_ns"]) > 1_000_000:
+                    fail(f"/truth/world: contact at {first_contact}, the stubs' report says {rep['contact_ns']}")
+            print(f"check_mcap: /truth/world: {len(truth)} states every ms from the start; contact where the report has it")
     if (a.run_dir / "diagnostics.postcard").exists():
         diag = topics.get("/ecu/diagnostics", [])
         n = int(bench.get("diagnostics_records", -1))

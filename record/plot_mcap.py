@@ -6,7 +6,7 @@ code): what the Foxglove layout record/foxglove-layout.json shows, for where Fox
 
 Panels, all on the recording's one clock (ms after the true contact when the file names it):
   1. the ECU's mode (diagnostics) as a state timeline, with the EcuStatus mode from the bus;
-  2. the estimate: closing speed ± σ and time to contact (diagnostics);
+  2. the estimate: closing speed ± σ and time to contact (diagnostics), the true closing speed;
   3. planned fire times on the bus (AirbagStageCmd.FireTime, BeltLimiterCmd.PretensionerFireTime)
      and the stubs' actions (airbag / pretensioner fired);
   4. the predicted pulse the ECU held at the end of pre-crash (/ecu/predicted_pulse);
@@ -60,6 +60,9 @@ def main():
         t, v, s, ttc = zip(*pts)
         s = [x if x is not None else 0.0 for x in s]
         ax[1].plot(t, v, label="closing speed [m/s]")
+        truth = [(ms(tt), d["closing_speed_mps"]) for tt, d in topics["/truth/world"] if ms(tt) < 0]
+        if truth:
+            ax[1].plot(*zip(*truth), "k--", lw=0.8, label="true closing speed before contact (/truth/world)")
         ax[1].fill_between(t, [a - b for a, b in zip(v, s)], [a + b for a, b in zip(v, s)], alpha=0.3, label="± σ")
         ax1b = ax[1].twinx()
         ax1b.plot(t, [x if x is not None else float("nan") for x in ttc], color="tab:green", label="time to contact [s]")

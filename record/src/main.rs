@@ -32,6 +32,9 @@ enum Command {
         /// Whether the route's timing was emulated (a virtual CPU's) or real.
         #[arg(long, value_parser = ["emulated", "real"])]
         timing: Option<String>,
+        /// The scenario file the run played (its truth goes on /truth/world).
+        #[arg(long, value_name = "FILE")]
+        scenario: Option<PathBuf>,
     },
     /// How long after the start of the ECU cycle that sent it each command frame reached the
     /// bus (p50 / p99 / max per message, and every fire), from the recording's own times.
@@ -49,6 +52,7 @@ fn main() -> Result<()> {
             out,
             route,
             timing,
+            scenario,
         } => {
             let out = out.unwrap_or_else(|| dir.join(RUN_MCAP));
             host::files::check_output_file(&out)?;
@@ -58,6 +62,7 @@ fn main() -> Result<()> {
                 &RunMeta {
                     route,
                     timing_emulated: timing.map(|t| t == "emulated"),
+                    scenario,
                 },
             )
             .with_context(|| format!("recording {}", dir.display()))?;

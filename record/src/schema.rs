@@ -106,6 +106,22 @@ pub fn message_values(signals: &[SignalInfo], payload: &[u8]) -> Value {
     Value::Object(o)
 }
 
+/// Schema name of `/truth/world`.
+pub const TRUTH_SCHEMA: &str = "restraint_bench.WorldState";
+
+/// JSON Schema of `/truth/world`, derived from the state's own serialization.
+pub fn truth_schema(s: &world::truth::WorldState) -> Value {
+    let mut v = schema_of(&serde_json::to_value(s).unwrap_or(Value::Null));
+    if let Some(o) = v.as_object_mut() {
+        o.insert("title".into(), json!(TRUTH_SCHEMA));
+        o.insert(
+            "description".into(),
+            json!("The scenario's closed-form true world every ms (world::Truth::state): what the sensors observe, units in the field names"),
+        );
+    }
+    v
+}
+
 /// Schema name of `/ecu/diagnostics`.
 pub const DIAGNOSTICS_SCHEMA: &str = "restraint_bench.EcuDiagnostics";
 

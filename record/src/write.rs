@@ -20,6 +20,8 @@ pub struct RunMeta {
     /// Whether the route's timing is emulated (a virtual CPU's), not the host's (`None`: not
     /// known, e.g. a folder recorded after the fact).
     pub timing_emulated: Option<bool>,
+    /// The scenario file the run played: its closed-form truth goes on `/truth/world`.
+    pub scenario: Option<std::path::PathBuf>,
 }
 
 /// What was written.
@@ -350,6 +352,23 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
     }
 
     let any = json!({ "type": "object" });
+    if let (Some(path), Some(r)) = (&meta.scenario, &report) {
+        let scenario = world::Scenario::load(path).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let truth = world::Truth::new(&scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let schema = schema::truth_schema(&truth.state(0.0));
+        let steps = (scenario.duration_s * 1e3).round() as u64;
+        for k in 0..=steps {
+            let t = r.start_ns + k * 1_000_000;
+            rec.write(
+                "/truth/world",
+                schema::TRUTH_SCHEMA,
+                &schema,
+                t,
+                t,
+                &serde_json::to_value(truth.state(k as f64 * 1e-3))?,
+            )?;
+        }
+    }
     for c in &commands {
         let t = c["rx_mono_ns"].as_u64().unwrap_or_default();
         rec.write(

@@ -435,6 +435,7 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
         &record::RunMeta {
             route: route.name().to_owned(),
             timing_emulated: Some(route.timing_emulated()),
+            scenario: Some(cfg.scenario.clone()),
         },
     );
     if let Err(e) = &recorded {

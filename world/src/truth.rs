@@ -52,8 +52,9 @@ pub fn braking_motion(v0_mps: f64, braking: Option<&Braking>, t_s: f64) -> (f64,
     (v.max(0.0), s0 + s, acc)
 }
 
-/// The state the sensors observe at one instant.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The state the sensors observe at one instant (serialized field by field into a run's
+/// recording, topic `/truth/world`).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct WorldState {
     /// Gap between the fronts [m] (0 while in contact).
     pub distance_m: f64,

@@ -25,6 +25,7 @@ fn meta() -> record::RunMeta {
     record::RunMeta {
         route: "test".into(),
         timing_emulated: None,
+        scenario: None,
     }
 }
 
