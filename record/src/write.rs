@@ -352,9 +352,20 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
     }
 
     let any = json!({ "type": "object" });
-    if let (Some(path), Some(r)) = (&meta.scenario, &report) {
-        let scenario = world::Scenario::load(path).map_err(|e| anyhow::anyhow!("{e}"))?;
-        let truth = world::Truth::new(&scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
+    // The truth of a scenario that cannot be loaded (a damaged file of the campaign) is left
+    // out and said so in the metadata; everything else is still recorded.
+    let truth = meta.scenario.as_ref().map(|path| {
+        world::Scenario::load(path)
+            .map_err(|e| e.to_string())
+            .and_then(|s| world::Truth::new(&s).map(|t| (s, t)))
+    });
+    if let Some(Err(e)) = &truth {
+        rec.w.write_metadata(&Metadata {
+            name: "truth".to_owned(),
+            metadata: BTreeMap::from([("left_out".to_owned(), e.clone())]),
+        })?;
+    }
+    if let (Some(Ok((scenario, truth))), Some(r)) = (&truth, &report) {
         let schema = schema::truth_schema(&truth.state(0.0));
         let steps = (scenario.duration_s * 1e3).round() as u64;
         for k in 0..=steps {

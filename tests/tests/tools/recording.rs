@@ -111,7 +111,15 @@ fn a_damaged_log_is_recorded_as_far_as_it_goes_and_a_missing_one_is_a_clear_erro
     let mut text = std::fs::read_to_string(dir.join("candump.log")).unwrap();
     text.insert_str(0, "garbage\n(12.5) vcan0 ZZZ#00\n");
     std::fs::write(dir.join("candump.log"), &text).unwrap();
-    let s = record::write_run(&dir, &dir.join("run.mcap"), &meta()).unwrap();
+    // A damaged scenario file (as the campaign plays some): its truth is left out, the rest
+    // recorded.
+    std::fs::write(dir.join("bad.toml"), "[ego\nspeed_kph = ").unwrap();
+    let with_bad_scenario = record::RunMeta {
+        scenario: Some(dir.join("bad.toml")),
+        ..meta()
+    };
+    let s = record::write_run(&dir, &dir.join("run.mcap"), &with_bad_scenario).unwrap();
+    assert!(!s.messages.contains_key("/truth/world"));
     assert_eq!(
         s.messages["/can/raw"],
         bus::candump::CandumpLog::parse(&text).frames.len() as u64
