@@ -54,8 +54,7 @@ pub fn message_schema(m: &MessageInfo, signals: &[SignalInfo]) -> Value {
     let mut props = Map::new();
     for s in signals {
         let mut p = Map::new();
-        // Integral steps without offset decode to integers, as cantools gives them.
-        let integral = s.factor.fract() == 0.0 && s.offset.fract() == 0.0;
+        let integral = decodes_to_integer(s);
         p.insert(
             "type".into(),
             json!(if integral { "integer" } else { "number" }),
@@ -89,14 +88,19 @@ pub fn message_schema(m: &MessageInfo, signals: &[SignalInfo]) -> Value {
     })
 }
 
+/// Integral step and offset: the signal decodes to integers, as cantools gives them (schema
+/// and message agree on it).
+fn decodes_to_integer(s: &SignalInfo) -> bool {
+    s.factor.fract() == 0.0 && s.offset.fract() == 0.0
+}
+
 /// A frame's signals as its topic's message: every signal as the bits lie (forged and damaged
 /// frames included: the recording shows what was on the bus, the verdicts are on
 /// `/stubs/commands`).
 pub fn message_values(signals: &[SignalInfo], payload: &[u8]) -> Value {
     let mut o = Map::new();
     for s in signals {
-        let integral = s.factor.fract() == 0.0 && s.offset.fract() == 0.0;
-        let v = if integral {
+        let v = if decodes_to_integer(s) {
             json!(s.raw(payload) * s.factor as i64 + s.offset as i64)
         } else {
             json!(s.value(payload))

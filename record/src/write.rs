@@ -6,6 +6,7 @@ use anyhow::{bail, Context, Result};
 use bus::candump::CandumpLog;
 use mcap::records::MessageHeader;
 use mcap::write::{Metadata, Writer};
+use serde::Deserialize;
 use serde_json::{json, Value};
 use signals::EcuDiagnostics;
 use std::collections::{BTreeMap, HashMap};
@@ -204,13 +205,15 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         (Vec::new(), 0)
     };
     let report_path = dir.join("report.json");
-    let report: Option<Report> = if report_path.exists() {
+    // Read once as JSON (recorded as it is) and typed from that (its times).
+    let report: Option<(Report, Value)> = if report_path.exists() {
         let text = std::fs::read_to_string(&report_path)
             .with_context(|| report_path.display().to_string())?;
-        Some(
-            serde_json::from_str(&text)
-                .with_context(|| format!("{}: invalid", report_path.display()))?,
-        )
+        let json: Value = serde_json::from_str(&text)
+            .with_context(|| format!("{}: invalid", report_path.display()))?;
+        let typed = Report::deserialize(&json)
+            .with_context(|| format!("{}: invalid", report_path.display()))?;
+        Some((typed, json))
     } else {
         None
     };
@@ -276,7 +279,7 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         ),
         ("candump_lines_skipped".to_owned(), log.skipped.to_string()),
     ]);
-    if let Some(r) = &report {
+    if let Some((r, _)) = &report {
         bench.insert("scenario".to_owned(), r.scenario.clone());
         bench.insert("start_ns".to_owned(), r.start_ns.to_string());
         bench.insert("contact_ns".to_owned(), r.contact_ns.to_string());
@@ -292,18 +295,28 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         })
     };
     let raw_schema = schema::raw_frame_schema();
-    let mut msg_schemas: HashMap<u32, (String, String, Value)> = HashMap::new();
-    for m in bus::MESSAGES {
-        let sigs = bus::signals_of(m.id).unwrap_or(&[]);
-        msg_schemas.insert(
-            m.id,
-            (
-                format!("/can/{}", m.name),
-                schema::message_schema_name(m),
-                schema::message_schema(m, sigs),
-            ),
-        );
+    /// A DBC message's topic: its table row and signals, topic and schema, made once.
+    struct MessageTopic {
+        info: &'static bus::MessageInfo,
+        signals: &'static [bus::SignalInfo],
+        topic: String,
+        schema_name: String,
+        schema: Value,
     }
+    let msg_topics: HashMap<u32, MessageTopic> = bus::MESSAGES
+        .iter()
+        .map(|m| {
+            let signals = bus::signals_of(m.id).unwrap_or(&[]);
+            let t = MessageTopic {
+                info: m,
+                signals,
+                topic: format!("/can/{}", m.name),
+                schema_name: schema::message_schema_name(m),
+                schema: schema::message_schema(m, signals),
+            };
+            (m.id, t)
+        })
+        .collect();
     for f in &log.frames {
         let publish = f.t_us * 1_000;
         let log_time = to_mono(publish);
@@ -315,12 +328,10 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
             publish,
             &schema::raw_frame(&f.device, &f.frame),
         )?;
-        if let (Some((topic, name, sch)), Some(sigs)) =
-            (msg_schemas.get(&f.frame.id), bus::signals_of(f.frame.id))
-        {
-            if f.frame.payload().len() == bus::message_info(f.frame.id).map_or(0, |m| m.size) {
-                let v = schema::message_values(sigs, f.frame.payload());
-                rec.write(topic, name, sch, log_time, publish, &v)?;
+        if let Some(m) = msg_topics.get(&f.frame.id) {
+            if f.frame.payload().len() == m.info.size {
+                let v = schema::message_values(m.signals, f.frame.payload());
+                rec.write(&m.topic, &m.schema_name, &m.schema, log_time, publish, &v)?;
             }
         }
     }
@@ -365,7 +376,7 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
             metadata: BTreeMap::from([("left_out".to_owned(), e.clone())]),
         })?;
     }
-    if let (Some(Ok((scenario, truth))), Some(r)) = (&truth, &report) {
+    if let (Some(Ok((scenario, truth))), Some((r, _))) = (&truth, &report) {
         let schema = schema::truth_schema(&truth.state(0.0));
         let steps = (scenario.duration_s * 1e3).round() as u64;
         for k in 0..=steps {
@@ -391,11 +402,10 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
             c,
         )?;
     }
-    if let Some(r) = &report {
+    if let Some((r, report_json)) = &report {
         // The channel exists in a run without actions too (no fire is an outcome; a layout's
         // panel then shows an empty topic, not a missing one).
         rec.topic("/stubs/actions", "restraint_bench.StubsAction", &any)?;
-        let report_json = serde_json::to_value(r)?;
         for (a, v) in r.actions.iter().zip(
             report_json["actions"]
                 .as_array()
@@ -416,7 +426,7 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
             .frames
             .last()
             .map_or(r.start_ns, |f| to_mono(f.t_us * 1_000));
-        let mut verdict = report_json;
+        let mut verdict = report_json.clone();
         if let Some(o) = verdict.as_object_mut() {
             o.remove("actions");
         }
