@@ -1,23 +1,25 @@
 #!/usr/bin/env bash
 # The bench's main command: one crash scenario through the real processes on vcan.
 #
-#   ./demo.sh [--scenario FILE] [--out DIR]
+#   ./demo.sh [--scenario FILE] [--out DIR] [--mf4]
 #
 # Installs what it needs (tests/setup-host.sh: can-utils, a Python venv with cantools, the vcan
 # route), builds the bench, then runs `hil-bench` (candump + actuator-stubs + ecu +
 # sensor-feeds) for the scenario — on the host if its kernel has vcan, otherwise inside a QEMU
 # guest with a real Debian kernel (vcan-setup.sh says which route) — and decodes the CAN log
-# with the DBC.
+# with the DBC. Every run leaves run.mcap (Foxglove); --mf4 adds run.mf4 (CANape, asammdf).
 # Default scenario: the paper's Taurus vs Taurus 48 + 48 km/h ABS case.
 set -euo pipefail
 cd "$(dirname "$0")"
 scenario=scenarios/taurus-48-48-abs.toml
 out=out
+mf4=()
 while [ $# -gt 0 ]; do
     case "$1" in
         --scenario) [ $# -ge 2 ] || { echo "demo: --scenario needs a file" >&2; exit 2; }; scenario=$2; shift 2 ;;
         --out) [ $# -ge 2 ] || { echo "demo: --out needs a folder" >&2; exit 2; }; out=$2; shift 2 ;;
-        -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
+        --mf4) mf4=(--mf4); shift ;;
+        -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
         *) echo "demo: unknown argument $1 (try --help)" >&2; exit 2 ;;
     esac
 done
@@ -39,7 +41,7 @@ out=$(cd "$out" && pwd -P)
 export VCAN_GUEST_RW="$out${VCAN_GUEST_RW:+:$VCAN_GUEST_RW}"
 
 rc=0
-./vcan-setup.sh --run -- "$target/release/hil-bench" --scenario "$scenario" --out "$out" --repo "$PWD" || rc=$?
+./vcan-setup.sh --run -- "$target/release/hil-bench" --scenario "$scenario" --out "$out" --repo "$PWD" "${mf4[@]}" || rc=$?
 
 dir="$out/$name"
 if [ -s "$dir/candump.log" ]; then
@@ -61,4 +63,6 @@ echo "  outcome.png           occupant deceleration and excursion over time, ada
 echo "  commands.jsonl        every received command frame with its CLOCK_MONOTONIC receive time and E2E verdict"
 echo "  ecu-report.json       ECU timing report"
 echo "  candump.log           raw bus log (candump -L), candump-decoded.txt decoded with cantools"
+echo "  run.mcap              the whole run on one clock: open in Foxglove (layout record/foxglove-layout.json)"
+[ -f "$dir/run.mf4" ] && echo "  run.mf4               CAN bus logging (DBC attached) + ECU diagnostics: open in asammdf or CANape"
 exit "$rc"

@@ -62,6 +62,21 @@ def candump_frames(path):
     return frames
 
 
+def frames_by_message(db, frames):
+    """The frames of each DBC message (id, IDE and length as the DBC says), in bus order: a list
+    of (cantools message, frames)."""
+    by_id = {}
+    for fr in frames:
+        try:
+            m = db.get_message_by_frame_id(fr["id"])
+        except KeyError:
+            continue
+        if fr["extended"] != m.is_extended_frame or len(fr["data"]) != m.length:
+            continue
+        by_id.setdefault(m.frame_id, (m, []))[1].append(fr)
+    return list(by_id.values())
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("run_dir", type=pathlib.Path)
@@ -110,15 +125,7 @@ def main():
     print(f"check_mcap: /can/raw: all {len(frames)} frames of candump.log, bytes and times (±1 µs) equal")
 
     decoded = 0
-    by_id = {}
-    for fr in frames:
-        try:
-            m = db.get_message_by_frame_id(fr["id"])
-        except KeyError:
-            continue
-        if fr["extended"] != m.is_extended_frame or len(fr["data"]) != m.length:
-            continue
-        by_id.setdefault(m.name, []).append((fr, m))
+    by_id = {m.name: [(fr, m) for fr in frs] for m, frs in frames_by_message(db, frames)}
     for name, items in by_id.items():
         got = topics.get(f"/can/{name}", [])
         if len(got) != len(items):

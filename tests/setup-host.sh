@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs everything the bench and its test suite need on a fresh Debian/Ubuntu machine
-# with Rust: Debian packages (idempotent: only what is missing), a Python venv with cantools, mcap
-# and matplotlib
+# with Rust: Debian packages (idempotent: only what is missing), a Python venv with cantools, mcap,
+# asammdf and matplotlib
 # (fresh Debian/Ubuntu Pythons refuse system-wide pip installs, PEP 668), and the vcan route
 # (vcan-setup.sh: the host's vcan, or the QEMU guest's kernel and QEMU, cached once per machine).
 # Prints the venv's bin directory on its last line so callers can put it on PATH.
@@ -52,11 +52,13 @@ fi
 
 venv="$here/target/pyenv"
 # cantools decodes the bus with the DBC; mcap reads the recordings (record/check_mcap.py,
-# record/plot_mcap.py with matplotlib): independent of the project's code.
-if ! "$venv/bin/python3" -c "import cantools, mcap, matplotlib" 2>/dev/null; then
-    echo "setup: creating $venv with cantools, mcap and matplotlib" >&2
+# record/plot_mcap.py with matplotlib), asammdf the MDF ones (record/check_mf4.py): independent of
+# the project's code.
+if ! "$venv/bin/python3" -c "import cantools, mcap, matplotlib, asammdf" 2>/dev/null; then
+    echo "setup: creating $venv with cantools, mcap, asammdf and matplotlib" >&2
     [ -x "$venv/bin/pip" ] || python3 -m venv "$venv" >&2
-    "$venv/bin/pip" install -q --disable-pip-version-check "cantools>=39" "mcap>=1.2" "matplotlib>=3.7" >&2
+    "$venv/bin/pip" install -q --disable-pip-version-check "cantools>=39" "mcap>=1.2" "matplotlib>=3.7" \
+        "asammdf>=8.0" >&2
 fi
 
 # The vcan route, prepared now (downloads happen here, not in the middle of a test) and named.

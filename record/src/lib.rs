@@ -23,9 +23,12 @@
 //! DBC's signal tables (`bus::signals_of`), never typed by hand.
 
 pub mod latency;
+mod mf4;
+mod run_folder;
 pub mod schema;
 pub mod write;
 
+pub use mf4::{write_run_mf4, Mf4Summary, RUN_MF4};
 pub use write::{write_run, RunMeta, WriteSummary};
 
 /// File name of a run's recording in its folder.

@@ -6,7 +6,7 @@
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
-use record::{write_run, RunMeta, RUN_MCAP};
+use record::{write_run, write_run_mf4, RunMeta, RUN_MCAP, RUN_MF4};
 use std::path::PathBuf;
 
 #[derive(Parser, Debug)]
@@ -35,6 +35,15 @@ enum Command {
         /// The scenario file the run played (its truth goes on /truth/world).
         #[arg(long, value_name = "FILE")]
         scenario: Option<PathBuf>,
+    },
+    /// Write the run folder's CAN bus in the ASAM MDF 4.1 bus-logging layout (CANape, asammdf;
+    /// the DBC attached) plus the ECU's diagnostics as plain channels.
+    Mf4 {
+        /// The run folder (holds candump.log; the stubs' diagnostics log when they ran).
+        dir: PathBuf,
+        /// Output file [default: DIR/run.mf4].
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
     },
     /// How long after the start of the ECU cycle that sent it each command frame reached the
     /// bus (p50 / p99 / max per message, and every fire), from the recording's own times.
@@ -80,6 +89,22 @@ fn main() -> Result<()> {
             for (topic, n) in &s.messages {
                 println!("  {topic:<28} {n}");
             }
+            Ok(())
+        }
+        Command::Mf4 { dir, out } => {
+            let out = out.unwrap_or_else(|| dir.join(RUN_MF4));
+            host::files::check_output_file(&out)?;
+            let s = write_run_mf4(&dir, &out)
+                .with_context(|| format!("recording {}", dir.display()))?;
+            println!(
+                "{}: {} CAN frames, {} diagnostics records, {:.1} kB{}",
+                out.display(),
+                s.can_frames,
+                s.diagnostics,
+                s.bytes as f64 / 1e3,
+                s.diagnostics_left_out
+                    .map_or(String::new(), |r| format!(" (diagnostics left out: {r})"))
+            );
             Ok(())
         }
         Command::Latency { file } => {

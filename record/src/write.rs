@@ -1,14 +1,11 @@
 //! `run.mcap` from a run folder (module docs of the crate: topics and clock).
 
+use crate::run_folder::{missed_cycles, RunFiles};
 use crate::schema;
-use actuator_stubs::report::Report;
 use anyhow::{bail, Context, Result};
-use bus::candump::CandumpLog;
 use mcap::records::MessageHeader;
 use mcap::write::{Metadata, Writer};
-use serde::Deserialize;
 use serde_json::{json, Value};
-use signals::EcuDiagnostics;
 use std::collections::{BTreeMap, HashMap};
 use std::io::BufWriter;
 use std::path::Path;
@@ -99,132 +96,21 @@ impl<W: std::io::Write + std::io::Seek> Recording<W> {
     }
 }
 
-/// candump's realtime stamps against the stubs' monotonic times of the same frames: the median
-/// difference, ns (module docs).
-fn clock_offset_ns(log: &CandumpLog, commands: &[Value]) -> Option<i64> {
-    let mut by_frame: HashMap<(u32, String), Vec<u64>> = HashMap::new();
-    for f in &log.frames {
-        let hex: String = f
-            .frame
-            .payload()
-            .iter()
-            .map(|b| format!("{b:02x}"))
-            .collect();
-        by_frame
-            .entry((f.frame.id, hex))
-            .or_default()
-            .push(f.t_us * 1_000);
-    }
-    let mut diffs: Vec<i64> = Vec::new();
-    for c in commands {
-        let (Some(id), Some(hex), Some(mono)) = (
-            c["id"].as_u64(),
-            c["data_hex"].as_str(),
-            c["rx_mono_ns"].as_u64(),
-        ) else {
-            continue;
-        };
-        let Ok(id) = u32::try_from(id) else { continue };
-        // Only payloads candump logged once: the E2E counter and CRC make nearly every command
-        // frame unique, and a repeated payload could pair with the wrong stamp.
-        if let Some([stamp]) = by_frame.get(&(id, hex.to_owned())).map(Vec::as_slice) {
-            diffs.push(*stamp as i64 - mono as i64);
-        }
-    }
-    if diffs.is_empty() {
-        return None;
-    }
-    diffs.sort_unstable();
-    Some(diffs[diffs.len() / 2])
-}
-
-/// The stubs' diagnostics log: postcard records back to back (a run killed mid-write leaves a
-/// partial last record: its bytes are counted, not an error).
-fn read_diagnostics(path: &Path) -> Result<(Vec<EcuDiagnostics>, usize)> {
-    let bytes = std::fs::read(path).with_context(|| path.display().to_string())?;
-    let mut rest = bytes.as_slice();
-    let mut out = Vec::new();
-    while !rest.is_empty() {
-        match postcard::take_from_bytes::<EcuDiagnostics>(rest) {
-            Ok((d, r)) => {
-                out.push(d);
-                rest = r;
-            }
-            Err(_) => break,
-        }
-    }
-    Ok((out, rest.len()))
-}
-
-/// Cycles whose record is not in the log (gaps in `cycle_count`). The ECU publishes from a
-/// helper thread the newest record of its triple buffer (the cycle never waits for iceoryx2), so
-/// a record overwritten before that thread ran was never published: ≈ 5 % of the cycles in the
-/// emulated guest, single records; a stall of the stubs beyond their queue would add more.
-fn missed_cycles(d: &[EcuDiagnostics]) -> u64 {
-    d.windows(2)
-        .map(|w| {
-            w[1].cycle_count
-                .saturating_sub(w[0].cycle_count)
-                .saturating_sub(1)
-        })
-        .sum()
-}
-
-/// A JSON-lines log and how many of its lines were no JSON object (a process killed mid-line
-/// leaves a partial last line: counted in the metadata, the rest recorded).
-fn read_jsonl(path: &Path) -> Result<(Vec<Value>, usize)> {
-    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-    let mut bad = 0;
-    let values = text
-        .lines()
-        .filter(|l| !l.trim().is_empty())
-        .filter_map(|l| match serde_json::from_str::<Value>(l) {
-            Ok(v) if v.is_object() => Some(v),
-            _ => {
-                bad += 1;
-                None
-            }
-        })
-        .collect();
-    Ok((values, bad))
-}
-
 /// Writes `out` (normally `DIR/run.mcap`) from the run folder `dir`. `candump.log` is required;
 /// `commands.jsonl` and `report.json` are recorded when present.
 ///
 /// # Errors
 /// A file that cannot be read or parsed, or the MCAP cannot be written.
 pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary> {
-    let candump_path = dir.join("candump.log");
-    let log = CandumpLog::read(&candump_path)
-        .with_context(|| format!("reading {}", candump_path.display()))?;
-    let commands_path = dir.join("commands.jsonl");
-    let (commands, commands_unreadable) = if commands_path.exists() {
-        read_jsonl(&commands_path)?
-    } else {
-        (Vec::new(), 0)
-    };
-    let report_path = dir.join("report.json");
-    // Read once as JSON (recorded as it is) and typed from that (its times).
-    let report: Option<(Report, Value)> = if report_path.exists() {
-        let text = std::fs::read_to_string(&report_path)
-            .with_context(|| report_path.display().to_string())?;
-        let json: Value = serde_json::from_str(&text)
-            .with_context(|| format!("{}: invalid", report_path.display()))?;
-        let typed = Report::deserialize(&json)
-            .with_context(|| format!("{}: invalid", report_path.display()))?;
-        Some((typed, json))
-    } else {
-        None
-    };
-    let diag_path = dir.join(actuator_stubs::DIAGNOSTICS_LOG);
-    let diagnostics = if diag_path.exists() {
-        read_diagnostics(&diag_path)?
-    } else {
-        (Vec::new(), 0)
-    };
-    let offset = clock_offset_ns(&log, &commands);
-
+    let RunFiles {
+        candump_path,
+        log,
+        commands,
+        commands_unreadable,
+        report,
+        diagnostics,
+        offset,
+    } = RunFiles::read(dir)?;
     let file = std::fs::File::create(out).with_context(|| out.display().to_string())?;
     let mut rec = Recording {
         w: Writer::new(BufWriter::new(file))?,

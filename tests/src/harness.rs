@@ -21,17 +21,35 @@ pub fn python3() -> PathBuf {
 /// on CLOCK_MONOTONIC, every path of `record/foxglove-layout.json` in the file); its report, or
 /// what failed.
 pub fn check_recording(run_dir: &Path, full: bool) -> Result<String, String> {
+    let root = crate::repo_root();
+    let mut args = vec![run_dir.into(), root.join("bus/restraint.dbc").into()];
+    if full {
+        args.extend([
+            "--full".into(),
+            "--layout".into(),
+            root.join("record/foxglove-layout.json").into(),
+        ]);
+    }
+    python_check("record/check_mcap.py", &args)
+}
+
+/// Runs `record/check_mf4.py` (asammdf, cantools and Foxglove's `mcap`, no project code) on run
+/// folders holding `run.mf4` (and `run.mcap`, whose diagnostics it compares), in one Python
+/// process; its report, or what failed.
+pub fn check_mf4<P: AsRef<Path>>(run_dirs: &[P]) -> Result<String, String> {
+    let mut args = vec![crate::repo_root().join("bus/restraint.dbc").into()];
+    args.extend(run_dirs.iter().map(|d| d.as_ref().into()));
+    python_check("record/check_mf4.py", &args)
+}
+
+/// One of the repository's independent Python checks with `args`: its output, `Err` when it
+/// failed (or could not start).
+fn python_check(script: &str, args: &[std::ffi::OsString]) -> Result<String, String> {
     let o = Command::new(python3())
-        .arg(crate::repo_root().join("record/check_mcap.py"))
-        .arg(run_dir)
-        .arg(crate::repo_root().join("bus/restraint.dbc"))
-        .args(full.then_some("--full"))
-        .args(full.then_some("--layout"))
-        .args(full.then(|| crate::repo_root().join("record/foxglove-layout.json")))
+        .arg(crate::repo_root().join(script))
+        .args(args)
         .output()
-        .map_err(|e| {
-            format!("python3 record/check_mcap.py: {e} (tests/setup-host.sh installs its venv)")
-        })?;
+        .map_err(|e| format!("python3 {script}: {e} (tests/setup-host.sh installs its venv)"))?;
     let text = format!(
         "{}{}",
         String::from_utf8_lossy(&o.stdout),

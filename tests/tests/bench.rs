@@ -59,6 +59,8 @@ fn bench_run() -> &'static Path {
                     out.clone().into(),
                     "--repo".into(),
                     root().into(),
+                    // Every run's run.mf4 too, for the independent asammdf check below.
+                    "--mf4".into(),
                 ];
                 for s in group {
                     args.push("--scenario".into());
@@ -324,14 +326,18 @@ fn candump_log_decodes_with_cantools_and_the_dbc() {
 /// (record/check_mcap.py: Foxglove's `mcap` package and cantools): every candump frame with its
 /// bytes and time, every DBC message decoded as cantools decodes it, the stubs' commands,
 /// actions and verdict — on the bench's CLOCK_MONOTONIC (the offset measured from the run) and
-/// ≤ 20 MB (issue 23).
+/// ≤ 20 MB (issue 23). And, asked for with `--mf4`, a `run.mf4` that asammdf reads as CAN bus
+/// logging and decodes with the DBC as cantools does, its diagnostics equal to the MCAP's
+/// (record/check_mf4.py, all runs in one Python process).
 #[test]
 fn every_run_leaves_a_recording_that_independent_readers_accept() {
     let out = bench_run();
     let mut failed = Vec::new();
+    let mut dirs = Vec::new();
     for s in library() {
         let name = Scenario::load(&s).expect("scenario").name;
         let dir = out.join(&name);
+        dirs.push(dir.clone());
         let mcap = dir.join("run.mcap");
         let bytes = std::fs::metadata(&mcap).map(|m| m.len()).unwrap_or(0);
         match harness::check_recording(&dir, true) {
@@ -339,6 +345,14 @@ fn every_run_leaves_a_recording_that_independent_readers_accept() {
             Ok(_) => failed.push(format!("{name}: run.mcap is {bytes} bytes")),
             Err(text) => failed.push(format!("{name}: {text}")),
         }
+    }
+    match harness::check_mf4(&dirs) {
+        Ok(text) => assert_eq!(
+            text.matches("EcuDiagnostics: all").count(),
+            dirs.len(),
+            "every run's MF4 with its diagnostics:\n{text}"
+        ),
+        Err(text) => failed.push(format!("run.mf4: {text}")),
     }
     assert!(
         failed.is_empty(),

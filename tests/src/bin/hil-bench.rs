@@ -41,6 +41,11 @@ struct Cli {
     /// the judge `offline-bench` uses, and a miss exits 1).
     #[arg(long)]
     no_expect: bool,
+    /// Also write each run's `run.mf4`: the CAN bus in the ASAM MDF 4.1 bus-logging layout
+    /// (CANape, asammdf; the DBC attached) and the ECU's diagnostics (every run writes
+    /// `run.mcap` anyway).
+    #[arg(long)]
+    mf4: bool,
 }
 
 fn main() -> std::process::ExitCode {
@@ -199,7 +204,26 @@ fn run() -> Result<bool> {
                 for m in &missed {
                     println!("hil-bench: MISSED {m}");
                 }
-                all_ok &= r.problems.is_empty() && missed.is_empty();
+                let mut recorded = true;
+                if cli.mf4 {
+                    let out = r.dir.join(record::RUN_MF4);
+                    match record::write_run_mf4(&r.dir, &out) {
+                        Ok(s) => println!(
+                            "recording (MDF 4.1): {} ({} CAN frames, {} diagnostics records, {:.0} kB; open in asammdf or CANape, README \"Recordings\"){}",
+                            out.display(),
+                            s.can_frames,
+                            s.diagnostics,
+                            s.bytes as f64 / 1e3,
+                            s.diagnostics_left_out
+                                .map_or(String::new(), |w| format!("; diagnostics left out: {w}"))
+                        ),
+                        Err(e) => {
+                            eprintln!("hil-bench: {}: {e:#}", out.display());
+                            recorded = false;
+                        }
+                    }
+                }
+                all_ok &= r.problems.is_empty() && missed.is_empty() && recorded;
             }
             Err(e) => {
                 eprintln!("hil-bench: {}: {e:#}", scenario.display());

@@ -2,7 +2,7 @@
 //! the same log with a command log whose clock is shifted by a known offset. Every file is read
 //! back by record/check_mcap.py (Foxglove's `mcap` package and cantools), not by our code.
 
-use e2e_tests::harness::check_recording;
+use e2e_tests::harness::{check_mf4, check_recording};
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
@@ -138,11 +138,66 @@ fn a_damaged_log_is_recorded_as_far_as_it_goes_and_a_missing_one_is_a_clear_erro
 /// latencies' percentiles (nearest rank), computed here from the construction.
 #[test]
 fn latency_is_measured_from_the_cycle_that_sent_each_frame() {
-    const OFFSET_NS: i64 = 1_700_000_000_000_000_000;
-    const T0: u64 = 5_000_000_000;
     let dir = std::env::temp_dir().join(format!("record-latency-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let Known {
+        mut cmd_lat,
+        mut status_lat,
+        mut fire_lat,
+    } = known_run(&dir);
+    let s = record::write_run(&dir, &dir.join("run.mcap"), &meta()).unwrap();
+    assert_eq!(s.realtime_minus_monotonic_ns, Some(KNOWN_OFFSET_NS));
+    python_check(&dir, false);
+    let l = record::latency::latency(&dir.join("run.mcap")).unwrap();
+    let nearest = |v: &mut Vec<f64>, p: f64| {
+        v.sort_by(f64::total_cmp);
+        v[((p / 100.0 * v.len() as f64).ceil() as usize).max(1) - 1]
+    };
+    let row = |what: &str| {
+        l.rows
+            .iter()
+            .find(|r| r.what == what)
+            .unwrap_or_else(|| panic!("no row {what}: {}", l.table()))
+            .clone()
+    };
+    for (what, v) in [
+        ("AirbagStageCmd (every frame)", &mut cmd_lat),
+        ("EcuStatus (every frame)", &mut status_lat),
+        ("airbag fire (every frame)", &mut fire_lat),
+    ] {
+        let r = row(what);
+        assert_eq!(r.n, v.len(), "{what}");
+        for (got, want) in [
+            (r.p50_us, nearest(v, 50.0)),
+            (r.p99_us, nearest(v, 99.0)),
+            (r.max_us, nearest(v, 100.0)),
+        ] {
+            assert!(
+                (got - want).abs() < 1e-6,
+                "{what}: {got} vs {want}\n{}",
+                l.table()
+            );
+        }
+    }
+    // The first fire frame: cycle 150's, 20 + 150 mod 7 = 23 µs.
+    assert!((row("airbag fire (first frame)").p50_us - 23.0).abs() < 1e-6);
+}
+
+/// The realtime − monotonic offset of [`known_run`].
+const KNOWN_OFFSET_NS: i64 = 1_700_000_000_000_000_000;
+
+/// The latencies [`known_run`] built in, µs.
+struct Known {
+    cmd_lat: Vec<f64>,
+    status_lat: Vec<f64>,
+    fire_lat: Vec<f64>,
+}
+
+/// A run folder built to known figures (see the latency test).
+fn known_run(dir: &Path) -> Known {
+    const OFFSET_NS: i64 = KNOWN_OFFSET_NS;
+    const T0: u64 = 5_000_000_000;
+    let _ = std::fs::remove_dir_all(dir);
+    std::fs::create_dir_all(dir).unwrap();
     let (mut candump, mut commands, mut diag) = (String::new(), String::new(), Vec::new());
     let (mut cmd_lat, mut status_lat, mut fire_lat) = (Vec::new(), Vec::new(), Vec::new());
     let mut frame = |mono: u64, f: &bus::RawFrame, name: &str| {
@@ -197,40 +252,77 @@ fn latency_is_measured_from_the_cycle_that_sent_each_frame() {
     std::fs::write(dir.join("candump.log"), candump).unwrap();
     std::fs::write(dir.join("commands.jsonl"), commands).unwrap();
     std::fs::write(dir.join(actuator_stubs::DIAGNOSTICS_LOG), diag).unwrap();
-    let s = record::write_run(&dir, &dir.join("run.mcap"), &meta()).unwrap();
-    assert_eq!(s.realtime_minus_monotonic_ns, Some(OFFSET_NS));
-    python_check(&dir, false);
-    let l = record::latency::latency(&dir.join("run.mcap")).unwrap();
-    let nearest = |v: &mut Vec<f64>, p: f64| {
-        v.sort_by(f64::total_cmp);
-        v[((p / 100.0 * v.len() as f64).ceil() as usize).max(1) - 1]
-    };
-    let row = |what: &str| {
-        l.rows
-            .iter()
-            .find(|r| r.what == what)
-            .unwrap_or_else(|| panic!("no row {what}: {}", l.table()))
-            .clone()
-    };
-    for (what, v) in [
-        ("AirbagStageCmd (every frame)", &mut cmd_lat),
-        ("EcuStatus (every frame)", &mut status_lat),
-        ("airbag fire (every frame)", &mut fire_lat),
-    ] {
-        let r = row(what);
-        assert_eq!(r.n, v.len(), "{what}");
-        for (got, want) in [
-            (r.p50_us, nearest(v, 50.0)),
-            (r.p99_us, nearest(v, 99.0)),
-            (r.max_us, nearest(v, 100.0)),
-        ] {
-            assert!(
-                (got - want).abs() < 1e-6,
-                "{what}: {got} vs {want}\n{}",
-                l.table()
-            );
-        }
+    Known {
+        cmd_lat,
+        status_lat,
+        fire_lat,
     }
-    // The first fire frame: cycle 150's, 20 + 150 mod 7 = 23 µs.
-    assert!((row("airbag fire (first frame)").p50_us - 23.0).abs() < 1e-6);
+}
+
+/// run.mf4 (ASAM MDF 4.1 bus logging) read by asammdf: every frame with its bytes and time,
+/// asammdf's own DBC decode equal to cantools', every diagnostics record equal to the MCAP's on
+/// the same instant. A frame changed after the file was written, or a stamp 2 µs off, fails
+/// the check (it is no check that cannot fail).
+#[test]
+fn run_mf4_is_the_bus_logging_asammdf_decodes_with_the_dbc() {
+    let dir = std::env::temp_dir().join(format!("record-mf4-{}", std::process::id()));
+    known_run(&dir);
+    record::write_run(&dir, &dir.join("run.mcap"), &meta()).unwrap();
+    let s = record::write_run_mf4(&dir, &dir.join(record::RUN_MF4)).unwrap();
+    assert_eq!(
+        s.diagnostics, 199,
+        "200 cycles, cycle 50's record never published"
+    );
+    assert_eq!(s.diagnostics_left_out, None);
+    let text = check_mf4(&[&dir]).unwrap_or_else(|e| panic!("{e}"));
+    for want in [
+        "CAN_DataFrame: all",
+        "2 DBC messages",
+        "EcuDiagnostics: all 199 records",
+        "restraint.dbc attached",
+    ] {
+        assert!(text.contains(want), "{want}: {text}");
+    }
+    let log = std::fs::read_to_string(dir.join("candump.log")).unwrap();
+    let line = log.lines().nth(100).unwrap().to_owned();
+    // One data byte changed.
+    let (head, data) = line.rsplit_once('#').unwrap();
+    let flipped = format!(
+        "{head}#{}{}",
+        if data.starts_with('0') { '1' } else { '0' },
+        &data[1..]
+    );
+    std::fs::write(dir.join("candump.log"), log.replacen(&line, &flipped, 1)).unwrap();
+    let e = check_mf4(&[&dir]).unwrap_err();
+    assert!(e.contains("frame 100"), "{e}");
+    // One stamp 2 µs late.
+    let (stamp, rest) = line.split_once(')').unwrap();
+    let us: u64 = stamp[stamp.len() - 6..].parse().unwrap();
+    let late = format!("{}{:06}){rest}", &stamp[..stamp.len() - 6], us + 2);
+    std::fs::write(dir.join("candump.log"), log.replacen(&line, &late, 1)).unwrap();
+    let e = check_mf4(&[&dir]).unwrap_err();
+    assert!(e.contains("frame 100: time"), "{e}");
+}
+
+/// Diagnostics whose clock cannot be placed (no command frame seen by both candump and the
+/// stubs) are left out and said so; the bus is still written and decodes.
+#[test]
+fn run_mf4_without_a_clock_pairing_leaves_the_diagnostics_out_and_says_so() {
+    let dir = sample_dir("mf4-unpaired");
+    let mut d = signals::EcuDiagnostics::ZERO;
+    d.cycle_count = 1;
+    std::fs::write(
+        dir.join(actuator_stubs::DIAGNOSTICS_LOG),
+        postcard::to_stdvec(&d).unwrap(),
+    )
+    .unwrap();
+    let s = record::write_run_mf4(&dir, &dir.join(record::RUN_MF4)).unwrap();
+    assert_eq!(s.diagnostics, 0);
+    assert!(s
+        .diagnostics_left_out
+        .unwrap()
+        .contains("candump and the stubs"));
+    let text = check_mf4(&[&dir]).unwrap_or_else(|e| panic!("{e}"));
+    assert!(text.contains("no run.mcap"), "{text}");
+    assert!(text.contains("extract_bus_logging"), "{text}");
 }
