@@ -77,6 +77,42 @@ def frames_by_message(db, frames):
     return list(by_id.values())
 
 
+def check_sensors(topics, bench, full):
+    """/sensors/*: what the feeds published, as they logged it (their own clock stamps): each
+    topic's sequences rising, a batch's samples before its publish and after the previous
+    batch's, and every accelerometer batch a diagnostics record names as read is on the topic."""
+    n = int(bench.get("feeds_records") or 0)
+    got = sum(len(topics.get(t, [])) for t in ("/sensors/object", "/sensors/crash_accel", "/sensors/safing_accel"))
+    if got != n:
+        fail(f"/sensors/*: {got} messages, metadata says {n} feed records")
+    if full and not topics.get("/sensors/crash_accel"):
+        fail("--full: no /sensors/crash_accel")
+    for topic in ("/sensors/crash_accel", "/sensors/safing_accel"):
+        last_seq, last_sample = 0, -1
+        for log_t, pub_t, m, _ in topics.get(topic, []):
+            if m["sequence"] <= last_seq:
+                fail(f"{topic}: sequence {m['sequence']} after {last_seq}")
+            if m["count"] != len(m["accel_mps2"]) or \
+                    m["newest_sample_ns"] != m["first_timestamp_ns"] + (m["count"] - 1) * m["sample_period_ns"]:
+                fail(f"{topic}: batch {m['sequence']}: count / newest sample inconsistent")
+            if m["first_timestamp_ns"] <= last_sample or m["newest_sample_ns"] > log_t or pub_t != log_t:
+                fail(f"{topic}: batch {m['sequence']}: samples {m['first_timestamp_ns']}…{m['newest_sample_ns']} "
+                     f"not after the previous ({last_sample}) and before the publish ({log_t})")
+            last_seq, last_sample = m["sequence"], m["newest_sample_ns"]
+    last_seq = 0
+    for log_t, _, m, _ in topics.get("/sensors/object", []):
+        if m["sequence"] <= last_seq or m["timestamp_ns"] > log_t:
+            fail(f"/sensors/object: {m['sequence']} after {last_seq}, measured {m['timestamp_ns']} published {log_t}")
+        last_seq = m["sequence"]
+    crash = {m["sequence"] for _, _, m, _ in topics.get("/sensors/crash_accel", [])}
+    if crash:
+        named = {m["last_accel_sequence"] for _, _, m, _ in topics.get("/ecu/diagnostics", [])} - {0}
+        if not named <= crash:
+            fail(f"/ecu/diagnostics: batches read but never published: {sorted(named - crash)[:5]}")
+    print(f"check_mcap: /sensors: {n} publications of the feeds in order, samples before their publish; "
+          f"every crash batch the ECU read is among them")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("run_dir", type=pathlib.Path)
@@ -223,6 +259,7 @@ def main():
             fail("--full: no diagnostics")
     elif a.full:
         fail("--full: no diagnostics.postcard")
+    check_sensors(topics, bench, a.full)
     if a.layout:
         layout = json.loads(a.layout.read_text())
         paths = []
@@ -232,6 +269,7 @@ def main():
                 paths.append(cfg["topicPath"])
         for p in paths:
             topic, _, field = p.partition(".")
+            field = field.split("[", 1)[0]  # accel_mps2[0]: the array's field
             if topic not in channels:
                 fail(f"layout: topic {topic} is not in the file")
             if field and topic in topics and field not in topics[topic][0][2]:

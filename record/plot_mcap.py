@@ -89,10 +89,21 @@ def main():
     if pulses:
         d = pulses[-1]
         n, dt = d["pulse_points"], d["pulse_dt_s"]
-        ax[3].plot([i * dt * 1e3 for i in range(n)], [-a / 9.80665 for a in d["pulse_accel_mps2"][:n]])
-        ax[3].set_xlabel("ms after the predicted contact")
-        ax[3].set_ylabel("deceleration [g]")
-    ax[3].set_title("predicted crash pulse at the end of pre-crash (/ecu/predicted_pulse)")
+        ax[3].plot([i * dt * 1e3 for i in range(n)], [-a / 9.80665 for a in d["pulse_accel_mps2"][:n]],
+                   label="predicted (/ecu/predicted_pulse), from the predicted contact")
+        span = n * dt * 1e3
+    else:
+        span = 150.0
+    for topic, style in (("/sensors/crash_accel", "tab:red"), ("/sensors/safing_accel", "tab:gray")):
+        pts = [(ms(b["first_timestamp_ns"] + k * b["sample_period_ns"]), -a / 9.80665)
+               for _, b in topics[topic] for k, a in enumerate(b["accel_mps2"])]
+        pts = [p for p in pts if -10.0 <= p[0] <= span]
+        if pts:
+            ax[3].plot(*zip(*pts), ".", ms=2, color=style, alpha=0.6, label=f"measured ({topic}), from the true contact")
+    ax[3].set_xlabel("ms after contact")
+    ax[3].set_ylabel("deceleration [g]")
+    ax[3].legend(loc="upper right", fontsize=8)
+    ax[3].set_title("crash pulse: predicted at the end of pre-crash, and as the accelerometers measured it")
 
     # 5. bus load
     counts = collections.defaultdict(collections.Counter)

@@ -9,6 +9,9 @@
 //! | `/stubs/commands` | `commands.jsonl` | frame the actuator stubs received, with its E2E / SecOC verdict |
 //! | `/stubs/actions` | `report.json` | action of a module (airbag fire, pretensioner fire / release …) |
 //! | `/stubs/verdict` | `report.json` | run: the occupant outcome and the modes |
+//! | `/ecu/diagnostics`, `/ecu/predicted_pulse` | `diagnostics.postcard` (the stubs' log) | cycle; change of the prediction |
+//! | `/sensors/object`, `/sensors/crash_accel`, `/sensors/safing_accel` | `feeds.postcard` (`sensor-feeds --log`) | publication |
+//! | `/truth/world` | the scenario file | ms of the scenario |
 //!
 //! **One clock.** Every message's `log_time` is CLOCK_MONOTONIC of the bench, ns — the clock
 //! of the ECU's cycles, the stubs' receive times and the diagnostics. candump stamps frames
@@ -22,6 +25,7 @@
 //! Message encoding is JSON; every schema is a JSON Schema, the CAN ones generated from the
 //! DBC's signal tables (`bus::signals_of`), never typed by hand.
 
+mod diag_fields;
 pub mod latency;
 mod mf4;
 mod run_folder;
@@ -30,6 +34,10 @@ pub mod write;
 
 pub use mf4::{write_run_mf4, Mf4Summary, RUN_MF4};
 pub use write::{write_run, RunMeta, WriteSummary};
+
+/// The sensor feeds' log of what they published in a run folder (`sensor-feeds --log`,
+/// postcard `signals::FeedLogRecord`s back to back).
+pub const FEEDS_LOG: &str = "feeds.postcard";
 
 /// File name of a run's recording in its folder.
 pub const RUN_MCAP: &str = "run.mcap";

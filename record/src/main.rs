@@ -2,7 +2,7 @@
 //!
 //! `record mcap DIR` writes `DIR/run.mcap` from the run folder a bench run left (`hil-bench`,
 //! `demo.sh`, the fault campaign write it themselves after every run); `record latency
-//! run.mcap` measures cycle → bus latency from it.
+//! run.mcap` measures cycle → bus and sample → bus latency from it.
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
@@ -45,8 +45,9 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
     },
-    /// How long after the start of the ECU cycle that sent it each command frame reached the
-    /// bus (p50 / p99 / max per message, and every fire), from the recording's own times.
+    /// How long after the start of the ECU cycle that sent it, and after the newest crash
+    /// sample that cycle had, each command frame reached the bus (p50 / p99 / max per message,
+    /// and every fire), from the recording's own times.
     Latency {
         /// A run's recording (run.mcap).
         file: PathBuf,

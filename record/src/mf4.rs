@@ -24,6 +24,7 @@
 //! that offset (no frame seen by both candump and the stubs) the diagnostics are left out and
 //! the header comment says so.
 
+use crate::diag_fields::DIAG_FIELDS;
 use crate::run_folder::RunFiles;
 use anyhow::{Context, Result};
 use signals::{EcuDiagnostics, EcuMode};
@@ -297,67 +298,6 @@ impl MdfFile {
 /// length, 8 data bytes).
 const CAN_RECORD_BYTES: usize = 8 + 1 + 4 + 1 + 1 + 8;
 
-/// One numeric field of the diagnostics record as a channel.
-struct DiagField {
-    name: &'static str,
-    unit: &'static str,
-    data_type: u8,
-    bytes: usize,
-    value: fn(&EcuDiagnostics) -> [u8; 8],
-}
-
-macro_rules! fields {
-    ($( $name:ident : $ty:ident, $unit:literal; )*) => {
-        [$( DiagField {
-            name: stringify!($name),
-            unit: $unit,
-            data_type: fields!(@dt $ty),
-            bytes: std::mem::size_of::<$ty>(),
-            value: |d| {
-                let mut b = [0; 8];
-                let v = d.$name.to_le_bytes();
-                b[..v.len()].copy_from_slice(&v);
-                b
-            },
-        } ),*]
-    };
-    (@dt f32) => { DT_FLOAT_LE };
-    (@dt $t:ident) => { DT_UINT_LE };
-}
-
-/// Every numeric field of [`EcuDiagnostics`] (the predicted pulse, an array, is on the MCAP's
-/// `/ecu/predicted_pulse`).
-const DIAG_FIELDS: [DiagField; 28] = fields! {
-    cycle_count: u64, "";
-    overrun_count: u64, "";
-    last_exec_ns: u64, "ns";
-    wake_latency_ns: u64, "ns";
-    last_object_sequence: u64, "";
-    last_accel_sequence: u64, "";
-    object_samples_rx: u64, "";
-    accel_batches_rx: u64, "";
-    predicted_delta_v_mps: f32, "m/s";
-    predicted_a_max_mps2: f32, "m/s²";
-    predicted_a_mean_mps2: f32, "m/s²";
-    predicted_contact_time_s: f32, "s";
-    time_to_contact_s: f32, "s";
-    time_to_contact_sigma_s: f32, "s";
-    closing_speed_mps: f32, "m/s";
-    closing_speed_sigma_mps: f32, "m/s";
-    opponent_mass_kg: f32, "kg";
-    opponent_mass_sigma_kg: f32, "kg";
-    pulse_dt_s: f32, "s";
-    pulse_points: u32, "";
-    belt_force_limit_n: f32, "N";
-    pretensioner_time_s: f32, "s";
-    airbag_time_s: f32, "s";
-    airbag_stage: u8, "";
-    mode: u8, "";
-    pretensioner_fired: u8, "";
-    airbag_fired: u8, "";
-    degraded_reasons: u32, "";
-};
-
 /// Writes `out` (normally `DIR/run.mf4`) from the run folder `dir` (`candump.log` required,
 /// the stubs' diagnostics log used when present).
 ///
@@ -423,7 +363,7 @@ pub fn write_run_mf4(dir: &Path, out: &Path) -> Result<Mf4Summary> {
             let t = diag_realtime(d).map_or(f64::NAN, seconds);
             diag.extend_from_slice(&t.to_le_bytes());
             for c in &DIAG_FIELDS {
-                diag.extend_from_slice(&(c.value)(d)[..c.bytes]);
+                diag.extend_from_slice(&(c.value)(d).le_bytes(c.bytes)[..c.bytes]);
             }
         }
     }
@@ -436,7 +376,8 @@ pub fn write_run_mf4(dir: &Path, out: &Path) -> Result<Mf4Summary> {
     let diag_channels: Vec<Channel> = DIAG_FIELDS
         .iter()
         .map(|c| {
-            let mut ch = Channel::value(c.name, c.data_type, offset, c.bytes as u32 * 8);
+            let data_type = if c.float { DT_FLOAT_LE } else { DT_UINT_LE };
+            let mut ch = Channel::value(c.name, data_type, offset, c.bytes as u32 * 8);
             ch.unit = c.unit;
             if c.name == "mode" {
                 ch.conversion = mode_cc;

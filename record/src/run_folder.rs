@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use bus::candump::CandumpLog;
 use serde::Deserialize;
 use serde_json::Value;
-use signals::EcuDiagnostics;
+use signals::{EcuDiagnostics, FeedLogRecord};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -21,6 +21,8 @@ pub(crate) struct RunFiles {
     pub report: Option<(Report, Value)>,
     /// The stubs' diagnostics log: records and trailing bytes of a partial last record.
     pub diagnostics: (Vec<EcuDiagnostics>, usize),
+    /// The feeds' log of what they published, and trailing bytes of a partial last record.
+    pub feeds: (Vec<FeedLogRecord>, usize),
     /// CLOCK_REALTIME − CLOCK_MONOTONIC, ns (`None`: no frame seen by both candump and the
     /// stubs).
     pub offset: Option<i64>,
@@ -52,12 +54,8 @@ impl RunFiles {
         } else {
             None
         };
-        let diag_path = dir.join(actuator_stubs::DIAGNOSTICS_LOG);
-        let diagnostics = if diag_path.exists() {
-            read_diagnostics(&diag_path)?
-        } else {
-            (Vec::new(), 0)
-        };
+        let diagnostics = read_postcard(&dir.join(actuator_stubs::DIAGNOSTICS_LOG))?;
+        let feeds = read_postcard(&dir.join(crate::FEEDS_LOG))?;
         let offset = clock_offset_ns(&log, &commands);
         Ok(Self {
             candump_path,
@@ -66,6 +64,7 @@ impl RunFiles {
             commands_unreadable,
             report,
             diagnostics,
+            feeds,
             offset,
         })
     }
@@ -110,14 +109,18 @@ fn clock_offset_ns(log: &CandumpLog, commands: &[Value]) -> Option<i64> {
     Some(diffs[diffs.len() / 2])
 }
 
-/// The stubs' diagnostics log: postcard records back to back (a run killed mid-write leaves a
-/// partial last record: its bytes are counted, not an error).
-fn read_diagnostics(path: &Path) -> Result<(Vec<EcuDiagnostics>, usize)> {
+/// A postcard log (the stubs' diagnostics, the feeds' publications): records back to back; a
+/// process killed mid-write leaves a partial last record: its bytes are counted, not an error.
+/// A file that is not there is an empty log.
+fn read_postcard<T: serde::de::DeserializeOwned>(path: &Path) -> Result<(Vec<T>, usize)> {
+    if !path.exists() {
+        return Ok((Vec::new(), 0));
+    }
     let bytes = std::fs::read(path).with_context(|| path.display().to_string())?;
     let mut rest = bytes.as_slice();
     let mut out = Vec::new();
     while !rest.is_empty() {
-        match postcard::take_from_bytes::<EcuDiagnostics>(rest) {
+        match postcard::take_from_bytes::<T>(rest) {
             Ok((d, r)) => {
                 out.push(d);
                 rest = r;

@@ -2,7 +2,7 @@
 
 use bus::{MessageInfo, RawFrame, SignalInfo, CAN_EFF_FLAG};
 use serde_json::{json, Map, Value};
-use signals::{Degraded, EcuDiagnostics, EcuMode};
+use signals::{CrashAccelSample, EcuDiagnostics, ObjectState};
 
 /// Schema name of `/can/raw`.
 pub const RAW_FRAME_SCHEMA: &str = "restraint_bench.CanFrame";
@@ -134,24 +134,36 @@ pub const PULSE_SCHEMA: &str = "restraint_bench.PredictedPulse";
 
 /// The record's predicted pulse: a message of its own, written when it changes (it changes
 /// with each prediction, not each cycle, and is 64 of the record's ~100 numbers).
-pub fn predicted_pulse(d: &EcuDiagnostics) -> Value {
+pub fn predicted_pulse(d: &EcuDiagnostics) -> PulseMessage {
     let n = (d.pulse_points as usize).min(d.pulse_accel_mps2.len());
-    json!({
-        "pulse_dt_s": d.pulse_dt_s,
-        "pulse_points": d.pulse_points,
-        "pulse_accel_mps2": &d.pulse_accel_mps2[..n],
-        "predicted_contact_time_s": d.predicted_contact_time_s,
-        "predicted_delta_v_mps": d.predicted_delta_v_mps,
-        "predicted_a_max_mps2": d.predicted_a_max_mps2,
-        "predicted_a_mean_mps2": d.predicted_a_mean_mps2,
-    })
+    PulseMessage {
+        pulse_dt_s: d.pulse_dt_s,
+        pulse_points: d.pulse_points,
+        pulse_accel_mps2: d.pulse_accel_mps2[..n].to_vec(),
+        predicted_contact_time_s: d.predicted_contact_time_s,
+        predicted_delta_v_mps: d.predicted_delta_v_mps,
+        predicted_a_max_mps2: d.predicted_a_max_mps2,
+        predicted_a_mean_mps2: d.predicted_a_mean_mps2,
+    }
+}
+
+/// A `/ecu/predicted_pulse` message (compared with the last one written: only changes are).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct PulseMessage {
+    pulse_dt_s: f32,
+    pulse_points: u32,
+    pulse_accel_mps2: Vec<f32>,
+    predicted_contact_time_s: f32,
+    predicted_delta_v_mps: f32,
+    predicted_a_max_mps2: f32,
+    predicted_a_mean_mps2: f32,
 }
 
 /// JSON Schema of `/ecu/predicted_pulse`.
 pub fn predicted_pulse_schema() -> Value {
     let mut z = EcuDiagnostics::ZERO;
     z.pulse_points = 1;
-    let mut s = schema_of(&predicted_pulse(&z));
+    let mut s = schema_of(&serde_json::to_value(predicted_pulse(&z)).unwrap_or(Value::Null));
     if let Some(o) = s.as_object_mut() {
         o.insert("title".into(), json!(PULSE_SCHEMA));
         o.insert(
@@ -162,32 +174,86 @@ pub fn predicted_pulse_schema() -> Value {
     s
 }
 
-/// A diagnostics record as published on iceoryx2, field by field (serde of the record itself)
-/// but for the predicted pulse's points (on `/ecu/predicted_pulse`), with the mode's and the
-/// degraded reasons' names beside their numbers.
-pub fn diagnostics(d: &EcuDiagnostics) -> Value {
-    let mut v = serde_json::to_value(d).unwrap_or(Value::Null);
-    if let Some(o) = v.as_object_mut() {
-        o.remove("pulse_accel_mps2");
-        o.insert(
-            "mode_name".into(),
-            json!(EcuMode::from_u8(d.mode).map_or("unknown", EcuMode::name)),
-        );
-        o.insert(
-            "degraded".into(),
-            json!(Degraded::from_bits_truncate(d.degraded_reasons)
-                .iter_names()
-                .map(|(n, _)| n.to_ascii_lowercase())
-                .collect::<Vec<_>>()),
-        );
+/// A diagnostics record as published on iceoryx2, field by field (`diag_fields`) but for the
+/// predicted pulse's points (on `/ecu/predicted_pulse`), with the mode's and the degraded
+/// reasons' names beside their numbers.
+pub fn diagnostics(d: &EcuDiagnostics) -> crate::diag_fields::DiagnosticsMessage<'_> {
+    crate::diag_fields::DiagnosticsMessage(d)
+}
+
+/// Schema name of `/sensors/object`.
+pub const OBJECT_SCHEMA: &str = "restraint_bench.ObjectState";
+/// Schema name of `/sensors/crash_accel` and `/sensors/safing_accel`.
+pub const ACCEL_SCHEMA: &str = "restraint_bench.AccelBatch";
+
+/// An object state as the feeds published it (serde of the record, without its padding).
+pub fn object(o: &ObjectState) -> Value {
+    let mut v = serde_json::to_value(o).unwrap_or(Value::Null);
+    if let Some(m) = v.as_object_mut() {
+        m.remove("_reserved");
     }
     v
+}
+
+/// An accelerometer batch as the feeds published it: its valid samples only, and the time of
+/// the newest one (what a cycle that read this batch knew last).
+#[derive(serde::Serialize)]
+pub struct AccelBatchMessage<'a> {
+    first_timestamp_ns: u64,
+    newest_sample_ns: u64,
+    sequence: u64,
+    sample_period_ns: u32,
+    count: u32,
+    accel_mps2: &'a [f32],
+}
+
+/// The `/sensors/…_accel` message of a batch.
+pub fn accel_batch(b: &CrashAccelSample) -> AccelBatchMessage<'_> {
+    let n = b.samples().len() as u64;
+    AccelBatchMessage {
+        first_timestamp_ns: b.first_timestamp_ns,
+        newest_sample_ns: b.first_timestamp_ns
+            + n.saturating_sub(1) * u64::from(b.sample_period_ns),
+        sequence: b.sequence,
+        sample_period_ns: b.sample_period_ns,
+        count: b.count,
+        accel_mps2: b.samples(),
+    }
+}
+
+/// JSON Schema of `/sensors/object`.
+pub fn object_schema() -> Value {
+    titled(
+        schema_of(&object(&ObjectState::INVALID)),
+        OBJECT_SCHEMA,
+        "The opponent object state the sensor feeds published on iceoryx2 (log time: the publish; timestamp_ns: the measurement, CLOCK_MONOTONIC)",
+    )
+}
+
+/// JSON Schema of the accelerometer topics.
+pub fn accel_batch_schema() -> Value {
+    let mut b = CrashAccelSample::EMPTY;
+    b.count = 1;
+    titled(
+        schema_of(&serde_json::to_value(accel_batch(&b)).unwrap_or(Value::Null)),
+        ACCEL_SCHEMA,
+        "One accelerometer batch the sensor feeds published on iceoryx2 (log time: the publish; sample k at first_timestamp_ns + k·sample_period_ns, CLOCK_MONOTONIC; m/s², negative = deceleration)",
+    )
+}
+
+fn titled(mut s: Value, title: &str, description: &str) -> Value {
+    if let Some(o) = s.as_object_mut() {
+        o.insert("title".into(), json!(title));
+        o.insert("description".into(), json!(description));
+    }
+    s
 }
 
 /// JSON Schema of `/ecu/diagnostics`, derived from the record's own serialization (so a field
 /// added to the record appears here without an edit).
 pub fn diagnostics_schema() -> Value {
-    let mut s = schema_of(&diagnostics(&EcuDiagnostics::ZERO));
+    let mut s =
+        schema_of(&serde_json::to_value(diagnostics(&EcuDiagnostics::ZERO)).unwrap_or(Value::Null));
     if let Some(o) = s.as_object_mut() {
         o.insert("title".into(), json!(DIAGNOSTICS_SCHEMA));
         o.insert(

@@ -6,6 +6,7 @@ use anyhow::{bail, Context, Result};
 use mcap::records::MessageHeader;
 use mcap::write::{Metadata, Writer};
 use serde_json::{json, Value};
+use signals::FeedItem;
 use std::collections::{BTreeMap, HashMap};
 use std::io::BufWriter;
 use std::path::Path;
@@ -45,6 +46,7 @@ struct Recording<W: std::io::Write + std::io::Seek> {
     w: Writer<W>,
     topics: HashMap<String, Topic>,
     counts: BTreeMap<String, u64>,
+    buf: Vec<u8>,
 }
 
 impl<W: std::io::Write + std::io::Seek> Recording<W> {
@@ -77,11 +79,14 @@ impl<W: std::io::Write + std::io::Seek> Recording<W> {
         schema: &Value,
         log_time: u64,
         publish_time: u64,
-        msg: &Value,
+        msg: &impl serde::Serialize,
     ) -> Result<()> {
         let channel_id = self.topic(topic, schema_name, schema)?;
         let t = self.topics.get_mut(topic).expect("added above");
         t.sequence = t.sequence.wrapping_add(1);
+        // Serialized straight into one reused buffer: no JSON tree, no string per message.
+        self.buf.clear();
+        serde_json::to_writer(&mut self.buf, msg)?;
         self.w.write_to_known_channel(
             &MessageHeader {
                 channel_id,
@@ -89,7 +94,7 @@ impl<W: std::io::Write + std::io::Seek> Recording<W> {
                 log_time,
                 publish_time,
             },
-            serde_json::to_string(msg)?.as_bytes(),
+            &self.buf,
         )?;
         *self.counts.entry(topic.to_owned()).or_default() += 1;
         Ok(())
@@ -109,6 +114,7 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         commands_unreadable,
         report,
         diagnostics,
+        feeds,
         offset,
     } = RunFiles::read(dir)?;
     let file = std::fs::File::create(out).with_context(|| out.display().to_string())?;
@@ -116,6 +122,7 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         w: Writer::new(BufWriter::new(file))?,
         topics: HashMap::new(),
         counts: BTreeMap::new(),
+        buf: Vec::with_capacity(4096),
     };
     let mut bench = BTreeMap::from([
         ("route".to_owned(), meta.route.clone()),
@@ -164,6 +171,8 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
             diagnostics.1.to_string(),
         ),
         ("candump_lines_skipped".to_owned(), log.skipped.to_string()),
+        ("feeds_records".to_owned(), feeds.0.len().to_string()),
+        ("feeds_log_trailing_bytes".to_owned(), feeds.1.to_string()),
     ]);
     if let Some((r, _)) = &report {
         bench.insert("scenario".to_owned(), r.scenario.clone());
@@ -224,7 +233,7 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
 
     let diag_schema = schema::diagnostics_schema();
     let pulse_schema = schema::predicted_pulse_schema();
-    let mut last_pulse: Option<Value> = None;
+    let mut last_pulse: Option<schema::PulseMessage> = None;
     for d in &diagnostics.0 {
         let pulse = schema::predicted_pulse(d);
         if last_pulse.as_ref() != Some(&pulse) {
@@ -246,6 +255,39 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
             d.timestamp_ns,
             &schema::diagnostics(d),
         )?;
+    }
+
+    // What the sensor feeds published, at the publish time (the measurement's own time is in
+    // the message).
+    let (object_schema, accel_schema) = (schema::object_schema(), schema::accel_batch_schema());
+    for r in &feeds.0 {
+        let t = r.published_ns;
+        match &r.item {
+            FeedItem::Object(o) => rec.write(
+                "/sensors/object",
+                schema::OBJECT_SCHEMA,
+                &object_schema,
+                t,
+                t,
+                &schema::object(o),
+            )?,
+            FeedItem::CrashAccel(b) => rec.write(
+                "/sensors/crash_accel",
+                schema::ACCEL_SCHEMA,
+                &accel_schema,
+                t,
+                t,
+                &schema::accel_batch(b),
+            )?,
+            FeedItem::SafingAccel(b) => rec.write(
+                "/sensors/safing_accel",
+                schema::ACCEL_SCHEMA,
+                &accel_schema,
+                t,
+                t,
+                &schema::accel_batch(b),
+            )?,
+        }
     }
 
     let any = json!({ "type": "object" });
@@ -273,7 +315,7 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
                 &schema,
                 t,
                 t,
-                &serde_json::to_value(truth.state(k as f64 * 1e-3))?,
+                &truth.state(k as f64 * 1e-3),
             )?;
         }
     }

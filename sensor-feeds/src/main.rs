@@ -14,6 +14,7 @@ use ipc::{
 };
 use sensor_feeds::player::TICK_NS;
 use sensor_feeds::{monotonic_ns, sleep_until_ns, Player, Scenario, TickOutput, Truth};
+use signals::{FeedItem, FeedLogRecord};
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 use world::scenario::{AccelEvent, AccelEventKind};
@@ -47,6 +48,12 @@ struct Cli {
     /// fault campaign kills and restarts the feeds this way).
     #[arg(long, value_name = "NS")]
     epoch_ns: Option<u64>,
+    /// Log every published object state and accelerometer batch with its publish time
+    /// (CLOCK_MONOTONIC) to FILE, postcard records back to back (`signals::FeedLogRecord`): the
+    /// run's recording puts them on `/sensors/...` and measures sample → command latency from
+    /// them. Appends, so a restarted feed continues the log of the run.
+    #[arg(long, value_name = "FILE")]
+    log: Option<PathBuf>,
 }
 
 const TRUTH_PERIOD_TICKS: u64 = 10;
@@ -206,6 +213,7 @@ fn run(cli: &Cli) -> Result<()> {
     truth_rec.ego_mass_kg = scenario.ego.mass_kg as f32;
     truth_rec.opponent_mass_kg = scenario.opponent_mass_kg() as f32;
     let mut contact_announced = false;
+    let mut log = FeedLog::open(cli.log.as_deref())?;
 
     for tick in first_tick..=total_ticks {
         if stop.load(Ordering::Relaxed) {
@@ -220,17 +228,27 @@ fn run(cli: &Cli) -> Result<()> {
         for o in &out.objects {
             if objects.publish(*o).is_err() {
                 counts.ipc_errors += 1;
+            } else {
+                log.write(FeedItem::Object(*o));
             }
         }
         for b in &out.accel {
             if accel.publish(*b).is_err() {
                 counts.ipc_errors += 1;
+            } else {
+                log.write(FeedItem::CrashAccel(*b));
             }
         }
         for b in &out.safing {
             if safing.publish(*b).is_err() {
                 counts.ipc_errors += 1;
+            } else {
+                log.write(FeedItem::SafingAccel(*b));
             }
+        }
+        // Every 10 ms: a feed killed mid-run (the fault campaign does) loses ≤ 10 ms of its log.
+        if tick % 10 == 0 {
+            log.flush();
         }
         if let Some(sock) = can.as_mut() {
             for f in &out.can {
@@ -271,9 +289,73 @@ fn run(cli: &Cli) -> Result<()> {
         "sensor-feeds: done: {} objects ({} dropped, {} stale repeats), {} accel samples ({} faulty), {} safing samples ({} faulty), {} spikes, {} CAN frames, {} CAN errors, {} IPC errors",
         p.objects, p.objects_dropped, p.objects_frozen, p.accel_samples, p.accel_faulty, p.safing_samples, p.safing_faulty, p.spikes, counts.can_frames, counts.can_errors, counts.ipc_errors
     );
+    log.finish();
     // Keep the publishers alive a moment so subscribers can read the last samples.
     std::thread::sleep(std::time::Duration::from_millis(50));
     Ok(())
+}
+
+/// `--log`: what was published, when. Written after each publish (it never delays one); a
+/// write error stops the log, is reported once at the end and never stops the play.
+struct FeedLog {
+    w: Option<std::io::BufWriter<std::fs::File>>,
+    error: Option<String>,
+    records: u64,
+}
+
+impl FeedLog {
+    fn open(path: Option<&std::path::Path>) -> Result<Self> {
+        let w = match path {
+            Some(p) => Some(std::io::BufWriter::with_capacity(
+                1 << 16,
+                std::fs::OpenOptions::new()
+                    .create(true)
+                    .append(true)
+                    .open(p)
+                    .with_context(|| format!("--log {}", p.display()))?,
+            )),
+            None => None,
+        };
+        Ok(Self {
+            w,
+            error: None,
+            records: 0,
+        })
+    }
+
+    fn write(&mut self, item: FeedItem) {
+        let Some(w) = self.w.as_mut() else { return };
+        let rec = FeedLogRecord {
+            published_ns: monotonic_ns(),
+            item,
+        };
+        match postcard::to_io(&rec, w) {
+            Ok(_) => self.records += 1,
+            Err(e) => {
+                self.error = Some(e.to_string());
+                self.w = None;
+            }
+        }
+    }
+
+    fn flush(&mut self) {
+        use std::io::Write;
+        if let Some(Err(e)) = self.w.as_mut().map(Write::flush) {
+            self.error = Some(e.to_string());
+            self.w = None;
+        }
+    }
+
+    fn finish(&mut self) {
+        self.flush();
+        self.w = None;
+        if let Some(e) = &self.error {
+            eprintln!(
+                "sensor-feeds: --log incomplete after {} records: {e}",
+                self.records
+            );
+        }
+    }
 }
 
 /// What the transports did with the player's output.

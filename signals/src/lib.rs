@@ -23,6 +23,7 @@ pub const VALID: u8 = 1;
 /// Opponent object / pre-crash state from the environment sensors (one tracked object).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ObjectState {
     /// CLOCK_MONOTONIC time of the measurement (not of publication), ns.
     pub timestamp_ns: u64,
@@ -85,6 +86,7 @@ pub const ACCEL_BATCH_CAPACITY: usize = 8;
 /// Batching keeps the sample rate (e.g. 4–8 kHz) decoupled from the message rate.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct CrashAccelSample {
     /// CLOCK_MONOTONIC time of `accel_mps2[0]`, ns.
     pub first_timestamp_ns: u64,
@@ -205,6 +207,30 @@ impl Degraded {
         .union(Self::E2E_FAILURE)
         .union(Self::LUT_INVALID)
         .union(Self::CAN_DISABLED);
+}
+
+/// One record the sensor feeds published, as they log it (`sensor-feeds --log`) for the run's
+/// recording: what was published, and when (CLOCK_MONOTONIC, ns). The log is postcard records
+/// back to back.
+#[cfg(feature = "serde")]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FeedLogRecord {
+    /// CLOCK_MONOTONIC time of the publish call, ns.
+    pub published_ns: u64,
+    /// What was published.
+    pub item: FeedItem,
+}
+
+/// A published record of [`FeedLogRecord`], by service.
+#[cfg(feature = "serde")]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum FeedItem {
+    /// On the object-list service.
+    Object(ObjectState),
+    /// On the crash accelerometer's service.
+    CrashAccel(CrashAccelSample),
+    /// On the safing accelerometer's service.
+    SafingAccel(CrashAccelSample),
 }
 
 /// ECU diagnostics, published every cycle (predicted pulse, chosen settings, mode, timing).

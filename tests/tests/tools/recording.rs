@@ -3,6 +3,7 @@
 //! back by record/check_mcap.py (Foxglove's `mcap` package and cantools), not by our code.
 
 use e2e_tests::harness::{check_mf4, check_recording};
+use record::latency::From;
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
@@ -143,6 +144,9 @@ fn latency_is_measured_from_the_cycle_that_sent_each_frame() {
         mut cmd_lat,
         mut status_lat,
         mut fire_lat,
+        mut cmd_sample_lat,
+        mut status_sample_lat,
+        mut fire_sample_lat,
     } = known_run(&dir);
     let s = record::write_run(&dir, &dir.join("run.mcap"), &meta()).unwrap();
     assert_eq!(s.realtime_minus_monotonic_ns, Some(KNOWN_OFFSET_NS));
@@ -152,19 +156,36 @@ fn latency_is_measured_from_the_cycle_that_sent_each_frame() {
         v.sort_by(f64::total_cmp);
         v[((p / 100.0 * v.len() as f64).ceil() as usize).max(1) - 1]
     };
-    let row = |what: &str| {
-        l.rows
-            .iter()
-            .find(|r| r.what == what)
-            .unwrap_or_else(|| panic!("no row {what}: {}", l.table()))
+    let row = |from: From, what: &str| {
+        l.row(from, what)
+            .unwrap_or_else(|| panic!("no row {from:?} {what}: {}", l.table()))
             .clone()
     };
-    for (what, v) in [
-        ("AirbagStageCmd (every frame)", &mut cmd_lat),
-        ("EcuStatus (every frame)", &mut status_lat),
-        ("airbag fire (every frame)", &mut fire_lat),
+    for (from, what, v) in [
+        (
+            From::CycleStart,
+            "AirbagStageCmd (every frame)",
+            &mut cmd_lat,
+        ),
+        (From::CycleStart, "EcuStatus (every frame)", &mut status_lat),
+        (From::CycleStart, "airbag fire (every frame)", &mut fire_lat),
+        (
+            From::CrashSample,
+            "AirbagStageCmd (every frame)",
+            &mut cmd_sample_lat,
+        ),
+        (
+            From::CrashSample,
+            "EcuStatus (every frame)",
+            &mut status_sample_lat,
+        ),
+        (
+            From::CrashSample,
+            "airbag fire (every frame)",
+            &mut fire_sample_lat,
+        ),
     ] {
-        let r = row(what);
+        let r = row(from, what);
         assert_eq!(r.n, v.len(), "{what}");
         for (got, want) in [
             (r.p50_us, nearest(v, 50.0)),
@@ -178,18 +199,26 @@ fn latency_is_measured_from_the_cycle_that_sent_each_frame() {
             );
         }
     }
-    // The first fire frame: cycle 150's, 20 + 150 mod 7 = 23 µs.
-    assert!((row("airbag fire (first frame)").p50_us - 23.0).abs() < 1e-6);
+    // The first fire frame: cycle 150's, 20 + 150 mod 7 = 23 µs after its start, and its
+    // newest crash sample 25 + 10 · (150 mod 3) = 25 µs before that start.
+    assert!((row(From::CycleStart, "airbag fire (first frame)").p50_us - 23.0).abs() < 1e-6);
+    assert!((row(From::CrashSample, "airbag fire (first frame)").p50_us - 48.0).abs() < 1e-6);
+    // Cycle 50 published no record: its two frames have no sample figure, and say so.
+    assert_eq!(l.no_sample, 2, "{}", l.table());
 }
 
 /// The realtime − monotonic offset of [`known_run`].
 const KNOWN_OFFSET_NS: i64 = 1_700_000_000_000_000_000;
 
-/// The latencies [`known_run`] built in, µs.
+/// The latencies [`known_run`] built in, µs: from the cycle's start, and from the newest crash
+/// sample the cycle had (only cycles whose diagnostics record was published).
 struct Known {
     cmd_lat: Vec<f64>,
     status_lat: Vec<f64>,
     fire_lat: Vec<f64>,
+    cmd_sample_lat: Vec<f64>,
+    status_sample_lat: Vec<f64>,
+    fire_sample_lat: Vec<f64>,
 }
 
 /// A run folder built to known figures (see the latency test).
@@ -200,6 +229,9 @@ fn known_run(dir: &Path) -> Known {
     std::fs::create_dir_all(dir).unwrap();
     let (mut candump, mut commands, mut diag) = (String::new(), String::new(), Vec::new());
     let (mut cmd_lat, mut status_lat, mut fire_lat) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut cmd_sample_lat, mut status_sample_lat, mut fire_sample_lat) =
+        (Vec::new(), Vec::new(), Vec::new());
+    let mut feeds = Vec::new();
     let mut frame = |mono: u64, f: &bus::RawFrame, name: &str| {
         let hex: String = f.payload().iter().map(|b| format!("{b:02x}")).collect();
         let rt = mono as i64 + OFFSET_NS;
@@ -218,10 +250,28 @@ fn known_run(dir: &Path) -> Known {
     let status = bus::message_info(bus::EcuStatus::RAW_ID).unwrap();
     for k in 1..=200u64 {
         let start = T0 + k * 1_000_000;
-        if k != 50 {
+        // Crash batch k: 8 samples 125 µs apart, the newest 25 + 10 · (k mod 3) µs before cycle
+        // k starts, published 5 µs after it; cycle k read it.
+        let age_us = 25 + 10 * (k % 3);
+        let mut b = signals::CrashAccelSample::EMPTY;
+        b.sequence = k;
+        b.count = 8;
+        b.sample_period_ns = 125_000;
+        b.first_timestamp_ns = start - age_us * 1_000 - 7 * 125_000;
+        let published_ns = start - age_us * 1_000 + 5_000;
+        feeds.extend(
+            postcard::to_stdvec(&signals::FeedLogRecord {
+                published_ns,
+                item: signals::FeedItem::CrashAccel(b),
+            })
+            .unwrap(),
+        );
+        let published = k != 50;
+        if published {
             let mut d = signals::EcuDiagnostics::ZERO;
             d.timestamp_ns = start;
             d.cycle_count = k;
+            d.last_accel_sequence = k;
             diag.extend(postcard::to_stdvec(&d).unwrap());
         }
         // Whole µs: candump's stamps have µs resolution.
@@ -239,23 +289,35 @@ fn known_run(dir: &Path) -> Known {
         let f = bus::encode_values(bag.id, &vals).unwrap();
         frame(start + lat_us * 1_000, &f, bag.name);
         cmd_lat.push(lat_us as f64);
+        let sample_us = (lat_us + age_us) as f64;
+        if published {
+            cmd_sample_lat.push(sample_us);
+        }
         if k >= 150 {
             fire_lat.push(lat_us as f64);
+            fire_sample_lat.push(sample_us);
         }
         if k % 10 == 0 {
             let sigs = bus::signals_of(status.id).unwrap();
             let f = bus::encode_values(status.id, &vec![0.0; sigs.len()]).unwrap();
             frame(start + 40_000, &f, status.name);
             status_lat.push(40.0);
+            if published {
+                status_sample_lat.push((40 + age_us) as f64);
+            }
         }
     }
     std::fs::write(dir.join("candump.log"), candump).unwrap();
     std::fs::write(dir.join("commands.jsonl"), commands).unwrap();
     std::fs::write(dir.join(actuator_stubs::DIAGNOSTICS_LOG), diag).unwrap();
+    std::fs::write(dir.join(record::FEEDS_LOG), feeds).unwrap();
     Known {
         cmd_lat,
         status_lat,
         fire_lat,
+        cmd_sample_lat,
+        status_sample_lat,
+        fire_sample_lat,
     }
 }
 
