@@ -41,7 +41,11 @@ out=$(cd "$out" && pwd -P)
 export VCAN_GUEST_RW="$out${VCAN_GUEST_RW:+:$VCAN_GUEST_RW}"
 
 rc=0
+# The run's recording (run.mcap, run.mf4) is written here on the host once the run has ended:
+# inside an emulated guest it would cost ≈ 15× as much (record/src/pending.rs).
+export RECORD_ON_HOST=1
 ./vcan-setup.sh --run -- "$target/release/hil-bench" --scenario "$scenario" --out "$out" --repo "$PWD" "${mf4[@]}" || rc=$?
+"$target/release/record" pending "$out" || rc=$(( rc == 0 ? 1 : rc ))
 
 dir="$out/$name"
 if [ -s "$dir/candump.log" ]; then

@@ -28,11 +28,12 @@
 mod diag_fields;
 pub mod latency;
 mod mf4;
+pub mod pending;
 mod run_folder;
 pub mod schema;
 pub mod write;
 
-pub use mf4::{write_run_mf4, Mf4Summary, RUN_MF4};
+pub use mf4::{summary_line as mf4_summary_line, write_run_mf4, Mf4Summary, RUN_MF4};
 pub use write::{write_run, RunMeta, WriteSummary};
 
 /// The sensor feeds' log of what they published in a run folder (`sensor-feeds --log`,

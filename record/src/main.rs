@@ -45,6 +45,14 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
     },
+    /// Write the recordings runs left to be written after the fact (`RECORD_ON_HOST=1`: runs
+    /// in an emulated guest leave record.pending.json), in ROOT and three levels below; each
+    /// run's lines are printed and appended to its summary.txt.
+    Pending {
+        /// Output roots of bench runs (e.g. out/).
+        #[arg(required = true)]
+        roots: Vec<PathBuf>,
+    },
     /// How long after the start of the ECU cycle that sent it, and after the newest crash
     /// sample that cycle had, each command frame reached the bus (p50 / p99 / max per message,
     /// and every fire), from the recording's own times.
@@ -97,15 +105,23 @@ fn main() -> Result<()> {
             host::files::check_output_file(&out)?;
             let s = write_run_mf4(&dir, &out)
                 .with_context(|| format!("recording {}", dir.display()))?;
-            println!(
-                "{}: {} CAN frames, {} diagnostics records, {:.1} kB{}",
-                out.display(),
-                s.can_frames,
-                s.diagnostics,
-                s.bytes as f64 / 1e3,
-                s.diagnostics_left_out
-                    .map_or(String::new(), |r| format!(" (diagnostics left out: {r})"))
-            );
+            println!("{}", record::mf4_summary_line(&out, &s));
+            Ok(())
+        }
+        Command::Pending { roots } => {
+            let mut failed = 0;
+            for root in &roots {
+                for w in record::pending::write_pending(root)? {
+                    match w.result {
+                        Ok(lines) => lines.iter().for_each(|l| println!("{l}")),
+                        Err(e) => {
+                            eprintln!("record: {}: {e}", w.dir.display());
+                            failed += 1;
+                        }
+                    }
+                }
+            }
+            anyhow::ensure!(failed == 0, "{failed} recordings could not be written");
             Ok(())
         }
         Command::Latency { file } => {

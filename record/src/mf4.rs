@@ -33,6 +33,20 @@ use std::path::Path;
 /// File name of a run's MDF recording in its folder.
 pub const RUN_MF4: &str = "run.mf4";
 
+/// The run summary's line for `path`.
+pub fn summary_line(path: &Path, s: &Mf4Summary) -> String {
+    format!(
+        "recording (MDF 4.1): {} ({} CAN frames, {} diagnostics records, {:.0} kB; open in asammdf or CANape, README \"Recordings\"){}",
+        path.display(),
+        s.can_frames,
+        s.diagnostics,
+        s.bytes as f64 / 1e3,
+        s.diagnostics_left_out
+            .as_deref()
+            .map_or(String::new(), |w| format!("; diagnostics left out: {w}"))
+    )
+}
+
 /// What was written.
 #[derive(Clone, Debug)]
 pub struct Mf4Summary {

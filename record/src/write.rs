@@ -12,7 +12,7 @@ use std::io::BufWriter;
 use std::path::Path;
 
 /// What the folder cannot say about the run: where it ran.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct RunMeta {
     /// The vcan route (`host-vcan`, `qemu-kvm`, `qemu-tcg`, …).
     pub route: String,

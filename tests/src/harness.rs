@@ -178,6 +178,9 @@ pub fn run_in_guests(
                     .args(["--run", "--"])
                     .args(&args)
                     .env("VCAN_GUEST_RW", rw)
+                    // Recordings are written here, on the host, when the guests have ended
+                    // (record::pending: in the emulated guest they cost ≈ 15× as much).
+                    .env(record::pending::RECORD_ON_HOST, "1")
                     .current_dir(crate::repo_root())
                     .output()
                     .expect("vcan-setup.sh --run")
@@ -197,5 +200,28 @@ pub fn run_in_guests(
             String::from_utf8_lossy(&o.stderr)
         );
     }
+    let started = std::time::Instant::now();
+    let written = record::pending::write_pending(out).expect("the runs' output folder");
+    let failed: Vec<String> = written
+        .iter()
+        .filter_map(|w| {
+            w.result
+                .as_ref()
+                .err()
+                .map(|e| format!("{}: {e}", w.dir.display()))
+        })
+        .collect();
+    // Reported, not asserted: the tests that read the recordings fail on a missing one, and a
+    // fault case may damage what its recording is written from.
+    eprintln!(
+        "{what}: {} recordings written on the host in {:.1} s{}",
+        written.len() - failed.len(),
+        started.elapsed().as_secs_f64(),
+        if failed.is_empty() {
+            String::new()
+        } else {
+            format!("; not written:\n{}", failed.join("\n"))
+        }
+    );
     outputs
 }

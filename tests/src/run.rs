@@ -275,6 +275,9 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
         "summary.txt",
         // Appended to by every feeds process of the run (a restart continues it).
         record::FEEDS_LOG,
+        record::pending::PENDING,
+        record::RUN_MCAP,
+        record::RUN_MF4,
     ] {
         let _ = std::fs::remove_file(dir.join(stale));
     }
@@ -440,36 +443,42 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     // The run's recording (record crate): everything above on one clock, for Foxglove and
     // any MCAP reader. A run that cannot be recorded is a problem of the run, not lost silently.
     let route = crate::Route::current();
-    let recording_started = std::time::Instant::now();
-    let recorded = record::write_run(
-        &dir,
-        &dir.join(record::RUN_MCAP),
-        &record::RunMeta {
-            route: route.name().to_owned(),
-            timing_emulated: Some(route.timing_emulated()),
-            scenario: Some(cfg.scenario.clone()),
-        },
-    );
-    // Its cost, on the clock the run ran on (the guest's own on an emulated route), against
-    // the whole run's (issue 23: ≤ 5 %).
-    let recording_s = recording_started.elapsed().as_secs_f64();
-    let run_s = run_started.elapsed().as_secs_f64();
-    if let Err(e) = &recorded {
-        problems.push(format!("recording: {e:#}"));
-    }
-    let mut summary = summarise(&scenario, &report, ecu_report.as_ref(), &dir, &problems);
-    if let Ok(s) = &recorded {
+    let meta = record::RunMeta {
+        route: route.name().to_owned(),
+        timing_emulated: Some(route.timing_emulated()),
+        scenario: Some(cfg.scenario.clone()),
+    };
+    let mut summary;
+    if record::pending::deferred() {
+        // The caller writes it on the host when the guest has ended (record::pending).
+        if let Err(e) = record::pending::defer(&dir, &meta) {
+            problems.push(format!("recording: {e:#}"));
+        }
+        summary = summarise(&scenario, &report, ecu_report.as_ref(), &dir, &problems);
         let _ = writeln!(
             summary,
-            "recording: {} ({} messages on {} topics, {:.0} kB, written in {:.2} s = {:.1} % of the run's {:.1} s; open in Foxglove, README \"Recordings\")",
+            "recording: {} to be written on the host after the run ({}=1)",
             dir.join(record::RUN_MCAP).display(),
-            s.messages.values().sum::<u64>(),
-            s.messages.len(),
-            s.bytes as f64 / 1e3,
-            recording_s,
-            100.0 * recording_s / run_s,
-            run_s
+            record::pending::RECORD_ON_HOST
         );
+    } else {
+        let recording_started = std::time::Instant::now();
+        let recorded = record::write_run(&dir, &dir.join(record::RUN_MCAP), &meta);
+        // Its cost, on the clock the run ran on (the guest's own on an emulated route),
+        // against the whole run's (issue 23: ≤ 5 %).
+        let recording_s = recording_started.elapsed().as_secs_f64();
+        let run_s = run_started.elapsed().as_secs_f64();
+        if let Err(e) = &recorded {
+            problems.push(format!("recording: {e:#}"));
+        }
+        summary = summarise(&scenario, &report, ecu_report.as_ref(), &dir, &problems);
+        if let Ok(s) = &recorded {
+            let cost = format!(
+                "written in {recording_s:.2} s = {:.1} % of the run's {run_s:.1} s",
+                100.0 * recording_s / run_s
+            );
+            let _ = writeln!(summary, "{}", record::pending::summary_line(&dir, s, &cost));
+        }
     }
     std::fs::write(dir.join("summary.txt"), &summary)?;
     Ok(RunResult {

@@ -207,16 +207,19 @@ fn run() -> Result<bool> {
                 let mut recorded = true;
                 if cli.mf4 {
                     let out = r.dir.join(record::RUN_MF4);
-                    match record::write_run_mf4(&r.dir, &out) {
-                        Ok(s) => println!(
-                            "recording (MDF 4.1): {} ({} CAN frames, {} diagnostics records, {:.0} kB; open in asammdf or CANape, README \"Recordings\"){}",
-                            out.display(),
-                            s.can_frames,
-                            s.diagnostics,
-                            s.bytes as f64 / 1e3,
-                            s.diagnostics_left_out
-                                .map_or(String::new(), |w| format!("; diagnostics left out: {w}"))
-                        ),
+                    // Where the run's recording is left to the host, so is its MF4.
+                    match record::pending::defer_mf4(&r.dir).and_then(|deferred| {
+                        if deferred {
+                            Ok(format!(
+                                "recording (MDF 4.1): {} to be written on the host after the run",
+                                out.display()
+                            ))
+                        } else {
+                            record::write_run_mf4(&r.dir, &out)
+                                .map(|s| record::mf4_summary_line(&out, &s))
+                        }
+                    }) {
+                        Ok(line) => println!("{line}"),
                         Err(e) => {
                             eprintln!("hil-bench: {}: {e:#}", out.display());
                             recorded = false;

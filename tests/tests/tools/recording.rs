@@ -388,3 +388,43 @@ fn run_mf4_without_a_clock_pairing_leaves_the_diagnostics_out_and_says_so() {
     assert!(text.contains("no run.mcap"), "{text}");
     assert!(text.contains("extract_bus_logging"), "{text}");
 }
+
+/// `RECORD_ON_HOST`: a run leaves a note; `record pending` (record::pending::write_pending) writes
+/// the recording and the asked-for MF4 afterwards, appends their lines to the run's summary and
+/// removes the note. A damaged note fails that folder alone, says which, and keeps its note.
+#[test]
+fn pending_recordings_are_written_after_the_run_and_a_bad_note_fails_alone() {
+    let root = std::env::temp_dir().join(format!("record-pending-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    let good = root.join("good");
+    known_run(&good);
+    std::fs::write(good.join("summary.txt"), "the run's summary\n").unwrap();
+    record::pending::defer(&good, &meta()).unwrap();
+    assert!(record::pending::defer_mf4(&good).unwrap());
+    let bad = root.join("bad");
+    std::fs::create_dir_all(&bad).unwrap();
+    std::fs::write(bad.join(record::pending::PENDING), "{ not json").unwrap();
+    let plain = root.join("plain");
+    std::fs::create_dir_all(&plain).unwrap();
+    assert!(
+        !record::pending::defer_mf4(&plain).unwrap(),
+        "no note: the caller writes the MF4 itself"
+    );
+
+    let written = record::pending::write_pending(&root).unwrap();
+    assert_eq!(written.len(), 2, "{written:?}");
+    let by = |d: &Path| written.iter().find(|w| w.dir == d).unwrap();
+    let lines = by(&good).result.as_ref().unwrap();
+    assert!(lines[0].starts_with("recording: ") && lines[0].contains("written on the host"));
+    assert!(lines[1].starts_with("recording (MDF 4.1): "));
+    assert!(!good.join(record::pending::PENDING).exists());
+    let summary = std::fs::read_to_string(good.join("summary.txt")).unwrap();
+    assert!(summary.starts_with("the run's summary\nrecording: "), "{summary}");
+    python_check(&good, false);
+    check_mf4(&[&good]).unwrap_or_else(|e| panic!("{e}"));
+    let e = by(&bad).result.as_ref().unwrap_err();
+    assert!(e.contains("record.pending.json"), "{e}");
+    assert!(bad.join(record::pending::PENDING).exists());
+    // Written once: a second pass finds only the bad note.
+    assert_eq!(record::pending::write_pending(&root).unwrap().len(), 1);
+}
