@@ -81,6 +81,7 @@ fn main() -> Result<()> {
                     route,
                     timing_emulated: timing.map(|t| t == "emulated"),
                     scenario,
+                    simulated_start_ns: None,
                 },
             )
             .with_context(|| format!("recording {}", dir.display()))?;

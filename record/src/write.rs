@@ -21,6 +21,11 @@ pub struct RunMeta {
     pub timing_emulated: Option<bool>,
     /// The scenario file the run played: its closed-form truth goes on `/truth/world`.
     pub scenario: Option<std::path::PathBuf>,
+    /// A simulated run (the offline bench): every time in the folder is on its simulated
+    /// clock, and its scenario starts at this time, ns. `None`: a bench run (the clocks are
+    /// the kernel's; the start is the stubs' report's).
+    #[serde(default)]
+    pub simulated_start_ns: Option<u64>,
 }
 
 /// What was written.
@@ -117,6 +122,12 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         feeds,
         offset,
     } = RunFiles::read(dir)?;
+    // A simulated run has one clock: candump's stamps and the records' are the same.
+    let offset = if meta.simulated_start_ns.is_some() {
+        Some(0)
+    } else {
+        offset
+    };
     let file = std::fs::File::create(out).with_context(|| out.display().to_string())?;
     let mut rec = Recording {
         w: Writer::new(BufWriter::new(file))?,
@@ -128,16 +139,21 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         ("route".to_owned(), meta.route.clone()),
         (
             "timing".to_owned(),
-            match meta.timing_emulated {
-                Some(true) => "emulated (a virtual CPU's; measure real timing on the host)",
-                Some(false) => "real",
-                None => "unknown",
+            match (meta.simulated_start_ns, meta.timing_emulated) {
+                (Some(_), _) => "simulated (the offline bench: the core on a simulated clock)",
+                (None, Some(true)) => "emulated (a virtual CPU's; measure real timing on the host)",
+                (None, Some(false)) => "real",
+                (None, None) => "unknown",
             }
             .to_owned(),
         ),
         (
             "log_time_clock".to_owned(),
-            if offset.is_some() {
+            if meta.simulated_start_ns.is_some() {
+                "the offline bench's simulated clock (restraint::SimLoop), ns: no processes, \
+                 frames at their cycle or tick without bus latency"
+                    .to_owned()
+            } else if offset.is_some() {
                 "CLOCK_MONOTONIC of the bench, ns".to_owned()
             } else {
                 "CLOCK_REALTIME (candump's stamps; no frame seen by both candump and the stubs)"
@@ -178,6 +194,8 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         bench.insert("scenario".to_owned(), r.scenario.clone());
         bench.insert("start_ns".to_owned(), r.start_ns.to_string());
         bench.insert("contact_ns".to_owned(), r.contact_ns.to_string());
+    } else if let Some(start) = meta.simulated_start_ns {
+        bench.insert("start_ns".to_owned(), start.to_string());
     }
     rec.w.write_metadata(&Metadata {
         name: "bench".to_owned(),
@@ -304,11 +322,15 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
             metadata: BTreeMap::from([("left_out".to_owned(), e.clone())]),
         })?;
     }
-    if let (Some(Ok((scenario, truth))), Some((r, _))) = (&truth, &report) {
+    let start_ns = report
+        .as_ref()
+        .map(|(r, _)| r.start_ns)
+        .or(meta.simulated_start_ns);
+    if let (Some(Ok((scenario, truth))), Some(start_ns)) = (&truth, start_ns) {
         let schema = schema::truth_schema(&truth.state(0.0));
         let steps = (scenario.duration_s * 1e3).round() as u64;
         for k in 0..=steps {
-            let t = r.start_ns + k * 1_000_000;
+            let t = start_ns + k * 1_000_000;
             rec.write(
                 "/truth/world",
                 schema::TRUTH_SCHEMA,

@@ -16,7 +16,7 @@
 use actuator_stubs::commands::{decode, Modules};
 use actuator_stubs::outcome::{evaluate, Evaluated};
 use actuator_stubs::status::{ecu_fault_names, ecu_mode_name};
-use anyhow::{anyhow, Result};
+use anyhow::{anyhow, Context, Result};
 use restraint::{CycleConfig, RestraintCycle, SimIo, SimLoop};
 use sensor_feeds::{Player, TickOutput};
 use world::{Scenario, Truth};
@@ -133,6 +133,67 @@ pub struct Trace {
     pub safing_g: Vec<(f64, f64)>,
     /// The core's state after each ECU cycle.
     pub cycles: Vec<TraceCycle>,
+    /// What a bench run's folder would hold, collected when `Some` (`offline-bench --record`).
+    pub record: Option<RunLog>,
+}
+
+/// A simulated run as a bench run's folder would hold it, for the same recording
+/// (`record::write_run`): the bus as candump logs it (the feeds' frames at their tick, the
+/// ECU's at its cycle: no bus latency), what the feeds published (`feeds.postcard`) and every
+/// cycle's diagnostics record (`diagnostics.postcard`) — all on the simulated clock.
+#[derive(Debug, Default, Clone)]
+pub struct RunLog {
+    candump: String,
+    feeds: Vec<u8>,
+    diagnostics: Vec<u8>,
+}
+
+impl RunLog {
+    fn frame(&mut self, t_ns: u64, f: &bus::RawFrame) {
+        use std::fmt::Write as _;
+        let _ = writeln!(
+            self.candump,
+            "({}.{:06}) vcan0 {}",
+            t_ns / 1_000_000_000,
+            (t_ns % 1_000_000_000) / 1_000,
+            bus::candump::cansend_arg(f)
+        );
+    }
+
+    fn publish(&mut self, t_ns: u64, item: signals::FeedItem) {
+        let rec = signals::FeedLogRecord {
+            published_ns: t_ns,
+            item,
+        };
+        if let Ok(b) = postcard::to_stdvec(&rec) {
+            self.feeds.extend(b);
+        }
+    }
+
+    /// Writes the folder's files into `dir` and its recording (`run.mcap`) from them.
+    ///
+    /// # Errors
+    /// A file cannot be written, or the recording fails.
+    pub fn write(
+        &self,
+        dir: &std::path::Path,
+        scenario: &std::path::Path,
+    ) -> Result<record::WriteSummary> {
+        std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+        std::fs::write(dir.join("candump.log"), &self.candump)?;
+        std::fs::write(dir.join(record::FEEDS_LOG), &self.feeds)?;
+        std::fs::write(dir.join(actuator_stubs::DIAGNOSTICS_LOG), &self.diagnostics)?;
+        record::write_run(
+            dir,
+            &dir.join(record::RUN_MCAP),
+            &record::RunMeta {
+                route: "offline (no processes, no bus)".to_owned(),
+                timing_emulated: None,
+                scenario: Some(scenario.to_path_buf()),
+                simulated_start_ns: Some(START_NS),
+            },
+        )
+    }
 }
 
 /// The core's crash-phase state after one cycle.
@@ -230,6 +291,20 @@ pub fn run_traced(
         out.accel.iter().for_each(|a| io.push_accel(*a));
         out.safing.iter().for_each(|a| io.push_safing(*a));
         out.can.iter().for_each(|f| io.push_can(*f));
+        if let Some(log) = trace.as_deref_mut().and_then(|t| t.record.as_mut()) {
+            let t = START_NS + tick * MS;
+            out.can.iter().for_each(|f| log.frame(t, f));
+            use signals::FeedItem;
+            out.objects
+                .iter()
+                .for_each(|o| log.publish(t, FeedItem::Object(*o)));
+            out.accel
+                .iter()
+                .for_each(|b| log.publish(t, FeedItem::CrashAccel(*b)));
+            out.safing
+                .iter()
+                .for_each(|b| log.publish(t, FeedItem::SafingAccel(*b)));
+        }
         if let Some(t) = trace.as_deref_mut() {
             out.accel.iter().for_each(|b| t.crash_g.extend(batch_g(b)));
             out.safing
@@ -238,6 +313,12 @@ pub fn run_traced(
         }
         let now = clock.step(&mut ecu, &mut io).now_ns;
         let m = io.diagnostics.mode;
+        if let Some(log) = trace.as_deref_mut().and_then(|t| t.record.as_mut()) {
+            clock.sent(&io).for_each(|f| log.frame(now, f));
+            if let Ok(b) = postcard::to_stdvec(&io.diagnostics) {
+                log.diagnostics.extend(b);
+            }
+        }
         for f in clock.sent(&io) {
             if let Ok(msg) = bus::decode(f.id, f.payload()) {
                 modules.apply(now, &decode(&msg));

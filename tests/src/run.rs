@@ -447,6 +447,7 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
         route: route.name().to_owned(),
         timing_emulated: Some(route.timing_emulated()),
         scenario: Some(cfg.scenario.clone()),
+        simulated_start_ns: None,
     };
     let mut summary;
     if record::pending::deferred() {

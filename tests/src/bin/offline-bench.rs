@@ -1,5 +1,5 @@
 //! `offline-bench [--scenario FILE …] [--no-lut] [--json FILE] [--cycle-config FILE] [--plot DIR]
-//! [--no-expect]`: runs scenarios through the restraint core under a simulated clock with the
+//! [--record DIR] [--no-expect]`: runs scenarios through the restraint core under a simulated clock with the
 //! real sensor model and the actuator stubs' judge (`e2e_tests::offline`), prints the outcome
 //! table (one line per run, one indented line per restraint action) and judges every
 //! `[expect]` key of every file (`e2e_tests::expect`, the judge `hil-bench` uses too). No vcan,
@@ -47,6 +47,11 @@ struct Cli {
     /// boundaries and floors, the ECU's mode and every restraint action (created if missing).
     #[arg(long, value_name = "DIR")]
     plot: Option<PathBuf>,
+    /// Record each run as a bench run is recorded: DIR/<scenario>/run.mcap (the bus, the
+    /// feeds' publications, every cycle's diagnostics, the truth — on the simulated clock, no
+    /// bus latency) beside the candump.log and logs it is written from (created if missing).
+    #[arg(long, value_name = "DIR")]
+    record: Option<PathBuf>,
     /// Do not judge the files' `[expect]` blocks (by default every key is asserted and a miss
     /// exits 1).
     #[arg(long)]
@@ -84,6 +89,9 @@ fn run_all() -> Result<bool> {
     if let Some(dir) = &cli.plot {
         host::check_output_dir(dir).with_context(|| format!("--plot {}", dir.display()))?;
     }
+    if let Some(dir) = &cli.record {
+        host::check_output_dir(dir).with_context(|| format!("--record {}", dir.display()))?;
+    }
     if let Some(p) = &cli.json {
         host::check_output_file(p).with_context(|| format!("--json {}", p.display()))?;
     }
@@ -101,6 +109,7 @@ fn run_all() -> Result<bool> {
     let mut say = |line: &str| writeln!(out, "{line}").is_ok();
     say(&table_header(width));
     let (mut json, mut failed, mut missed) = (Vec::new(), 0usize, Vec::new());
+    let (mut recorded, mut recorded_bytes) = (0usize, 0u64);
     for (file, loaded) in loaded {
         let file_name = file.display().to_string();
         let s = match loaded {
@@ -112,8 +121,12 @@ fn run_all() -> Result<bool> {
                 continue;
             }
         };
-        let mut trace = Trace::default();
-        let r = match run_traced(&s, &cfg, cli.plot.is_some().then_some(&mut trace)) {
+        let mut trace = Trace {
+            record: cli.record.is_some().then(Default::default),
+            ..Trace::default()
+        };
+        let traced = cli.plot.is_some() || cli.record.is_some();
+        let r = match run_traced(&s, &cfg, traced.then_some(&mut trace)) {
             Ok(r) => r,
             Err(e) => {
                 eprintln!("offline-bench: {file_name}: {e:#}");
@@ -128,6 +141,13 @@ fn run_all() -> Result<bool> {
             e2e_tests::offline_plot::draw(&dir.join(format!("{}.png", r.name)), &r, &trace)
                 .map_err(anyhow::Error::msg)?;
         }
+        if let (Some(dir), Some(log)) = (&cli.record, &trace.record) {
+            let w = log
+                .write(&dir.join(&r.name), file)
+                .with_context(|| format!("--record {}", dir.join(&r.name).display()))?;
+            recorded += 1;
+            recorded_bytes += w.bytes;
+        }
         let mismatches = (!cli.no_expect).then(|| check(&s, &Observed::offline(&r)));
         if !say(&table_row(&r, width)) {
             return Ok(true);
@@ -138,6 +158,13 @@ fn run_all() -> Result<bool> {
         json.push(run_json(&r, file, mismatches.as_deref()));
     }
     say("(! = bottomed out; confirm = first ECU cycle in mode crash; airbag = ms after the true contact, plan = its FireTime; action lines: ms after the true contact, or after the start without one; times on the simulated 1 kHz grid, no CAN latency)");
+    if let Some(dir) = &cli.record {
+        say(&format!(
+            "recordings: {recorded} runs in {}/<scenario>/run.mcap ({:.1} MB; simulated clock, no bus latency; README \"Recordings\")",
+            dir.display(),
+            recorded_bytes as f64 / 1e6
+        ));
+    }
     if let Some(p) = &cli.json {
         std::fs::write(p, serde_json::to_string_pretty(&json)?)
             .with_context(|| format!("writing {}", p.display()))?;

@@ -558,3 +558,37 @@ fn the_table_shows_every_restraint_action_and_says_when_there_is_no_contact() {
         "{stdout}"
     );
 }
+
+/// `offline-bench --record DIR` records a simulated run as a bench run is recorded — the bus,
+/// the feeds' publications, every cycle's diagnostics, the truth — on the simulated clock, and
+/// record/check_mcap.py (Foxglove's `mcap` package and cantools, no project code) accepts it:
+/// one diagnostics record per 1 ms cycle of the scenario, none missing, the truth every ms from
+/// the scenario's start.
+#[test]
+fn offline_bench_records_a_run_as_the_bench_does_on_its_simulated_clock() {
+    let name = "taurus-48-48-abs";
+    let dir = std::env::temp_dir().join(format!("offline-bench-record-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_offline-bench"))
+        .arg("--scenario")
+        .arg(root().join(format!("scenarios/{name}.toml")))
+        .arg("--record")
+        .arg(&dir)
+        .output()
+        .expect("offline-bench runs");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{stdout}");
+    assert!(stdout.contains("recordings: 1 runs in"), "{stdout}");
+    let run = dir.join(name);
+    let text = e2e_tests::harness::check_recording(&run, false).unwrap_or_else(|e| panic!("{e}"));
+    let cycles = (scenario(name).duration_s * 1e3).round() as u64 + 1;
+    for want in [
+        format!("/ecu/diagnostics: {cycles} records at their timestamps, 0 cycles never published"),
+        format!("/truth/world: {cycles} states every ms from the start"),
+        "route offline".to_owned(),
+        "every crash batch the ECU read is among them".to_owned(),
+    ] {
+        assert!(text.contains(&want), "{want}:\n{text}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

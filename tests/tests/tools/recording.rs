@@ -27,6 +27,7 @@ fn meta() -> record::RunMeta {
         route: "test".into(),
         timing_emulated: None,
         scenario: None,
+        simulated_start_ns: None,
     }
 }
 
@@ -419,7 +420,10 @@ fn pending_recordings_are_written_after_the_run_and_a_bad_note_fails_alone() {
     assert!(lines[1].starts_with("recording (MDF 4.1): "));
     assert!(!good.join(record::pending::PENDING).exists());
     let summary = std::fs::read_to_string(good.join("summary.txt")).unwrap();
-    assert!(summary.starts_with("the run's summary\nrecording: "), "{summary}");
+    assert!(
+        summary.starts_with("the run's summary\nrecording: "),
+        "{summary}"
+    );
     python_check(&good, false);
     check_mf4(&[&good]).unwrap_or_else(|e| panic!("{e}"));
     let e = by(&bad).result.as_ref().unwrap_err();
