@@ -18,6 +18,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod bound;
 pub mod distributed;
 pub mod estimation;
 pub mod fallback_study;

@@ -577,14 +577,9 @@ pub struct VerifyRow {
     pub problem: Option<String>,
 }
 
-/// Re-optimise `n` random cells (chosen with `seed`, and re-optimised with seeds derived from
-/// `seed`, independent of the build's) and check the table: (1) the stored setting re-simulated
-/// reproduces the stored objective and flag within [`RESIM_TOL_ABS_G`]/[`RESIM_TOL_REL`];
-/// (2) the independent optimum is not better than the table by more than
-/// [`REOPT_TOL_ABS_G`]/[`REOPT_TOL_REL`], and not feasible where the table says infeasible.
-pub fn verify(d: &Diagram, n: usize, seed: u64) -> Result<Vec<VerifyRow>> {
-    let grid = Grid::from_table(d)?;
-    let count = grid.axes.cell_count();
+/// `n` distinct cell indices below `count`, drawn with SplitMix64 from `seed` (the same cells
+/// for the same seed, on any machine).
+pub fn sample_cells(count: usize, n: usize, seed: u64) -> Vec<usize> {
     let mut picks = Vec::new();
     let mut state = seed;
     while picks.len() < n.min(count) {
@@ -594,6 +589,17 @@ pub fn verify(d: &Diagram, n: usize, seed: u64) -> Result<Vec<VerifyRow>> {
             picks.push(i);
         }
     }
+    picks
+}
+
+/// Re-optimise `n` random cells (chosen with `seed`, and re-optimised with seeds derived from
+/// `seed`, independent of the build's) and check the table: (1) the stored setting re-simulated
+/// reproduces the stored objective and flag within [`RESIM_TOL_ABS_G`]/[`RESIM_TOL_REL`];
+/// (2) the independent optimum is not better than the table by more than
+/// [`REOPT_TOL_ABS_G`]/[`REOPT_TOL_REL`], and not feasible where the table says infeasible.
+pub fn verify(d: &Diagram, n: usize, seed: u64) -> Result<Vec<VerifyRow>> {
+    let grid = Grid::from_table(d)?;
+    let picks = sample_cells(grid.axes.cell_count(), n, seed);
     let hw = RestraintHardware::default();
     picks
         .par_iter()

@@ -10,6 +10,7 @@ use physics::{
 use serde_json::json;
 use std::path::PathBuf;
 
+mod bound;
 mod estimation;
 mod fallback;
 mod occupant;
@@ -31,6 +32,10 @@ pub enum StudyCommand {
     /// crashes: no-fire and must-fire lines, fire times against the occupant's deadline;
     /// `--derive` calibrates its boundary.
     Fallback(fallback::FallbackArgs),
+    /// How close the table's optima come to the ideal constant-force bound a*, and which
+    /// limitation of the restraint model (belt slack, airbag fill time, force ceilings) keeps
+    /// them from it.
+    Bound(bound::BoundArgs),
     /// The ECU's track filter against the newest sample alone over the scenario library and
     /// noisier sensors: errors at contact, occupant outcome, a plot of one case.
     Estimation(estimation::EstimationArgs),
@@ -54,6 +59,7 @@ pub fn run(cmd: &StudyCommand) -> Result<()> {
         StudyCommand::Robustness(args) => robustness::run(args),
         StudyCommand::Fallback(args) => fallback::run(args),
         StudyCommand::Estimation(args) => estimation::run(args),
+        StudyCommand::Bound(args) => bound::run(args),
     }
 }
 
