@@ -25,6 +25,7 @@ pub mod fallback_study;
 pub mod optimise;
 pub mod progress;
 pub mod reference;
+pub mod robust_cells;
 pub mod robustness;
 pub mod scenario;
 pub mod shard;

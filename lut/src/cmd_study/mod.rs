@@ -14,6 +14,7 @@ mod bound;
 mod estimation;
 mod fallback;
 mod occupant;
+mod robust_cells;
 mod robustness;
 
 #[derive(Subcommand, Debug)]
@@ -36,6 +37,9 @@ pub enum StudyCommand {
     /// limitation of the restraint model (belt slack, airbag fill time, force ceilings) keeps
     /// them from it.
     Bound(bound::BoundArgs),
+    /// Robust cells (optimised over the opponent-mass and closing-speed uncertainty set)
+    /// against no margin and today's +1 200 kg planning on the library's nominal cases.
+    RobustCells(robust_cells::RobustCellsArgs),
     /// The ECU's track filter against the newest sample alone over the scenario library and
     /// noisier sensors: errors at contact, occupant outcome, a plot of one case.
     Estimation(estimation::EstimationArgs),
@@ -60,6 +64,7 @@ pub fn run(cmd: &StudyCommand) -> Result<()> {
         StudyCommand::Fallback(args) => fallback::run(args),
         StudyCommand::Estimation(args) => estimation::run(args),
         StudyCommand::Bound(args) => bound::run(args),
+        StudyCommand::RobustCells(args) => robust_cells::run(args),
     }
 }
 

@@ -1,0 +1,135 @@
+//! `lut study robust-cells`: robust cells against today's two rules on the library's nominal
+//! belted car-to-car cases (`lut::robust_cells`).
+
+use anyhow::Result;
+use clap::Args;
+use lut::robust_cells::{judge, point_optimum, robust_optimum, Judged, Situation, Uncertainty};
+use lut::scenario::Ego;
+use lut::table::Grid;
+use physics::reference::ReferenceRestraint;
+use physics::OccupantInput;
+use rayon::prelude::*;
+use serde_json::json;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct RobustCellsArgs {
+    /// Reference restraint file.
+    #[arg(long, default_value = "data/reference-restraint.toml")]
+    pub reference: PathBuf,
+    /// The grid whose optimiser settings the cells use.
+    #[arg(long, default_value = "data/default-grid.toml")]
+    pub grid: PathBuf,
+    /// Opponent mass half-width of the set [kg].
+    #[arg(long, default_value_t = Uncertainty::MISREPORT.mass_kg)]
+    pub mass_kg: f64,
+    /// Closing speed half-width of the set [km/h].
+    #[arg(long, default_value_t = Uncertainty::MISREPORT.speed_kph)]
+    pub speed_kph: f64,
+    /// Both errors at once (the box's corners), not only one at a time.
+    #[arg(long)]
+    pub corners: bool,
+    /// JSON output.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The library's nominal belted car-to-car cases at contact: name, closing km/h, opponent kg
+/// (75 kg occupant, 300 mm).
+pub const CASES: [(&str, f64, f64); 6] = [
+    ("taurus-52-52-none", 104.0, 1785.0),
+    ("taurus-48-48-abs", 96.0, 1785.0),
+    ("taurus-31-31-abs-eba", 62.0, 1785.0),
+    ("mass-sweep-1000kg", 96.0, 1000.0),
+    ("mass-sweep-1300kg", 96.0, 1300.0),
+    ("mass-sweep-2200kg", 96.0, 2200.0),
+];
+
+pub fn run(a: &RobustCellsArgs) -> Result<()> {
+    let reference = ReferenceRestraint::load(&a.reference)
+        .map_err(anyhow::Error::msg)?
+        .settings();
+    let cfg = Grid::load(&a.grid)?.optimiser;
+    let u = Uncertainty {
+        mass_kg: a.mass_kg,
+        speed_kph: a.speed_kph,
+        corners: a.corners,
+    };
+    let ego = Ego::default();
+    let occupant = OccupantInput {
+        mass_kg: 75.0,
+        chest_to_wheel_m: 0.300,
+        belted: true,
+    };
+    let rows: Vec<(&str, [Judged; 3])> = CASES
+        .par_iter()
+        .map(|&(name, v, m)| -> Result<(&str, [Judged; 3])> {
+            let s = Situation {
+                closing_kph: v,
+                opponent_kg: m,
+                occupant,
+            };
+            let none = point_optimum(&ego, &occupant, v, m, &cfg)?;
+            let margin = point_optimum(&ego, &occupant, v, m + u.mass_kg, &cfg)?;
+            let robust = robust_optimum(&ego, &s, &u, &reference, &cfg)?;
+            Ok((
+                name,
+                [
+                    judge(&ego, &s, &u, &reference, &none)?,
+                    judge(&ego, &s, &u, &reference, &margin)?,
+                    judge(&ego, &s, &u, &reference, &robust)?,
+                ],
+            ))
+        })
+        .collect::<Result<_>>()?;
+    const RULES: [&str; 3] = ["no margin", "+mass margin", "robust cell"];
+    if a.json {
+        let v: Vec<_> = rows
+            .iter()
+            .map(|(n, j)| json!({ "case": n, RULES[0]: j[0], RULES[1]: j[1], RULES[2]: j[2] }))
+            .collect();
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&json!({ "set": u, "cases": v }))?
+        );
+        return Ok(());
+    }
+    println!(
+        "a_max + a_mean against the reference restraint, %: nominal (estimate = truth) / worst over the set (opponent ± {:.0} kg, closing ± {:.0} km/h, {}) / points bottoming out where the reference does not",
+        u.mass_kg,
+        u.speed_kph,
+        if u.corners { "both at once: 9 points" } else { "one at a time: 5 points" }
+    );
+    println!(
+        "{:<22} {:>24} {:>24} {:>24}",
+        "case", RULES[0], RULES[1], RULES[2]
+    );
+    let cell = |j: &Judged| {
+        format!(
+            "{:+6.1} / {:+6.1} / {}",
+            j.nominal_change_pct, j.worst_change_pct, j.bottoms_out_alone
+        )
+    };
+    for (n, j) in &rows {
+        println!(
+            "{n:<22} {:>24} {:>24} {:>24}",
+            cell(&j[0]),
+            cell(&j[1]),
+            cell(&j[2])
+        );
+    }
+    let mean = |k: usize| {
+        rows.iter()
+            .map(|(_, j)| j[k].nominal_change_pct)
+            .sum::<f64>()
+            / rows.len() as f64
+    };
+    println!(
+        "{:<22} {:>24.1} {:>24.1} {:>24.1}",
+        "mean nominal",
+        mean(0),
+        mean(1),
+        mean(2)
+    );
+    Ok(())
+}
