@@ -65,6 +65,11 @@ struct Cli {
     /// campaign compares them with what the ECU sent).
     #[arg(long)]
     until_signal: bool,
+    /// Do not draw outcome.png: leave what it is drawn from in outcome-plot.json
+    /// (`actuator_stubs::plot::draw_later`, run by `record pending` on the host). Drawing costs
+    /// 0.6–1.0 s of an emulated guest's time at the end of the run.
+    #[arg(long)]
+    plot_later: bool,
 }
 
 /// The ECU's default key file, for the default of `--secoc-keys`.
@@ -408,16 +413,36 @@ fn build_report(
         .iter()
         .map(|a| -physics::mps2_to_g(*a))
         .collect();
-    match plot::draw(
-        &png,
-        &scenario.name,
-        &judged.outcome.adaptive,
-        &judged.outcome.reference,
-        &pulse_g,
-        pulse.step_s * 1e3,
-    ) {
-        Ok(()) => report.plot = Some("outcome.png".into()),
-        Err(e) => eprintln!("actuator-stubs: warning: {e}"),
+    if cli.plot_later {
+        let data = plot::PlotData {
+            title: scenario.name.clone(),
+            adaptive: judged.outcome.adaptive.clone(),
+            adaptive_trace: plot::Trace::of(&judged.outcome.adaptive),
+            reference: judged.outcome.reference.clone(),
+            reference_trace: plot::Trace::of(&judged.outcome.reference),
+            pulse_g,
+            pulse_step_ms: pulse.step_s * 1e3,
+        };
+        let note = cli.out.join(plot::PLOT_LATER);
+        match serde_json::to_vec(&data)
+            .map_err(|e| e.to_string())
+            .and_then(|b| std::fs::write(&note, b).map_err(|e| e.to_string()))
+        {
+            Ok(()) => report.plot = Some("outcome.png".into()),
+            Err(e) => eprintln!("actuator-stubs: warning: {}: {e}", note.display()),
+        }
+    } else {
+        match plot::draw(
+            &png,
+            &scenario.name,
+            &judged.outcome.adaptive,
+            &judged.outcome.reference,
+            &pulse_g,
+            pulse.step_s * 1e3,
+        ) {
+            Ok(()) => report.plot = Some("outcome.png".into()),
+            Err(e) => eprintln!("actuator-stubs: warning: {e}"),
+        }
     }
     report.outcome = Some(judged.outcome);
     Ok(report)

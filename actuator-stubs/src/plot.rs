@@ -3,7 +3,87 @@
 
 use crate::report::Judged;
 use plotters::prelude::*;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
+
+/// File name of a picture left to be drawn after the run (`actuator-stubs --plot-later`):
+/// drawing costs 0.6–1.0 s of an emulated guest's time at the end of every run, on the run's
+/// critical path, and a few ms on the host. `draw_later` draws it there.
+pub const PLOT_LATER: &str = "outcome-plot.json";
+
+/// Everything [`draw`] needs, as written for [`draw_later`] (the time histories are not in
+/// report.json).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PlotData {
+    /// Picture title (the scenario name).
+    pub title: String,
+    /// Adaptive outcome.
+    pub adaptive: Judged,
+    /// Its time histories.
+    pub adaptive_trace: Trace,
+    /// Reference outcome.
+    pub reference: Judged,
+    /// Its time histories.
+    pub reference_trace: Trace,
+    /// Compartment deceleration [g], one value per `pulse_step_ms`.
+    pub pulse_g: Vec<f64>,
+    /// Pulse step [ms].
+    pub pulse_step_ms: f64,
+}
+
+/// A judged outcome's time histories.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct Trace {
+    /// t [ms after contact].
+    pub t_ms: Vec<f64>,
+    /// Occupant deceleration [g].
+    pub decel_g: Vec<f64>,
+    /// Excursion [mm].
+    pub excursion_mm: Vec<f64>,
+}
+
+impl Trace {
+    /// The time histories of `j`.
+    pub fn of(j: &Judged) -> Self {
+        Self {
+            t_ms: j.t_ms.clone(),
+            decel_g: j.decel_g.clone(),
+            excursion_mm: j.excursion_trace_mm.clone(),
+        }
+    }
+
+    fn into_judged(self, mut j: Judged) -> Judged {
+        j.t_ms = self.t_ms;
+        j.decel_g = self.decel_g;
+        j.excursion_trace_mm = self.excursion_mm;
+        j
+    }
+}
+
+/// Draws `dir/outcome.png` from `dir/`[`PLOT_LATER`] when a run left it, and removes the
+/// note; `Ok(false)` when there is none.
+///
+/// # Errors
+/// The note cannot be read or parsed, or the picture cannot be drawn.
+pub fn draw_later(dir: &Path) -> Result<bool, String> {
+    let note = dir.join(PLOT_LATER);
+    if !note.exists() {
+        return Ok(false);
+    }
+    let text = std::fs::read_to_string(&note).map_err(|e| format!("{}: {e}", note.display()))?;
+    let d: PlotData =
+        serde_json::from_str(&text).map_err(|e| format!("{}: invalid: {e}", note.display()))?;
+    draw(
+        &dir.join("outcome.png"),
+        &d.title,
+        &d.adaptive_trace.into_judged(d.adaptive),
+        &d.reference_trace.into_judged(d.reference),
+        &d.pulse_g,
+        d.pulse_step_ms,
+    )?;
+    std::fs::remove_file(&note).map_err(|e| format!("{}: {e}", note.display()))?;
+    Ok(true)
+}
 
 /// Draws the two-panel PNG; `pulse_g` is the compartment deceleration [g] at `pulse_step_ms`.
 pub fn draw(

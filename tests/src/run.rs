@@ -276,6 +276,7 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
         // Appended to by every feeds process of the run (a restart continues it).
         record::FEEDS_LOG,
         record::pending::PENDING,
+        actuator_stubs::plot::PLOT_LATER,
         record::RUN_MCAP,
         record::RUN_MF4,
     ] {
@@ -320,6 +321,9 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
             .arg("--out")
             .arg(&dir)
             .args(&cfg.stubs_args)
+            // Where the recording is left to the host, so is the outcome picture (0.6–1.0 s of
+            // an emulated guest's time, on the run's critical path).
+            .args(record::pending::deferred().then_some("--plot-later"))
             .stderr(Stdio::piped()),
         "actuator-stubs",
     )?;

@@ -412,12 +412,36 @@ fn pending_recordings_are_written_after_the_run_and_a_bad_note_fails_alone() {
         "no note: the caller writes the MF4 itself"
     );
 
+    // The stubs' picture left to the host (`--plot-later`): a rising deceleration and
+    // excursion, drawn to outcome.png by the same pass.
+    let judged = |a: f64| {
+        format!(
+            r#"{{"load_limiter_kn": 6.0, "airbag_level_kn": 5.0, "pretensioner_ms": -30.0,
+                "airbag_ms": 12.0, "a_max_g": {a}, "a_mean_g": 15.0, "excursion_mm": 180.0,
+                "available_mm": 240.0, "bottomed_out": false}}"#
+        )
+    };
+    let trace = r#"{"t_ms": [0.0, 50.0, 100.0], "decel_g": [0.0, 20.0, 5.0], "excursion_mm": [0.0, 150.0, 180.0]}"#;
+    std::fs::write(
+        good.join(actuator_stubs::plot::PLOT_LATER),
+        format!(
+            r#"{{"title": "known", "adaptive": {}, "adaptive_trace": {trace}, "reference": {},
+                "reference_trace": {trace}, "pulse_g": [0.0, 10.0, 20.0, 0.0], "pulse_step_ms": 30.0}}"#,
+            judged(20.0),
+            judged(24.0)
+        ),
+    )
+    .unwrap();
     let written = record::pending::write_pending(&root).unwrap();
     assert_eq!(written.len(), 2, "{written:?}");
     let by = |d: &Path| written.iter().find(|w| w.dir == d).unwrap();
     let lines = by(&good).result.as_ref().unwrap();
     assert!(lines[0].starts_with("recording: ") && lines[0].contains("written on the host"));
     assert!(lines[1].starts_with("recording (MDF 4.1): "));
+    assert!(lines[2].starts_with("outcome picture: "), "{lines:?}");
+    let png = std::fs::read(good.join("outcome.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    assert!(!good.join(actuator_stubs::plot::PLOT_LATER).exists());
     assert!(!good.join(record::pending::PENDING).exists());
     let summary = std::fs::read_to_string(good.join("summary.txt")).unwrap();
     assert!(
