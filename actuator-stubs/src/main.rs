@@ -225,7 +225,7 @@ fn run(cli: &Cli) -> Result<()> {
                 rx_mono_ns: rx_ns,
                 id: f.id,
                 message: name,
-                data_hex: f.payload().iter().map(|b| format!("{b:02x}")).collect(),
+                data_hex: actuator_stubs::commands::data_hex(f.payload()),
                 e2e: v.e2e,
                 secoc: v.secoc,
                 decoded: v.decoded,

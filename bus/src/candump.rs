@@ -64,6 +64,17 @@ impl CandumpLog {
     }
 }
 
+/// One line of a `candump -L` log (without its newline): `(seconds.µs) DEVICE ID#HEX`, what
+/// [`CandumpLog::parse`] reads back; for logs written by simulations and tests.
+pub fn log_line(t_us: u64, device: &str, f: &RawFrame) -> String {
+    format!(
+        "({}.{:06}) {device} {}",
+        t_us / 1_000_000,
+        t_us % 1_000_000,
+        cansend_arg(f)
+    )
+}
+
 /// `ID#HEX` as `cansend` takes it (3 hex digits for a standard id, 8 for an extended one).
 pub fn cansend_arg(f: &RawFrame) -> String {
     let hex: String = f.payload().iter().map(|b| format!("{b:02X}")).collect();
@@ -77,6 +88,21 @@ pub fn cansend_arg(f: &RawFrame) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_written_line_reads_back_as_the_same_frame_and_stamp() {
+        for f in [
+            RawFrame::new(0x30, &[0x12, 0xab, 0, 7]),
+            RawFrame::new(0x1234_5678 | CAN_EFF_FLAG, &[]),
+        ] {
+            let line = log_line(1_733_000_123_000_456, "vcan0", &f);
+            let log = CandumpLog::parse(&line);
+            assert_eq!(log.skipped, 0, "{line}");
+            assert_eq!(log.frames[0].t_us, 1_733_000_123_000_456, "{line}");
+            assert_eq!(log.frames[0].device, "vcan0");
+            assert_eq!(log.frames[0].frame, f, "{line}");
+        }
+    }
 
     #[test]
     fn a_log_reads_back_what_cansend_would_send() {

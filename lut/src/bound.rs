@@ -21,8 +21,8 @@
 //! The lever that moves a_max / a\* most is what limits the optimum in this model; the
 //! figures are in the main README ("Towards the bound").
 
-use crate::optimise::{self, Case, OptimiserConfig, SearchSpace, Var};
-use crate::table::{occupant_at, pulse_at, sample_cells, Grid};
+use crate::optimise::{OptimiserConfig, SearchSpace, Var};
+use crate::table::{optimise_query, sample_cells, Grid};
 use anyhow::{anyhow, Result};
 use diagram::{Diagram, Query};
 use physics::{defaults, mps2_to_g, RestraintHardware};
@@ -277,16 +277,8 @@ pub fn optimise_with(grid: &Grid, i: usize, lever: &Lever) -> Result<(f64, f64, 
         .axes
         .point(i)
         .ok_or_else(|| anyhow!("cell {i} outside the grid"))?;
-    let pulse = pulse_at(&grid.ego, &p.query)?;
-    let case = Case {
-        pulse: pulse.ego(),
-        occupant: occupant_at(&p.query),
-    };
     let cfg = lever.config(grid.cell_config(i));
-    let space = lever
-        .space()
-        .with_earliest_airbag_s(cfg.earliest_airbag_s(&case.pulse));
-    let o = optimise::optimise(&[case], &space, &lever.hardware(), &cfg)?;
+    let o = optimise_query(&grid.ego, &p.query, lever.space(), &lever.hardware(), &cfg)?;
     let out = o
         .outcomes
         .first()

@@ -26,6 +26,7 @@ use crate::optimise::{
     self, effective_settings, minimise, Case, OptimiserConfig, SearchSpace, INFEASIBLE_OFFSET,
 };
 use crate::scenario::{Ego, Opponent, Pulse};
+use crate::table::optimise_situation;
 use anyhow::{anyhow, Result};
 use physics::{
     defaults, mps2_to_g, simulate_occupant, OccupantInput, OccupantOutcome, RestraintHardware,
@@ -94,10 +95,10 @@ struct Point {
     pulse: Pulse,
     reference_g: f64,
     reference_bottoms_out: bool,
-    /// The reference stays within the ride-down reserve too.
-    reference_keeps_reserve: bool,
-    /// The reference's cost as the optimiser counts it (`case_cost`, with the reserve where the
-    /// reference keeps it, without where it does not).
+    /// The ride-down reserve the cell is held to here: the optimiser's where the reference
+    /// keeps it, none where the reference only avoids bottoming out (or does not).
+    reserve_m: f64,
+    /// The reference's cost as the optimiser counts it (`case_cost` with `reserve_m`).
     reference_cost: f64,
 }
 
@@ -106,95 +107,132 @@ pub fn objective_g(o: &OccupantOutcome) -> f64 {
     mps2_to_g(o.max_decel_mps2) + mps2_to_g(o.mean_decel_mps2)
 }
 
-fn points(
-    ego: &Ego,
-    s: &Situation,
-    u: &Uncertainty,
-    reference: &RestraintSettings,
-    hw: &RestraintHardware,
-    reserve_m: f64,
-) -> Result<Vec<Point>> {
-    set_points(s, u)
-        .into_iter()
-        .map(|(v, m)| {
-            let pulse = Pulse::predict(ego, Opponent::Car { mass_kg: m }, v)?;
-            let r = simulate_occupant(&pulse.ego(), &s.occupant, reference, hw)?;
-            let keeps = optimise::case_cost(&r, reserve_m) < INFEASIBLE_OFFSET;
-            Ok(Point {
-                reference_g: objective_g(&r),
-                reference_bottoms_out: r.bottomed_out,
-                reference_keeps_reserve: keeps,
-                reference_cost: optimise::case_cost(&r, if keeps { reserve_m } else { 0.0 }),
-                pulse,
-            })
-        })
-        .collect()
+/// A situation's uncertainty set, its pulses predicted and the reference restraint simulated
+/// at every point once, for the robust optimum and for judging any setting over it.
+pub struct UncertainSet {
+    occupant: OccupantInput,
+    points: Vec<Point>,
 }
 
-/// The robust optimum of a situation (module docs); its setting.
-///
-/// # Errors
-/// A pulse cannot be predicted or the optimiser fails.
-pub fn robust_optimum(
-    ego: &Ego,
-    s: &Situation,
-    u: &Uncertainty,
-    reference: &RestraintSettings,
-    cfg: &OptimiserConfig,
-) -> Result<RestraintSettings> {
-    let hw = RestraintHardware::default();
-    let pts = points(ego, s, u, reference, &hw, cfg.reserve_m)?;
-    let nominal = pts.first().ok_or_else(|| anyhow!("no point"))?;
-    let space = SearchSpace::adaptive().with_earliest_airbag_s(
-        // The earliest the ECU can fire at any point of the set is the latest of the points'
-        // own earliest times: the airbag must wait for its floor wherever the truth lies.
-        pts.iter()
-            .map(|p| cfg.earliest_airbag_s(&p.pulse.ego()))
-            .fold(0.0, f64::max),
-    );
-    let cost = |x: &[f64]| -> Result<f64> {
-        let (set, outside_sq) = space.decode(x);
-        let set = effective_settings(&set, cfg);
-        // Where the reference keeps the ride-down reserve, so must the cell; where it only
-        // avoids bottoming out, so must the cell; where it bottoms out, the cell may too.
-        let no_reserve = OptimiserConfig {
-            reserve_m: 0.0,
-            ..*cfg
-        };
-        let c = |p: &Point, cfg: &OptimiserConfig| -> Result<f64> {
-            optimise::robust_case_cost(
-                &Case {
-                    pulse: p.pulse.ego(),
-                    occupant: s.occupant,
-                },
-                &set,
-                &hw,
-                cfg,
-            )
-        };
-        let mut total = c(nominal, cfg)?;
-        for p in &pts[1..] {
-            let cp = if p.reference_keeps_reserve {
-                c(p, cfg)?
-            } else {
-                c(p, &no_reserve)?
+impl UncertainSet {
+    /// The set of `s` under `u` (module docs), with the reference restraint's outcome at
+    /// every point; `reserve_m` is the optimiser's ride-down reserve.
+    ///
+    /// # Errors
+    /// A pulse cannot be predicted or an occupant simulation fails.
+    pub fn new(
+        ego: &Ego,
+        s: &Situation,
+        u: &Uncertainty,
+        reference: &RestraintSettings,
+        reserve_m: f64,
+    ) -> Result<Self> {
+        let hw = RestraintHardware::default();
+        let points = set_points(s, u)
+            .into_iter()
+            .map(|(v, m)| {
+                let pulse = Pulse::predict(ego, Opponent::Car { mass_kg: m }, v)?;
+                let r = simulate_occupant(&pulse.ego(), &s.occupant, reference, &hw)?;
+                let keeps = optimise::case_cost(&r, reserve_m) < INFEASIBLE_OFFSET;
+                let reserve_m = if keeps { reserve_m } else { 0.0 };
+                Ok(Point {
+                    reference_g: objective_g(&r),
+                    reference_bottoms_out: r.bottomed_out,
+                    reserve_m,
+                    reference_cost: optimise::case_cost(&r, reserve_m),
+                    pulse,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Self {
+            occupant: s.occupant,
+            points,
+        })
+    }
+
+    /// The robust optimum (module docs); its setting.
+    ///
+    /// # Errors
+    /// The optimiser fails.
+    pub fn robust_optimum(&self, cfg: &OptimiserConfig) -> Result<RestraintSettings> {
+        let hw = RestraintHardware::default();
+        let (nominal, others) = self
+            .points
+            .split_first()
+            .ok_or_else(|| anyhow!("no point"))?;
+        let space = SearchSpace::adaptive().with_earliest_airbag_s(
+            // The earliest the ECU can fire at any point of the set is the latest of the
+            // points' own earliest times: the airbag must wait for its floor wherever the
+            // truth lies.
+            self.points
+                .iter()
+                .map(|p| cfg.earliest_airbag_s(&p.pulse.ego()))
+                .fold(0.0, f64::max),
+        );
+        let cost = |x: &[f64]| -> Result<f64> {
+            let (set, outside_sq) = space.decode(x);
+            let set = effective_settings(&set, cfg);
+            // Where the reference keeps the ride-down reserve, so must the cell; where it only
+            // avoids bottoming out, so must the cell; where it bottoms out, the cell may too.
+            let c = |p: &Point, reserve_m: f64| -> Result<f64> {
+                optimise::robust_case_cost(
+                    &Case {
+                        pulse: p.pulse.ego(),
+                        occupant: self.occupant,
+                    },
+                    &set,
+                    &hw,
+                    &OptimiserConfig { reserve_m, ..*cfg },
+                )
             };
-            let r = p.reference_cost;
-            if cp > r {
-                total += match (cp >= INFEASIBLE_OFFSET, r >= INFEASIBLE_OFFSET) {
-                    // Bottoming out (or eating the reserve) where the reference does not.
-                    (true, false) => cp,
-                    // Both do: more overshoot (1 000 per mm) or more g than the reference.
-                    (true, true) => cp - r,
-                    (false, _) => WORSE_PENALTY_PER_G * (cp - r),
-                };
+            let mut total = c(nominal, cfg.reserve_m)?;
+            for p in others {
+                let (cp, r) = (c(p, p.reserve_m)?, p.reference_cost);
+                if cp > r {
+                    total += match (cp >= INFEASIBLE_OFFSET, r >= INFEASIBLE_OFFSET) {
+                        // Bottoming out (or eating the reserve) where the reference does not.
+                        (true, false) => cp,
+                        // Both do: more overshoot (1 000 per mm) or more g than the reference.
+                        (true, true) => cp - r,
+                        (false, _) => WORSE_PENALTY_PER_G * (cp - r),
+                    };
+                }
+            }
+            Ok(total + 1.0e3 * outside_sq)
+        };
+        let min = minimise(space.free_count(), &cost, cfg)?;
+        let (set, _) = space.decode(&min.u);
+        Ok(effective_settings(&set, cfg))
+    }
+
+    /// `set` (planned for the situation by some rule) on the truth at every point of the set.
+    ///
+    /// # Errors
+    /// An occupant simulation fails.
+    pub fn judge(&self, set: &RestraintSettings) -> Result<Judged> {
+        let hw = RestraintHardware::default();
+        let mut j = Judged {
+            nominal_change_pct: 0.0,
+            worst_change_pct: f64::NEG_INFINITY,
+            bottoms_out_alone: 0,
+            worse_than_reference: 0,
+        };
+        for (k, p) in self.points.iter().enumerate() {
+            let o = simulate_occupant(&p.pulse.ego(), &self.occupant, set, &hw)?;
+            let change = 100.0 * (objective_g(&o) - p.reference_g) / p.reference_g;
+            if k == 0 {
+                j.nominal_change_pct = change;
+            }
+            j.worst_change_pct = j.worst_change_pct.max(change);
+            if o.bottomed_out && !p.reference_bottoms_out {
+                j.bottoms_out_alone += 1;
+            }
+            if change > 0.0 {
+                j.worse_than_reference += 1;
             }
         }
-        Ok(total + 1.0e3 * outside_sq)
-    };
-    let min = minimise(space.free_count(), &cost, cfg)?;
-    let (set, _) = space.decode(&min.u);
-    Ok(effective_settings(&set, cfg))
+        Ok(j)
+    }
 }
 
 /// One setting judged over the set.
@@ -208,42 +246,6 @@ pub struct Judged {
     pub bottoms_out_alone: usize,
     /// Points where it is worse than the reference.
     pub worse_than_reference: usize,
-}
-
-/// `set` (planned for the situation by some rule) on the truth at every point of the set.
-///
-/// # Errors
-/// A pulse cannot be predicted or an occupant simulation fails.
-pub fn judge(
-    ego: &Ego,
-    s: &Situation,
-    u: &Uncertainty,
-    reference: &RestraintSettings,
-    set: &RestraintSettings,
-) -> Result<Judged> {
-    let hw = RestraintHardware::default();
-    let pts = points(ego, s, u, reference, &hw, 0.0)?;
-    let mut j = Judged {
-        nominal_change_pct: 0.0,
-        worst_change_pct: f64::NEG_INFINITY,
-        bottoms_out_alone: 0,
-        worse_than_reference: 0,
-    };
-    for (k, p) in pts.iter().enumerate() {
-        let o = simulate_occupant(&p.pulse.ego(), &s.occupant, set, &hw)?;
-        let change = 100.0 * (objective_g(&o) - p.reference_g) / p.reference_g;
-        if k == 0 {
-            j.nominal_change_pct = change;
-        }
-        j.worst_change_pct = j.worst_change_pct.max(change);
-        if o.bottomed_out && !p.reference_bottoms_out {
-            j.bottoms_out_alone += 1;
-        }
-        if change > 0.0 {
-            j.worse_than_reference += 1;
-        }
-    }
-    Ok(j)
 }
 
 /// The cell optimum at one (speed, mass): what the table stores there today.
@@ -264,10 +266,12 @@ pub fn point_optimum(
         },
         closing_kph,
     )?;
-    let case = Case {
-        pulse: pulse.ego(),
-        occupant: *occupant,
-    };
-    let space = SearchSpace::adaptive().with_earliest_airbag_s(cfg.earliest_airbag_s(&case.pulse));
-    Ok(optimise::optimise(&[case], &space, &RestraintHardware::default(), cfg)?.settings)
+    Ok(optimise_situation(
+        &pulse,
+        *occupant,
+        SearchSpace::adaptive(),
+        &RestraintHardware::default(),
+        cfg,
+    )?
+    .settings)
 }

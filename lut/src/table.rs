@@ -347,14 +347,14 @@ pub struct CellResult {
 
 /// Optimise the cell at grid point `p` with `cfg`.
 pub fn optimise_point(grid: &Grid, p: &GridPoint, cfg: &OptimiserConfig) -> Result<CellResult> {
-    let pulse = pulse_at(&grid.ego, &p.query)?;
-    let case = Case {
-        pulse: pulse.ego(),
-        occupant: occupant_at(&p.query),
-    };
-    let space = SearchSpace::adaptive().with_earliest_airbag_s(cfg.earliest_airbag_s(&case.pulse));
-    let optimum = optimise::optimise(&[case], &space, &RestraintHardware::default(), cfg)
-        .with_context(|| format!("cell {} {:?}", p.index, p.coords))?;
+    let optimum = optimise_query(
+        &grid.ego,
+        &p.query,
+        SearchSpace::adaptive(),
+        &RestraintHardware::default(),
+        cfg,
+    )
+    .with_context(|| format!("cell {} {:?}", p.index, p.coords))?;
     let o = optimum
         .outcomes
         .first()
@@ -363,6 +363,42 @@ pub fn optimise_point(grid: &Grid, p: &GridPoint, cfg: &OptimiserConfig) -> Resu
         cell: cell_of(&optimum.settings, o),
         optimum,
     })
+}
+
+/// The optimum of one grid point (`q`: closing speed, opponent, belted occupant): what every
+/// cell of a build is, and what the studies re-optimise with other spaces and hardware
+/// ([`optimise_situation`] on the point's predicted pulse and occupant).
+///
+/// # Errors
+/// The pulse cannot be predicted or the optimiser fails.
+pub fn optimise_query(
+    ego: &Ego,
+    q: &diagram::Query,
+    space: SearchSpace,
+    hw: &RestraintHardware,
+    cfg: &OptimiserConfig,
+) -> Result<optimise::Optimum> {
+    optimise_situation(&pulse_at(ego, q)?, occupant_at(q), space, hw, cfg)
+}
+
+/// The optimum of one situation within `space` on `hw`, the airbag no earlier than the pulse
+/// carries its floor (`OptimiserConfig::earliest_airbag_s`).
+///
+/// # Errors
+/// The optimiser fails.
+pub fn optimise_situation(
+    pulse: &Pulse,
+    occupant: OccupantInput,
+    space: SearchSpace,
+    hw: &RestraintHardware,
+    cfg: &OptimiserConfig,
+) -> Result<optimise::Optimum> {
+    let case = Case {
+        pulse: pulse.ego(),
+        occupant,
+    };
+    let space = space.with_earliest_airbag_s(cfg.earliest_airbag_s(&case.pulse));
+    optimise::optimise(&[case], &space, hw, cfg)
 }
 
 /// Optimise cell `index` of the grid (with its per-cell seed).

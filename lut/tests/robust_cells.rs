@@ -2,7 +2,7 @@
 //! of their set, they cannot beat the unconstrained optimum on the nominal case, and the set is
 //! what it says.
 
-use lut::robust_cells::{judge, point_optimum, robust_optimum, set_points, Situation, Uncertainty};
+use lut::robust_cells::{point_optimum, set_points, Situation, UncertainSet, Uncertainty};
 use lut::scenario::Ego;
 use lut::table::Grid;
 use physics::reference::ReferenceRestraint;
@@ -65,12 +65,13 @@ fn a_robust_cell_keeps_its_guarantee_over_the_whole_set() {
             occupant: occupant(),
         };
         let u = Uncertainty::MISREPORT;
-        let robust = robust_optimum(&ego, &s, &u, &reference, &cfg).unwrap();
-        let j = judge(&ego, &s, &u, &reference, &robust).unwrap();
+        let set = UncertainSet::new(&ego, &s, &u, &reference, cfg.reserve_m).unwrap();
+        let robust = set.robust_optimum(&cfg).unwrap();
+        let j = set.judge(&robust).unwrap();
         assert_eq!(j.bottoms_out_alone, 0, "{v} km/h, {m} kg: {j:?}");
         assert_eq!(j.worse_than_reference, 0, "{v} km/h, {m} kg: {j:?}");
         let free = point_optimum(&ego, &occupant(), v, m, &cfg).unwrap();
-        let jf = judge(&ego, &s, &u, &reference, &free).unwrap();
+        let jf = set.judge(&free).unwrap();
         assert!(
             j.nominal_change_pct >= jf.nominal_change_pct - 0.5,
             "{v} km/h, {m} kg: robust {j:?} beat the nominal optimum {jf:?}"

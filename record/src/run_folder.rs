@@ -75,14 +75,11 @@ impl RunFiles {
 fn clock_offset_ns(log: &CandumpLog, commands: &[Value]) -> Option<i64> {
     let mut by_frame: HashMap<(u32, String), Vec<u64>> = HashMap::new();
     for f in &log.frames {
-        let hex: String = f
-            .frame
-            .payload()
-            .iter()
-            .map(|b| format!("{b:02x}"))
-            .collect();
         by_frame
-            .entry((f.frame.id, hex))
+            .entry((
+                f.frame.id,
+                actuator_stubs::commands::data_hex(f.frame.payload()),
+            ))
             .or_default()
             .push(f.t_us * 1_000);
     }

@@ -153,10 +153,8 @@ impl RunLog {
         use std::fmt::Write as _;
         let _ = writeln!(
             self.candump,
-            "({}.{:06}) vcan0 {}",
-            t_ns / 1_000_000_000,
-            (t_ns % 1_000_000_000) / 1_000,
-            bus::candump::cansend_arg(f)
+            "{}",
+            bus::candump::log_line(t_ns / 1_000, "vcan0", f)
         );
     }
 

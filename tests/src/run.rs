@@ -453,37 +453,35 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
         scenario: Some(cfg.scenario.clone()),
         simulated_start_ns: None,
     };
-    let mut summary;
-    if record::pending::deferred() {
+    let recording = if record::pending::deferred() {
         // The caller writes it on the host when the guest has ended (record::pending).
-        if let Err(e) = record::pending::defer(&dir, &meta) {
-            problems.push(format!("recording: {e:#}"));
-        }
-        summary = summarise(&scenario, &report, ecu_report.as_ref(), &dir, &problems);
-        let _ = writeln!(
-            summary,
-            "recording: {} to be written on the host after the run ({}=1)",
-            dir.join(record::RUN_MCAP).display(),
-            record::pending::RECORD_ON_HOST
-        );
+        record::pending::defer(&dir, &meta).map(|()| {
+            format!(
+                "recording: {} to be written on the host after the run ({}=1)",
+                dir.join(record::RUN_MCAP).display(),
+                record::pending::RECORD_ON_HOST
+            )
+        })
     } else {
         let recording_started = std::time::Instant::now();
-        let recorded = record::write_run(&dir, &dir.join(record::RUN_MCAP), &meta);
-        // Its cost, on the clock the run ran on (the guest's own on an emulated route),
-        // against the whole run's (issue 23: ≤ 5 %).
-        let recording_s = recording_started.elapsed().as_secs_f64();
-        let run_s = run_started.elapsed().as_secs_f64();
-        if let Err(e) = &recorded {
-            problems.push(format!("recording: {e:#}"));
-        }
-        summary = summarise(&scenario, &report, ecu_report.as_ref(), &dir, &problems);
-        if let Ok(s) = &recorded {
+        record::write_run(&dir, &dir.join(record::RUN_MCAP), &meta).map(|s| {
+            // Its cost, on the clock the run ran on (the guest's own on an emulated route),
+            // against the whole run's (issue 23: ≤ 5 %).
+            let recording_s = recording_started.elapsed().as_secs_f64();
+            let run_s = run_started.elapsed().as_secs_f64();
             let cost = format!(
                 "written in {recording_s:.2} s = {:.1} % of the run's {run_s:.1} s",
                 100.0 * recording_s / run_s
             );
-            let _ = writeln!(summary, "{}", record::pending::summary_line(&dir, s, &cost));
-        }
+            record::pending::summary_line(&dir, &s, &cost)
+        })
+    };
+    let recording = recording
+        .map_err(|e| problems.push(format!("recording: {e:#}")))
+        .ok();
+    let mut summary = summarise(&scenario, &report, ecu_report.as_ref(), &dir, &problems);
+    if let Some(line) = recording {
+        let _ = writeln!(summary, "{line}");
     }
     std::fs::write(dir.join("summary.txt"), &summary)?;
     Ok(RunResult {

@@ -3,7 +3,7 @@
 
 use anyhow::Result;
 use clap::Args;
-use lut::robust_cells::{judge, point_optimum, robust_optimum, Judged, Situation, Uncertainty};
+use lut::robust_cells::{point_optimum, Judged, Situation, UncertainSet, Uncertainty};
 use lut::scenario::Ego;
 use lut::table::Grid;
 use physics::reference::ReferenceRestraint;
@@ -69,16 +69,13 @@ pub fn run(a: &RobustCellsArgs) -> Result<()> {
                 opponent_kg: m,
                 occupant,
             };
+            let set = UncertainSet::new(&ego, &s, &u, &reference, cfg.reserve_m)?;
             let none = point_optimum(&ego, &occupant, v, m, &cfg)?;
             let margin = point_optimum(&ego, &occupant, v, m + u.mass_kg, &cfg)?;
-            let robust = robust_optimum(&ego, &s, &u, &reference, &cfg)?;
+            let robust = set.robust_optimum(&cfg)?;
             Ok((
                 name,
-                [
-                    judge(&ego, &s, &u, &reference, &none)?,
-                    judge(&ego, &s, &u, &reference, &margin)?,
-                    judge(&ego, &s, &u, &reference, &robust)?,
-                ],
+                [set.judge(&none)?, set.judge(&margin)?, set.judge(&robust)?],
             ))
         })
         .collect::<Result<_>>()?;

@@ -31,6 +31,21 @@ fn meta() -> record::RunMeta {
     }
 }
 
+/// One line of the stubs' commands.jsonl for `f`, received at `mono` (CLOCK_MONOTONIC ns),
+/// E2E accepted — written as the stubs write it.
+fn command_line(mono: u64, f: &bus::RawFrame, message: &str) -> String {
+    let rec = actuator_stubs::commands::CommandRecord {
+        rx_mono_ns: mono,
+        id: f.id,
+        message: message.to_owned(),
+        data_hex: actuator_stubs::commands::data_hex(f.payload()),
+        e2e: "ok".to_owned(),
+        secoc: None,
+        decoded: None,
+    };
+    format!("{}\n", serde_json::to_string(&rec).unwrap())
+}
+
 fn python_check(dir: &Path, full: bool) -> String {
     check_recording(dir, full).unwrap_or_else(|e| panic!("{e}"))
 }
@@ -80,17 +95,8 @@ fn log_times_are_on_the_monotonic_clock_the_stubs_measured() {
         if m.transmitter != "RestraintEcu" {
             continue;
         }
-        let hex: String = f
-            .frame
-            .payload()
-            .iter()
-            .map(|b| format!("{b:02x}"))
-            .collect();
         let mono = (f.t_us * 1_000) as i64 - OFFSET_NS;
-        lines += &format!(
-            "{{\"rx_mono_ns\":{mono},\"id\":{},\"message\":\"{}\",\"data_hex\":\"{hex}\",\"e2e\":\"ok\"}}\n",
-            f.frame.id, m.name
-        );
+        lines += &command_line(mono as u64, &f.frame, m.name);
     }
     assert!(lines.lines().count() > 100);
     // A stubs process killed mid-line leaves a partial last line: recorded up to it.
@@ -234,18 +240,10 @@ fn known_run(dir: &Path) -> Known {
         (Vec::new(), Vec::new(), Vec::new());
     let mut feeds = Vec::new();
     let mut frame = |mono: u64, f: &bus::RawFrame, name: &str| {
-        let hex: String = f.payload().iter().map(|b| format!("{b:02x}")).collect();
-        let rt = mono as i64 + OFFSET_NS;
-        candump += &format!(
-            "({}.{:06}) vcan0 {}\n",
-            rt / 1_000_000_000,
-            (rt % 1_000_000_000) / 1_000,
-            bus::candump::cansend_arg(f)
-        );
-        commands += &format!(
-            "{{\"rx_mono_ns\":{mono},\"id\":{},\"message\":\"{name}\",\"data_hex\":\"{hex}\",\"e2e\":\"ok\"}}\n",
-            f.id
-        );
+        let rt_us = (mono as i64 + OFFSET_NS) as u64 / 1_000;
+        candump += &bus::candump::log_line(rt_us, "vcan0", f);
+        candump.push('\n');
+        commands += &command_line(mono, f, name);
     };
     let bag = bus::message_info(bus::AirbagStageCmd::RAW_ID).unwrap();
     let status = bus::message_info(bus::EcuStatus::RAW_ID).unwrap();
