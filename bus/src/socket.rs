@@ -163,6 +163,22 @@ impl BusSocket {
         }
     }
 
+    /// Waits until the socket has something to read (a frame, an error frame) or `timeout_ms`
+    /// passed, and says which. For a process with nothing to do between frames (the actuator
+    /// stubs): it wakes when a frame arrives rather than polling on a short timer, which on an
+    /// emulated bench costs thousands of wake-ups per second. A signal ends the wait early
+    /// (`Ok(false)`), so a stop request is seen within one wait.
+    pub fn wait_readable(&self, timeout_ms: u16) -> io::Result<bool> {
+        use nix::poll::{poll, PollFd, PollFlags};
+        use std::os::fd::AsFd;
+        let mut fds = [PollFd::new(self.sock.as_fd(), PollFlags::POLLIN)];
+        match poll(&mut fds, timeout_ms) {
+            Ok(n) => Ok(n > 0),
+            Err(nix::errno::Errno::EINTR) => Ok(false),
+            Err(e) => Err(io::Error::from(e)),
+        }
+    }
+
     /// Writes one frame. On a full transmit queue this returns `WouldBlock` (the caller decides
     /// whether to drop or retry next cycle; never blocks).
     pub fn send(&mut self, frame: &RawFrame) -> io::Result<()> {

@@ -302,10 +302,30 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
         // flood and the recorded fire pair are counted from.
         Command::new("candump")
             .args(["-L", "-r", "8388608", &cfg.can])
-            .stdout(candump_log)
+            .stdout(Stdio::piped())
             .stderr(Stdio::inherit()),
         "candump (install can-utils)",
     )?;
+    // candump flushes its output after every frame: written straight to the log, that is one
+    // write per frame, and in a guest each is a round trip to the host's shared folder. Copied
+    // through a buffer instead (by hand: std::io::copy would splice pipe to file, one write per
+    // frame again); the copy ends when candump does and writes the rest.
+    let candump_copy = candump.stdout.take().map(|mut from| {
+        std::thread::spawn(move || -> std::io::Result<()> {
+            use std::io::{Read, Write};
+            let mut to = std::io::BufWriter::with_capacity(1 << 16, candump_log);
+            let mut chunk = [0u8; 4096];
+            loop {
+                match from.read(&mut chunk) {
+                    Ok(0) => break,
+                    Ok(n) => to.write_all(&chunk[..n])?,
+                    Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                    Err(e) => return Err(e),
+                }
+            }
+            to.flush()
+        })
+    });
     let mut stubs = spawn(
         Command::new(bin("actuator-stubs"))
             .arg("--scenario")
@@ -434,6 +454,12 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     let _ = stubs_stderr.map(std::thread::JoinHandle::join);
     std::thread::sleep(Duration::from_millis(50));
     let _ = terminate(&mut candump, "candump", Duration::from_secs(2))?;
+    match candump_copy.map(std::thread::JoinHandle::join) {
+        Some(Ok(Ok(_))) => {}
+        Some(Ok(Err(e))) => problems.push(format!("candump.log: {e}")),
+        Some(Err(_)) => problems.push("candump.log: its copy panicked".to_owned()),
+        None => problems.push("candump.log: candump had no output pipe".to_owned()),
+    }
 
     let report_path = dir.join("report.json");
     let report: Report = serde_json::from_str(
