@@ -13,6 +13,7 @@
 #   FUZZ_TIMEOUT_S    per-input time limit, s (default 2)
 #   FUZZ_RSS_MB       memory limit, MiB (default 1024)
 #   FUZZ_SANITIZER    none | address (default none: fastest; address for long runs)
+#   FUZZ_JOBS         targets run at once (default: the CPUs, nproc)
 #   FUZZ_TARGET_DIR   cargo target dir of the fuzz build (default: $CARGO_TARGET_DIR-fuzz or
 #                     target/fuzz under the repo)
 #   FUZZ_REPORT_JSON  if set, also write the per-target figures there as JSON (a relative
@@ -71,28 +72,41 @@ bin_dir="$target_dir/$host/release"
 scratch="$(mktemp -d "${TMPDIR:-/tmp}/fuzz-smoke.XXXXXX")"
 [[ "${FUZZ_KEEP:-0}" == 1 ]] || trap 'rm -rf "$scratch"' EXIT
 
+# The targets run side by side, FUZZ_JOBS at a time (default: one per CPU; libFuzzer is single-
+# threaded), each into its own log; the table below is printed in target order when all are done.
+jobs_max="${FUZZ_JOBS:-$(nproc)}"
+run_one() {
+  local t=$1 start_ns rc
+  start_ns=$(date +%s%N)
+  set +e
+  # Outer timeout: a hang the per-input limit cannot catch (e.g. in libFuzzer's own startup).
+  timeout --kill-after=5 $(( seconds * 3 + 60 )) "$bin_dir/$t" \
+    -max_total_time="$seconds" -timeout="$timeout_s" -rss_limit_mb="$rss_mb" \
+    -malloc_limit_mb="$rss_mb" -max_len=16384 -print_final_stats=1 \
+    -artifact_prefix="$scratch/$t/artifacts/" \
+    "$scratch/$t/corpus" "$fuzz_dir/corpus/$t" >"$scratch/$t/log" 2>&1
+  rc=$?
+  echo "$rc $(( ($(date +%s%N) - start_ns) / 1000000 ))" >"$scratch/$t/result"
+}
+running=0
+for t in "${targets[@]}"; do
+  if [[ ! -x "$bin_dir/$t" ]]; then
+    echo "fuzz-smoke: no binary $bin_dir/$t" >&2
+    exit 2
+  fi
+  mkdir -p "$scratch/$t/corpus" "$scratch/$t/artifacts" "$fuzz_dir/corpus/$t"
+  run_one "$t" &
+  running=$((running + 1))
+  if (( running >= jobs_max )); then wait -n || true; running=$((running - 1)); fi
+done
+wait
+
 failed=0
 json="["
 printf '%-16s %12s %8s %12s %7s  %s\n' target execs time_s execs_per_s corpus status
 for t in "${targets[@]}"; do
-  bin="$bin_dir/$t"
-  if [[ ! -x "$bin" ]]; then
-    echo "fuzz-smoke: no binary $bin" >&2
-    exit 2
-  fi
-  mkdir -p "$scratch/$t/corpus" "$scratch/$t/artifacts" "$fuzz_dir/corpus/$t"
   log="$scratch/$t/log"
-  start_ns=$(date +%s%N)
-  set +e
-  # Outer timeout: a hang the per-input limit cannot catch (e.g. in libFuzzer's own startup).
-  timeout --kill-after=5 $(( seconds * 3 + 60 )) "$bin" \
-    -max_total_time="$seconds" -timeout="$timeout_s" -rss_limit_mb="$rss_mb" \
-    -malloc_limit_mb="$rss_mb" -max_len=16384 -print_final_stats=1 \
-    -artifact_prefix="$scratch/$t/artifacts/" \
-    "$scratch/$t/corpus" "$fuzz_dir/corpus/$t" >"$log" 2>&1
-  rc=$?
-  set -e
-  elapsed_ms=$(( ($(date +%s%N) - start_ns) / 1000000 ))
+  read -r rc elapsed_ms <"$scratch/$t/result" || { rc=125; elapsed_ms=0; }
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
   units=$(sed -n 's/.*DONE *cov: [0-9]* ft: [0-9]* corp: \([0-9]*\)\/.*/\1/p' "$log" | tail -1)
