@@ -1,4 +1,4 @@
-//! Shared by the real-bus integration tests (`bus/tests/real_bus.rs`, `ecu/tests/cycle_vcan.rs`,
+//! Shared by the real-bus integration tests (`bus/tests/real_bus.rs`, `ecu/tests/shell/cycle_vcan.rs`,
 //! each includes this file with `#[path]`): run a test's worker on a usable host vcan, else
 //! re-run it inside the QEMU guest of `vcan-setup.sh --run`. A file rather than a crate because
 //! it is ~50 lines of std-only test glue that only test binaries compile.

@@ -3,7 +3,7 @@
 //! `hdrhistogram::Histogram::new_with_bounds` allocates its whole counts array up front;
 //! auto-resize is off unless enabled, and `saturating_record` clamps out-of-range values
 //! to the bounds instead of growing, so recording never allocates (the allocation test in
-//! `tests/no_alloc.rs` checks this over the whole loop).
+//! `tests/shell/no_alloc.rs` checks this over the whole loop).
 
 use hdrhistogram::Histogram;
 

@@ -7,10 +7,8 @@
 //! On a host without SocketCAN the visible test re-runs the `#[ignore]`d worker inside the
 //! QEMU guest of `vcan-setup.sh --run`; with no route it FAILS (never skipped).
 
-#[path = "../../restraint/tests/cycle/cycle_support/mod.rs"]
-mod cycle_support;
-#[path = "../../bus/tests/support/vcan_rerun.rs"]
-mod vcan_rerun;
+use crate::cycle_support;
+use crate::vcan_rerun;
 
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -26,7 +24,7 @@ const ECU: &str = env!("CARGO_BIN_EXE_ecu");
 
 #[test]
 fn ecu_process_on_vcan_sends_e2e_valid_commands() {
-    run_here_or_in_guest("inner_vcan_worker", worker_body);
+    run_here_or_in_guest("cycle_vcan::inner_vcan_worker", worker_body);
 }
 
 #[test]

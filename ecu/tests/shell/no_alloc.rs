@@ -6,15 +6,12 @@
 //! loop really receives every cycle and its diagnostics really reach a subscriber (via
 //! the companion publisher thread, see `runtime::com`).
 
-#[path = "../../restraint/tests/alloc_counter/mod.rs"]
-mod alloc_counter;
-
-use alloc_counter::{allocations_here, set_counting};
+use crate::alloc_counter::{allocations_here, set_counting};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
-mod support;
+use crate::support;
 
 use ecu::runtime::{
     run_activity, Activity, CycleInfo, CycleIo, IceoryxIo, LoopConfig, LoopStats, MonotonicClock,

@@ -2,10 +2,7 @@
 //! the safing service's batches in order, never the crash accelerometer's, counts its receive
 //! errors apart, and — a cycle-path call — neither allocates nor blocks.
 
-#[path = "../../restraint/tests/alloc_counter/mod.rs"]
-mod alloc_counter;
-
-use alloc_counter::{allocations_here, set_counting};
+use crate::alloc_counter::{allocations_here, set_counting};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
