@@ -3,11 +3,15 @@
 //! and `cansend` writes are decoded by our receive path.
 //!
 //! On a host without SocketCAN the visible test re-runs the `#[ignore]`d worker inside the
-//! QEMU guest of `vcan-setup.sh --run`; with no route it FAILS (never skipped).
+//! QEMU guest of `vcan-setup.sh --run`; with no route it FAILS (never skipped). The worker does
+//! the bus side (our sockets, candump, cansend); cantools runs on this side, before and after it,
+//! on files in the exchange folder both sides see: under emulation one Python start with
+//! cantools costs ≈ 13 s, and this test once spent 27 of its 39 s on two of them.
 
 #[path = "support/vcan_rerun.rs"]
 mod vcan_rerun;
 
+use std::path::PathBuf;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant, SystemTime};
 
@@ -15,15 +19,64 @@ use bus::socket::BusSocket;
 use bus::{encode_values, message_info, signal_values, signals_of, E2eChecker, RawFrame, MESSAGES};
 use vcan_rerun::{iface, repo_root, run_here_or_in_guest};
 
+/// Frames of each message we send for candump (k = 0..23: counters wrap once).
+const OURS_PER_MESSAGE: u64 = 24;
+/// Frames of each input message cantools encodes for cansend.
+const CANTOOLS_PER_MESSAGE: u64 = 16;
+/// What cantools encoded (`ID#HEX` lines, written before the worker runs).
+const CANSEND_LINES: &str = "cansend.txt";
+/// What candump logged of our frames (read by cantools after the worker).
+const CANDUMP_LOG: &str = "candump.log";
+
 #[test]
 fn real_bus_candump_cantools_cansend() {
+    let dir = exchange_dir();
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let (requests, _) = cantools_requests();
+    let lines = cantools(
+        "encode",
+        &serde_json::to_vec(&requests).unwrap(),
+        "requests.json",
+    );
+    std::fs::write(dir.join(CANSEND_LINES), &lines).unwrap();
+
     run_here_or_in_guest("inner_real_bus_worker", real_bus_worker_body);
+
+    let log = std::fs::read(dir.join(CANDUMP_LOG)).expect("the worker's candump log");
+    check_cantools_decoded(&cantools("decode", &log, CANDUMP_LOG));
 }
 
 #[test]
 #[ignore = "worker: needs a vcan interface; run by real_bus_candump_cantools_cansend"]
 fn inner_real_bus_worker() {
     real_bus_worker_body();
+}
+
+/// The folder both sides of the test see: under the target directory, which the guest of
+/// `vcan-setup.sh` shares read-write at the same path.
+fn exchange_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("real-bus")
+}
+
+/// Runs `bus/tests/cantools_check.py MODE DBC FILE` on `input` (written to `name` in the
+/// exchange folder) and returns its stdout.
+fn cantools(mode: &str, input: &[u8], name: &str) -> Vec<u8> {
+    let path = exchange_dir().join(format!("cantools-{mode}-{name}"));
+    std::fs::write(&path, input).unwrap();
+    let out = Command::new(python3())
+        .arg(repo_root().join("bus/tests/cantools_check.py"))
+        .arg(mode)
+        .arg(repo_root().join("bus/restraint.dbc"))
+        .arg(&path)
+        .output()
+        .expect("run python3 cantools helper");
+    assert!(
+        out.status.success(),
+        "cantools {mode} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out.stdout
 }
 
 /// Deterministic pseudo-random raw values covering both range ends.
@@ -86,13 +139,15 @@ fn real_bus_worker_body() {
     need("candump");
     need("cansend");
     let iface = iface();
-    let dir = std::env::temp_dir().join(format!("bus-real-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let dbc = repo_root().join("bus/restraint.dbc");
-    let helper = repo_root().join("bus/tests/cantools_check.py");
+    let dir = exchange_dir();
+    let lines: Vec<String> = std::fs::read_to_string(dir.join(CANSEND_LINES))
+        .expect("the frames cantools encoded (written by the visible test before the worker)")
+        .lines()
+        .map(str::to_owned)
+        .collect();
 
-    // ---------- our frames → candump -L → cantools
-    let log = dir.join("candump.log");
+    // ---------- our frames → candump -L (→ cantools, after the worker)
+    let log = dir.join(CANDUMP_LOG);
     let mut candump = Command::new("candump")
         .args(["-L", &iface])
         .stdout(std::fs::File::create(&log).unwrap())
@@ -122,13 +177,8 @@ fn real_bus_worker_body() {
             "candump never saw the probe frame"
         );
     }
-    let mut expected = Vec::new();
-    for k in 0..24u64 {
-        for m in MESSAGES {
-            let (f, phys) = build(m.id, k);
-            tx.send(&f).unwrap();
-            expected.push((m.id, phys));
-        }
+    for (f, _) in our_frames() {
+        tx.send(&f).unwrap();
     }
     std::thread::sleep(Duration::from_millis(500));
     candump.kill().ok();
@@ -140,57 +190,6 @@ fn real_bus_worker_body() {
         .status()
         .unwrap();
     assert!(status.success());
-
-    let out = Command::new(python3())
-        .arg(&helper)
-        .args(["decode"])
-        .arg(&dbc)
-        .arg(&log)
-        .output()
-        .expect("run python3 cantools helper");
-    assert!(
-        out.status.success(),
-        "cantools decode failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let decoded: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let decoded: Vec<_> = decoded
-        .as_array()
-        .unwrap()
-        .iter()
-        .filter(|d| d["id"].as_u64() != Some(0x7FF))
-        .collect();
-    assert_eq!(
-        decoded.len(),
-        expected.len(),
-        "candump captured a different number of frames"
-    );
-    for (d, (id, phys)) in decoded.iter().zip(&expected) {
-        assert_eq!(d["id"].as_u64().unwrap(), u64::from(*id));
-        let info = message_info(*id).unwrap();
-        assert_eq!(d["name"].as_str().unwrap(), info.name);
-        if info.e2e_data_id.is_some() {
-            assert_eq!(
-                d["crc_ok"].as_bool(),
-                Some(true),
-                "python's CRC check of {}",
-                info.name
-            );
-        }
-        for (s, want) in signals_of(*id).unwrap().iter().zip(phys) {
-            let got = d["signals"][s.name].as_f64().unwrap();
-            assert!(
-                close(got, *want, s.factor),
-                "{}.{}: cantools {got}, we sent {want}",
-                info.name,
-                s.name
-            );
-        }
-    }
-    eprintln!(
-        "cantools decoded {} frames written by us to the same values",
-        decoded.len()
-    );
 
     // Kernel filter: only input ids reached rx (plus the error frame, counted not returned).
     let mut checker = E2eChecker::new();
@@ -212,58 +211,23 @@ fn real_bus_worker_body() {
                     .expect("our own frames pass our checker");
                 got_inputs += 1;
             }
-            None if got_inputs == 24 * input_ids.len() && rx.stats().error_frames > errs_before => {
+            None if got_inputs == OURS_PER_MESSAGE as usize * input_ids.len()
+                && rx.stats().error_frames > errs_before =>
+            {
                 break
             }
             None => std::thread::sleep(Duration::from_millis(10)),
         }
     }
-    assert_eq!(got_inputs, 24 * input_ids.len());
+    assert_eq!(got_inputs, OURS_PER_MESSAGE as usize * input_ids.len());
     assert_eq!(
         rx.stats().error_frames,
         errs_before + 1,
         "error frame not counted"
     );
 
-    // ---------- cantools encodes → cansend → our decoder
-    let mut reqs = Vec::new();
-    let mut want = Vec::new();
-    for k in 0..16u64 {
-        for m in MESSAGES.iter().filter(|m| m.transmitter != "RestraintEcu") {
-            let (_, phys) = build(m.id, k + 100);
-            let sigs = signals_of(m.id).unwrap();
-            let mut obj = serde_json::Map::new();
-            for (s, v) in sigs.iter().zip(&phys) {
-                obj.insert(s.name.to_string(), serde_json::json!(v));
-            }
-            // counters continue the sequence the checker has already seen (k = 0..23 above)
-            obj.insert("AliveCounter".into(), serde_json::json!((24 + k) % 16));
-            let mut phys = phys;
-            let ai = sigs.iter().position(|s| s.name == "AliveCounter").unwrap();
-            phys[ai] = ((24 + k) % 16) as f64;
-            reqs.push(serde_json::json!({"name": m.name, "signals": obj}));
-            want.push((m.id, phys));
-        }
-    }
-    let req_path = dir.join("requests.json");
-    std::fs::write(&req_path, serde_json::to_vec(&reqs).unwrap()).unwrap();
-    let out = Command::new(python3())
-        .arg(&helper)
-        .arg("encode")
-        .arg(&dbc)
-        .arg(&req_path)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "cantools encode failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let lines: Vec<String> = String::from_utf8(out.stdout)
-        .unwrap()
-        .lines()
-        .map(str::to_owned)
-        .collect();
+    // ---------- cantools encoded (before the worker) → cansend → our decoder
+    let (_, want) = cantools_requests();
     assert_eq!(lines.len(), want.len());
     for (line, (id, phys)) in lines.iter().zip(&want) {
         let st = Command::new("cansend")
@@ -308,7 +272,6 @@ fn real_bus_worker_body() {
         lines.len(),
         checker.stats()
     );
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The cantools venv's Python (`tests/setup-host.sh` makes `target/pyenv`), so that `cargo
@@ -320,4 +283,85 @@ fn python3() -> std::path::PathBuf {
     } else {
         "python3".into()
     }
+}
+
+/// Our frames for candump, with their physical values: every message, k = 0..23.
+fn our_frames() -> Vec<(RawFrame, (u32, Vec<f64>))> {
+    let mut v = Vec::new();
+    for k in 0..OURS_PER_MESSAGE {
+        for m in MESSAGES {
+            let (f, phys) = build(m.id, k);
+            v.push((f, (m.id, phys)));
+        }
+    }
+    v
+}
+
+/// What cantools is asked to encode (one JSON request per frame) and the physical values each
+/// frame must decode to on our side. The counters continue the sequence our checker has
+/// already seen from our frames (k = 0..23).
+fn cantools_requests() -> (Vec<serde_json::Value>, Vec<(u32, Vec<f64>)>) {
+    let mut reqs = Vec::new();
+    let mut want = Vec::new();
+    for k in 0..CANTOOLS_PER_MESSAGE {
+        for m in MESSAGES.iter().filter(|m| m.transmitter != "RestraintEcu") {
+            let (_, phys) = build(m.id, k + 100);
+            let sigs = signals_of(m.id).unwrap();
+            let mut obj = serde_json::Map::new();
+            for (s, v) in sigs.iter().zip(&phys) {
+                obj.insert(s.name.to_string(), serde_json::json!(v));
+            }
+            let counter = (OURS_PER_MESSAGE + k) % 16;
+            obj.insert("AliveCounter".into(), serde_json::json!(counter));
+            let mut phys = phys;
+            let ai = sigs.iter().position(|s| s.name == "AliveCounter").unwrap();
+            phys[ai] = counter as f64;
+            reqs.push(serde_json::json!({"name": m.name, "signals": obj}));
+            want.push((m.id, phys));
+        }
+    }
+    (reqs, want)
+}
+
+/// cantools' decode of candump's log of our frames (`stdout`: its JSON) against what we sent.
+fn check_cantools_decoded(stdout: &[u8]) {
+    let expected: Vec<(u32, Vec<f64>)> = our_frames().into_iter().map(|(_, e)| e).collect();
+    let decoded: serde_json::Value = serde_json::from_slice(stdout).unwrap();
+    let decoded: Vec<_> = decoded
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|d| d["id"].as_u64() != Some(0x7FF))
+        .collect();
+    assert_eq!(
+        decoded.len(),
+        expected.len(),
+        "candump captured a different number of frames"
+    );
+    for (d, (id, phys)) in decoded.iter().zip(&expected) {
+        assert_eq!(d["id"].as_u64().unwrap(), u64::from(*id));
+        let info = message_info(*id).unwrap();
+        assert_eq!(d["name"].as_str().unwrap(), info.name);
+        if info.e2e_data_id.is_some() {
+            assert_eq!(
+                d["crc_ok"].as_bool(),
+                Some(true),
+                "python's CRC check of {}",
+                info.name
+            );
+        }
+        for (s, want) in signals_of(*id).unwrap().iter().zip(phys) {
+            let got = d["signals"][s.name].as_f64().unwrap();
+            assert!(
+                close(got, *want, s.factor),
+                "{}.{}: cantools {got}, we sent {want}",
+                info.name,
+                s.name
+            );
+        }
+    }
+    eprintln!(
+        "cantools decoded {} frames written by us to the same values",
+        decoded.len()
+    );
 }
