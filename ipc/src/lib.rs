@@ -19,7 +19,12 @@
 //! The ECU's records are the `signals` crate's types (re-exported here), carried in a
 //! transport wrapper so the core never depends on iceoryx2 and the transport never on the core. The subscriber wrappers are
 //! poll-only (`receive()` every cycle, no event waits) and their hot-path methods neither
-//! allocate nor block; errors on the hot path are counted, not formatted.
+//! allocate nor block; errors on the hot path are counted, not formatted. The ports are generic
+//! over the topic, but opening one (iceoryx2's service, subscriber and publisher builders, the
+//! bulk of its code) happens in per-topic functions of this crate ([`port::Topic::subscribe`]),
+//! compiled once here: a release build does not share generic instances between crates, and
+//! every binary that opened a port used to compile its own copy (the sensor-feeds binary
+//! 6.2 → 1.7 s to compile, the actuator stubs' 6.3 → 2.2 s).
 //!
 //! Without the default `transport` feature the crate is [`names`] only (no iceoryx2): what the
 //! ECU's configuration needs for its defaults where the transport is not built (fuzz).

@@ -114,6 +114,47 @@ pub trait Topic {
     fn value(p: &Self::Payload) -> &Self::Value;
     /// The value inside a payload, writable.
     fn value_mut(p: &mut Self::Payload) -> &mut Self::Value;
+    /// The service opened (or created) under `names` and a subscriber on it.
+    fn subscribe(node: &IpcNode, names: &ServiceNames) -> Result<SubscriberPort<Self>, IpcError>
+    where
+        Self: Sized;
+    /// The service opened (or created) under `names` and a publisher on it.
+    fn publisher(node: &IpcNode, names: &ServiceNames) -> Result<PublisherPort<Self>, IpcError>
+    where
+        Self: Sized;
+}
+
+/// A topic's service and a subscriber on it.
+pub type SubscriberPort<T> = (
+    PubSubFactory<IpcService, <T as Topic>::Payload, ()>,
+    Subscriber<IpcService, <T as Topic>::Payload, ()>,
+);
+/// A topic's service and a publisher on it.
+pub type PublisherPort<T> = (
+    PubSubFactory<IpcService, <T as Topic>::Payload, ()>,
+    Publisher<IpcService, <T as Topic>::Payload, ()>,
+);
+
+/// [`Topic::subscribe`] and [`Topic::publisher`] of one topic: written in each topic's own
+/// `impl` so that they are ordinary (non-generic) functions of this crate. iceoryx2's service,
+/// subscriber and publisher builders are generic over the payload, and a release build does not
+/// share generic instances between crates: as generic code here, every crate that opened a port
+/// (the ECU, feeds, stubs, each test binary) compiled its own copy of them.
+macro_rules! port_openers {
+    () => {
+        fn subscribe(
+            node: &IpcNode,
+            names: &ServiceNames,
+        ) -> Result<SubscriberPort<Self>, IpcError> {
+            subscribe_to::<Self>(node, names)
+        }
+        fn publisher(
+            node: &IpcNode,
+            names: &ServiceNames,
+        ) -> Result<PublisherPort<Self>, IpcError> {
+            publish_on::<Self>(node, names)
+        }
+    };
 }
 
 macro_rules! shm_topic {
@@ -137,6 +178,7 @@ macro_rules! shm_topic {
             fn value_mut(p: &mut Shm<$value>) -> &mut $value {
                 &mut p.0
             }
+            port_openers!();
         }
     };
 }
@@ -178,6 +220,7 @@ impl Topic for BenchTruthTopic {
     fn value_mut(p: &mut BenchTruth) -> &mut BenchTruth {
         p
     }
+    port_openers!();
 }
 
 fn open_service<T: Topic>(
@@ -203,6 +246,31 @@ fn open_service<T: Topic>(
         .map_err(|e| setup_err("service open_or_create", name, e))
 }
 
+fn subscribe_to<T: Topic>(
+    node: &IpcNode,
+    names: &ServiceNames,
+) -> Result<SubscriberPort<T>, IpcError> {
+    let service = open_service::<T>(node, names)?;
+    let subscriber = service
+        .subscriber_builder()
+        .buffer_size(T::PORTS.subscriber_buffer)
+        .create()
+        .map_err(|e| setup_err("subscriber creation", T::service_name(names), e))?;
+    Ok((service, subscriber))
+}
+
+fn publish_on<T: Topic>(
+    node: &IpcNode,
+    names: &ServiceNames,
+) -> Result<PublisherPort<T>, IpcError> {
+    let service = open_service::<T>(node, names)?;
+    let publisher = service
+        .publisher_builder()
+        .create()
+        .map_err(|e| setup_err("publisher creation", T::service_name(names), e))?;
+    Ok((service, publisher))
+}
+
 /// Counters of a polled subscriber (hot path: counts only, never formats).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct RxCounters {
@@ -223,12 +291,7 @@ pub struct PolledSubscriber<T: Topic> {
 impl<T: Topic> PolledSubscriber<T> {
     /// Subscribes to the topic's service under `names`.
     pub fn new(node: &IpcNode, names: &ServiceNames) -> Result<Self, IpcError> {
-        let service = open_service::<T>(node, names)?;
-        let subscriber = service
-            .subscriber_builder()
-            .buffer_size(T::PORTS.subscriber_buffer)
-            .create()
-            .map_err(|e| setup_err("subscriber creation", T::service_name(names), e))?;
+        let (service, subscriber) = T::subscribe(node, names)?;
         Ok(Self {
             _service: service,
             subscriber,
@@ -313,11 +376,7 @@ pub struct ZeroCopyPublisher<T: Topic> {
 impl<T: Topic> ZeroCopyPublisher<T> {
     /// Publishes on the topic's service under `names`.
     pub fn new(node: &IpcNode, names: &ServiceNames) -> Result<Self, IpcError> {
-        let service = open_service::<T>(node, names)?;
-        let publisher = service
-            .publisher_builder()
-            .create()
-            .map_err(|e| setup_err("publisher creation", T::service_name(names), e))?;
+        let (service, publisher) = T::publisher(node, names)?;
         Ok(Self {
             _service: service,
             publisher,
