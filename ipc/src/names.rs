@@ -49,8 +49,8 @@ pub const OBJECT_STATE_PORTS: PortSettings = PortSettings {
 };
 
 /// Accelerometer batches arrive at ≥ 1 kHz of batches of up to
-/// [`ACCEL_BATCH_CAPACITY`] samples; every sample matters for crash confirmation, so
-/// the queue covers ~64 ms of a stalled ECU at 1 kHz batches.
+/// [`ACCEL_BATCH_CAPACITY`](crate::ACCEL_BATCH_CAPACITY) samples; every sample matters for
+/// crash confirmation, so the queue covers ~64 ms of a stalled ECU at 1 kHz batches.
 pub const CRASH_ACCEL_PORTS: PortSettings = PortSettings {
     subscriber_buffer: 64,
     history: 0,
