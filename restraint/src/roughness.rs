@@ -27,6 +27,9 @@ pub const HIGH_PASS_S: f64 = 0.050;
 /// right at its floor, by 2 ms); a rough road's swings are tenths of m/s and more.
 pub const DEAD_BAND_MPS: f64 = 0.05;
 
+/// Velocities below this are zero (see [`Roughness::push`]), m/s.
+const FLUSH_BELOW_MPS: f64 = 1e-100;
+
 /// State of the roughness measure.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Roughness {
@@ -66,6 +69,16 @@ impl Roughness {
         self.peak_mps *= 1.0 - (span_s / self.hold_s).min(1.0);
         if self.v_hp_mps > self.peak_mps {
             self.peak_mps = self.v_hp_mps;
+        }
+        // Both decay geometrically on a quiet road and would sink into subnormal numbers
+        // (the peak after ≈ 6 min at a 0.5 s hold), on which Intel CPUs take ≈ 100 cycles an
+        // operation: a cycle's cost would then depend on the CPU. Far below any excursion
+        // that matters, they are zero.
+        if self.v_hp_mps.abs() < FLUSH_BELOW_MPS {
+            self.v_hp_mps = 0.0;
+        }
+        if self.peak_mps < FLUSH_BELOW_MPS {
+            self.peak_mps = 0.0;
         }
     }
 
@@ -123,6 +136,24 @@ mod tests {
         // ... and it decays once the road is smooth again (hold 2 s: e⁻¹ after 2 s).
         run(&mut r, 2_000, |_| 0.0);
         assert!((r.peak_mps() / peak - (-1.0f64).exp()).abs() < 0.05);
+    }
+
+    /// Minutes of a quiet road after a swing: the decaying measure reaches zero instead of
+    /// lingering as subnormal numbers.
+    #[test]
+    fn a_quiet_road_decays_the_measure_to_zero_not_to_subnormal_numbers() {
+        let mut r = Roughness::new(1.0, 0.5);
+        run(&mut r, 500, |t| {
+            5.0 * (core::f64::consts::TAU * 10.0 * t).sin()
+        });
+        assert!(r.peak_mps() > 0.5);
+        for _ in 0..600_000 {
+            r.push(0.0, 1e-3);
+            for v in [r.v_hp_mps, r.peak_mps] {
+                assert!(v == 0.0 || v.is_normal(), "{v:e}");
+            }
+        }
+        assert_eq!(r.peak_mps(), 0.0);
     }
 
     #[test]
