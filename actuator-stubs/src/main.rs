@@ -151,7 +151,6 @@ fn run(cli: &Cli) -> Result<()> {
             .with_context(|| format!("creating {}", diag_path.display()))?,
     );
     let mut diag_log_error: Option<String> = None;
-    let mut diag_buf: Vec<u8> = Vec::with_capacity(512);
     let log_path = cli.out.join("commands.jsonl");
     let mut log = std::io::BufWriter::new(
         std::fs::File::create(&log_path)
@@ -242,18 +241,9 @@ fn run(cli: &Cli) -> Result<()> {
             // postcard is self-delimiting for a fixed record: the log is the records back to
             // back. A write error is reported once at the end, never aborts the judging.
             if diag_log_error.is_none() {
-                // (postcard::to_io would flush the buffer after every record: one write
-                // per ECU cycle, each a round trip to the host on a guest's shared folder.)
-                diag_buf.clear();
-                let written = match postcard::to_extend(d, std::mem::take(&mut diag_buf)) {
-                    Ok(b) => {
-                        diag_buf = b;
-                        diag_log.write_all(&diag_buf).map_err(|e| e.to_string())
-                    }
-                    Err(e) => Err(e.to_string()),
-                };
-                if let Err(e) = written {
-                    diag_log_error = Some(e);
+                // Not flushed per record (host::NoFlush): the buffer goes out when full.
+                if let Err(e) = postcard::to_io(d, host::NoFlush(&mut diag_log)) {
+                    diag_log_error = Some(e.to_string());
                 }
             }
         });

@@ -53,6 +53,26 @@ pub fn check_output_dir(dir: &Path) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)
 }
 
+/// A writer whose `flush` does nothing, around one that the caller flushes on its own
+/// schedule. For a serializer that flushes after every record (`postcard::to_io`) writing into
+/// a `BufWriter`: flushed per record, a log is one `write()` per record, and on a guest's
+/// shared folder each is a round trip to the host.
+pub struct NoFlush<W>(pub W);
+
+impl<W: std::io::Write> std::io::Write for NoFlush<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.write(buf)
+    }
+
+    fn write_all(&mut self, buf: &[u8]) -> std::io::Result<()> {
+        self.0.write_all(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -81,5 +101,28 @@ mod tests {
         assert!(check_output_file(Path::new("/proc/no-such-dir/x.json")).is_err());
         assert!(check_output_file(&dir.join("a/b/report.json/x")).is_err());
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Writes pass through; flushes stop here (the inner writer sees none).
+    #[test]
+    fn no_flush_passes_writes_and_keeps_flushes() {
+        use std::io::Write;
+        struct Inner(Vec<u8>, usize);
+        impl Write for Inner {
+            fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+                self.0.extend_from_slice(buf);
+                Ok(buf.len())
+            }
+            fn flush(&mut self) -> std::io::Result<()> {
+                self.1 += 1;
+                Ok(())
+            }
+        }
+        let mut inner = Inner(Vec::new(), 0);
+        let mut w = NoFlush(&mut inner);
+        w.write_all(b"ab").expect("write");
+        w.write_all(b"c").expect("write");
+        w.flush().expect("flush");
+        assert_eq!((inner.0.as_slice(), inner.1), (&b"abc"[..], 0));
     }
 }

@@ -6,7 +6,8 @@
 //!   (CLOCK_REALTIME µs), absolute sleeps, and the simulated clock of deterministic tests;
 //! * [`stop`] — the SIGTERM/SIGINT stop flag (and SIGPIPE's default for the command-line
 //!   tools);
-//! * [`files`] — where a tool finds the repository's files from any folder.
+//! * [`files`] — where a tool finds the repository's files from any folder, output paths
+//!   checked before the work, and [`NoFlush`] for logs that flush on their own schedule.
 
 pub mod clock;
 pub mod files;
@@ -16,5 +17,5 @@ pub use clock::{
     monotonic_ns, realtime_ns, sleep_through_signals_until_ns, sleep_until_ns, sync_time_us, Clock,
     MonotonicClock, SimClock, SleepOutcome,
 };
-pub use files::{check_output_dir, check_output_file, find_repo, find_upwards};
+pub use files::{check_output_dir, check_output_file, find_repo, find_upwards, NoFlush};
 pub use stop::{default_sigpipe, install_stop_signals};

@@ -301,8 +301,6 @@ struct FeedLog {
     w: Option<std::io::BufWriter<std::fs::File>>,
     error: Option<String>,
     records: u64,
-    /// One record's bytes, reused.
-    scratch: Vec<u8>,
 }
 
 impl FeedLog {
@@ -322,32 +320,20 @@ impl FeedLog {
             w,
             error: None,
             records: 0,
-            scratch: Vec::with_capacity(256),
         })
     }
 
     fn write(&mut self, item: FeedItem) {
-        use std::io::Write;
         let Some(w) = self.w.as_mut() else { return };
         let rec = FeedLogRecord {
             published_ns: monotonic_ns(),
             item,
         };
-        // Into the buffer, not postcard::to_io: that flushes after every record (one write per
-        // sample batch, each a round trip to the host on a guest's shared folder); the buffer
-        // is flushed every 10 ms instead.
-        self.scratch.clear();
-        let written = match postcard::to_extend(&rec, std::mem::take(&mut self.scratch)) {
-            Ok(b) => {
-                self.scratch = b;
-                w.write_all(&self.scratch).map_err(|e| e.to_string())
-            }
-            Err(e) => Err(e.to_string()),
-        };
-        match written {
-            Ok(()) => self.records += 1,
+        // Not flushed per record (host::NoFlush): the buffer is flushed every 10 ms.
+        match postcard::to_io(&rec, host::NoFlush(&mut *w)) {
+            Ok(_) => self.records += 1,
             Err(e) => {
-                self.error = Some(e);
+                self.error = Some(e.to_string());
                 self.w = None;
             }
         }
