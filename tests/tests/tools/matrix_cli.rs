@@ -213,6 +213,23 @@ fn one_flag_vocabulary_across_tools() {
     assert!(shown.contains("vcan9"), "{shown}");
 }
 
+/// Runs a just-written executable. Another test thread that forks while the copy's file is
+/// still open for writing hands its child that descriptor until the child's exec closes it, and
+/// exec of the copy then fails with "Text file busy" (ETXTBSY; seen once in a suite run): that
+/// window is short, so the run is tried again, up to 50 times 20 ms apart.
+fn run_fresh_copy(cmd: &mut Command) -> std::process::Output {
+    let mut tries = 0;
+    loop {
+        match cmd.output() {
+            Err(e) if e.kind() == std::io::ErrorKind::ExecutableFileBusy && tries < 50 => {
+                tries += 1;
+                std::thread::sleep(std::time::Duration::from_millis(20));
+            }
+            r => return r.expect("runs"),
+        }
+    }
+}
+
 #[test]
 fn tools_find_the_repository_they_run_in_not_the_one_they_were_built_in() {
     // Issue 22 item 1: `--repo` defaulted to the folder the crate was built in. A tool copied
@@ -229,11 +246,7 @@ fn tools_find_the_repository_they_run_in_not_the_one_they_were_built_in() {
         } else {
             &["--variants", "8"]
         };
-        let out = Command::new(&copy)
-            .args(args)
-            .current_dir(&outside)
-            .output()
-            .expect("runs");
+        let out = run_fresh_copy(Command::new(&copy).args(args).current_dir(&outside));
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success(), "{tool}: {err}");
         assert!(
