@@ -13,6 +13,8 @@
 //! * [`distributed`] — a computation split into N shards run as a Slurm job array plus a
 //!   dependent collect job: submit, watch, resume, status, collect.
 //! * [`robustness`] — the Monte-Carlo study of the pre-crash estimate's errors.
+//! * [`robust_cells`] / [`limiter_switch`] — the planning margin's cost: cells robust over the
+//!   uncertainty set, and a two-level load limiter switched on what the pulse shows.
 //! * [`estimation`] — the ECU's track filter against the newest-sample estimate over the
 //!   scenario library and noisier sensors (`lut study estimation`).
 #![forbid(unsafe_code)]
@@ -22,6 +24,7 @@ pub mod bound;
 pub mod distributed;
 pub mod estimation;
 pub mod fallback_study;
+pub mod limiter_switch;
 pub mod optimise;
 pub mod progress;
 pub mod reference;

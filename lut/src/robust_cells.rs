@@ -91,13 +91,13 @@ pub fn set_points(s: &Situation, u: &Uncertainty) -> Vec<(f64, f64)> {
 }
 
 /// One point of the set with its reference outcome.
-struct Point {
-    pulse: Pulse,
+pub(crate) struct Point {
+    pub(crate) pulse: Pulse,
     reference_g: f64,
     reference_bottoms_out: bool,
     /// The ride-down reserve the cell is held to here: the optimiser's where the reference
     /// keeps it, none where the reference only avoids bottoming out (or does not).
-    reserve_m: f64,
+    pub(crate) reserve_m: f64,
     /// The reference's cost as the optimiser counts it (`case_cost` with `reserve_m`).
     reference_cost: f64,
 }
@@ -110,8 +110,8 @@ pub fn objective_g(o: &OccupantOutcome) -> f64 {
 /// A situation's uncertainty set, its pulses predicted and the reference restraint simulated
 /// at every point once, for the robust optimum and for judging any setting over it.
 pub struct UncertainSet {
-    occupant: OccupantInput,
-    points: Vec<Point>,
+    pub(crate) occupant: OccupantInput,
+    pub(crate) points: Vec<Point>,
 }
 
 impl UncertainSet {
@@ -156,25 +156,11 @@ impl UncertainSet {
     /// The optimiser fails.
     pub fn robust_optimum(&self, cfg: &OptimiserConfig) -> Result<RestraintSettings> {
         let hw = RestraintHardware::default();
-        let (nominal, others) = self
-            .points
-            .split_first()
-            .ok_or_else(|| anyhow!("no point"))?;
-        let space = SearchSpace::adaptive().with_earliest_airbag_s(
-            // The earliest the ECU can fire at any point of the set is the latest of the
-            // points' own earliest times: the airbag must wait for its floor wherever the
-            // truth lies.
-            self.points
-                .iter()
-                .map(|p| cfg.earliest_airbag_s(&p.pulse.ego()))
-                .fold(0.0, f64::max),
-        );
+        let space = self.search_space(cfg);
         let cost = |x: &[f64]| -> Result<f64> {
             let (set, outside_sq) = space.decode(x);
             let set = effective_settings(&set, cfg);
-            // Where the reference keeps the ride-down reserve, so must the cell; where it only
-            // avoids bottoming out, so must the cell; where it bottoms out, the cell may too.
-            let c = |p: &Point, reserve_m: f64| -> Result<f64> {
+            let total = self.robust_total(cfg.reserve_m, |p, reserve_m| {
                 optimise::robust_case_cost(
                     &Case {
                         pulse: p.pulse.ego(),
@@ -184,25 +170,57 @@ impl UncertainSet {
                     &hw,
                     &OptimiserConfig { reserve_m, ..*cfg },
                 )
-            };
-            let mut total = c(nominal, cfg.reserve_m)?;
-            for p in others {
-                let (cp, r) = (c(p, p.reserve_m)?, p.reference_cost);
-                if cp > r {
-                    total += match (cp >= INFEASIBLE_OFFSET, r >= INFEASIBLE_OFFSET) {
-                        // Bottoming out (or eating the reserve) where the reference does not.
-                        (true, false) => cp,
-                        // Both do: more overshoot (1 000 per mm) or more g than the reference.
-                        (true, true) => cp - r,
-                        (false, _) => WORSE_PENALTY_PER_G * (cp - r),
-                    };
-                }
-            }
+            })?;
             Ok(total + 1.0e3 * outside_sq)
         };
         let min = minimise(space.free_count(), &cost, cfg)?;
         let (set, _) = space.decode(&min.u);
         Ok(effective_settings(&set, cfg))
+    }
+
+    /// The adaptive search space with the airbag no earlier than the latest of the points'
+    /// own earliest fire times: the airbag must wait for its floor wherever the truth lies.
+    pub(crate) fn search_space(&self, cfg: &OptimiserConfig) -> SearchSpace {
+        SearchSpace::adaptive().with_earliest_airbag_s(
+            self.points
+                .iter()
+                .map(|p| cfg.earliest_airbag_s(&p.pulse.ego()))
+                .fold(0.0, f64::max),
+        )
+    }
+
+    /// The robust objective (module docs) from a setting's cost at each point, `cost(point,
+    /// reserve_m)` counted as the optimiser does: the nominal point's cost (held to
+    /// `nominal_reserve_m`, the optimiser's reserve) plus the penalties where another point is
+    /// worse than the reference.
+    ///
+    /// # Errors
+    /// `cost` fails, or the set is empty.
+    pub(crate) fn robust_total(
+        &self,
+        nominal_reserve_m: f64,
+        cost: impl Fn(&Point, f64) -> Result<f64>,
+    ) -> Result<f64> {
+        let (nominal, others) = self
+            .points
+            .split_first()
+            .ok_or_else(|| anyhow!("no point"))?;
+        // Where the reference keeps the ride-down reserve, so must the cell; where it only
+        // avoids bottoming out, so must the cell; where it bottoms out, the cell may too.
+        let mut total = cost(nominal, nominal_reserve_m)?;
+        for p in others {
+            let (cp, r) = (cost(p, p.reserve_m)?, p.reference_cost);
+            if cp > r {
+                total += match (cp >= INFEASIBLE_OFFSET, r >= INFEASIBLE_OFFSET) {
+                    // Bottoming out (or eating the reserve) where the reference does not.
+                    (true, false) => cp,
+                    // Both do: more overshoot (1 000 per mm) or more g than the reference.
+                    (true, true) => cp - r,
+                    (false, _) => WORSE_PENALTY_PER_G * (cp - r),
+                };
+            }
+        }
+        Ok(total)
     }
 
     /// `set` (planned for the situation by some rule) on the truth at every point of the set.
@@ -211,6 +229,17 @@ impl UncertainSet {
     /// An occupant simulation fails.
     pub fn judge(&self, set: &RestraintSettings) -> Result<Judged> {
         let hw = RestraintHardware::default();
+        self.judge_by(|p| Ok(simulate_occupant(&p.pulse.ego(), &self.occupant, set, &hw)?))
+    }
+
+    /// A rule's outcome `outcome(point)` on the truth at every point of the set.
+    ///
+    /// # Errors
+    /// `outcome` fails.
+    pub(crate) fn judge_by(
+        &self,
+        outcome: impl Fn(&Point) -> Result<OccupantOutcome>,
+    ) -> Result<Judged> {
         let mut j = Judged {
             nominal_change_pct: 0.0,
             worst_change_pct: f64::NEG_INFINITY,
@@ -218,7 +247,7 @@ impl UncertainSet {
             worse_than_reference: 0,
         };
         for (k, p) in self.points.iter().enumerate() {
-            let o = simulate_occupant(&p.pulse.ego(), &self.occupant, set, &hw)?;
+            let o = outcome(p)?;
             let change = 100.0 * (objective_g(&o) - p.reference_g) / p.reference_g;
             if k == 0 {
                 j.nominal_change_pct = change;

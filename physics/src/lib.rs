@@ -42,8 +42,9 @@ pub use collision::{
 pub use error::PhysicsError;
 pub use exact::{predict_summary, simulate_collision_exact, ExactCollision, SampleCursor};
 pub use occupant::{
-    ideal_constant_force_decel_mps2, simulate_occupant, simulate_occupant_observed, OccupantInput,
-    OccupantOutcome, RestraintHardware, RestraintSettings,
+    ideal_constant_force_decel_mps2, simulate_occupant, simulate_occupant_observed,
+    simulate_occupant_switched, LimiterSwitch, OccupantInput, OccupantOutcome, RestraintHardware,
+    RestraintSettings,
 };
 pub use reference_settings::ReferenceSettings;
 pub use stiffness::{class_for_mass_kg, CombinedSpring, Curve, MassClass};

@@ -64,6 +64,24 @@ pub struct RestraintSettings {
     pub airbag_time_s: f64,
 }
 
+/// A two-level load limiter's one switch: from [`RestraintSettings::load_limiter_n`] to
+/// `level_n` at `at_s` after first contact.
+///
+/// Why: the opponent's mass does not show in the ego pulse before the restraint is committed
+/// (≈ 30 ms at 96 km/h), so a single level must be planned for the heaviest opponent the
+/// sensing could be wrong about. Switchable load limiters exist as hardware (a pyrotechnic
+/// switch that releases one of two torsion bars: **high → low** only, so a switch that is
+/// never commanded leaves the robust level — the fail-safe direction). Not in the paper's
+/// restraint model, which has one adaptive level: this is an extension, studied in
+/// `lut study limiter-switch`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LimiterSwitch {
+    /// Switch time relative to first contact [s].
+    pub at_s: f64,
+    /// Load-limiter level from then on, lumped [N].
+    pub level_n: f64,
+}
+
 /// Restraint hardware constants (defaults in [`crate::defaults`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RestraintHardware {
@@ -233,6 +251,38 @@ pub fn simulate_occupant_observed(
     occ: &OccupantInput,
     set: &RestraintSettings,
     hw: &RestraintHardware,
+    observe: impl FnMut(f64, f64, f64),
+) -> Result<OccupantOutcome, PhysicsError> {
+    simulate(pulse, occ, set, None, hw, observe)
+}
+
+/// [`simulate_occupant`] with a two-level load limiter: the cap is
+/// [`RestraintSettings::load_limiter_n`] until `switch.at_s`, then `switch.level_n`. A belt
+/// above the new level pays out at once down to it (pay-out stays permanent).
+///
+/// # Errors
+/// Invalid input, or a switch level / time that is not finite and non-negative.
+pub fn simulate_occupant_switched(
+    pulse: &CompartmentPulse<'_>,
+    occ: &OccupantInput,
+    set: &RestraintSettings,
+    switch: &LimiterSwitch,
+    hw: &RestraintHardware,
+) -> Result<OccupantOutcome, PhysicsError> {
+    if !(switch.at_s.is_finite() && switch.level_n.is_finite() && switch.level_n >= 0.0) {
+        return Err(PhysicsError::InvalidInput(
+            "limiter switch time or level not finite and non-negative",
+        ));
+    }
+    simulate(pulse, occ, set, Some(*switch), hw, |_, _, _| {})
+}
+
+fn simulate(
+    pulse: &CompartmentPulse<'_>,
+    occ: &OccupantInput,
+    set: &RestraintSettings,
+    switch: Option<LimiterSwitch>,
+    hw: &RestraintHardware,
     mut observe: impl FnMut(f64, f64, f64),
 ) -> Result<OccupantOutcome, PhysicsError> {
     validate(pulse, occ, set, hw)?;
@@ -255,7 +305,9 @@ pub fn simulate_occupant_observed(
         f64::INFINITY
     };
     let airbag_fires = set.airbag_force_n > 0.0;
-    let belt_force_cap = set.load_limiter_n;
+    let mut belt_force_cap = set.load_limiter_n;
+    let (switch_at_s, switched_cap_n) =
+        switch.map_or((f64::INFINITY, belt_force_cap), |w| (w.at_s, w.level_n));
     let k_belt = hw.belt_stiffness_n_per_m;
     // One pass: reject NaN/∞/> 1000 g samples and find the last non-zero sample. After it nothing
     // can push the occupant further forward once it moves rearward (restraint forces are
@@ -295,6 +347,9 @@ pub fn simulate_occupant_observed(
         }
         a_prev = a_c;
         steps_done = i;
+        if t >= switch_at_s {
+            belt_force_cap = switched_cap_n;
+        }
         // Belt.
         let mut f_belt = 0.0;
         if occ.belted {

@@ -13,6 +13,7 @@ use std::path::PathBuf;
 mod bound;
 mod estimation;
 mod fallback;
+mod limiter_switch;
 mod occupant;
 mod robust_cells;
 mod robustness;
@@ -40,6 +41,9 @@ pub enum StudyCommand {
     /// Robust cells (optimised over the opponent-mass and closing-speed uncertainty set)
     /// against no margin and today's +1 200 kg planning on the library's nominal cases.
     RobustCells(robust_cells::RobustCellsArgs),
+    /// A two-level load limiter that switches high → low when the pulse shows the opponent is
+    /// not the margin heavier, against no margin and today's +1 200 kg planning.
+    LimiterSwitch(limiter_switch::LimiterSwitchArgs),
     /// The ECU's track filter against the newest sample alone over the scenario library and
     /// noisier sensors: errors at contact, occupant outcome, a plot of one case.
     Estimation(estimation::EstimationArgs),
@@ -65,6 +69,7 @@ pub fn run(cmd: &StudyCommand) -> Result<()> {
         StudyCommand::Estimation(args) => estimation::run(args),
         StudyCommand::Bound(args) => bound::run(args),
         StudyCommand::RobustCells(args) => robust_cells::run(args),
+        StudyCommand::LimiterSwitch(args) => limiter_switch::run(args),
     }
 }
 

@@ -1,0 +1,201 @@
+//! `lut study limiter-switch`: a two-level load limiter switched on what the pulse shows,
+//! against today's rules on the library's nominal belted car-to-car cases
+//! (`lut::limiter_switch`).
+
+use super::robust_cells::CASES;
+use anyhow::{bail, Result};
+use clap::Args;
+use lut::limiter_switch::{JudgedTwoLevel, SwitchRule};
+use lut::robust_cells::{point_optimum, Judged, Situation, UncertainSet, Uncertainty};
+use lut::scenario::Ego;
+use lut::table::Grid;
+use physics::reference::ReferenceRestraint;
+use physics::OccupantInput;
+use rayon::prelude::*;
+use serde_json::json;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct LimiterSwitchArgs {
+    /// Reference restraint file.
+    #[arg(long, default_value = "data/reference-restraint.toml")]
+    pub reference: PathBuf,
+    /// The grid whose optimiser settings the plans use.
+    #[arg(long, default_value = "data/default-grid.toml")]
+    pub grid: PathBuf,
+    /// Switch times after contact [ms], comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [30.0, 40.0, 50.0])]
+    pub switch_ms: Vec<f64>,
+    /// Opponent mass half-width of the set (and the margin of today's rule) [kg].
+    #[arg(long, default_value_t = Uncertainty::MISREPORT.mass_kg)]
+    pub mass_kg: f64,
+    /// Closing speed half-width of the set [km/h].
+    #[arg(long, default_value_t = Uncertainty::MISREPORT.speed_kph)]
+    pub speed_kph: f64,
+    /// The measured speed loss reads this much low [%] (sensitivity error of the accelerometer,
+    /// in the direction that switches a heavy crash down).
+    #[arg(long, default_value_t = 0.0)]
+    pub evidence_error_pct: f64,
+    /// Both errors at once (the box's corners), not only one at a time.
+    #[arg(long)]
+    pub corners: bool,
+    /// JSON output.
+    #[arg(long)]
+    pub json: bool,
+}
+
+struct Row {
+    name: &'static str,
+    none: Judged,
+    margin: Judged,
+    switched: Vec<(SwitchRule, JudgedTwoLevel)>,
+}
+
+pub fn run(a: &LimiterSwitchArgs) -> Result<()> {
+    if a.switch_ms.is_empty() || a.switch_ms.iter().any(|t| !(*t > 0.0 && *t <= 200.0)) {
+        bail!("--switch-ms: times in (0, 200] ms");
+    }
+    if !(0.0..50.0).contains(&a.evidence_error_pct) {
+        bail!("--evidence-error-pct: in [0, 50)");
+    }
+    let reference = ReferenceRestraint::load(&a.reference)
+        .map_err(anyhow::Error::msg)?
+        .settings();
+    let cfg = Grid::load(&a.grid)?.optimiser;
+    let u = Uncertainty {
+        mass_kg: a.mass_kg,
+        speed_kph: a.speed_kph,
+        corners: a.corners,
+    };
+    let ego = Ego::default();
+    let occupant = OccupantInput {
+        mass_kg: 75.0,
+        chest_to_wheel_m: 0.300,
+        belted: true,
+    };
+    let rows: Vec<Row> = CASES
+        .par_iter()
+        .map(|&(name, v, m)| -> Result<Row> {
+            let s = Situation {
+                closing_kph: v,
+                opponent_kg: m,
+                occupant,
+            };
+            let set = UncertainSet::new(&ego, &s, &u, &reference, cfg.reserve_m)?;
+            let none = set.judge(&point_optimum(&ego, &occupant, v, m, &cfg)?)?;
+            let margin = set.judge(&point_optimum(&ego, &occupant, v, m + u.mass_kg, &cfg)?)?;
+            let switched = a
+                .switch_ms
+                .iter()
+                .map(|t_ms| {
+                    let rule = SwitchRule::new(
+                        &ego,
+                        &s,
+                        u.mass_kg,
+                        t_ms * 1e-3,
+                        a.evidence_error_pct * 1e-2,
+                        &cfg,
+                    )?;
+                    let plan = set.two_level_optimum(&rule, &cfg)?;
+                    Ok((rule, set.judge_two_level(&plan, &rule)?))
+                })
+                .collect::<Result<_>>()?;
+            Ok(Row {
+                name,
+                none,
+                margin,
+                switched,
+            })
+        })
+        .collect::<Result<_>>()?;
+    if a.json {
+        let v: Vec<_> = rows
+            .iter()
+            .map(|r| {
+                let sw: Vec<_> = r
+                    .switched
+                    .iter()
+                    .map(|(rule, j)| json!({ "rule": rule, "outcome": j }))
+                    .collect();
+                json!({ "case": r.name, "no margin": r.none, "+mass margin": r.margin, "two-level": sw })
+            })
+            .collect();
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&json!({ "set": u, "cases": v }))?
+        );
+        return Ok(());
+    }
+    print_table(a, &u, &rows);
+    Ok(())
+}
+
+fn print_table(a: &LimiterSwitchArgs, u: &Uncertainty, rows: &[Row]) {
+    println!(
+        "a_max + a_mean against the reference restraint, %: nominal / worst over the set (opponent ± {:.0} kg, closing ± {:.0} km/h, {}) / points bottoming out where the reference does not",
+        u.mass_kg,
+        u.speed_kph,
+        if u.corners { "both at once: 9 points" } else { "one at a time: 5 points" }
+    );
+    let cell = |j: &Judged| {
+        format!(
+            "{:+.1} / {:+.1} / {}",
+            j.nominal_change_pct, j.worst_change_pct, j.bottoms_out_alone
+        )
+    };
+    let mut head = format!("{:<22} {:>21} {:>21}", "case", "no margin", "+mass margin");
+    for t in &a.switch_ms {
+        head += &format!(" {:>21}", format!("two-level @{t:.0} ms"));
+    }
+    println!("{head}");
+    for r in rows {
+        let mut line = format!(
+            "{:<22} {:>21} {:>21}",
+            r.name,
+            cell(&r.none),
+            cell(&r.margin)
+        );
+        for (_, j) in &r.switched {
+            line += &format!(" {:>21}", cell(&j.judged));
+        }
+        println!("{line}");
+    }
+    let n = rows.len() as f64;
+    let mut line = format!(
+        "{:<22} {:>21.1} {:>21.1}",
+        "mean nominal",
+        rows.iter().map(|r| r.none.nominal_change_pct).sum::<f64>() / n,
+        rows.iter()
+            .map(|r| r.margin.nominal_change_pct)
+            .sum::<f64>()
+            / n
+    );
+    for k in 0..a.switch_ms.len() {
+        let mean = rows
+            .iter()
+            .map(|r| r.switched[k].1.judged.nominal_change_pct)
+            .sum::<f64>()
+            / n;
+        line += &format!(" {mean:>21.1}");
+    }
+    println!("{line}");
+    println!();
+    println!("two-level plans: high → low level [kN]; speed lost by the decision, predicted for the estimate / the opponent {:.0} kg heavier [m/s] (read {:.1} % low); points of the set switched (nominal first)", u.mass_kg, a.evidence_error_pct);
+    for r in rows {
+        for (rule, j) in &r.switched {
+            println!(
+                "{:<22} @{:>3.0} ms  {:>5.2} → {:>5.2} kN   {:>5.2} / {:>5.2} m/s   {}",
+                r.name,
+                rule.at_s * 1e3,
+                j.levels_kn.0,
+                j.levels_kn.1,
+                rule.predicted_mps.0,
+                rule.predicted_mps.1,
+                j.switched
+                    .iter()
+                    .map(|s| if *s { "S" } else { "-" })
+                    .collect::<String>()
+            );
+        }
+    }
+}
