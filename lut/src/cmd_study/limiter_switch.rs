@@ -3,11 +3,13 @@
 //! (`lut::limiter_switch`).
 
 use super::robust_cells::CASES;
+use crate::plot;
 use anyhow::{bail, Result};
 use clap::Args;
+use lut::limiter_switch::speed_lost_by_mps;
 use lut::limiter_switch::{JudgedTwoLevel, SwitchRule};
 use lut::robust_cells::{point_optimum, Judged, Situation, UncertainSet, Uncertainty};
-use lut::scenario::Ego;
+use lut::scenario::{Ego, Opponent, Pulse};
 use lut::table::Grid;
 use physics::reference::ReferenceRestraint;
 use physics::OccupantInput;
@@ -42,6 +44,10 @@ pub struct LimiterSwitchArgs {
     /// JSON output.
     #[arg(long)]
     pub json: bool,
+    /// Also plot (SVG if .svg, else PNG) how little the heavier opponent shows in the speed the
+    /// ego has lost, for the 48 + 48 km/h Taurus case.
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
 }
 
 struct Row {
@@ -73,6 +79,9 @@ pub fn run(a: &LimiterSwitchArgs) -> Result<()> {
         chest_to_wheel_m: 0.300,
         belted: true,
     };
+    if let Some(path) = &a.plot {
+        plot_evidence(path, &ego, u.mass_kg)?;
+    }
     let rows: Vec<Row> = CASES
         .par_iter()
         .map(|&(name, v, m)| -> Result<Row> {
@@ -198,4 +207,73 @@ fn print_table(a: &LimiterSwitchArgs, u: &Uncertainty, rows: &[Row]) {
             );
         }
     }
+}
+
+/// Speed lost against time for the estimate and the opponent `margin_kg` heavier (48 + 48 km/h
+/// Taurus), and their difference against the estimate's loss.
+fn plot_evidence(path: &std::path::Path, ego: &Ego, margin_kg: f64) -> Result<()> {
+    let (closing_kph, opponent_kg) = (96.0, 1785.0);
+    let t_ms: Vec<f64> = (0..=150).map(f64::from).collect();
+    let lost = |m: f64| -> Result<Vec<f64>> {
+        let p = Pulse::predict(
+            ego,
+            Opponent::Car {
+                mass_kg: m.min(3000.0),
+            },
+            closing_kph,
+        )?;
+        Ok(t_ms
+            .iter()
+            .map(|t| speed_lost_by_mps(&p.ego(), t * 1e-3))
+            .collect())
+    };
+    let (est, heavy) = (lost(opponent_kg)?, lost(opponent_kg + margin_kg)?);
+    let pct: Vec<f64> = est
+        .iter()
+        .zip(&heavy)
+        .map(|(e, h)| if *e > 0.1 { 100.0 * (h - e) / e } else { 0.0 })
+        .collect();
+    let one = vec![1.0; t_ms.len()];
+    plot::draw(
+        path,
+        &[
+            plot::Panel {
+                title: format!(
+                    "Ego speed lost, {closing_kph:.0} km/h closing: opponent {opponent_kg:.0} kg vs {:.0} kg",
+                    (opponent_kg + margin_kg).min(3000.0)
+                ),
+                x_label: "time after contact [ms]",
+                y_label: "speed lost [m/s]",
+                series: vec![
+                    plot::Series {
+                        label: format!("{opponent_kg:.0} kg (the estimate)"),
+                        x: &t_ms,
+                        y: &est,
+                    },
+                    plot::Series {
+                        label: format!("{:.0} kg", (opponent_kg + margin_kg).min(3000.0)),
+                        x: &t_ms,
+                        y: &heavy,
+                    },
+                ],
+            },
+            plot::Panel {
+                title: "How much more the heavier opponent's crash has taken, against a 1 % accelerometer error".into(),
+                x_label: "time after contact [ms]",
+                y_label: "difference [% of the estimate's]",
+                series: vec![
+                    plot::Series {
+                        label: "heavier − estimate".into(),
+                        x: &t_ms,
+                        y: &pct,
+                    },
+                    plot::Series {
+                        label: "1 % sensitivity error".into(),
+                        x: &t_ms,
+                        y: &one,
+                    },
+                ],
+            },
+        ],
+    )
 }
