@@ -7,4 +7,5 @@ mod docs_check;
 mod matrix_cli;
 mod matrix_slurm;
 mod offline;
+mod one_build;
 mod recording;
