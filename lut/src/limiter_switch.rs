@@ -32,8 +32,8 @@
 //! Not in the paper's restraint model (one adaptive level): an extension, said so wherever it
 //! is reported.
 
-use crate::optimise::{case_cost, effective_settings, minimise, OptimiserConfig};
-use crate::robust_cells::{Judged, Point, Situation, UncertainSet};
+use crate::optimise::{cost_with_late_airbag, effective_settings, minimise, OptimiserConfig};
+use crate::robust_cells::{Judged, Situation, UncertainSet};
 use crate::scenario::{Ego, Opponent, Pulse};
 use anyhow::Result;
 use physics::{
@@ -181,39 +181,23 @@ impl UncertainSet {
         let cost = |x: &[f64]| -> Result<f64> {
             let (plan, outside_sq) = decode(x);
             let total = self.robust_total(cfg.reserve_m, |p, reserve_m| {
-                self.two_level_cost(&plan, p, rule, reserve_m, cfg, &hw)
+                let pulse = p.pulse.ego();
+                cost_with_late_airbag(
+                    &plan.settings,
+                    &OptimiserConfig { reserve_m, ..*cfg },
+                    |settings| {
+                        let plan = TwoLevelPlan {
+                            settings: *settings,
+                            ..plan
+                        };
+                        plan.outcome(&pulse, &self.occupant, rule, &hw)
+                    },
+                )
             })?;
             Ok(total + 1.0e3 * outside_sq)
         };
         let min = minimise(n + 1, &cost, cfg)?;
         Ok(decode(&min.u).0)
-    }
-
-    /// The optimiser's cost of `plan` at one point: on time and with the airbag up to the
-    /// fire-delay tolerance late, the worse.
-    fn two_level_cost(
-        &self,
-        plan: &TwoLevelPlan,
-        p: &Point,
-        rule: &SwitchRule,
-        reserve_m: f64,
-        cfg: &OptimiserConfig,
-        hw: &RestraintHardware,
-    ) -> Result<f64> {
-        let pulse = p.pulse.ego();
-        let on_time = case_cost(&plan.outcome(&pulse, &self.occupant, rule, hw)?, reserve_m);
-        if !(plan.settings.airbag_force_n > 0.0 && cfg.fire_delay_tolerance_s > 0.0) {
-            return Ok(on_time);
-        }
-        let late = TwoLevelPlan {
-            settings: RestraintSettings {
-                airbag_time_s: plan.settings.airbag_time_s + cfg.fire_delay_tolerance_s,
-                ..plan.settings
-            },
-            ..*plan
-        };
-        let late_cost = case_cost(&late.outcome(&pulse, &self.occupant, rule, hw)?, reserve_m);
-        Ok(on_time.max(late_cost))
     }
 
     /// `plan` under `rule` on the truth at every point of the set.

@@ -326,10 +326,23 @@ pub fn robust_case_cost(
     hw: &RestraintHardware,
     cfg: &OptimiserConfig,
 ) -> Result<f64> {
-    let on_time = case_cost(
-        &simulate_occupant(&c.pulse, &c.occupant, set, hw)?,
-        cfg.reserve_m,
-    );
+    cost_with_late_airbag(set, cfg, |s| {
+        Ok(simulate_occupant(&c.pulse, &c.occupant, s, hw)?)
+    })
+}
+
+/// The fire-delay rule of [`robust_case_cost`] for any way of simulating a setting
+/// (`outcome`): the worse of [`case_cost`] on time and with the airbag
+/// `fire_delay_tolerance_s` late, when it fires and a tolerance is set.
+///
+/// # Errors
+/// `outcome` fails.
+pub fn cost_with_late_airbag(
+    set: &RestraintSettings,
+    cfg: &OptimiserConfig,
+    outcome: impl Fn(&RestraintSettings) -> Result<OccupantOutcome>,
+) -> Result<f64> {
+    let on_time = case_cost(&outcome(set)?, cfg.reserve_m);
     if !(set.airbag_force_n > 0.0 && cfg.fire_delay_tolerance_s > 0.0) {
         return Ok(on_time);
     }
@@ -337,11 +350,7 @@ pub fn robust_case_cost(
         airbag_time_s: set.airbag_time_s + cfg.fire_delay_tolerance_s,
         ..*set
     };
-    let late_cost = case_cost(
-        &simulate_occupant(&c.pulse, &c.occupant, &late, hw)?,
-        cfg.reserve_m,
-    );
-    Ok(on_time.max(late_cost))
+    Ok(on_time.max(case_cost(&outcome(&late)?, cfg.reserve_m)))
 }
 
 /// Evaluate one setting on all cases: total cost (with ride-down reserve `reserve_m`) and

@@ -34,6 +34,25 @@ use physics::{
 };
 use serde::Serialize;
 
+/// The library's nominal belted car-to-car cases at contact — name, closing km/h, opponent kg —
+/// that the margin studies (`lut study robust-cells`, `lut study limiter-switch`) compare on,
+/// with [`LIBRARY_OCCUPANT`].
+pub const LIBRARY_CASES: [(&str, f64, f64); 6] = [
+    ("taurus-52-52-none", 104.0, 1785.0),
+    ("taurus-48-48-abs", 96.0, 1785.0),
+    ("taurus-31-31-abs-eba", 62.0, 1785.0),
+    ("mass-sweep-1000kg", 96.0, 1000.0),
+    ("mass-sweep-1300kg", 96.0, 1300.0),
+    ("mass-sweep-2200kg", 96.0, 2200.0),
+];
+
+/// The library cases' occupant: 75 kg, 300 mm, belted.
+pub const LIBRARY_OCCUPANT: OccupantInput = OccupantInput {
+    mass_kg: 75.0,
+    chest_to_wheel_m: 0.300,
+    belted: true,
+};
+
 /// Penalty per g a setting is worse than the reference restraint at a point of the set.
 pub const WORSE_PENALTY_PER_G: f64 = 1.0e3;
 

@@ -2,17 +2,15 @@
 //! against today's rules on the library's nominal belted car-to-car cases
 //! (`lut::limiter_switch`).
 
-use super::robust_cells::CASES;
+use super::robust_cells::load_settings;
 use crate::plot;
 use anyhow::{bail, Result};
 use clap::Args;
-use lut::limiter_switch::speed_lost_by_mps;
-use lut::limiter_switch::{JudgedTwoLevel, SwitchRule};
-use lut::robust_cells::{point_optimum, Judged, Situation, UncertainSet, Uncertainty};
+use lut::limiter_switch::{speed_lost_by_mps, JudgedTwoLevel, SwitchRule};
+use lut::robust_cells::{
+    point_optimum, Judged, Situation, UncertainSet, Uncertainty, LIBRARY_CASES, LIBRARY_OCCUPANT,
+};
 use lut::scenario::{Ego, Opponent, Pulse};
-use lut::table::Grid;
-use physics::reference::ReferenceRestraint;
-use physics::OccupantInput;
 use rayon::prelude::*;
 use serde_json::json;
 use std::path::PathBuf;
@@ -64,25 +62,18 @@ pub fn run(a: &LimiterSwitchArgs) -> Result<()> {
     if !(0.0..50.0).contains(&a.evidence_error_pct) {
         bail!("--evidence-error-pct: in [0, 50)");
     }
-    let reference = ReferenceRestraint::load(&a.reference)
-        .map_err(anyhow::Error::msg)?
-        .settings();
-    let cfg = Grid::load(&a.grid)?.optimiser;
+    let (reference, cfg) = load_settings(&a.reference, &a.grid)?;
     let u = Uncertainty {
         mass_kg: a.mass_kg,
         speed_kph: a.speed_kph,
         corners: a.corners,
     };
     let ego = Ego::default();
-    let occupant = OccupantInput {
-        mass_kg: 75.0,
-        chest_to_wheel_m: 0.300,
-        belted: true,
-    };
+    let occupant = LIBRARY_OCCUPANT;
     if let Some(path) = &a.plot {
         plot_evidence(path, &ego, u.mass_kg)?;
     }
-    let rows: Vec<Row> = CASES
+    let rows: Vec<Row> = LIBRARY_CASES
         .par_iter()
         .map(|&(name, v, m)| -> Result<Row> {
             let s = Situation {
@@ -213,21 +204,16 @@ fn print_table(a: &LimiterSwitchArgs, u: &Uncertainty, rows: &[Row]) {
 /// Taurus), and their difference against the estimate's loss.
 fn plot_evidence(path: &std::path::Path, ego: &Ego, margin_kg: f64) -> Result<()> {
     let (closing_kph, opponent_kg) = (96.0, 1785.0);
+    let heavy_kg = (opponent_kg + margin_kg).min(physics::defaults::OPPONENT_MASS_KG.max);
     let t_ms: Vec<f64> = (0..=150).map(f64::from).collect();
     let lost = |m: f64| -> Result<Vec<f64>> {
-        let p = Pulse::predict(
-            ego,
-            Opponent::Car {
-                mass_kg: m.min(3000.0),
-            },
-            closing_kph,
-        )?;
+        let p = Pulse::predict(ego, Opponent::Car { mass_kg: m }, closing_kph)?;
         Ok(t_ms
             .iter()
             .map(|t| speed_lost_by_mps(&p.ego(), t * 1e-3))
             .collect())
     };
-    let (est, heavy) = (lost(opponent_kg)?, lost(opponent_kg + margin_kg)?);
+    let (est, heavy) = (lost(opponent_kg)?, lost(heavy_kg)?);
     let pct: Vec<f64> = est
         .iter()
         .zip(&heavy)
@@ -239,8 +225,7 @@ fn plot_evidence(path: &std::path::Path, ego: &Ego, margin_kg: f64) -> Result<()
         &[
             plot::Panel {
                 title: format!(
-                    "Ego speed lost, {closing_kph:.0} km/h closing: opponent {opponent_kg:.0} kg vs {:.0} kg",
-                    (opponent_kg + margin_kg).min(3000.0)
+                    "Ego speed lost, {closing_kph:.0} km/h closing: opponent {opponent_kg:.0} kg vs {heavy_kg:.0} kg"
                 ),
                 x_label: "time after contact [ms]",
                 y_label: "speed lost [m/s]",
@@ -251,7 +236,7 @@ fn plot_evidence(path: &std::path::Path, ego: &Ego, margin_kg: f64) -> Result<()
                         y: &est,
                     },
                     plot::Series {
-                        label: format!("{:.0} kg", (opponent_kg + margin_kg).min(3000.0)),
+                        label: format!("{heavy_kg:.0} kg"),
                         x: &t_ms,
                         y: &heavy,
                     },

@@ -3,14 +3,17 @@
 
 use anyhow::Result;
 use clap::Args;
-use lut::robust_cells::{point_optimum, Judged, Situation, UncertainSet, Uncertainty};
+use lut::optimise::OptimiserConfig;
+use lut::robust_cells::{
+    point_optimum, Judged, Situation, UncertainSet, Uncertainty, LIBRARY_CASES, LIBRARY_OCCUPANT,
+};
 use lut::scenario::Ego;
 use lut::table::Grid;
 use physics::reference::ReferenceRestraint;
-use physics::OccupantInput;
+use physics::RestraintSettings;
 use rayon::prelude::*;
 use serde_json::json;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct RobustCellsArgs {
@@ -34,34 +37,28 @@ pub struct RobustCellsArgs {
     pub json: bool,
 }
 
-/// The library's nominal belted car-to-car cases at contact: name, closing km/h, opponent kg
-/// (75 kg occupant, 300 mm).
-pub const CASES: [(&str, f64, f64); 6] = [
-    ("taurus-52-52-none", 104.0, 1785.0),
-    ("taurus-48-48-abs", 96.0, 1785.0),
-    ("taurus-31-31-abs-eba", 62.0, 1785.0),
-    ("mass-sweep-1000kg", 96.0, 1000.0),
-    ("mass-sweep-1300kg", 96.0, 1300.0),
-    ("mass-sweep-2200kg", 96.0, 2200.0),
-];
-
-pub fn run(a: &RobustCellsArgs) -> Result<()> {
-    let reference = ReferenceRestraint::load(&a.reference)
+/// The reference restraint's settings and the grid's optimiser settings the margin studies
+/// plan with.
+pub fn load_settings(
+    reference: &Path,
+    grid: &Path,
+) -> Result<(RestraintSettings, OptimiserConfig)> {
+    let reference = ReferenceRestraint::load(reference)
         .map_err(anyhow::Error::msg)?
         .settings();
-    let cfg = Grid::load(&a.grid)?.optimiser;
+    Ok((reference, Grid::load(grid)?.optimiser))
+}
+
+pub fn run(a: &RobustCellsArgs) -> Result<()> {
+    let (reference, cfg) = load_settings(&a.reference, &a.grid)?;
     let u = Uncertainty {
         mass_kg: a.mass_kg,
         speed_kph: a.speed_kph,
         corners: a.corners,
     };
     let ego = Ego::default();
-    let occupant = OccupantInput {
-        mass_kg: 75.0,
-        chest_to_wheel_m: 0.300,
-        belted: true,
-    };
-    let rows: Vec<(&str, [Judged; 3])> = CASES
+    let occupant = LIBRARY_OCCUPANT;
+    let rows: Vec<(&str, [Judged; 3])> = LIBRARY_CASES
         .par_iter()
         .map(|&(name, v, m)| -> Result<(&str, [Judged; 3])> {
             let s = Situation {
