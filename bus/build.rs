@@ -76,6 +76,7 @@ fn unit_suffix(unit: &str) -> &'static str {
         "m/s2" => "_mps2",
         "kg" => "_kg",
         "mm" => "_mm",
+        "m" => "_m",
         "%" => "_pct",
         "" | "cycles" => "",
         other => panic!("unit {other:?}: add a suffix in build.rs"),

@@ -28,7 +28,7 @@ pub mod codec {
 pub use codec::Messages;
 pub use codec::{
     AirbagStageAuth, AirbagStageCmd, BeltLimiterAuth, BeltLimiterCmd, EcuStatus, EgoVehicleState,
-    OccupantClassification,
+    OccupantClassification, V2xOpponentMass,
 };
 
 mod meta {

@@ -1,7 +1,7 @@
 //! The SocketCAN port of the ECU: [`CanPort`] over [`bus::socket::BusSocket`].
 //!
 //! Opened non-blocking with a kernel filter that passes only the ECU's input frames
-//! ([`restraint::input_can_ids`]: EgoVehicleState, OccupantClassification), so the cycle
+//! ([`restraint::input_can_ids`]: EgoVehicleState, OccupantClassification, V2xOpponentMass), so the cycle
 //! never spends time on other traffic and a flooded bus costs the kernel, not the cycle.
 //! Nothing here allocates after [`SocketCanPort::open`].
 

@@ -99,6 +99,22 @@ pub struct CycleConfig {
     /// until long after the restraint is committed (the pulses of 1300 and 2400 kg opponents at
     /// 96 km/h agree within 0.1 g for 30 ms), so the plan must already hold the heavier one.
     pub mass_misreport_kg: f64,
+    /// Robust planning with a second, independent mass source — the opponent's own mass from
+    /// V2X (`V2xOpponentMass`), when it describes the tracked object: the lookup is for the
+    /// heavier of the object list's estimate and the station's mass plus this margin, kg
+    /// (*default* 300: the paper's payload uncertainty), instead of `mass_misreport_kg`. One
+    /// source that reads too light (a single fault) is outvoted by the other; one that reads
+    /// too heavy over-restrains (the safe direction). 10 000 = V2X never lowers the margin.
+    pub v2x_mass_margin_kg: f64,
+    /// A `V2xOpponentMass` frame older than this is not used, ms (*default* 300: three of its
+    /// 100 ms periods).
+    pub v2x_timeout_ms: f64,
+    /// The station is the tracked object when its GNSS range, carried forward to the cycle at
+    /// its closing speed, is within this of the track's distance, m (*default* 8: GNSS ≈ 2 m
+    /// plus a 100 ms old position at 30 m/s) ...
+    pub v2x_gate_distance_m: f64,
+    /// ... and its closing speed within this of the track's, m/s (*default* 3).
+    pub v2x_gate_speed_mps: f64,
 
     /// Backup confirmation with a faulty crash accelerometer: the vehicle-dynamics
     /// deceleration on CAN (`EgoVehicleState.EgoLongAccel`, 10 ms) at or above this, g, inside
@@ -298,6 +314,10 @@ impl Default for CycleConfig {
             match_ratio_min: 0.5,
             match_ratio_max: 2.5,
             mass_misreport_kg: 1200.0,
+            v2x_mass_margin_kg: 300.0,
+            v2x_timeout_ms: 300.0,
+            v2x_gate_distance_m: 8.0,
+            v2x_gate_speed_mps: 3.0,
             backup_confirm_g: 4.0,
             fallback_dv_mps: crate::fallback::DEFAULT_DV_MPS,
             fallback_min_dv_mps: 1.25,
@@ -391,6 +411,10 @@ impl CycleConfig {
             10.0,
         )?;
         range("mass_misreport_kg", self.mass_misreport_kg, 0.0, 10_000.0)?;
+        range("v2x_mass_margin_kg", self.v2x_mass_margin_kg, 0.0, 10_000.0)?;
+        range("v2x_timeout_ms", self.v2x_timeout_ms, 1.0, 5_000.0)?;
+        range("v2x_gate_distance_m", self.v2x_gate_distance_m, 0.0, 100.0)?;
+        range("v2x_gate_speed_mps", self.v2x_gate_speed_mps, 0.0, 30.0)?;
         range("backup_confirm_g", self.backup_confirm_g, 1.5, 15.0)?;
         crate::fallback::validate_thresholds("fallback_dv_mps", &self.fallback_dv_mps)?;
         range("fallback_min_dv_mps", self.fallback_min_dv_mps, 0.0, 20.0)?;

@@ -33,6 +33,8 @@ pub struct CycleCounters {
     pub prediction_errors: u64,
     /// LUT lookups.
     pub lut_lookups: u64,
+    /// Lookups planned with the V2X station's mass as the second source (`v2x_mass_margin_kg`).
+    pub v2x_lookups: u64,
     /// Lookups outside the table (reference used).
     pub lut_out_of_range: u64,
     /// Lookups whose optimum still bottoms out (reported, not hidden).

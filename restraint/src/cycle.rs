@@ -395,6 +395,7 @@ impl Activity for RestraintCycle<'_> {
             ("predictions", c.predictions),
             ("prediction_errors", c.prediction_errors),
             ("lut_lookups", c.lut_lookups),
+            ("v2x_lookups", c.v2x_lookups),
             ("lut_out_of_range", c.lut_out_of_range),
             ("lut_bottoming_out", c.lut_bottoming_out),
             ("degraded_cycles", c.degraded_cycles),

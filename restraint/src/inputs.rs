@@ -11,7 +11,7 @@
 
 use bus::codec::{
     EgoVehicleStateBrakeState, OccupantClassificationBeltBuckle,
-    OccupantClassificationOccupantClass,
+    OccupantClassificationOccupantClass, V2xOpponentMassStationStatus,
 };
 use bus::{E2eChecker, Messages, RawFrame, RejectReason, CAN_EFF_FLAG};
 use heapless::Deque;
@@ -26,11 +26,25 @@ use crate::signals::{CrashAccelSample, Degraded, ObjectState};
 const MAX_OPPONENT_SPEED_MPS: f32 = 70.0;
 
 /// CAN ids the ECU consumes (kernel filter of the SocketCAN port), from the generated codec.
-pub fn input_can_ids() -> [u32; 2] {
+pub fn input_can_ids() -> [u32; 3] {
     [
         bus::EgoVehicleState::RAW_ID,
         bus::OccupantClassification::RAW_ID,
+        bus::V2xOpponentMass::RAW_ID,
     ]
+}
+
+/// What the station ahead says of itself over V2X (`V2xOpponentMass`), as last received.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct V2xStation {
+    /// The station's own mass (load included), kg.
+    pub mass_kg: f64,
+    /// Range from the GNSS positions, m.
+    pub range_m: f64,
+    /// Closing speed from the GNSS velocities, m/s.
+    pub closing_speed_mps: f64,
+    /// When the frame was received, ns.
+    pub rx_ns: u64,
 }
 
 /// Occupant as last reported on CAN.
@@ -116,6 +130,11 @@ pub struct InputMonitor {
     /// Occupant as last reported.
     pub(crate) occupant: Occupant,
     occupant_rx_ns: Option<u64>,
+    /// The newest `V2xOpponentMass` with a station (`None`: never, or the newest said none).
+    v2x: Option<V2xStation>,
+    /// When the newest `V2xOpponentMass` (station or not) was accepted.
+    v2x_rx_ns: Option<u64>,
+    v2x_timeout_ns: u64,
     /// The occupant report changed this cycle.
     pub(crate) occupant_changed: bool,
     /// Sequence of the newest accelerometer batch.
@@ -164,6 +183,9 @@ impl InputMonitor {
                 adult: false,
             },
             occupant_rx_ns: None,
+            v2x: None,
+            v2x_rx_ns: None,
+            v2x_timeout_ns: ms_to_ns(cfg.v2x_timeout_ms),
             occupant_changed: false,
             last_accel_sequence: 0,
             accel: AccelMonitor::new(cfg.accel_limits()),
@@ -205,6 +227,14 @@ impl InputMonitor {
         Self::stale(self.occupant_rx_ns, now, self.occupant_timeout_ns)
     }
 
+    /// The station V2X reports, if its frame is fresh (`v2x_timeout_ms`). Optional equipment:
+    /// no frame is no fault, only no second mass source.
+    pub(crate) fn v2x_station(&self, now: u64) -> Option<&V2xStation> {
+        self.v2x
+            .as_ref()
+            .filter(|v| now.saturating_sub(v.rx_ns) <= self.v2x_timeout_ns)
+    }
+
     /// One received CAN frame.
     pub(crate) fn on_can(&mut self, f: &RawFrame, now: u64, counters: &mut CycleCounters) {
         counters.can_frames_rx = counters.can_frames_rx.saturating_add(1);
@@ -216,6 +246,7 @@ impl InputMonitor {
         let resync = match f.id {
             bus::EgoVehicleState::RAW_ID => self.vehicle_stale(now),
             bus::OccupantClassification::RAW_ID => self.occupant_stale(now),
+            bus::V2xOpponentMass::RAW_ID => Self::stale(self.v2x_rx_ns, now, self.v2x_timeout_ns),
             _ => false,
         };
         let checked = if resync {
@@ -245,6 +276,20 @@ impl InputMonitor {
                 self.occupant_changed |= occ != self.occupant;
                 self.occupant = occ;
                 self.occupant_rx_ns = Some(now);
+            }
+            Ok(Messages::V2xOpponentMass(m)) => {
+                // The codec's ranges hold (out-of-range frames are rejected above): a station
+                // that reports no mass says nothing about the opponent's.
+                let mass_kg = f64::from(m.opponent_mass());
+                self.v2x_rx_ns = Some(now);
+                self.v2x = (m.station_status() == V2xOpponentMassStationStatus::Valid
+                    && mass_kg > 0.0)
+                    .then_some(V2xStation {
+                        mass_kg,
+                        range_m: f64::from(m.station_range()),
+                        closing_speed_mps: f64::from(m.closing_speed()),
+                        rx_ns: now,
+                    });
             }
             Ok(_) => {}
             Err(e) if e.reason() == RejectReason::UnknownId => {}

@@ -110,6 +110,9 @@ pub struct Player {
     next_obj_s: f64,
     next_veh_s: f64,
     next_occ_s: f64,
+    /// The V2X frame's period, ms (`None`: the scenario has no `[v2x]`).
+    v2x_period_ms: Option<f64>,
+    next_v2x_s: f64,
     last_object: Option<ObjectState>,
     crash: AccelChannel,
     safing: AccelChannel,
@@ -126,7 +129,10 @@ impl Player {
         let t0_s = first_tick as f64 * 1e-3;
         // First instant of each feed at or after t0 (all 0 on a fresh start).
         let first_at = |period_s: f64| (t0_s / period_s - 1e-9).ceil().max(0.0) * period_s;
+        let v2x_period_ms = truth.scenario().v2x.as_ref().map(|v| v.period_ms);
         Player {
+            v2x_period_ms,
+            next_v2x_s: v2x_period_ms.map_or(0.0, |p| first_at(p * 1e-3)),
             next_obj_s: first_at(sensor.object_period_ms * 1e-3),
             next_veh_s: first_at(sensor.vehicle_period_ms * 1e-3),
             next_occ_s: first_at(sensor.occupant_period_ms * 1e-3),
@@ -236,6 +242,17 @@ impl Player {
                 out.can
                     .push(self.protector.seal(self.model.occupant_frame()?));
                 self.counts.can_frames += 1;
+            }
+        }
+        while let Some(period_ms) = self.v2x_period_ms.filter(|_| self.next_v2x_s <= t + 1e-9) {
+            let tp = self.next_v2x_s;
+            self.next_v2x_s += period_ms * 1e-3;
+            if let Some(frame) = self.model.v2x_frame(tp) {
+                // The noise is drawn even for a dropped frame: a dropout does not shift the rest.
+                if !self.sensor.dropped(DropoutTarget::V2x, tp) {
+                    out.can.push(self.protector.seal(frame?));
+                    self.counts.can_frames += 1;
+                }
             }
         }
         Ok(())

@@ -99,6 +99,9 @@ pub struct OfflineRun {
     /// Largest crash-minus-safing Δv over a confirmed event's window, m/s (`None`: no event
     /// judged): what two sensors showed against the severity agreement's tolerance.
     pub severity_excess_mps: Option<f64>,
+    /// Lookups the core planned with the V2X station's mass (`v2x_lookups`): the second mass
+    /// source was used.
+    pub v2x_lookups: u64,
 }
 
 impl OfflineRun {
@@ -334,6 +337,12 @@ pub fn run_traced(
     }
     let confirmed_by = ecu.crash_kind();
     let severity_excess_mps = ecu.agreement().worst_excess_mps();
+    let mut v2x_lookups = 0;
+    restraint::Activity::report_counters(&ecu, &mut |name, n| {
+        if name == "v2x_lookups" {
+            v2x_lookups = n;
+        }
+    });
     let truth = Truth::new(scenario).map_err(|e| anyhow!("{}: {e}", scenario.name))?;
     let contact_ns = contact_s.map_or(u64::MAX, |tc| START_NS + (tc * 1e9).round() as u64);
     let evaluated = match contact_s {
@@ -361,6 +370,7 @@ pub fn run_traced(
         confirmed_by,
         action_modes,
         severity_excess_mps,
+        v2x_lookups,
     })
 }
 
@@ -573,6 +583,29 @@ pub const ACCEPTED_COSTS: &[(&str, f64, &str)] = &[
          table before plan = fire)",
     ),
 ];
+
+/// Variations whose adaptive airbag may come later after its plan than the table's fire-delay
+/// tolerance, matched by name prefix: (prefix, the most it may be late, ms, why). The airbag's
+/// severity floor comes first in the safety order (no misuse may fire it); these are the cases
+/// where a plan made for a heavier opponent than the truth is earlier than the floor.
+pub const ACCEPTED_LATE_AIRBAGS: &[(&str, f64, &str)] = &[(
+    "taurus-31-31-abs-eba-true1300-",
+    4.5,
+    "at 31 + 31 km/h the pulse of a 1 300 kg (class 2) opponent carries the airbag's 1.25 m/s \
+     severity floor only at +16.9 ms; planned for a source 600 kg too heavy (2 200 kg with the \
+     V2X margin) the airbag is due at +12.5 ms: 4.4 ms late, outcome −40.1 %, no bottoming-out. \
+     Today's +1 200 kg rule has the same wait on the truly reported case (plan +13.4 ms for \
+     2 500 kg: 3.5 ms late, −37.5 %), which the ±1 200 kg grid (errors ≠ 0) does not run",
+)];
+
+/// How late after its plan the adaptive airbag of variation `name` may fire, ms, and why
+/// (`None`: the table's fire-delay tolerance).
+pub fn accepted_late_airbag(name: &str) -> Option<(f64, &'static str)> {
+    ACCEPTED_LATE_AIRBAGS
+        .iter()
+        .find(|c| name.starts_with(c.0))
+        .map(|c| (c.1, c.2))
+}
 
 /// The accepted cost of scenario `name`: the most it may lose against the reference, %, and
 /// why (`None`: it must be no worse).

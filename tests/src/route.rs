@@ -206,6 +206,9 @@ fn injected_flags(scenario: &sensor_feeds::Scenario) -> Vec<&'static str> {
             DropoutTarget::Occupant => &["occupant_input"],
             DropoutTarget::Accel => &["accel_sensor"],
             DropoutTarget::Safing => &["safing_sensor"],
+            // Optional equipment: a silent V2X receiver raises no fault, it only takes the
+            // second mass source away.
+            DropoutTarget::V2x => &[],
             DropoutTarget::All => &[
                 "object_input",
                 "vehicle_input",

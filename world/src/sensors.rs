@@ -12,11 +12,12 @@ use crate::events::AccelEvents;
 use crate::lowpass::AntiAlias;
 use crate::scenario::{AccelSensor, BrakeStateName, Scenario};
 use crate::truth::Truth;
+use bus::codec::V2xOpponentMassStationStatus;
 use bus::codec::{
     EgoVehicleStateBrakeState, OccupantClassificationBeltBuckle,
     OccupantClassificationOccupantClass,
 };
-use bus::{EgoVehicleState, EncodeError, OccupantClassification};
+use bus::{EgoVehicleState, EncodeError, OccupantClassification, V2xOpponentMass};
 use rand::SeedableRng;
 
 use crate::noise::gauss;
@@ -30,11 +31,16 @@ pub const OPPONENT_OBJECT_ID: u32 = 7;
 /// the main stream 0, which the object list and the crash accelerometer draw from).
 pub const SAFING_STREAM: u64 = 1;
 
+/// ChaCha8 stream of the V2X receiver's GNSS noise (`[v2x]`; its own, so a scenario with and
+/// without `[v2x]` draws the same object-list and accelerometer noise).
+pub const V2X_STREAM: u64 = 2;
+
 /// Seeded sensor model over a solved [`Truth`].
 pub struct SensorModelSim {
     truth: Truth,
     rng: ChaCha8Rng,
     safing_rng: ChaCha8Rng,
+    v2x_rng: ChaCha8Rng,
     events: AccelEvents,
     /// The anti-alias filters of the crash and the safing accelerometer.
     lowpass: [AntiAlias; 2],
@@ -47,7 +53,10 @@ impl SensorModelSim {
         let seed = truth.scenario().seed;
         let mut safing_rng = ChaCha8Rng::seed_from_u64(seed);
         safing_rng.set_stream(SAFING_STREAM);
+        let mut v2x_rng = ChaCha8Rng::seed_from_u64(seed);
+        v2x_rng.set_stream(V2X_STREAM);
         SensorModelSim {
+            v2x_rng,
             events: AccelEvents::new(truth.scenario()),
             lowpass: [(); 2].map(|_| AntiAlias::new(truth.scenario().sensor.accel_lowpass_hz)),
             truth,
@@ -185,6 +194,37 @@ impl SensorModelSim {
             w.ego_speed_mps.clamp(0.0, 100.0) as f32,
             w.ego_accel_mps2.clamp(-150.0, 150.0) as f32,
         )
+    }
+
+    /// The `V2xOpponentMass` frame content at `t_s` (`None`: the scenario has no `[v2x]`):
+    /// the station's position and speed `latency_ms` old, with GNSS noise; `NoStation` when
+    /// the opponent does not transmit (not equipped, a barrier), is out of reception range or
+    /// has left the ego's path. The reported mass is the station's own (true, load included)
+    /// unless `[v2x] mass_kg` says otherwise.
+    pub fn v2x_frame(&mut self, t_s: f64) -> Option<Result<V2xOpponentMass, EncodeError>> {
+        let v = self.scenario().v2x.clone()?;
+        let w = self.truth.state((t_s - v.latency_ms * 1e-3).max(0.0));
+        let true_mass = self.scenario().opponent_mass_kg();
+        let station =
+            v.opponent_equipped && true_mass.is_finite() && w.in_path && w.distance_m <= v.range_m;
+        if !station {
+            return Some(V2xOpponentMass::encode(
+                V2xOpponentMassStationStatus::NoStation,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+            ));
+        }
+        let range = w.distance_m + v.distance_noise_m * gauss(&mut self.v2x_rng);
+        let closing = w.closing_speed_mps + v.speed_noise_mps * gauss(&mut self.v2x_rng);
+        Some(V2xOpponentMass::encode(
+            V2xOpponentMassStationStatus::Valid,
+            v.mass_kg.unwrap_or(true_mass).clamp(0.0, 40_000.0) as f32,
+            v.mass_sigma_kg.clamp(0.0, 2550.0) as f32,
+            range.clamp(0.0, 400.0) as f32,
+            closing.clamp(-100.0, 100.0) as f32,
+        ))
     }
 
     /// The `OccupantClassification` frame content (the occupant does not change in a run).
@@ -325,5 +365,75 @@ mod tests {
             u8::from(f.brake_state()),
             u8::from(EgoVehicleStateBrakeState::Released)
         );
+    }
+
+    /// The scenario of [`sim`] with a `[v2x]` table (`v2x` = its keys).
+    fn sim_v2x(v2x: &str) -> SensorModelSim {
+        let text = format!(
+            "name = \"t\"\nduration_s = 3\nseed = 42\n[ego]\nmass_kg = 1785\nspeed_kph = 36\n\
+             [opponent]\nkind = \"vehicle\"\nmass_kg = 1500\nspeed_kph = 36\ninitial_distance_m = 40\n\
+             [sensor]\nmass_noise_kg = 50\n[occupant]\nmass_kg = 110\nbelted = false\n[v2x]\n{v2x}\n"
+        );
+        let s = Scenario::parse("t.toml", &text).expect("valid");
+        SensorModelSim::new(Truth::new(&s).expect("truth"))
+    }
+
+    #[test]
+    fn v2x_reports_the_true_mass_and_the_delayed_gnss_range() {
+        let mut m = sim_v2x("latency_ms = 100\ndistance_noise_m = 0\nspeed_noise_mps = 0");
+        let f = m.v2x_frame(1.1).expect("[v2x]").expect("in range");
+        assert_eq!(f.station_status(), V2xOpponentMassStationStatus::Valid);
+        assert_eq!(f.opponent_mass(), 1500);
+        assert_eq!(f.mass_sigma(), 100);
+        // Position of 1.0 s: 40 − 2·10 m/s·1 s = 20 m, closing 20 m/s (DBC steps 0.1 m, 0.05 m/s).
+        assert!(
+            (f.station_range() - 20.0).abs() < 0.051,
+            "{}",
+            f.station_range()
+        );
+        assert!(
+            (f.closing_speed() - 20.0).abs() < 0.026,
+            "{}",
+            f.closing_speed()
+        );
+        // A forged or misconfigured station: the mass it says.
+        let mut forged = sim_v2x("mass_kg = 700");
+        let f = forged.v2x_frame(1.1).expect("[v2x]").expect("in range");
+        assert_eq!(f.opponent_mass(), 700);
+        // Not equipped, out of reception range: the module says no station.
+        for keys in ["opponent_equipped = false", "range_m = 10"] {
+            let f = sim_v2x(keys)
+                .v2x_frame(0.2)
+                .expect("[v2x]")
+                .expect("in range");
+            assert_eq!(
+                f.station_status(),
+                V2xOpponentMassStationStatus::NoStation,
+                "{keys}"
+            );
+        }
+        // No `[v2x]`: no frame at all.
+        assert!(sim("").v2x_frame(1.0).is_none());
+    }
+
+    #[test]
+    fn v2x_noise_has_its_own_stream() {
+        // The object list's noise is the same with and without `[v2x]`, however many V2X
+        // frames are drawn in between.
+        let mut with = sim_v2x("distance_noise_m = 2");
+        let text = "name = \"t\"\nduration_s = 3\nseed = 42\n[ego]\nmass_kg = 1785\nspeed_kph = 36\n\
+                    [opponent]\nkind = \"vehicle\"\nmass_kg = 1500\nspeed_kph = 36\ninitial_distance_m = 40\n\
+                    [sensor]\nmass_noise_kg = 50\n[occupant]\nmass_kg = 110\nbelted = false\n";
+        let s = Scenario::parse("t.toml", text).expect("valid");
+        let mut without = SensorModelSim::new(Truth::new(&s).expect("truth"));
+        let mut ranges = Vec::new();
+        for k in 0..20 {
+            let t = 0.1 + 0.05 * f64::from(k);
+            let f = with.v2x_frame(t).expect("[v2x]").expect("in range");
+            ranges.push(f.station_range());
+            assert_eq!(with.object(t), without.object(t), "t = {t}");
+        }
+        // ... and the V2X range is noisy (σ 2 m), not the truth repeated.
+        assert!(ranges.windows(2).any(|w| w[0] != w[1]));
     }
 }

@@ -23,7 +23,7 @@ use physics::{CollisionInput, CollisionSummary, CombinedSpring, ExactCollision, 
 
 use crate::config::CycleConfig;
 use crate::counters::CycleCounters;
-use crate::inputs::InputMonitor;
+use crate::inputs::{InputMonitor, V2xStation};
 use crate::plan::RestraintPlan;
 use crate::settings::ms_to_ns;
 use crate::settings::ConfigError;
@@ -172,6 +172,9 @@ pub struct Situation {
     pub opponent_mass_estimate_kg: f64,
     /// σ of the fused opponent mass, kg.
     pub opponent_mass_sigma_kg: f64,
+    /// The mass the V2X station reports for itself, kg, when its frame is fresh and it is the
+    /// tracked object (`v2x_gate_*`): the second, independent mass source of the planning mass.
+    pub v2x_mass_kg: Option<f64>,
     /// Ego equivalent barrier speed, km/h.
     pub ebs_kph: f64,
     /// Below the no-fire threshold.
@@ -195,6 +198,9 @@ pub struct Estimator<'a> {
     conservative_mass_k: f64,
     contact_time_k: f64,
     mass_misreport_kg: f64,
+    v2x_mass_margin_kg: f64,
+    v2x_gate_distance_m: f64,
+    v2x_gate_speed_mps: f64,
     no_fire_ebs_kph: f64,
     exit_horizon_ns: u64,
     springs: [Option<CombinedSpring>; 6],
@@ -238,6 +244,9 @@ impl<'a> Estimator<'a> {
             conservative_mass_k: cfg.conservative_mass_k,
             contact_time_k: cfg.track.contact_time_k,
             mass_misreport_kg: cfg.mass_misreport_kg,
+            v2x_mass_margin_kg: cfg.v2x_mass_margin_kg,
+            v2x_gate_distance_m: cfg.v2x_gate_distance_m,
+            v2x_gate_speed_mps: cfg.v2x_gate_speed_mps,
             no_fire_ebs_kph: cfg.no_fire_ebs_kph,
             exit_horizon_ns: horizon_ns.saturating_add(ms_to_ns(cfg.preset_exit_hysteresis_ms)),
             springs,
@@ -341,7 +350,10 @@ impl<'a> Estimator<'a> {
             self.situation = None; // no track, or it does not reach us
             return None;
         };
-        let sit = self.situation_of(&e);
+        let station = inputs
+            .v2x_station(now)
+            .filter(|st| self.is_tracked_object(&e, st));
+        let sit = self.situation_of(&e, station);
         self.situation = Some(sit);
         // Predict only what can become relevant before the next sample: contact within the
         // exit horizon (bounds the work to objects that matter).
@@ -354,8 +366,20 @@ impl<'a> Estimator<'a> {
         Some(self.lookup(&sit, inputs, counters))
     }
 
-    /// The situation of a track estimate.
-    fn situation_of(&self, e: &TrackEstimate) -> Situation {
+    /// Whether the V2X station is the tracked object: its GNSS range, carried forward from its
+    /// frame's reception to the estimate's time at its closing speed, and its closing speed
+    /// agree with the track's within the gates. A wrong pairing matters only together with a
+    /// second fault: the planning mass takes the heavier source.
+    fn is_tracked_object(&self, e: &TrackEstimate, st: &V2xStation) -> bool {
+        let age_s = e.at_ns.saturating_sub(st.rx_ns) as f64 * 1.0e-9;
+        let range_now_m = st.range_m - st.closing_speed_mps * age_s;
+        (range_now_m - e.distance_m).abs() <= self.v2x_gate_distance_m
+            && (st.closing_speed_mps - e.closing_speed_mps).abs() <= self.v2x_gate_speed_mps
+    }
+
+    /// The situation of a track estimate (`station`: the V2X station that is the tracked
+    /// object, if any).
+    fn situation_of(&self, e: &TrackEstimate, station: Option<&V2xStation>) -> Situation {
         let to_ns = |t_s: f64| (t_s * 1.0e9) as u64; // saturating, NaN → 0
         let contact_estimate_ns = e.at_ns.saturating_add(to_ns(e.contact.ttc_s));
         let early_ns = to_ns(self.contact_time_k * e.ttc_sigma_s);
@@ -371,6 +395,7 @@ impl<'a> Estimator<'a> {
             opponent_mass_kg: opp_kg,
             opponent_mass_estimate_kg: e.mass_kg,
             opponent_mass_sigma_kg: e.mass_sigma_kg,
+            v2x_mass_kg: station.map(|st| st.mass_kg),
             ebs_kph,
             low_speed: !(ebs_kph >= self.no_fire_ebs_kph),
         }
@@ -410,7 +435,10 @@ impl<'a> Estimator<'a> {
     /// opponent. The opponent's mass does not show in the ego pulse before the restraint is
     /// committed (`crash_match`), so the plan must already hold the heaviest opponent the
     /// sensing could be wrong about; where even the conservative mass is beyond the table, the
-    /// lookup stays out of range (reference restraint).
+    /// lookup stays out of range (reference restraint). With a second, independent source — the
+    /// V2X station that is the tracked object — the heavier of the two + `v2x_mass_margin_kg`
+    /// instead: a single fault makes one source read light, and the other still holds the
+    /// plan; one reading heavy only over-restrains.
     pub(crate) fn lookup(
         &self,
         sit: &Situation,
@@ -427,7 +455,15 @@ impl<'a> Estimator<'a> {
         let heaviest = lut.view.axes()[1]
             .last()
             .map_or(f64::NAN, |m| f64::from(*m));
-        let robust = (sit.opponent_mass_estimate_kg + self.mass_misreport_kg).min(heaviest);
+        let robust = match sit.v2x_mass_kg {
+            // f64::max: a NaN estimate yields the station's mass.
+            Some(station_kg) => {
+                counters.v2x_lookups = counters.v2x_lookups.saturating_add(1);
+                sit.opponent_mass_estimate_kg.max(station_kg) + self.v2x_mass_margin_kg
+            }
+            None => sit.opponent_mass_estimate_kg + self.mass_misreport_kg,
+        }
+        .min(heaviest);
         // NaN-safe: a NaN robust mass keeps the conservative one.
         let mass = if robust > sit.opponent_mass_kg {
             robust

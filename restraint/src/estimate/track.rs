@@ -108,6 +108,10 @@ pub struct TrackEstimate {
     pub mass_kg: f64,
     /// σ of the fused opponent mass, kg.
     pub mass_sigma_kg: f64,
+    /// Distance to the object at `at_ns`, m.
+    pub distance_m: f64,
+    /// Closing speed at `at_ns`, m/s.
+    pub closing_speed_mps: f64,
 }
 
 /// Information-weighted opponent mass (see the module docs).
@@ -484,6 +488,8 @@ impl TrackFilter {
             closing_speed_sigma_mps: sd(var(&j_v)),
             mass_kg,
             mass_sigma_kg,
+            distance_m: x.x,
+            closing_speed_mps: x.y,
         })
     }
 }

@@ -14,3 +14,4 @@ mod no_panic;
 mod scenarios;
 mod secoc;
 mod single_fault;
+mod v2x;

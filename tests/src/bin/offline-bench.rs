@@ -56,6 +56,11 @@ struct Cli {
     /// exits 1).
     #[arg(long)]
     no_expect: bool,
+    /// Give every scenario without a `[v2x]` table the default V2X receiver, the opponent
+    /// transmitting its true mass (scenarios/README.md, `[v2x]`): what the second opponent-mass
+    /// source buys across the library.
+    #[arg(long)]
+    v2x: bool,
 }
 
 fn main() -> std::process::ExitCode {
@@ -113,7 +118,12 @@ fn run_all() -> Result<bool> {
     for (file, loaded) in loaded {
         let file_name = file.display().to_string();
         let s = match loaded {
-            Ok(s) => s,
+            Ok(mut s) => {
+                if cli.v2x && s.v2x.is_none() {
+                    s.v2x = Some(sensor_feeds::scenario::V2x::default());
+                }
+                s
+            }
             Err(e) => {
                 eprintln!("offline-bench: {e}");
                 json.push(serde_json::json!({ "file": file_name, "error": e.to_string() }));

@@ -48,6 +48,50 @@ pub struct Scenario {
     /// the whole car feels and single-sensor faults ([`AccelEvent`]).
     #[serde(default, rename = "accel_event")]
     pub accel_events: Vec<AccelEvent>,
+    /// The ego's V2X receiver (`[v2x]`; absent: the ego has none, as before): a second
+    /// opponent-mass source, independent of the object list ([`V2x`]).
+    #[serde(default)]
+    pub v2x: Option<V2x>,
+}
+
+/// The ego's V2X receiver and what the station ahead says of itself (`V2xOpponentMass` on
+/// CAN): the opponent's own mass including its load, with range and closing speed from the two
+/// stations' GNSS. Its noise has its own random stream, so adding `[v2x]` changes no other draw.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct V2x {
+    /// Frame period [ms] (DBC: 100; CAM / BSM at 10 Hz).
+    pub period_ms: f64,
+    /// Age of the station's position and speed at reception [ms].
+    pub latency_ms: f64,
+    /// Stations beyond this distance are not received [m].
+    pub range_m: f64,
+    /// Gaussian noise of the GNSS range [m, 1σ].
+    pub distance_noise_m: f64,
+    /// Gaussian noise of the GNSS closing speed [m/s, 1σ].
+    pub speed_noise_mps: f64,
+    /// The opponent transmits (false: the ego's module is alive and reports no station).
+    pub opponent_equipped: bool,
+    /// Mass the station reports instead of its true mass [kg] (a misconfigured or forged
+    /// station).
+    pub mass_kg: Option<f64>,
+    /// σ the station gives its mass [kg] (its own vehicle data, load included).
+    pub mass_sigma_kg: f64,
+}
+
+impl Default for V2x {
+    fn default() -> Self {
+        V2x {
+            period_ms: 100.0,
+            latency_ms: 100.0,
+            range_m: 300.0,
+            distance_noise_m: 1.0,
+            speed_noise_mps: 0.2,
+            opponent_equipped: true,
+            mass_kg: None,
+            mass_sigma_kg: 100.0,
+        }
+    }
 }
 
 fn default_seed() -> u64 {
@@ -151,6 +195,8 @@ pub enum DropoutTarget {
     Accel,
     /// The safing accelerometer (the independent second acceleration channel).
     Safing,
+    /// The V2X receiver's `V2xOpponentMass` frame.
+    V2x,
     /// Everything.
     All,
 }
@@ -799,6 +845,7 @@ mass_kg = 75
             ("[sensor]\n", full.clone()),
             ("[occupant]\n", top.to_owned()),
             ("[expect]\n", full.clone()),
+            ("[v2x]\n", full.clone()),
             (
                 "[[accel_event]]\nkind = \"spike\"\nstart_s = 0\n",
                 full.clone(),

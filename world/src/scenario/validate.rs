@@ -198,6 +198,29 @@ impl Scenario {
             ));
         }
         range("sensor.confidence", s.confidence, 0.0, 1.0, "")?;
+        if let Some(v) = &self.v2x {
+            range("v2x.period_ms", v.period_ms, 10.0, 1000.0, "ms")?;
+            range("v2x.latency_ms", v.latency_ms, 0.0, 500.0, "ms")?;
+            range(
+                "v2x.range_m",
+                v.range_m,
+                1.0,
+                400.0,
+                "m (the frame's range)",
+            )?;
+            range("v2x.distance_noise_m", v.distance_noise_m, 0.0, 20.0, "m")?;
+            range("v2x.speed_noise_mps", v.speed_noise_mps, 0.0, 10.0, "m/s")?;
+            range(
+                "v2x.mass_sigma_kg",
+                v.mass_sigma_kg,
+                0.0,
+                2550.0,
+                "kg (the frame's range)",
+            )?;
+            if let Some(m) = v.mass_kg {
+                range("v2x.mass_kg", m, 0.0, 40000.0, "kg (the frame's range)")?;
+            }
+        }
         range(
             "sensor.vehicle_period_ms",
             s.vehicle_period_ms,
