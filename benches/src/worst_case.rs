@@ -8,13 +8,15 @@
 //! relative to contact (before it: PRE-CRASH or MONITORING; after it: confirmation, CRASH),
 //! with or without LUT, SecOC, CAN — and the *inputs of the measured cycle itself*: up to 2
 //! object samples (on track, outlier, out of order, non-finite, new object, "no object", low
-//! confidence), up to 3 CAN frames (ego; occupant unchanged or changed; a corrupt or foreign
-//! frame), up to 2 accelerometer batches, and its timing (late start, overruns).
+//! confidence), up to 4 CAN frames (ego; occupant unchanged or changed; V2X; a corrupt or
+//! foreign frame), up to 2 accelerometer batches, and its timing (late start, overruns). A V2X
+//! station that is the tracked object can report throughout the prefix (`v2x`): the lookups
+//! then take the second-source branch.
 //!
 //! **Bounds of the space.** The measured cycle's own inputs are bounded by what the senders'
 //! contracts deliver in one 1 ms cycle plus one of catching up: object list ≥ 5 ms period (2
 //! samples), one accelerometer batch per ms (2 batches), and per CAN message at most one
-//! frame per cycle (EgoVehicleState 10 ms, OccupantClassification 100 ms in the DBC) plus one
+//! frame per cycle (EgoVehicleState 10 ms, OccupantClassification and V2xOpponentMass 100 ms in the DBC) plus one
 //! frame that the E2E check rejects or the ECU does not consume. A babbling node or a burst of
 //! queued frames after a stall is outside the budget's contract (each received frame costs
 //! 400–1 200 instructions in the bus crate's E2E check and decode); the shell bounds it at 64
@@ -93,6 +95,8 @@ pub enum CanKind {
     Corrupt,
     /// A standard id the ECU does not consume.
     Foreign,
+    /// The next V2xOpponentMass of a station that is the tracked object.
+    V2x,
 }
 
 /// One point of the search space (see the module docs). Every field is clamped to its
@@ -141,10 +145,14 @@ pub struct CycleCase {
     pub secoc: bool,
     /// The default table loaded (else: DEGRADED on the reference restraint).
     pub lut: bool,
+    /// A V2X station that is the tracked object reports every 100 ms of the prefix (absent in
+    /// a case file: none, as before the second mass source).
+    #[serde(default)]
+    pub v2x: bool,
     /// Object samples of the measured cycle (at most 2).
     pub objects: Vec<ObjectKind>,
     /// CAN frames of the measured cycle: at most one EgoVehicleState, one
-    /// OccupantClassification and one rejected or foreign frame.
+    /// OccupantClassification, one V2xOpponentMass and one rejected or foreign frame.
     pub can: Vec<CanKind>,
     /// Accelerometer batches of the measured cycle (0..=2).
     pub accel_batches: u32,
@@ -179,6 +187,7 @@ impl CycleCase {
             accel_rate_hz: 8000.0,
             secoc: false,
             lut: true,
+            v2x: false,
             objects: vec![ObjectKind::OnTrack],
             can: vec![],
             accel_batches: 0,
@@ -216,8 +225,9 @@ impl CycleCase {
             CanKind::Ego => 0,
             CanKind::Occupant | CanKind::OccupantChanged => 1,
             CanKind::Corrupt | CanKind::Foreign => 2,
+            CanKind::V2x => 3,
         };
-        let mut seen = [false; 3];
+        let mut seen = [false; 4];
         self.can
             .retain(|k| !std::mem::replace(&mut seen[class(k)], true));
         self.accel_batches = self.accel_batches.min(2);
@@ -402,6 +412,21 @@ impl Feed<'_> {
         Ok(self.tx.seal(m))
     }
 
+    /// The V2X station's frame at `now`: the tracked object's range and closing speed, its
+    /// mass (σ 100 kg).
+    fn v2x_frame(&mut self, now: u64) -> anyhow::Result<RawFrame> {
+        let c = self.case;
+        let m = bus::V2xOpponentMass::encode(
+            bus::codec::V2xOpponentMassStationStatus::Valid,
+            c.opponent_mass_kg as f32,
+            100.0,
+            c.distance_at(now, self.contact_ns).clamp(0.0, 400.0) as f32,
+            c.speed_at(now, self.contact_ns).clamp(-100.0, 100.0) as f32,
+        )
+        .map_err(|e| anyhow::anyhow!("V2X frame: {e:?}"))?;
+        Ok(self.tx.seal(m))
+    }
+
     /// The accelerometer batch of the millisecond starting at `t_ns`: the crash pulse after
     /// contact, before it a live sensor's quiet reading (±0.05 m/s² alternating: the ECU flags
     /// bit-identical readings as a stuck sensor).
@@ -439,6 +464,9 @@ impl Feed<'_> {
         }
         if ms.is_multiple_of(100) {
             io.push_can(self.occupant_frame(0.0)?);
+            if c.v2x {
+                io.push_can(self.v2x_frame(now)?);
+            }
         }
         let track_from = T_MEASURED.saturating_sub((c.tracked_ms * 1e6) as u64);
         let latency = u64::from(c.latency_ms) * MS;
@@ -496,6 +524,7 @@ impl Feed<'_> {
                     f
                 }
                 CanKind::Foreign => RawFrame::new(0x123, &[1, 2, 3, 4, 5, 6, 7, 8]),
+                CanKind::V2x => self.v2x_frame(now)?,
             };
             io.push_can(f);
         }
@@ -598,7 +627,7 @@ pub fn random_case(rng: &mut ChaCha8Rng) -> CycleCase {
     let objects = (0..rng.gen_range(0..=2))
         .map(|_| object_kind(rng))
         .collect();
-    let can = (0..rng.gen_range(0..=3)).map(|_| can_kind(rng)).collect();
+    let can = (0..rng.gen_range(0..=4)).map(|_| can_kind(rng)).collect();
     let case = CycleCase {
         closing_speed_mps: rng.gen_range(5.0..45.0),
         closing_accel_mps2: rng.gen_range(-12.0..2.0),
@@ -620,6 +649,7 @@ pub fn random_case(rng: &mut ChaCha8Rng) -> CycleCase {
         accel_rate_hz: rng.gen_range(1000.0..8000.0),
         secoc: rng.gen(),
         lut: rng.gen_bool(0.8),
+        v2x: rng.gen(),
         objects,
         can,
         accel_batches: rng.gen_range(0..=2),
@@ -644,7 +674,7 @@ fn object_kind(rng: &mut ChaCha8Rng) -> ObjectKind {
 
 fn can_kind(rng: &mut ChaCha8Rng) -> CanKind {
     use CanKind::*;
-    [Ego, Occupant, OccupantChanged, Corrupt, Foreign][rng.gen_range(0..5)]
+    [Ego, Occupant, OccupantChanged, Corrupt, Foreign, V2x][rng.gen_range(0..6)]
 }
 
 /// A mutation of `c`: each field changes with probability `p` (numbers by a normal step of a
@@ -681,7 +711,13 @@ pub fn mutate(c: &CycleCase, p: f64, rng: &mut ChaCha8Rng) -> CycleCase {
     if rng.gen_bool(p) {
         m.noise_seed = rng.gen();
     }
-    for flag in [&mut m.buckled, &mut m.adult, &mut m.secoc, &mut m.lut] {
+    for flag in [
+        &mut m.buckled,
+        &mut m.adult,
+        &mut m.secoc,
+        &mut m.lut,
+        &mut m.v2x,
+    ] {
         if rng.gen_bool(p * 0.5) {
             *flag = !*flag;
         }
@@ -702,7 +738,7 @@ pub fn mutate(c: &CycleCase, p: f64, rng: &mut ChaCha8Rng) -> CycleCase {
     }
     if rng.gen_bool(p) {
         match rng.gen_range(0..3) {
-            0 if m.can.len() < 3 => m.can.push(can_kind(rng)),
+            0 if m.can.len() < 4 => m.can.push(can_kind(rng)),
             1 if !m.can.is_empty() => {
                 let i = rng.gen_range(0..m.can.len());
                 m.can.remove(i);

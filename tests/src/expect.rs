@@ -23,6 +23,8 @@ pub struct Observed<'a> {
     pub modes: &'a [(f64, String)],
     /// EcuStatus fault-flag changes, on the time base of `modes`.
     pub faults: &'a [(f64, Vec<String>)],
+    /// The ECU planned with the V2X station's mass (its `v2x_lookups` counter).
+    pub v2x_planned: bool,
 }
 
 impl<'a> Observed<'a> {
@@ -38,11 +40,16 @@ impl<'a> Observed<'a> {
             pretensioner_released: r.action("pretensioner_release").is_some(),
             modes: &r.modes,
             faults: &r.faults,
+            v2x_planned: r.v2x_lookups > 0,
         }
     }
 
-    /// A run of the real processes, from the actuator stubs' report (`hil-bench`).
-    pub fn bench(r: &'a Report) -> Self {
+    /// A run of the real processes, from the actuator stubs' report and the ECU's
+    /// (`ecu-report.json`; `None`: it wrote none, and nothing the ECU counted is observed).
+    pub fn bench(r: &'a Report, ecu_report: Option<&serde_json::Value>) -> Self {
+        let v2x_lookups = ecu_report
+            .and_then(|e| e.pointer("/counters/v2x_lookups"))
+            .and_then(serde_json::Value::as_u64);
         Self {
             contact_s: (r.contact_ns != 0)
                 .then(|| r.contact_ns.saturating_sub(r.start_ns) as f64 * 1e-9),
@@ -51,6 +58,7 @@ impl<'a> Observed<'a> {
             pretensioner_released: r.pretensioner_released,
             modes: &r.ecu_modes,
             faults: &r.ecu_faults,
+            v2x_planned: v2x_lookups.is_some_and(|n| n > 0),
         }
     }
 }
@@ -107,6 +115,7 @@ pub fn check(s: &Scenario, o: &Observed<'_>) -> Vec<Mismatch> {
             e.accel_fault_before_contact,
             crate::accel_fault_before_contact(s, o.faults, o.contact_s),
         ),
+        ("v2x_planned", e.v2x_planned, o.v2x_planned),
     ];
     measured
         .into_iter()
@@ -148,10 +157,13 @@ mod tests {
             pretensioner_released: false,
             modes: &modes,
             faults: &[],
+            v2x_planned: false,
         };
         assert!(check(&scenario(""), &o).is_empty());
         let bad = check(
-            &scenario("contact = false\nairbag_fires = false\nreference_fallback = true"),
+            &scenario(
+                "contact = false\nairbag_fires = false\nreference_fallback = true\nv2x_planned = true",
+            ),
             &o,
         );
         let keys: Vec<_> = bad
@@ -162,7 +174,8 @@ mod tests {
             keys,
             [
                 ("airbag_fires", false, true),
-                ("reference_fallback", true, false)
+                ("reference_fallback", true, false),
+                ("v2x_planned", true, false)
             ]
         );
         assert_eq!(

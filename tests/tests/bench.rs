@@ -82,6 +82,12 @@ fn bench_run() -> &'static Path {
     })
 }
 
+/// The ECU's report of scenario `name`'s run (`None`: it wrote none).
+fn ecu_report(name: &str) -> Option<serde_json::Value> {
+    let text = std::fs::read_to_string(bench_run().join(name).join("ecu-report.json")).ok()?;
+    serde_json::from_str(&text).ok()
+}
+
 fn load(name: &str) -> (Scenario, Report) {
     let out = bench_run();
     let s = Scenario::load(root().join(format!("scenarios/{name}.toml"))).expect("scenario");
@@ -106,9 +112,12 @@ fn every_scenario_meets_its_declared_expectations() {
     for (s, r) in all() {
         // The judge `hil-bench` and `offline-bench` use (`e2e_tests::expect`).
         failures.extend(
-            e2e_tests::expect::check(&s, &e2e_tests::expect::Observed::bench(&r))
-                .iter()
-                .map(ToString::to_string),
+            e2e_tests::expect::check(
+                &s,
+                &e2e_tests::expect::Observed::bench(&r, ecu_report(&s.name).as_ref()),
+            )
+            .iter()
+            .map(ToString::to_string),
         );
         if !r.e2e_rejected.is_empty() {
             failures.push(format!(

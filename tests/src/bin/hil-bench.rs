@@ -156,7 +156,7 @@ fn run() -> Result<bool> {
                     match sensor_feeds::Scenario::load(scenario) {
                         Ok(s) => e2e_tests::expect::check(
                             &s,
-                            &e2e_tests::expect::Observed::bench(&r.report),
+                            &e2e_tests::expect::Observed::bench(&r.report, r.ecu_report.as_ref()),
                         )
                         .iter()
                         .map(ToString::to_string)

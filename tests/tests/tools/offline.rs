@@ -208,7 +208,7 @@ fn with_v2x_one_mass_source_misreported_up_to_1200_kg_is_never_worse_than_the_re
         }
     }
     eprintln!("{table}");
-    assert!(runs >= 140, "{runs} runs");
+    assert_eq!(runs, 155, "{runs} runs");
     assert!(bad.is_empty(), "{bad:#?}\n{table}");
 }
 

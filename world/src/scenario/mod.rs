@@ -602,6 +602,9 @@ pub struct Expect {
     /// The ECU reports the crash accelerometer faulty (`EcuStatus.FaultAccelSensor`) before the
     /// true contact.
     pub accel_fault_before_contact: Option<bool>,
+    /// The ECU planned with the V2X station's mass as the second source (its `v2x_lookups`
+    /// counter is not 0).
+    pub v2x_planned: Option<bool>,
 }
 
 impl Scenario {
