@@ -25,7 +25,8 @@ pub(super) fn must_fire_crash(r: &mut ChaCha8Rng, name: &str, i: u64) -> String 
 
 pub(super) fn must_fire_car(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let (v, tc) = (r.gen_range(35.0..56.0), r.gen_range(0.35..0.5));
-    head_on(name, i, v, 1785.0, tc, None, tc + 0.25, "", "").replace(
+    let v2x = v2x_station(r, true);
+    head_on(name, i, v, 1785.0, tc, None, tc + 0.25, "", &v2x).replace(
         "[opponent]\nkind = \"vehicle\"\n",
         "[opponent]\nkind = \"vehicle\"\nclass = 4\n",
     )
@@ -43,7 +44,9 @@ pub(super) fn must_fire_misreported(r: &mut ChaCha8Rng, name: &str, i: u64) -> S
     } else {
         format!("speed_bias_mps = {}\n", r.gen_range(-5.0..5.0))
     };
-    head_on(name, i, v, m, tc, None, tc + 0.25, &keys, "")
+    // A true station only: the object list is this case's one fault.
+    let v2x = v2x_station(r, false);
+    head_on(name, i, v, m, tc, None, tc + 0.25, &keys, &v2x)
 }
 
 pub(super) fn must_fire_safing_dead(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {

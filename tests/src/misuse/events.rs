@@ -125,7 +125,8 @@ pub(super) fn kerb_at_predicted_contact(r: &mut ChaCha8Rng, name: &str, i: u64) 
     let v = r.gen_range(20.0..55.0);
     let tc = r.gen_range(0.45..0.6);
     let opp = r.gen_range(1000.0..2500.0);
-    let ev = wheel_event(r, tc, &KERB, KERB.dv_mps);
+    let mut ev = wheel_event(r, tc, &KERB, KERB.dv_mps);
+    ev += &v2x_station(r, true);
     head_on(name, i, v, opp, tc, Some(tc - 0.001), tc + 0.3, "", &ev)
 }
 
@@ -135,6 +136,7 @@ pub(super) fn ghost_object_and_pothole(r: &mut ChaCha8Rng, name: &str, i: u64) -
     let evade = tc - r.gen_range(0.001..0.3);
     let at = r.gen_range(evade - 0.1..tc + 0.05);
     let opp = r.gen_range(1000.0..2500.0);
-    let ev = pothole_events(r, at, v / 3.6, tc + 0.3);
+    let mut ev = pothole_events(r, at, v / 3.6, tc + 0.3);
+    ev += &v2x_station(r, true);
     head_on(name, i, v, opp, tc, Some(evade), tc + 0.3, "", &ev)
 }

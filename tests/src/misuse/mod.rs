@@ -163,13 +163,13 @@ pub const FAMILIES: &[Family] = &[
     },
     Family {
         name: "kerb-at-predicted-contact",
-        envelope: "a tracked object (20–55 km/h each, 1 000–2 500 kg) evading 1 ms before the predicted contact, a kerb strike (as kerb-strike) at it",
+        envelope: "a tracked object (20–55 km/h each, 1 000–2 500 kg) evading 1 ms before the predicted contact, a kerb strike (as kerb-strike) at it; half with a V2X station, true or forged at 0–40 000 kg",
         requirement: Requirement::NoFire,
         make: kerb_at_predicted_contact,
     },
     Family {
         name: "ghost-object-and-pothole",
-        envelope: "a tracked object evading 1–300 ms before the predicted contact, a pothole (as pothole) from 100 ms before the evasion to 50 ms after the contact",
+        envelope: "a tracked object evading 1–300 ms before the predicted contact, a pothole (as pothole) from 100 ms before the evasion to 50 ms after the contact; half with a V2X station, true or forged at 0–40 000 kg",
         requirement: Requirement::NoFire,
         make: ghost_object_and_pothole,
     },
@@ -277,13 +277,13 @@ pub const FAMILIES: &[Family] = &[
     },
     Family {
         name: "must-fire-car",
-        envelope: "equal cars 35 + 35 to 56 + 56 km/h",
+        envelope: "equal cars 35 + 35 to 56 + 56 km/h; half with a V2X station, true or forged at 0–40 000 kg",
         requirement: Requirement::MustFire,
         make: must_fire_car,
     },
     Family {
         name: "must-fire-misreported",
-        envelope: "1 000–2 800 kg opponents at an ego EBS of 35–56 km/h, the mass reported ±1 200 kg off or the closing speed ±5 m/s",
+        envelope: "1 000–2 800 kg opponents at an ego EBS of 35–56 km/h, the mass reported ±1 200 kg off or the closing speed ±5 m/s; half with a true V2X station",
         requirement: Requirement::MustFire,
         make: must_fire_misreported,
     },

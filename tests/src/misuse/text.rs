@@ -58,6 +58,17 @@ pub(super) fn head_on(
     )
 }
 
+/// A `[v2x]` table half the time (drawn last, so a family's other draws stay what they were):
+/// a station that reports the opponent's true mass, or — `forged` — half of those a station
+/// that reports any mass from 0 to 40 t (a forged or misconfigured one).
+pub(super) fn v2x_station(r: &mut ChaCha8Rng, forged: bool) -> String {
+    match r.gen_range(0..4) {
+        0 | 1 => String::new(),
+        2 if forged => format!("\n[v2x]\nmass_kg = {}\n", r.gen_range(0.0..40_000.0)),
+        _ => "\n[v2x]\n".to_owned(),
+    }
+}
+
 /// A rigid barrier at `v` km/h, contact at `tc` s.
 pub(super) fn barrier(
     name: &str,
