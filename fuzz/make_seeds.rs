@@ -288,6 +288,10 @@ fn cycle_seeds(frames: &[RawFrame]) {
         "lut-crash-belt-only",
         &cycle_seed_generated(1, 128, 78, true),
     );
+    // The same with a V2X station reporting 2 400 kg (15 · 160): the lookups plan for it.
+    let mut v2x = cycle_seed_generated(1, 192, 78, true);
+    v2x.splice(1..6, [CAN_GEN, 38, 112, 100, 1 | 3 << 2 | 0x80, 15]);
+    write("ecu_cycle", "lut-v2x-crash-fire", &v2x);
     // The same without a LUT: DEGRADED, reference restraint fires.
     write(
         "ecu_cycle",

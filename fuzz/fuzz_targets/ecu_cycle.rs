@@ -23,9 +23,12 @@
 //!   `v · (contact − now)` is published — a coherent approach from tens of metres;
 //! * 5 — vehicle / occupant CAN generator: ego speed `0.4·b` m/s, occupant mass `30 + 0.4·b` kg,
 //!   chest to wheel `150 + 1.5·b` mm, flags (bits 0–1 buckle, bits 2–4 class % 5, bit 5 off,
-//!   bit 6: `EgoLongAccel` −8 g, a crash on the vehicle-dynamics sensor). While on, genuine
+//!   bit 6: `EgoLongAccel` −8 g, a crash on the vehicle-dynamics sensor; bit 7: a V2X station,
+//!   then one more byte `b`: its reported mass `160·b` kg, 0–40 t). While on, genuine
 //!   E2E-sealed `EgoVehicleState` every 10 ms and `OccupantClassification` every 100 ms (own
-//!   `E2eProtector`, so alive counters are consistent);
+//!   `E2eProtector`, so alive counters are consistent), and with the station a
+//!   `V2xOpponentMass` every 100 ms at the track generator's range and speed (`NoStation`
+//!   without a track) — the second mass source the lookup plans with;
 //! * 6 — accelerometer, `[b, n, p]`: for `n < 128` one crash-pulse batch, `n % 8 + 1` samples of
 //!   `−0.5·b·g` at `(1 + p % 20) × 125 µs`, continuing the accelerometer time line (what a real
 //!   crash sensor delivers); for `n ≥ 128` the live sensor: bit 6 of `n` switches it off (a dead
@@ -57,9 +60,11 @@ use std::sync::OnceLock;
 use bus::codec::{
     AirbagStageCmdCmdSource, AirbagStageCmdFire, BeltLimiterCmdCmdSource,
     EgoVehicleStateBrakeState, OccupantClassificationBeltBuckle,
-    OccupantClassificationOccupantClass,
+    OccupantClassificationOccupantClass, V2xOpponentMassStationStatus,
 };
-use bus::{E2eProtector, EgoVehicleState, Messages, OccupantClassification, RawFrame};
+use bus::{
+    E2eProtector, EgoVehicleState, Messages, OccupantClassification, RawFrame, V2xOpponentMass,
+};
 use diagram::Diagram;
 use restraint::crash::ConfirmKind;
 use restraint::{Activity, CycleConfig, CycleInfo, Phase, RestraintCycle, SimIo, G_MPS2};
@@ -146,6 +151,9 @@ struct CanGen {
     class: OccupantClassificationOccupantClass,
     next_vehicle_ns: u64,
     next_occupant_ns: u64,
+    /// The V2X station's reported mass, kg (`None`: no station).
+    v2x_kg: Option<f32>,
+    next_v2x_ns: u64,
 }
 
 /// What the input made possible so far (the independent fire oracle).
@@ -315,6 +323,23 @@ impl Harness {
                 if let Ok(m) =
                     OccupantClassification::encode(g.buckle, g.class, 90, g.occ_kg, g.chest_mm, 150)
                 {
+                    self.io.push_can(self.tx.seal(m));
+                }
+            }
+            if let Some(kg) = g.v2x_kg.filter(|_| now >= g.next_v2x_ns) {
+                g.next_v2x_ns = now.saturating_add(OCCUPANT_PERIOD_NS);
+                let (status, range_m, closing_mps) = match &self.track {
+                    Some(t) => {
+                        let to_contact_s = (t.contact_ns as f64 - now as f64) * 1.0e-9;
+                        (
+                            V2xOpponentMassStationStatus::Valid,
+                            (f64::from(t.closing_mps) * to_contact_s).clamp(0.0, 400.0) as f32,
+                            t.closing_mps,
+                        )
+                    }
+                    None => (V2xOpponentMassStationStatus::NoStation, 0.0, 0.0),
+                };
+                if let Ok(m) = V2xOpponentMass::encode(status, kg, 100.0, range_m, closing_mps) {
                     self.io.push_can(self.tx.seal(m));
                 }
             }
@@ -533,7 +558,10 @@ fuzz_target!(|data: &[u8]| {
                 let occ = r.u8().unwrap_or(112);
                 let chest = r.u8().unwrap_or(100);
                 let f = r.u8().unwrap_or(0b1101);
+                let v2x_kg = (f & 0x80 != 0).then(|| (160.0 * f32::from(r.u8().unwrap_or(11))).min(40_000.0));
                 h.can_gen = (f & 0x20 == 0).then(|| CanGen {
+                    v2x_kg,
+                    next_v2x_ns: now_ns,
                     ego_speed_mps: (0.4 * f32::from(speed)).min(100.0),
                     ego_long_accel_mps2: if f & 0x40 != 0 {
                         (-8.0 * G_MPS2) as f32
