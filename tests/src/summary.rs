@@ -143,6 +143,20 @@ pub fn summarise(
             .collect();
         let _ = writeln!(s, "  ECU faults (EcuStatus): {}", faults.join(" → "));
     }
+    // Which opponent mass the ECU's plans were for (issue 24), from its counters.
+    let counter = |k: &str| {
+        ecu.and_then(|e| e.pointer(&format!("/counters/{k}")))
+            .and_then(serde_json::Value::as_u64)
+    };
+    if let (Some(lookups @ 1..), Some(v2x)) = (counter("lut_lookups"), counter("v2x_lookups")) {
+        let _ = writeln!(
+            s,
+            "  planning mass: {v2x} of {lookups} table lookups with the V2X station as the second \
+             mass source (the heavier source + v2x_mass_margin_kg), {} with the object list + \
+             mass_misreport_kg",
+            lookups.saturating_sub(v2x)
+        );
+    }
     let frames: Vec<String> = r.frames.iter().map(|(k, v)| format!("{k} {v}")).collect();
     let _ = writeln!(
         s,
