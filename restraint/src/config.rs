@@ -104,7 +104,8 @@ pub struct CycleConfig {
     /// heavier of the object list's estimate and the station's mass plus this margin, kg
     /// (*default* 300: the paper's payload uncertainty), instead of `mass_misreport_kg`. One
     /// source that reads too light (a single fault) is outvoted by the other; one that reads
-    /// too heavy over-restrains (the safe direction). 10 000 = V2X never lowers the margin.
+    /// too heavy over-restrains (the safe direction). Set to `mass_misreport_kg` and V2X can
+    /// only raise the plan, never lower it.
     pub v2x_mass_margin_kg: f64,
     /// A `V2xOpponentMass` frame older than this is not used, ms (*default* 300: three of its
     /// 100 ms periods).
