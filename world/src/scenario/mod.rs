@@ -767,6 +767,41 @@ mass_kg = 75
     }
 
     #[test]
+    fn v2x_table_defaults_ranges_and_located_errors() {
+        let s = Scenario::parse("x.toml", OK).expect("valid");
+        assert!(s.v2x.is_none(), "no [v2x]: no receiver");
+        let s = Scenario::parse("x.toml", &format!("{OK}\n[v2x]\n")).expect("valid");
+        assert_eq!(s.v2x, Some(V2x::default()));
+        let v = V2x::default();
+        assert_eq!(
+            (v.period_ms, v.latency_ms, v.range_m),
+            (100.0, 100.0, 300.0)
+        );
+        assert_eq!(
+            (v.mass_kg, v.mass_sigma_kg, v.opponent_equipped),
+            (None, 100.0, true)
+        );
+        // Out of the frame's range, or a period the bench cannot play: the key and its line.
+        for (key, bad) in [
+            ("period_ms", "5"),
+            ("range_m", "500"),
+            ("mass_kg", "50000"),
+            ("mass_sigma_kg", "-1"),
+        ] {
+            let text = format!("{OK}\n[v2x]\n{key} = {bad}\n");
+            let e = Scenario::parse("x.toml", &text).unwrap_err();
+            assert_eq!(
+                e.field.as_deref(),
+                Some(format!("v2x.{key}").as_str()),
+                "{e}"
+            );
+            assert_eq!(e.line, Some(text.lines().count()), "{e}");
+        }
+        let e = Scenario::parse("x.toml", &format!("{OK}\n[v2x]\nmass = 1\n")).unwrap_err();
+        assert!(e.message.contains("unknown field `mass`"), "{e}");
+    }
+
+    #[test]
     fn missing_required_field_is_reported() {
         let text = OK.replace("duration_s = 3.0\n", "");
         let e = Scenario::parse("x.toml", &text).unwrap_err();
