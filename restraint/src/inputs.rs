@@ -232,7 +232,7 @@ impl InputMonitor {
     pub(crate) fn v2x_station(&self, now: u64) -> Option<&V2xStation> {
         self.v2x
             .as_ref()
-            .filter(|v| now.saturating_sub(v.rx_ns) <= self.v2x_timeout_ns)
+            .filter(|v| !Self::stale(Some(v.rx_ns), now, self.v2x_timeout_ns))
     }
 
     /// One received CAN frame.

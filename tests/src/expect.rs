@@ -47,9 +47,7 @@ impl<'a> Observed<'a> {
     /// A run of the real processes, from the actuator stubs' report and the ECU's
     /// (`ecu-report.json`; `None`: it wrote none, and nothing the ECU counted is observed).
     pub fn bench(r: &'a Report, ecu_report: Option<&serde_json::Value>) -> Self {
-        let v2x_lookups = ecu_report
-            .and_then(|e| e.pointer("/counters/v2x_lookups"))
-            .and_then(serde_json::Value::as_u64);
+        let v2x_lookups = crate::ecu_counter(ecu_report, "v2x_lookups");
         Self {
             contact_s: (r.contact_ns != 0)
                 .then(|| r.contact_ns.saturating_sub(r.start_ns) as f64 * 1e-9),

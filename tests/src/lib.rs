@@ -73,6 +73,12 @@ pub fn accel_fault_before_contact(
     )
 }
 
+/// The ECU's counter `name` in its JSON report (`ecu-report.json`, `counters`; `None`: no
+/// report, or no such counter).
+pub fn ecu_counter(ecu_report: Option<&serde_json::Value>, name: &str) -> Option<u64> {
+    ecu_report?.get("counters")?.get(name)?.as_u64()
+}
+
 /// When the ECU fell back to the reference restraint after it had been Normal, given its
 /// EcuStatus mode changes `(ms, mode)`. Every run starts in ReferenceFallback (no input is
 /// fresh yet): that start is not a fallback, so "the ECU fell back" needs a Normal before it.

@@ -144,10 +144,7 @@ pub fn summarise(
         let _ = writeln!(s, "  ECU faults (EcuStatus): {}", faults.join(" → "));
     }
     // Which opponent mass the ECU's plans were for (issue 24), from its counters.
-    let counter = |k: &str| {
-        ecu.and_then(|e| e.pointer(&format!("/counters/{k}")))
-            .and_then(serde_json::Value::as_u64)
-    };
+    let counter = |k: &str| crate::ecu_counter(ecu, k);
     if let (Some(lookups @ 1..), Some(v2x)) = (counter("lut_lookups"), counter("v2x_lookups")) {
         let _ = writeln!(
             s,
@@ -169,9 +166,7 @@ pub fn summarise(
         s,
         "SecOC: {} commands authenticated (ECU sent {}), rejected {:?}, unpaired {}; pairing timeout {} ms, freshness window {} ms",
         r.secoc_accepted,
-        ecu.and_then(|e| e.pointer("/counters/secoc_commands_tx"))
-            .and_then(|v| v.as_u64())
-            .map_or("?".to_owned(), |n| n.to_string()),
+        counter("secoc_commands_tx").map_or("?".to_owned(), |n| n.to_string()),
         r.secoc_rejected,
         r.secoc_commands_dropped,
         r.secoc_pairing_timeout_ms,

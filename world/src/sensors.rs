@@ -263,10 +263,15 @@ mod tests {
     use super::*;
 
     fn sim(extra_sensor: &str) -> SensorModelSim {
+        sim_with(extra_sensor, "")
+    }
+
+    /// The scenario of [`sim`] with `tables` appended (e.g. a `[v2x]` table).
+    fn sim_with(extra_sensor: &str, tables: &str) -> SensorModelSim {
         let text = format!(
             "name = \"t\"\nduration_s = 3\nseed = 42\n[ego]\nmass_kg = 1785\nspeed_kph = 36\n\
              [opponent]\nkind = \"vehicle\"\nmass_kg = 1500\nspeed_kph = 36\ninitial_distance_m = 40\n\
-             [sensor]\n{extra_sensor}\n[occupant]\nmass_kg = 110\nbelted = false\n"
+             [sensor]\n{extra_sensor}\n[occupant]\nmass_kg = 110\nbelted = false\n{tables}"
         );
         let s = Scenario::parse("t.toml", &text).expect("valid");
         SensorModelSim::new(Truth::new(&s).expect("truth"))
@@ -367,15 +372,9 @@ mod tests {
         );
     }
 
-    /// The scenario of [`sim`] with a `[v2x]` table (`v2x` = its keys).
+    /// The scenario of [`sim`] (a noisy mass estimate) with a `[v2x]` table (`v2x` = its keys).
     fn sim_v2x(v2x: &str) -> SensorModelSim {
-        let text = format!(
-            "name = \"t\"\nduration_s = 3\nseed = 42\n[ego]\nmass_kg = 1785\nspeed_kph = 36\n\
-             [opponent]\nkind = \"vehicle\"\nmass_kg = 1500\nspeed_kph = 36\ninitial_distance_m = 40\n\
-             [sensor]\nmass_noise_kg = 50\n[occupant]\nmass_kg = 110\nbelted = false\n[v2x]\n{v2x}\n"
-        );
-        let s = Scenario::parse("t.toml", &text).expect("valid");
-        SensorModelSim::new(Truth::new(&s).expect("truth"))
+        sim_with("mass_noise_kg = 50", &format!("[v2x]\n{v2x}\n"))
     }
 
     #[test]
@@ -421,11 +420,7 @@ mod tests {
         // The object list's noise is the same with and without `[v2x]`, however many V2X
         // frames are drawn in between.
         let mut with = sim_v2x("distance_noise_m = 2");
-        let text = "name = \"t\"\nduration_s = 3\nseed = 42\n[ego]\nmass_kg = 1785\nspeed_kph = 36\n\
-                    [opponent]\nkind = \"vehicle\"\nmass_kg = 1500\nspeed_kph = 36\ninitial_distance_m = 40\n\
-                    [sensor]\nmass_noise_kg = 50\n[occupant]\nmass_kg = 110\nbelted = false\n";
-        let s = Scenario::parse("t.toml", text).expect("valid");
-        let mut without = SensorModelSim::new(Truth::new(&s).expect("truth"));
+        let mut without = sim("mass_noise_kg = 50");
         let mut ranges = Vec::new();
         for k in 0..20 {
             let t = 0.1 + 0.05 * f64::from(k);

@@ -114,39 +114,84 @@ fn misreported(base: &Scenario, true_kg: f64, reported_kg: f64) -> Scenario {
     s
 }
 
-#[test]
-fn a_misreported_opponent_mass_up_to_1200_kg_is_never_worse_than_the_reference() {
-    let cfg = cfg();
-    let late_ms = fire_delay_tolerance_ms(&cfg);
-    let mut table = format!("{}\n", table_header(NAME_WIDTH));
-    let mut bad = Vec::new();
-    let mut runs = 0;
-    for base in [
-        "taurus-48-48-abs",
-        "taurus-52-52-none",
-        "taurus-31-31-abs-eba",
-        "occupant-light-45kg",
-        "occupant-heavy-110kg",
-    ] {
-        let base = scenario(base);
-        for true_kg in [1000.0, 1300.0, 1785.0, 2200.0, 2600.0] {
-            for error_kg in [-1200.0, -600.0, 600.0, 1200.0] {
-                let reported = true_kg + error_kg;
-                if !(800.0..=3000.0).contains(&reported) {
-                    continue;
-                }
-                let s = misreported(&base, true_kg, reported);
-                let r = run(&s, &cfg).expect("offline run");
-                runs += 1;
-                table.push_str(&table_row(&r, NAME_WIDTH));
-                table.push('\n');
-                bad.extend(problems(&s, &r, late_ms));
-            }
+/// The base cases of the ±1 200 kg mass grid.
+const MASS_GRID_BASES: [&str; 5] = [
+    "taurus-48-48-abs",
+    "taurus-52-52-none",
+    "taurus-31-31-abs-eba",
+    "occupant-light-45kg",
+    "occupant-heavy-110kg",
+];
+/// The true opponents of the mass grid, kg.
+const MASS_GRID_TRUE_KG: [f64; 5] = [1000.0, 1300.0, 1785.0, 2200.0, 2600.0];
+/// How wrong a mass source is in the mass grid, kg.
+const MASS_GRID_ERRORS_KG: [f64; 4] = [-1200.0, -600.0, 600.0, 1200.0];
+
+/// Every (base case, true opponent kg, wrong mass kg) of the mass grid.
+fn mass_grid() -> impl Iterator<Item = (Scenario, f64, f64)> {
+    MASS_GRID_BASES.into_iter().flat_map(|name| {
+        let base = scenario(name);
+        MASS_GRID_TRUE_KG.into_iter().flat_map(move |true_kg| {
+            let base = base.clone();
+            MASS_GRID_ERRORS_KG
+                .into_iter()
+                .map(move |e| (base.clone(), true_kg, true_kg + e))
+        })
+    })
+}
+
+/// The runs of a grid test: their table (names `width` wide), their problems and their count.
+struct Judged {
+    cfg: OfflineConfig,
+    late_ms: f64,
+    width: usize,
+    table: String,
+    bad: Vec<String>,
+    runs: usize,
+}
+
+impl Judged {
+    fn new(width: usize) -> Self {
+        let cfg = cfg();
+        let late_ms = fire_delay_tolerance_ms(&cfg);
+        let table = format!("{}\n", table_header(width));
+        Self {
+            cfg,
+            late_ms,
+            width,
+            table,
+            bad: Vec::new(),
+            runs: 0,
         }
     }
-    eprintln!("{table}");
-    assert!(runs >= 60, "{runs} runs");
-    assert!(bad.is_empty(), "{bad:#?}\n{table}");
+
+    /// Runs `s` and judges it (expectations, the judge's verdict, the airbag against its plan).
+    fn judge(&mut self, s: &Scenario) -> OfflineRun {
+        let r = run(s, &self.cfg).expect("offline run");
+        self.runs += 1;
+        self.table.push_str(&table_row(&r, self.width));
+        self.table.push('\n');
+        self.bad.extend(problems(s, &r, self.late_ms));
+        r
+    }
+
+    /// Prints the table; fails with every problem.
+    fn assert_no_problems(&self) {
+        eprintln!("{}", self.table);
+        assert!(self.bad.is_empty(), "{:#?}\n{}", self.bad, self.table);
+    }
+}
+
+#[test]
+fn a_misreported_opponent_mass_up_to_1200_kg_is_never_worse_than_the_reference() {
+    let mut j = Judged::new(NAME_WIDTH);
+    for (base, true_kg, reported) in mass_grid() {
+        if (800.0..=3000.0).contains(&reported) {
+            j.judge(&misreported(&base, true_kg, reported));
+        }
+    }
+    assert!(j.runs >= 60, "{} runs", j.runs);
+    j.assert_no_problems();
 }
 
 /// `s` with the default V2X receiver (scenarios/README.md `[v2x]`), the station reporting
@@ -166,50 +211,23 @@ fn with_v2x(mut s: Scenario, station_kg: Option<f64>) -> Scenario {
 /// is 300 kg instead of 1 200 kg.
 #[test]
 fn with_v2x_one_mass_source_misreported_up_to_1200_kg_is_never_worse_than_the_reference() {
-    let cfg = cfg();
-    let late_ms = fire_delay_tolerance_ms(&cfg);
-    let mut table = format!("{}\n", table_header(NAME_WIDTH + 12));
-    let (mut bad, mut runs) = (Vec::new(), 0);
-    let mut judge = |s: Scenario| {
-        let r = run(&s, &cfg).expect("offline run");
-        table.push_str(&table_row(&r, NAME_WIDTH + 12));
-        table.push('\n');
-        bad.extend(problems(&s, &r, late_ms));
-        r
-    };
-    for base in [
-        "taurus-48-48-abs",
-        "taurus-52-52-none",
-        "taurus-31-31-abs-eba",
-        "occupant-light-45kg",
-        "occupant-heavy-110kg",
-    ] {
-        let base = scenario(base);
-        for true_kg in [1000.0, 1300.0, 1785.0, 2200.0, 2600.0] {
-            for error_kg in [-1200.0, -600.0, 600.0, 1200.0] {
-                let wrong = true_kg + error_kg;
-                if (800.0..=3000.0).contains(&wrong) {
-                    let s = misreported(&base, true_kg, wrong);
-                    let mut s = with_v2x(s, None);
-                    s.name.push_str("-v2x");
-                    judge(s);
-                    runs += 1;
-                }
-                if wrong > 0.0 {
-                    let s = misreported(&base, true_kg, true_kg);
-                    let mut s = with_v2x(s, Some(wrong));
-                    s.name = format!("{}-true{true_kg:.0}-v2x{wrong:.0}", base.name);
-                    let r = judge(s);
-                    runs += 1;
-                    // The station is the tracked object: it planned (not the 1 200 kg rule).
-                    assert!(r.v2x_lookups > 0, "{}", r.name);
-                }
-            }
+    let mut j = Judged::new(NAME_WIDTH + 12);
+    for (base, true_kg, wrong) in mass_grid() {
+        if (800.0..=3000.0).contains(&wrong) {
+            let mut s = with_v2x(misreported(&base, true_kg, wrong), None);
+            s.name.push_str("-v2x");
+            j.judge(&s);
+        }
+        if wrong > 0.0 {
+            let mut s = with_v2x(misreported(&base, true_kg, true_kg), Some(wrong));
+            s.name = format!("{}-true{true_kg:.0}-v2x{wrong:.0}", base.name);
+            let r = j.judge(&s);
+            // The station is the tracked object: it planned (not the 1 200 kg rule).
+            assert!(r.v2x_lookups > 0, "{}", r.name);
         }
     }
-    eprintln!("{table}");
-    assert_eq!(runs, 155, "{runs} runs");
-    assert!(bad.is_empty(), "{bad:#?}\n{table}");
+    assert_eq!(j.runs, 155, "{} runs", j.runs);
+    j.assert_no_problems();
 }
 
 /// The same for the closing speed: the object list's speed wrong by up to ±5 m/s, the V2X
@@ -217,30 +235,7 @@ fn with_v2x_one_mass_source_misreported_up_to_1200_kg_is_never_worse_than_the_re
 /// falls back to the 1 200 kg margin).
 #[test]
 fn with_v2x_a_misreported_closing_speed_up_to_5_mps_is_never_worse_than_the_reference() {
-    let cfg = cfg();
-    let late_ms = fire_delay_tolerance_ms(&cfg);
-    let mut table = format!("{}\n", table_header(NAME_WIDTH));
-    let mut bad = Vec::new();
-    for base in [
-        "taurus-48-48-abs",
-        "taurus-52-52-none",
-        "taurus-31-31-abs-eba",
-        "mass-sweep-1300kg",
-    ] {
-        for bias in [-5.0, -3.0, 3.0, 5.0] {
-            let mut s = with_v2x(scenario(base), None);
-            // The name of the case without V2X: its accepted cost (if any) is V2X's too.
-            s.name = format!("{base}-speed{bias:+.0}");
-            s.sensor.speed_bias_mps = bias;
-            s.expect = Default::default();
-            let r = run(&s, &cfg).expect("offline run");
-            table.push_str(&table_row(&r, NAME_WIDTH));
-            table.push('\n');
-            bad.extend(problems(&s, &r, late_ms));
-        }
-    }
-    eprintln!("{table}");
-    assert!(bad.is_empty(), "{bad:#?}\n{table}");
+    speed_grid(true);
 }
 
 /// Issue 24's bar: on the library's nominal belted car-to-car cases, the benefit with the
@@ -252,14 +247,8 @@ fn with_v2x_the_nominal_benefit_is_within_4_points_of_no_margin() {
     let shipped = cfg();
     let mut no_margin = cfg();
     no_margin.cycle.mass_misreport_kg = 0.0;
-    let cases = [
-        "taurus-52-52-none",
-        "taurus-48-48-abs",
-        "taurus-31-31-abs-eba",
-        "mass-sweep-1000kg",
-        "mass-sweep-1300kg",
-        "mass-sweep-2200kg",
-    ];
+    // The six the margin studies average over (README, "Robust cells").
+    let cases = lut::robust_cells::LIBRARY_CASES.map(|c| c.0);
     let change = |s: &Scenario, c: &OfflineConfig| {
         let r = run(s, c).expect("offline run");
         r.evaluated.expect("judged").outcome.change_pct
@@ -283,38 +272,43 @@ fn with_v2x_the_nominal_benefit_is_within_4_points_of_no_margin() {
 
 #[test]
 fn a_misreported_closing_speed_up_to_5_mps_is_never_worse_than_the_reference() {
-    let cfg = cfg();
-    let late_ms = fire_delay_tolerance_ms(&cfg);
-    let mut table = format!("{}\n", table_header(NAME_WIDTH));
-    let mut bad = Vec::new();
-    for base in [
+    speed_grid(false);
+}
+
+/// The object list's closing speed wrong by ±3 and ±5 m/s on four base cases (`v2x`: with a
+/// true V2X station), each run judged: never worse than the reference.
+fn speed_grid(v2x: bool) {
+    let mut j = Judged::new(NAME_WIDTH);
+    for name in [
         "taurus-48-48-abs",
         "taurus-52-52-none",
         "taurus-31-31-abs-eba",
         "mass-sweep-1300kg",
     ] {
-        let base = scenario(base);
+        let base = scenario(name);
         for bias in [-5.0, -3.0, 3.0, 5.0] {
-            let mut s = base.clone();
-            s.name = format!("{}-speed{bias:+.0}", base.name);
+            let mut s = if v2x {
+                with_v2x(base.clone(), None)
+            } else {
+                base.clone()
+            };
+            // With V2X too the name of the case without it: its accepted cost (if any) is the
+            // same.
+            s.name = format!("{name}-speed{bias:+.0}");
             s.sensor.speed_bias_mps = bias;
             s.expect = Default::default();
-            let r = run(&s, &cfg).expect("offline run");
-            table.push_str(&table_row(&r, NAME_WIDTH));
-            table.push('\n');
-            bad.extend(problems(&s, &r, late_ms));
+            let r = j.judge(&s);
             // Which path confirmed: with the track filter a 5 m/s bias is seen as outliers and
             // the range keeps the track (prediction-matched, re-planned in the crash); a 3 m/s
             // bias that the filter absorbs can put the predicted contact outside the match
             // window, and the crash then goes the generic way (restraint README, "Track
             // filter": a speed-bias state is the next step). Either way: never worse.
             if let Some(by) = &r.confirmed_by {
-                let _ = writeln!(table, "  confirmed by {by:?}");
+                let _ = writeln!(j.table, "  confirmed by {by:?}");
             }
         }
     }
-    eprintln!("{table}");
-    assert!(bad.is_empty(), "{bad:#?}\n{table}");
+    j.assert_no_problems();
 }
 
 /// The fault campaign's scenario variants (issue 14: misreported crashes, dead and stuck
