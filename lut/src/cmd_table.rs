@@ -6,6 +6,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use diagram::{AxisId, Cell, Diagram, Query};
 use lut::distributed::{Job, TableJob};
+use lut::margin;
 use lut::progress::Progress;
 use lut::table::{self, Grid, GridFile};
 use std::path::PathBuf;
@@ -163,6 +164,15 @@ pub struct VerifyArgs {
     /// Print the rows as JSON.
     #[arg(long)]
     pub json: bool,
+    /// The planning margin's check over every cell: a setting planned for opponent mass M
+    /// judged at every true opponent from M − this down to M (`lut::margin`). Default: the span
+    /// the table states in its header (then enforced), else 2 400 kg (then reported only).
+    /// Given explicitly, it is enforced.
+    #[arg(long)]
+    pub margin_kg: Option<f64>,
+    /// Step between the true opponent masses of the margin check [kg].
+    #[arg(long, default_value_t = margin::DEFAULT_STEP_KG)]
+    pub margin_step_kg: f64,
 }
 
 pub fn run_verify(a: &VerifyArgs) -> Result<()> {
@@ -200,10 +210,80 @@ pub fn run_verify(a: &VerifyArgs) -> Result<()> {
         table::REOPT_TOL_ABS_G,
         table::REOPT_TOL_REL * 100.0
     );
+    let margin_failed = verify_margin(&d, a)?;
     if bad > 0 {
         bail!("{bad} of {} verified cells do not match", rows.len());
     }
+    if let Some(why) = margin_failed {
+        bail!("{why}");
+    }
     Ok(())
+}
+
+/// The planning margin's check over every cell (`lut::margin`), printed on stderr; `Some(why)`
+/// when it fails and is enforced (the span stated in the header, or given).
+fn verify_margin(d: &Diagram, a: &VerifyArgs) -> Result<Option<String>> {
+    let stated = margin::stated_span_kg(d)?;
+    let (span_kg, enforced) = match (a.margin_kg, stated) {
+        (Some(kg), _) => (kg, true),
+        (None, Some(kg)) => (kg, true),
+        (None, None) => (margin::DEFAULT_SPAN_KG, false),
+    };
+    if !(span_kg.is_finite()
+        && span_kg >= 0.0
+        && a.margin_step_kg.is_finite()
+        && a.margin_step_kg > 0.0)
+    {
+        bail!("--margin-kg must be ≥ 0 and --margin-step-kg > 0 (finite)");
+    }
+    let reference = physics::reference::ReferenceRestraint::builtin()
+        .map_err(anyhow::Error::msg)?
+        .settings();
+    let rows = margin::check_cells(d, &reference, span_kg, a.margin_step_kg)?;
+    let s = margin::MarginSummary::of(d, &rows);
+    let source = match (a.margin_kg, stated) {
+        (Some(_), _) => "given",
+        (None, Some(_)) => "stated in the header",
+        (None, None) => {
+            "the shipped rule's 2 × 1 200 kg; the table states none: reported, not enforced"
+        }
+    };
+    eprintln!(
+        "planning margin ({source}): each cell's setting, planned for opponent mass M, on the true pulse of every opponent from M − {span_kg:.0} kg to M ({:.0} kg steps, airbag as executed) against the reference restraint: holds in {} of {} cells",
+        a.margin_step_kg, s.hold, s.cells
+    );
+    if !s.holds() {
+        eprintln!(
+            "  fails in {}: bottoms out where the reference does not {}, worse than the reference {} (of all failing: {} infeasible at M, i.e. no setting avoids bottoming out there); a_max + a_mean change p50 {:+.1} %",
+            s.cells - s.hold,
+            s.bottom_out_alone,
+            s.worse_only,
+            s.failing_infeasible_at_plan,
+            s.failing_p50_change_pct
+        );
+        if let Some(w) = &s.worst {
+            let q = d.axes();
+            let at = |axis: &[f32], i: usize| axis.get(i).copied().unwrap_or(f32::NAN);
+            eprintln!(
+                "  worst: cell {} ({} km/h, {} kg planned, occupant {} kg, seat {} mm) at a {:.0} kg opponent: {:+.1} %, {} truths bottoming out alone",
+                w.index,
+                at(&q.closing_speed_kph, w.coords[0]),
+                at(&q.opponent_mass_kg, w.coords[1]),
+                at(&q.occupant_mass_kg, w.coords[2]),
+                at(&q.seat_distance_mm, w.coords[3]),
+                w.worst_truth_kg,
+                w.worst_change_pct,
+                w.bottoms_out_alone
+            );
+        }
+    }
+    Ok((enforced && !s.holds()).then(|| {
+        format!(
+            "planning margin of {span_kg:.0} kg fails in {} of {} cells",
+            s.cells - s.hold,
+            s.cells
+        )
+    }))
 }
 
 #[derive(Args, Debug)]

@@ -15,6 +15,8 @@
 //! * [`robustness`] — the Monte-Carlo study of the pre-crash estimate's errors.
 //! * [`robust_cells`] / [`limiter_switch`] — the planning margin's cost: cells robust over the
 //!   uncertainty set, and a two-level load limiter switched on what the pulse shows.
+//! * [`margin`] — the planning margin as a property of the table: every cell's setting on the
+//!   lighter opponents it may meet, against the reference restraint (`lut verify`).
 //! * [`estimation`] — the ECU's track filter against the newest-sample estimate over the
 //!   scenario library and noisier sensors (`lut study estimation`).
 #![forbid(unsafe_code)]
@@ -25,6 +27,7 @@ pub mod distributed;
 pub mod estimation;
 pub mod fallback_study;
 pub mod limiter_switch;
+pub mod margin;
 pub mod optimise;
 pub mod progress;
 pub mod reference;

@@ -112,8 +112,10 @@ pub fn set_points(s: &Situation, u: &Uncertainty) -> Vec<(f64, f64)> {
 /// One point of the set with its reference outcome.
 pub(crate) struct Point {
     pub(crate) pulse: Pulse,
-    reference_g: f64,
-    reference_bottoms_out: bool,
+    pub(crate) reference_g: f64,
+    pub(crate) reference_bottoms_out: bool,
+    /// The reference's largest excursion here [m].
+    pub(crate) reference_excursion_m: f64,
     /// The ride-down reserve the cell is held to here: the optimiser's where the reference
     /// keeps it, none where the reference only avoids bottoming out (or does not).
     pub(crate) reserve_m: f64,
@@ -146,17 +148,33 @@ impl UncertainSet {
         reference: &RestraintSettings,
         reserve_m: f64,
     ) -> Result<Self> {
+        Self::from_points(ego, &s.occupant, &set_points(s, u), reference, reserve_m)
+    }
+
+    /// The set of explicit (closing km/h, opponent kg) `points` (nominal first) for `occupant`,
+    /// with the reference restraint's outcome at every point.
+    ///
+    /// # Errors
+    /// A pulse cannot be predicted or an occupant simulation fails.
+    pub fn from_points(
+        ego: &Ego,
+        occupant: &OccupantInput,
+        points: &[(f64, f64)],
+        reference: &RestraintSettings,
+        reserve_m: f64,
+    ) -> Result<Self> {
         let hw = RestraintHardware::default();
-        let points = set_points(s, u)
-            .into_iter()
-            .map(|(v, m)| {
+        let points = points
+            .iter()
+            .map(|&(v, m)| {
                 let pulse = Pulse::predict(ego, Opponent::Car { mass_kg: m }, v)?;
-                let r = simulate_occupant(&pulse.ego(), &s.occupant, reference, &hw)?;
+                let r = simulate_occupant(&pulse.ego(), occupant, reference, &hw)?;
                 let keeps = optimise::case_cost(&r, reserve_m) < INFEASIBLE_OFFSET;
                 let reserve_m = if keeps { reserve_m } else { 0.0 };
                 Ok(Point {
                     reference_g: objective_g(&r),
                     reference_bottoms_out: r.bottomed_out,
+                    reference_excursion_m: r.max_excursion_m,
                     reserve_m,
                     reference_cost: optimise::case_cost(&r, reserve_m),
                     pulse,
@@ -164,7 +182,7 @@ impl UncertainSet {
             })
             .collect::<Result<Vec<_>>>()?;
         Ok(Self {
-            occupant: s.occupant,
+            occupant: *occupant,
             points,
         })
     }

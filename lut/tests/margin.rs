@@ -1,0 +1,215 @@
+//! The planning margin as a property of the table (`lut::margin`, `lut verify`): the lighter
+//! truths of a plan, the check against the reference restraint with two oracles (the
+//! reference's own setting changes nothing; a restraint too weak for any crash bottoms out
+//! where the reference does not), the span a header states, and the binary enforcing it.
+
+use diagram::{Cell, Diagram};
+use lut::margin::{self, check_cells, truths, MarginSummary, EXTRA_SPAN_KG};
+use lut::table::{self, Grid};
+use physics::reference::ReferenceRestraint;
+use physics::RestraintSettings;
+use std::path::PathBuf;
+use std::process::Command;
+
+fn workspace() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn reference() -> RestraintSettings {
+    ReferenceRestraint::builtin().unwrap().settings()
+}
+
+/// The CI grid's table with every cell's setting replaced by `set`, the header's airbag floor
+/// set to `floor_dv_mps` and `extra` added.
+fn ci_table(
+    set: Option<&RestraintSettings>,
+    floor_dv_mps: &str,
+    extra: &[(&str, &str)],
+) -> Diagram {
+    let grid = Grid::load(workspace().join("data/ci-grid.toml")).unwrap();
+    let (d, _) = table::build_table(&grid, Some(2), true).unwrap();
+    let mut data = d.into_data();
+    if let Some(s) = set {
+        for c in &mut data.cells {
+            *c = with_setting(c, s);
+        }
+    }
+    let x = &mut data.header.build.extra;
+    x.insert("optimiser.airbag_floor_dv_mps".into(), floor_dv_mps.into());
+    for (k, v) in extra {
+        x.insert((*k).into(), (*v).into());
+    }
+    Diagram::new(data).unwrap()
+}
+
+fn with_setting(c: &Cell, s: &RestraintSettings) -> Cell {
+    Cell {
+        belt_limiter_kn: (s.load_limiter_n * 1e-3) as f32,
+        airbag_level_kn: (s.airbag_force_n * 1e-3) as f32,
+        pretensioner_time_ms: (s.pretensioner_time_s * 1e3) as f32,
+        airbag_time_ms: (s.airbag_time_s * 1e3) as f32,
+        ..*c
+    }
+}
+
+#[test]
+fn truths_run_from_the_plan_down_by_the_step_to_the_span_clamped_to_the_axis() {
+    let t = truths(3000.0, 2400.0, 200.0, 800.0);
+    let want: Vec<f64> = (0..12).map(|k| 3000.0 - 200.0 * f64::from(k)).collect();
+    assert_eq!(t, want);
+    // The span's end is a truth even off the step; the axis clamps and nothing repeats.
+    assert_eq!(
+        truths(2000.0, 500.0, 200.0, 800.0),
+        vec![2000.0, 1800.0, 1600.0, 1500.0]
+    );
+    assert_eq!(truths(1000.0, 2400.0, 200.0, 800.0), vec![1000.0, 800.0]);
+    assert_eq!(truths(800.0, 2400.0, 200.0, 800.0), vec![800.0]);
+    assert_eq!(truths(1800.0, 0.0, 200.0, 800.0), vec![1800.0]);
+}
+
+#[test]
+fn the_reference_restraint_planned_anywhere_is_never_worse_than_itself() {
+    // Oracle: with no airbag floor the setting executes exactly as the reference at every
+    // truth, so every change is 0 and every cell holds.
+    let d = ci_table(Some(&reference()), "0", &[]);
+    let rows = check_cells(&d, &reference(), 2400.0, 200.0).unwrap();
+    assert_eq!(rows.len(), 24);
+    for r in &rows {
+        assert!(r.ok, "{r:?}");
+        if r.coords[1] == 1 {
+            // The stored setting is f32: a rounding, not a difference.
+            assert!(r.worst_change_pct.abs() < 1e-5, "{r:?}");
+        } else {
+            // The 1 000 kg cells have no lighter truth on the axis.
+            assert_eq!(r.worst_change_pct, f64::NEG_INFINITY, "{r:?}");
+        }
+    }
+    assert!(MarginSummary::of(&d, &rows).holds());
+}
+
+#[test]
+fn a_restraint_too_weak_for_a_crash_fails_where_the_reference_holds_the_occupant() {
+    // 1 kN limiter, no airbag, pretensioner after the crash: the occupant strikes through at
+    // 74 and 108 km/h where the reference restraint holds him.
+    let weak = RestraintSettings {
+        load_limiter_n: 1000.0,
+        airbag_force_n: 0.0,
+        pretensioner_time_s: 0.020,
+        airbag_time_s: 0.010,
+    };
+    let d = ci_table(Some(&weak), "0", &[]);
+    let hw = physics::RestraintHardware::default();
+    let rows = check_cells(&d, &reference(), 2400.0, 200.0).unwrap();
+    let mut seen_bottoming = 0;
+    for r in &rows {
+        let p = Grid::from_table(&d).unwrap().axes.point(r.index).unwrap();
+        let occupant = table::occupant_at(&p.query);
+        // Independently: the lighter truth of the 2 500 kg cells is the 1 000 kg axis point,
+        // simulated here directly with both restraints.
+        if p.coords[1] == 1 {
+            let pulse = lut::scenario::Pulse::predict(
+                &Grid::from_table(&d).unwrap().ego,
+                lut::scenario::Opponent::Car { mass_kg: 1000.0 },
+                f64::from(p.query.closing_speed_kph),
+            )
+            .unwrap();
+            let w = physics::simulate_occupant(&pulse.ego(), &occupant, &weak, &hw).unwrap();
+            let rf =
+                physics::simulate_occupant(&pulse.ego(), &occupant, &reference(), &hw).unwrap();
+            if w.bottomed_out && !rf.bottomed_out {
+                seen_bottoming += 1;
+                assert!(!r.ok && r.bottoms_out_alone > 0, "{r:?}");
+            }
+        } else {
+            // The 1 000 kg cells have no lighter truth on the axis: nothing to judge.
+            assert!(r.ok && r.worst_change_pct == f64::NEG_INFINITY, "{r:?}");
+        }
+    }
+    assert!(
+        seen_bottoming >= 2,
+        "the weak restraint should strike through at speed"
+    );
+    let s = MarginSummary::of(&d, &rows);
+    assert!(!s.holds() && s.bottom_out_alone >= seen_bottoming, "{s:?}");
+}
+
+#[test]
+fn the_span_a_header_states_is_read_and_a_bad_one_refused() {
+    let none = ci_table(None, "0", &[]);
+    assert_eq!(margin::stated_span_kg(&none).unwrap(), None);
+    let stated = ci_table(None, "0", &[(EXTRA_SPAN_KG, "2400")]);
+    assert_eq!(margin::stated_span_kg(&stated).unwrap(), Some(2400.0));
+    for bad in ["-1", "NaN", "heavy"] {
+        let d = ci_table(None, "0", &[(EXTRA_SPAN_KG, bad)]);
+        let e = margin::stated_span_kg(&d).unwrap_err().to_string();
+        assert!(e.contains(EXTRA_SPAN_KG), "{e}");
+    }
+}
+
+#[test]
+fn lut_verify_enforces_a_stated_or_given_span_and_reports_an_unstated_one() {
+    let weak = RestraintSettings {
+        load_limiter_n: 1000.0,
+        airbag_force_n: 0.0,
+        pretensioner_time_s: 0.020,
+        airbag_time_s: 0.010,
+    };
+    let dir = std::env::temp_dir().join(format!("lut-margin-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |d: &Diagram, name: &str, args: &[&str]| {
+        let path = dir.join(name);
+        std::fs::write(&path, d.to_bytes()).unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_lut"))
+            .arg("verify")
+            .arg(&path)
+            .args(["--cells", "0"])
+            .args(args)
+            .output()
+            .unwrap();
+        (
+            out.status.success(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    // Unstated: reported, exit 0.
+    let (ok, err) = run(&ci_table(Some(&weak), "0", &[]), "unstated.lut", &[]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("reported, not enforced")
+            && err.contains("bottoms out where the reference does not"),
+        "{err}"
+    );
+    // Stated in the header: enforced.
+    let (ok, err) = run(
+        &ci_table(Some(&weak), "0", &[(EXTRA_SPAN_KG, "2400")]),
+        "stated.lut",
+        &[],
+    );
+    assert!(
+        !ok && err.contains("planning margin of 2400 kg fails in"),
+        "{err}"
+    );
+    // Given: enforced; the reference's own setting holds.
+    let (ok, err) = run(
+        &ci_table(Some(&weak), "0", &[]),
+        "given.lut",
+        &["--margin-kg", "1500"],
+    );
+    assert!(
+        !ok && err.contains("planning margin of 1500 kg fails in"),
+        "{err}"
+    );
+    let (ok, err) = run(
+        &ci_table(Some(&reference()), "0", &[(EXTRA_SPAN_KG, "2400")]),
+        "holds.lut",
+        &[],
+    );
+    assert!(ok && err.contains("holds in 24 of 24 cells"), "{err}");
+    let (ok, err) = run(
+        &ci_table(None, "0", &[]),
+        "bad-arg.lut",
+        &["--margin-kg=-5"],
+    );
+    assert!(!ok && err.contains("--margin-kg"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
