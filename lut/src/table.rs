@@ -5,6 +5,7 @@
 //! grid seed and the cell index only. Hence a build is byte-identical whatever the thread count
 //! or sharding, and `lut merge` of shards equals a full build.
 
+use crate::margin;
 use crate::optimise::{self, Case, OptimiserConfig, SearchSpace};
 use crate::progress::Progress;
 use crate::scenario::{Ego, Opponent, Pulse};
@@ -34,6 +35,20 @@ pub struct GridFile {
     pub optimiser: OptimiserSpec,
     /// Axis points.
     pub axes: AxesSpec,
+    /// The planning margin the cells must hold (`lut::margin`); none: cells as optimised.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robust: Option<RobustSpec>,
+}
+
+/// `[robust]` of a grid file: every cell's setting, planned for opponent mass M, must not
+/// bottom out (or strike deeper than the reference restraint) at any opponent from
+/// M − `lighter_opponent_kg` to M; a cell whose optimum does is re-optimised over those
+/// opponents (`lut::margin::LighterSet::robust_optimum`). Written to the table's header.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RobustSpec {
+    /// The span below the planned opponent mass [kg].
+    pub lighter_opponent_kg: f64,
 }
 
 impl GridFile {
@@ -96,6 +111,8 @@ pub struct Grid {
     pub optimiser: OptimiserConfig,
     /// Axes.
     pub axes: Axes,
+    /// The planning margin's span the cells hold [kg] (`[robust]`), if any.
+    pub robust_lighter_kg: Option<f64>,
 }
 
 const EXTRA_PARTICLES: &str = "optimiser.particles";
@@ -137,6 +154,16 @@ impl Grid {
         if seat.first().is_some_and(|&d| f64::from(d) <= lo) {
             bail!("{origin}: seat_distance_mm must exceed the {lo} mm module thickness");
         }
+        let robust_lighter_kg = match f.robust {
+            None => None,
+            Some(r) if r.lighter_opponent_kg.is_finite() && r.lighter_opponent_kg > 0.0 => {
+                Some(r.lighter_opponent_kg)
+            }
+            Some(r) => bail!(
+                "{origin}: robust.lighter_opponent_kg must be a finite mass > 0 kg, not {}",
+                r.lighter_opponent_kg
+            ),
+        };
         let optimiser = OptimiserConfig {
             seed: f.optimiser.seed,
             particles: f.optimiser.particles,
@@ -152,6 +179,7 @@ impl Grid {
             description: f.ego.description,
             optimiser,
             axes,
+            robust_lighter_kg,
         })
     }
 
@@ -193,6 +221,9 @@ impl Grid {
             "occupant".into(),
             "belted; seat friction and hardware: physics::defaults".into(),
         );
+        if let Some(kg) = self.robust_lighter_kg {
+            extra.insert(margin::EXTRA_SPAN_KG.into(), format!("{kg}"));
+        }
         extra.insert(
             "objective".into(),
             "a_max_g + a_mean_g, no bottoming-out (penalty)".into(),
@@ -244,6 +275,7 @@ impl Grid {
             description: h.ego.description.clone(),
             optimiser,
             axes: d.axes().clone(),
+            robust_lighter_kg: margin::stated_span_kg(d)?,
         })
     }
 
@@ -355,6 +387,11 @@ pub fn optimise_point(grid: &Grid, p: &GridPoint, cfg: &OptimiserConfig) -> Resu
         cfg,
     )
     .with_context(|| format!("cell {} {:?}", p.index, p.coords))?;
+    let optimum = match grid.robust_lighter_kg {
+        Some(span_kg) => hold_margin(grid, p, cfg, optimum, span_kg)
+            .with_context(|| format!("cell {} {:?}: planning margin", p.index, p.coords))?,
+        None => optimum,
+    };
     let o = optimum
         .outcomes
         .first()
@@ -362,6 +399,65 @@ pub fn optimise_point(grid: &Grid, p: &GridPoint, cfg: &OptimiserConfig) -> Resu
     Ok(CellResult {
         cell: cell_of(&optimum.settings, o),
         optimum,
+    })
+}
+
+/// The cell's optimum if it holds the planning margin over `span_kg` (`lut::margin`), else the
+/// robust setting over the lighter opponents when that one fails at fewer of them (a cell where
+/// no setting holds keeps the better of the two; `lut verify` reports it).
+fn hold_margin(
+    grid: &Grid,
+    p: &GridPoint,
+    cfg: &OptimiserConfig,
+    optimum: optimise::Optimum,
+    span_kg: f64,
+) -> Result<optimise::Optimum> {
+    let reference = physics::reference::ReferenceRestraint::builtin()
+        .map_err(|e| anyhow!("the built-in reference restraint: {e}"))?
+        .settings();
+    let floor_kg = grid
+        .axes
+        .opponent_mass_kg
+        .first()
+        .map_or(0.0, |&m| f64::from(m));
+    let set = margin::LighterSet::new(
+        &grid.ego,
+        &p.query,
+        span_kg,
+        margin::DEFAULT_STEP_KG,
+        floor_kg,
+        &reference,
+        cfg,
+    )?;
+    let before = set.judge(p, &optimum.settings)?;
+    if before.ok {
+        return Ok(optimum);
+    }
+    let (robust, sims) = set.robust_optimum(cfg)?;
+    let after = set.judge(p, &robust)?;
+    let failing = |r: &margin::MarginRow| r.bottoms_out_alone + r.strikes_deeper;
+    if failing(&after) >= failing(&before) {
+        return Ok(optimise::Optimum {
+            occupant_simulations: optimum.occupant_simulations + sims,
+            ..optimum
+        });
+    }
+    let pulse = pulse_at(&grid.ego, &p.query)?;
+    let case = Case {
+        pulse: pulse.ego(),
+        occupant: occupant_at(&p.query),
+    };
+    let (cost, outcomes) = optimise::evaluate(
+        &[case],
+        &robust,
+        &RestraintHardware::default(),
+        cfg.reserve_m,
+    )?;
+    Ok(optimise::Optimum {
+        settings: robust,
+        cost,
+        outcomes,
+        occupant_simulations: optimum.occupant_simulations + sims + 1,
     })
 }
 

@@ -84,7 +84,7 @@ fn the_reference_restraint_planned_anywhere_is_never_worse_than_itself() {
             assert_eq!(r.worst_change_pct, f64::NEG_INFINITY, "{r:?}");
         }
     }
-    assert!(MarginSummary::of(&d, &rows).holds());
+    assert!(MarginSummary::of(&rows).holds());
 }
 
 #[test]
@@ -129,7 +129,7 @@ fn a_restraint_too_weak_for_a_crash_fails_where_the_reference_holds_the_occupant
         seen_bottoming >= 2,
         "the weak restraint should strike through at speed"
     );
-    let s = MarginSummary::of(&d, &rows);
+    let s = MarginSummary::of(&rows);
     assert!(!s.holds() && s.bottom_out_alone >= seen_bottoming, "{s:?}");
 }
 
@@ -212,4 +212,66 @@ fn lut_verify_enforces_a_stated_or_given_span_and_reports_an_unstated_one() {
     );
     assert!(!ok && err.contains("--margin-kg"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_grid_with_a_robust_span_builds_cells_that_hold_it_or_hold_it_better() {
+    // A small grid at the fast end, where light occupants close to the wheel bottom out
+    // against a lighter opponent than planned (the shipped grid's plain optima did at 108 km/h,
+    // 45–60 kg, 200 mm), with and without [robust]: every cell that holds in the plain build
+    // is byte-identical, every changed cell fails the safety part at fewer lighter opponents
+    // than before, and the header states the span (so `lut verify` enforces it).
+    let ci = std::fs::read_to_string(workspace().join("data/ci-grid.toml")).unwrap();
+    let text = ci
+        .split("[axes]")
+        .next()
+        .unwrap()
+        .to_string()
+        + "[axes]\nclosing_speed_kph = [99.5, 108.0]\nopponent_mass_kg = [1000.0, 1200.0, 1400.0]\n\
+           occupant_mass_kg = [45.0, 60.0]\nseat_distance_mm = [200.0, 250.0]\n";
+    let plain = Grid::parse("ci", &text).unwrap();
+    let robust = Grid::parse(
+        "ci+robust",
+        &format!("{text}\n[robust]\nlighter_opponent_kg = 2400.0\n"),
+    )
+    .unwrap();
+    assert_eq!(robust.robust_lighter_kg, Some(2400.0));
+    let (p, _) = table::build_table(&plain, Some(2), true).unwrap();
+    let (r, _) = table::build_table(&robust, Some(2), true).unwrap();
+    assert_eq!(margin::stated_span_kg(&p).unwrap(), None);
+    assert_eq!(margin::stated_span_kg(&r).unwrap(), Some(2400.0));
+    let rows_p = check_cells(&p, &reference(), 2400.0, margin::DEFAULT_STEP_KG).unwrap();
+    let rows_r = check_cells(&r, &reference(), 2400.0, margin::DEFAULT_STEP_KG).unwrap();
+    let fails = |x: &margin::MarginRow| x.bottoms_out_alone + x.strikes_deeper;
+    let mut changed = 0;
+    for ((a, b), (ca, cb)) in rows_p
+        .iter()
+        .zip(&rows_r)
+        .zip(p.cells().iter().zip(r.cells()))
+    {
+        if a.ok {
+            assert_eq!(ca, cb, "cell {} held and must not change", a.index);
+        } else if ca != cb {
+            changed += 1;
+            assert!(fails(b) < fails(a), "cell {}: {a:?} → {b:?}", a.index);
+        }
+    }
+    let failing_plain = rows_p.iter().filter(|x| !x.ok).count();
+    assert!(
+        failing_plain > 0,
+        "the CI grid should have a cell the plain optimum fails"
+    );
+    assert!(changed > 0, "no failing cell was re-optimised");
+    // Grid validation: the span must be a positive, finite mass.
+    for bad in ["0.0", "-10.0", "nan"] {
+        let e = Grid::parse(
+            "ci",
+            &format!("{text}\n[robust]\nlighter_opponent_kg = {bad}\n"),
+        )
+        .unwrap_err();
+        assert!(
+            format!("{e:#}").contains("robust.lighter_opponent_kg"),
+            "{e:#}"
+        );
+    }
 }
