@@ -122,6 +122,11 @@ fn bench_lut() -> restraint::Lut<'static> {
         id: d.lut_id(),
         ego_mass_kg: d.header().ego.mass_kg,
         ego_class: d.header().ego.class,
+        // An unreadable span: NaN, which the core rejects.
+        verified_lighter_kg: d
+            .header()
+            .lighter_opponent_span_kg()
+            .map_or(Some(f32::NAN), |s| s.map(|kg| kg as f32)),
     }
 }
 

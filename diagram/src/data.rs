@@ -49,6 +49,32 @@ pub struct Header {
     pub airbag_thresholds: AirbagThresholds,
 }
 
+/// Header key (`build.extra`) of the planning margin a table's cells hold: a setting planned
+/// for opponent mass M does not bottom the occupant out where the reference restraint does not
+/// (nor deeper where both do) at any opponent from M − this [kg] to M. Written by `lut build`
+/// (`[robust]`), checked by `lut verify`, and the ECU refuses a configuration whose planning
+/// margins need more.
+pub const EXTRA_LIGHTER_OPPONENT_KG: &str = "robust.lighter_opponent_kg";
+
+impl Header {
+    /// The span the table states for its planning margin ([`EXTRA_LIGHTER_OPPONENT_KG`]),
+    /// `None` when it states none.
+    ///
+    /// # Errors
+    /// The key is there but not a finite mass ≥ 0 kg.
+    pub fn lighter_opponent_span_kg(&self) -> Result<Option<f64>, String> {
+        match self.build.extra.get(EXTRA_LIGHTER_OPPONENT_KG) {
+            None => Ok(None),
+            Some(v) => match v.parse::<f64>() {
+                Ok(x) if x.is_finite() && x >= 0.0 => Ok(Some(x)),
+                _ => Err(format!(
+                    "table header: {EXTRA_LIGHTER_OPPONENT_KG} = {v:?} is not a mass ≥ 0 kg"
+                )),
+            },
+        }
+    }
+}
+
 /// The four axes (each strictly increasing) plus the NaN fallback point.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Axes {

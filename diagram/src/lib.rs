@@ -35,8 +35,8 @@ pub use view::{DiagramView, Lookup};
 
 #[cfg(feature = "std")]
 pub use data::{
-    Axes, BuildInfo, DiagramData, EgoVehicle, GridPoint, Header, NAN_FALLBACK_OCCUPANT_KG,
-    NAN_FALLBACK_SEAT_MM,
+    Axes, BuildInfo, DiagramData, EgoVehicle, GridPoint, Header, EXTRA_LIGHTER_OPPONENT_KG,
+    NAN_FALLBACK_OCCUPANT_KG, NAN_FALLBACK_SEAT_MM,
 };
 #[cfg(feature = "std")]
 pub use file::{

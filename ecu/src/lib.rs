@@ -17,12 +17,18 @@ pub mod runtime;
 pub mod can_port;
 
 /// The loaded characteristic diagram as the core takes it: the borrowed view plus the header
-/// facts it checks (ego vehicle) and reports (LUT id).
+/// facts it checks (ego vehicle, the planning margin the cells are verified for) and reports
+/// (LUT id).
 pub fn lut_input(d: &diagram::Diagram) -> restraint::Lut<'_> {
     restraint::Lut {
         view: d.view(),
         id: d.lut_id(),
         ego_mass_kg: d.header().ego.mass_kg,
         ego_class: d.header().ego.class,
+        // An unreadable span: NaN, which the core rejects.
+        verified_lighter_kg: d
+            .header()
+            .lighter_opponent_span_kg()
+            .map_or(Some(f32::NAN), |s| s.map(|kg| kg as f32)),
     }
 }

@@ -28,8 +28,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 /// Header key (`build.extra`) of the span the table is verified for: a setting planned for
-/// opponent mass M holds for every true opponent from M − this [kg] to M.
-pub const EXTRA_SPAN_KG: &str = "robust.lighter_opponent_kg";
+/// opponent mass M holds for every true opponent from M − this [kg] to M (the diagram crate's,
+/// which the ECU reads too).
+pub const EXTRA_SPAN_KG: &str = diagram::EXTRA_LIGHTER_OPPONENT_KG;
 /// The span the shipped rule needs: the truth up to twice the misreport bound (1 200 kg)
 /// lighter than the plan.
 pub const DEFAULT_SPAN_KG: f64 = 2400.0;
@@ -41,15 +42,9 @@ pub const DEFAULT_STEP_KG: f64 = 200.0;
 /// # Errors
 /// The key is there but not a finite, non-negative number.
 pub fn stated_span_kg(d: &Diagram) -> Result<Option<f64>> {
-    match d.header().build.extra.get(EXTRA_SPAN_KG) {
-        None => Ok(None),
-        Some(v) => match v.parse::<f64>() {
-            Ok(x) if x.is_finite() && x >= 0.0 => Ok(Some(x)),
-            _ => Err(anyhow!(
-                "table header: {EXTRA_SPAN_KG} = {v:?} is not a mass ≥ 0 kg"
-            )),
-        },
-    }
+    d.header()
+        .lighter_opponent_span_kg()
+        .map_err(|e| anyhow!(e))
 }
 
 /// One cell checked over the lighter truths.

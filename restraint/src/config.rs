@@ -98,6 +98,8 @@ pub struct CycleConfig {
     /// mass m + k·σ only). Why: an opponent's mass does not show in the ego pulse
     /// until long after the restraint is committed (the pulses of 1300 and 2400 kg opponents at
     /// 96 km/h agree within 0.1 g for 30 ms), so the plan must already hold the heavier one.
+    /// A table that states the span its cells are verified for (`robust.lighter_opponent_kg`)
+    /// is rejected when 2 × this (or this + `v2x_mass_margin_kg`) exceeds it.
     pub mass_misreport_kg: f64,
     /// Robust planning with a second, independent mass source — the opponent's own mass from
     /// V2X (`V2xOpponentMass`), when it describes the tracked object: the lookup is for the

@@ -27,7 +27,8 @@ use crate::signals::Degraded;
 /// What [`RestraintCycle::new`] found (for start-up messages).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct StartupNotes {
-    /// The LUT given was optimised for another car: rejected, the ECU runs DEGRADED.
+    /// The LUT given was optimised for another car, or verified for a smaller planning margin
+    /// than the configured one needs: rejected, the ECU runs DEGRADED.
     pub lut_rejected: Option<LutMismatch>,
 }
 
@@ -64,7 +65,7 @@ const E2E_COUNTER_NAMES: [&str; RejectReason::COUNT] = [
 
 impl<'lut> RestraintCycle<'lut> {
     /// Builds the activity: validates `cfg`, precomputes the collision model and checks that
-    /// `lut` belongs to the configured ego vehicle. `lut = None` (or a mismatching table) →
+    /// `lut` belongs to the configured ego vehicle and margins. `lut = None` (or a mismatching table) →
     /// permanent `LUT_INVALID`: the ECU runs DEGRADED on the `reference` restraint.
     pub fn new(
         cfg: CycleConfig,

@@ -100,55 +100,101 @@ pub struct Lut<'a> {
     pub ego_mass_kg: f32,
     /// Ego stiffness class the table was optimised for.
     pub ego_class: u8,
+    /// The planning margin the table's cells are verified for (its header's
+    /// `robust.lighter_opponent_kg`): a plan up to this much heavier than the true opponent
+    /// does not bottom the occupant out where the reference does not. `None`: the table states
+    /// none (no claim, accepted); NaN: it states one the shell could not read (rejected).
+    pub verified_lighter_kg: Option<f32>,
 }
 
-/// A LUT optimised for another car than the configured one (rejected at start-up).
+/// Why a LUT was rejected at start-up (the ECU then runs DEGRADED on the reference restraint).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LutMismatch {
-    /// The table's ego mass, kg.
-    pub table_mass_kg: f32,
-    /// The table's ego class.
-    pub table_class: u8,
-    /// The configured ego mass, kg.
-    pub config_mass_kg: f64,
-    /// The configured ego class.
-    pub config_class: u8,
+pub enum LutMismatch {
+    /// Optimised for another car than the configured one.
+    Ego {
+        /// The table's ego mass, kg.
+        table_mass_kg: f32,
+        /// The table's ego class.
+        table_class: u8,
+        /// The configured ego mass, kg.
+        config_mass_kg: f64,
+        /// The configured ego class.
+        config_class: u8,
+    },
+    /// Verified for plans less heavy than the truth than the configured margins make them.
+    Margin {
+        /// The span the table states, kg (NaN: unreadable).
+        verified_lighter_kg: f32,
+        /// The span the configuration needs, kg: 2 × `mass_misreport_kg`, or
+        /// `mass_misreport_kg` + `v2x_mass_margin_kg` if more.
+        needed_kg: f64,
+    },
 }
 
 impl core::fmt::Display for LutMismatch {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(
-            f,
-            "LUT is for ego {} kg class {}, ECU configured for {} kg class {}: \
-             LUT rejected, DEGRADED (reference restraint)",
-            self.table_mass_kg, self.table_class, self.config_mass_kg, self.config_class
-        )
+        match self {
+            Self::Ego {
+                table_mass_kg,
+                table_class,
+                config_mass_kg,
+                config_class,
+            } => write!(
+                f,
+                "LUT is for ego {table_mass_kg} kg class {table_class}, ECU configured for \
+                 {config_mass_kg} kg class {config_class}: LUT rejected, DEGRADED (reference \
+                 restraint)"
+            ),
+            Self::Margin {
+                verified_lighter_kg,
+                needed_kg,
+            } => write!(
+                f,
+                "LUT is verified for plans up to {verified_lighter_kg} kg heavier than the \
+                 opponent (robust.lighter_opponent_kg), the ECU's planning margins need \
+                 {needed_kg} kg (2 × mass_misreport_kg, or mass_misreport_kg + \
+                 v2x_mass_margin_kg): LUT rejected, DEGRADED (reference restraint)"
+            ),
+        }
     }
 }
 
 /// `lut` if it was optimised for the configured ego vehicle (class equal, mass within 1 %):
-/// its cells are optimal for that car only. A mismatch drops it and says why.
+/// its cells are optimal for that car only; and if the planning margin its cells are verified
+/// for covers the configured margins — with one mass source off by up to `mass_misreport_kg`
+/// either way the plan is up to twice that heavier than the truth, with a V2X station up to
+/// `mass_misreport_kg` + `v2x_mass_margin_kg`. A mismatch drops it and says why.
 pub fn check_lut<'a>(
     cfg: &CycleConfig,
     lut: Option<Lut<'a>>,
 ) -> (Option<Lut<'a>>, Option<LutMismatch>) {
-    match lut {
-        Some(l) => {
-            let rel = (f64::from(l.ego_mass_kg) - cfg.ego_mass_kg).abs() / cfg.ego_mass_kg;
-            if l.ego_class != cfg.ego_class || rel > 0.01 {
-                let m = LutMismatch {
-                    table_mass_kg: l.ego_mass_kg,
-                    table_class: l.ego_class,
-                    config_mass_kg: cfg.ego_mass_kg,
-                    config_class: cfg.ego_class,
-                };
-                (None, Some(m))
-            } else {
-                (Some(l), None)
-            }
-        }
-        None => (None, None),
+    let Some(l) = lut else {
+        return (None, None);
+    };
+    let rel = (f64::from(l.ego_mass_kg) - cfg.ego_mass_kg).abs() / cfg.ego_mass_kg;
+    if l.ego_class != cfg.ego_class || rel > 0.01 {
+        let m = LutMismatch::Ego {
+            table_mass_kg: l.ego_mass_kg,
+            table_class: l.ego_class,
+            config_mass_kg: cfg.ego_mass_kg,
+            config_class: cfg.ego_class,
+        };
+        return (None, Some(m));
     }
+    if let Some(span_kg) = l.verified_lighter_kg {
+        let needed_kg =
+            (2.0 * cfg.mass_misreport_kg).max(cfg.mass_misreport_kg + cfg.v2x_mass_margin_kg);
+        // NaN-safe: an unreadable span (NaN) covers nothing. 0.5 kg: the span is stored as
+        // text and read as f32.
+        if !(needed_kg <= f64::from(span_kg) + 0.5) {
+            let m = LutMismatch::Margin {
+                verified_lighter_kg: span_kg,
+                needed_kg,
+            };
+            return (None, Some(m));
+        }
+    }
+    (Some(l), None)
 }
 
 /// The estimated situation: the track's contact estimate at the cycle's time.

@@ -80,6 +80,11 @@ pub fn lut_of(d: &Diagram) -> Lut<'_> {
         id: d.lut_id(),
         ego_mass_kg: d.header().ego.mass_kg,
         ego_class: d.header().ego.class,
+        // An unreadable span: NaN, which the core rejects.
+        verified_lighter_kg: d
+            .header()
+            .lighter_opponent_span_kg()
+            .map_or(Some(f32::NAN), |s| s.map(|kg| kg as f32)),
     }
 }
 
