@@ -239,7 +239,7 @@ fn verify_margin(d: &Diagram, a: &VerifyArgs) -> Result<Option<String>> {
     let reference = physics::reference::ReferenceRestraint::builtin()
         .map_err(anyhow::Error::msg)?
         .settings();
-    let rows = margin::check_cells(d, &reference, span_kg, a.margin_step_kg)?;
+    let rows = table::check_margin(d, &reference, span_kg, a.margin_step_kg)?;
     let s = margin::MarginSummary::of(&rows);
     let source = match (a.margin_kg, stated) {
         (Some(_), _) => "given",

@@ -20,11 +20,11 @@
 use crate::optimise::{self, effective_settings, minimise, Case, OptimiserConfig, SearchSpace};
 use crate::robust_cells::{objective_g, UncertainSet};
 use crate::scenario::Ego;
-use crate::table::{occupant_at, settings_of, Grid};
 use anyhow::{anyhow, Result};
 use diagram::Diagram;
-use physics::{simulate_occupant, OccupantOutcome, RestraintHardware, RestraintSettings};
-use rayon::prelude::*;
+use physics::{
+    simulate_occupant, OccupantInput, OccupantOutcome, RestraintHardware, RestraintSettings,
+};
 use serde::Serialize;
 
 /// Header key (`build.extra`) of the span the table is verified for: a setting planned for
@@ -95,6 +95,18 @@ pub fn truths(planned_kg: f64, span_kg: f64, step_kg: f64, floor_kg: f64) -> Vec
     out
 }
 
+/// The lighter opponents a check runs over: from the plan down to the plan − `lighter_kg` by
+/// `step_kg`, never below `floor_kg` (the mass axis' lightest).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Span {
+    /// How far below the plan [kg].
+    pub lighter_kg: f64,
+    /// Step between the checked masses [kg].
+    pub step_kg: f64,
+    /// The lightest checked mass [kg].
+    pub floor_kg: f64,
+}
+
 /// A grid point's lighter truths — its pulse and the reference restraint's outcome at each —
 /// for checking a setting planned there and for the robust setting that holds over them.
 pub struct LighterSet {
@@ -105,25 +117,28 @@ pub struct LighterSet {
 }
 
 impl LighterSet {
-    /// The truths of grid point `q` (planned mass = `q`'s) over `span_kg` by `step_kg`, down to
-    /// `floor_kg`; `cfg` gives the airbag floor and the ride-down reserve.
+    /// The truths of grid point `q` (planned mass = `q`'s) for `occupant` over `span`; `cfg`
+    /// gives the airbag floor and the ride-down reserve.
     ///
     /// # Errors
     /// A pulse cannot be predicted or an occupant simulation fails.
     pub fn new(
         ego: &Ego,
         q: &diagram::Query,
-        span_kg: f64,
-        step_kg: f64,
-        floor_kg: f64,
+        occupant: &OccupantInput,
+        span: &Span,
         reference: &RestraintSettings,
         cfg: &OptimiserConfig,
     ) -> Result<Self> {
         let v = f64::from(q.closing_speed_kph);
-        let masses_kg = truths(f64::from(q.opponent_mass_kg), span_kg, step_kg, floor_kg);
+        let masses_kg = truths(
+            f64::from(q.opponent_mass_kg),
+            span.lighter_kg,
+            span.step_kg,
+            span.floor_kg,
+        );
         let points: Vec<(f64, f64)> = masses_kg.iter().map(|&m| (v, m)).collect();
-        let set =
-            UncertainSet::from_points(ego, &occupant_at(q), &points, reference, cfg.reserve_m)?;
+        let set = UncertainSet::from_points(ego, occupant, &points, reference, cfg.reserve_m)?;
         let earliest_airbag_s = set
             .points
             .iter()
@@ -249,49 +264,7 @@ impl LighterSet {
     }
 }
 
-/// Check every cell of `d` (module docs) over `span_kg` in steps of `step_kg`.
-///
-/// # Errors
-/// The header lacks the optimiser settings, or a pulse / simulation fails.
-pub fn check_cells(
-    d: &Diagram,
-    reference: &RestraintSettings,
-    span_kg: f64,
-    step_kg: f64,
-) -> Result<Vec<MarginRow>> {
-    let grid = Grid::from_table(d)?;
-    let floor_kg = grid
-        .axes
-        .opponent_mass_kg
-        .first()
-        .map(|&m| f64::from(m))
-        .ok_or_else(|| anyhow!("no mass axis"))?;
-    (0..grid.axes.cell_count())
-        .into_par_iter()
-        .map(|i| {
-            let p = grid
-                .axes
-                .point(i)
-                .ok_or_else(|| anyhow!("cell {i} outside the grid"))?;
-            let c = d
-                .cells()
-                .get(i)
-                .ok_or_else(|| anyhow!("cell {i} missing"))?;
-            LighterSet::new(
-                &grid.ego,
-                &p.query,
-                span_kg,
-                step_kg,
-                floor_kg,
-                reference,
-                &grid.optimiser,
-            )?
-            .judge(&p, &settings_of(c))
-        })
-        .collect()
-}
-
-/// What [`check_cells`] found, for a report.
+/// What the check of a table (`table::check_margin`) found, for a report.
 #[derive(Clone, Debug, Serialize)]
 pub struct MarginSummary {
     /// Cells checked.

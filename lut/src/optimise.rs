@@ -520,3 +520,23 @@ pub fn optimise(
         occupant_simulations: evaluations * cases.len() as u64,
     })
 }
+
+/// The optimum of one situation within `space` on `hw`, the airbag no earlier than the pulse
+/// carries its floor (`OptimiserConfig::earliest_airbag_s`).
+///
+/// # Errors
+/// The optimiser fails.
+pub fn optimise_situation(
+    pulse: &crate::scenario::Pulse,
+    occupant: OccupantInput,
+    space: SearchSpace,
+    hw: &RestraintHardware,
+    cfg: &OptimiserConfig,
+) -> Result<Optimum> {
+    let case = Case {
+        pulse: pulse.ego(),
+        occupant,
+    };
+    let space = space.with_earliest_airbag_s(cfg.earliest_airbag_s(&case.pulse));
+    optimise(&[case], &space, hw, cfg)
+}

@@ -26,7 +26,6 @@ use crate::optimise::{
     self, effective_settings, minimise, Case, OptimiserConfig, SearchSpace, INFEASIBLE_OFFSET,
 };
 use crate::scenario::{Ego, Opponent, Pulse};
-use crate::table::optimise_situation;
 use anyhow::{anyhow, Result};
 use physics::{
     defaults, mps2_to_g, simulate_occupant, OccupantInput, OccupantOutcome, RestraintHardware,
@@ -332,7 +331,7 @@ pub fn point_optimum(
         },
         closing_kph,
     )?;
-    Ok(optimise_situation(
+    Ok(optimise::optimise_situation(
         &pulse,
         *occupant,
         SearchSpace::adaptive(),

@@ -423,9 +423,12 @@ fn hold_margin(
     let set = margin::LighterSet::new(
         &grid.ego,
         &p.query,
-        span_kg,
-        margin::DEFAULT_STEP_KG,
-        floor_kg,
+        &occupant_at(&p.query),
+        &margin::Span {
+            lighter_kg: span_kg,
+            step_kg: margin::DEFAULT_STEP_KG,
+            floor_kg,
+        },
         &reference,
         cfg,
     )?;
@@ -463,7 +466,7 @@ fn hold_margin(
 
 /// The optimum of one grid point (`q`: closing speed, opponent, belted occupant): what every
 /// cell of a build is, and what the studies re-optimise with other spaces and hardware
-/// ([`optimise_situation`] on the point's predicted pulse and occupant).
+/// ([`optimise::optimise_situation`] on the point's predicted pulse and occupant).
 ///
 /// # Errors
 /// The pulse cannot be predicted or the optimiser fails.
@@ -474,27 +477,7 @@ pub fn optimise_query(
     hw: &RestraintHardware,
     cfg: &OptimiserConfig,
 ) -> Result<optimise::Optimum> {
-    optimise_situation(&pulse_at(ego, q)?, occupant_at(q), space, hw, cfg)
-}
-
-/// The optimum of one situation within `space` on `hw`, the airbag no earlier than the pulse
-/// carries its floor (`OptimiserConfig::earliest_airbag_s`).
-///
-/// # Errors
-/// The optimiser fails.
-pub fn optimise_situation(
-    pulse: &Pulse,
-    occupant: OccupantInput,
-    space: SearchSpace,
-    hw: &RestraintHardware,
-    cfg: &OptimiserConfig,
-) -> Result<optimise::Optimum> {
-    let case = Case {
-        pulse: pulse.ego(),
-        occupant,
-    };
-    let space = space.with_earliest_airbag_s(cfg.earliest_airbag_s(&case.pulse));
-    optimise::optimise(&[case], &space, hw, cfg)
+    optimise::optimise_situation(&pulse_at(ego, q)?, occupant_at(q), space, hw, cfg)
 }
 
 /// Optimise cell `index` of the grid (with its per-cell seed).
@@ -768,6 +751,52 @@ pub fn verify(d: &Diagram, n: usize, seed: u64) -> Result<Vec<VerifyRow>> {
                 ok: problem.is_none(),
                 problem,
             })
+        })
+        .collect()
+}
+
+/// The planning margin's check of every cell of `d` (`lut::margin`) over `span_kg` in steps of
+/// `step_kg`, against the `reference` restraint: what `lut verify` reports and enforces.
+///
+/// # Errors
+/// The header lacks the optimiser settings, or a pulse / simulation fails.
+pub fn check_margin(
+    d: &Diagram,
+    reference: &RestraintSettings,
+    span_kg: f64,
+    step_kg: f64,
+) -> Result<Vec<margin::MarginRow>> {
+    let grid = Grid::from_table(d)?;
+    let floor_kg = grid
+        .axes
+        .opponent_mass_kg
+        .first()
+        .map(|&m| f64::from(m))
+        .ok_or_else(|| anyhow!("no mass axis"))?;
+    (0..grid.axes.cell_count())
+        .into_par_iter()
+        .map(|i| {
+            let p = grid
+                .axes
+                .point(i)
+                .ok_or_else(|| anyhow!("cell {i} outside the grid"))?;
+            let c = d
+                .cells()
+                .get(i)
+                .ok_or_else(|| anyhow!("cell {i} missing"))?;
+            margin::LighterSet::new(
+                &grid.ego,
+                &p.query,
+                &occupant_at(&p.query),
+                &margin::Span {
+                    lighter_kg: span_kg,
+                    step_kg,
+                    floor_kg,
+                },
+                reference,
+                &grid.optimiser,
+            )?
+            .judge(&p, &settings_of(c))
         })
         .collect()
 }

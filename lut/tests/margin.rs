@@ -4,7 +4,7 @@
 //! where the reference does not), the span a header states, and the binary enforcing it.
 
 use diagram::{Cell, Diagram};
-use lut::margin::{self, check_cells, truths, MarginSummary, EXTRA_SPAN_KG};
+use lut::margin::{self, truths, MarginSummary, EXTRA_SPAN_KG};
 use lut::table::{self, Grid};
 use physics::reference::ReferenceRestraint;
 use physics::RestraintSettings;
@@ -72,7 +72,7 @@ fn the_reference_restraint_planned_anywhere_is_never_worse_than_itself() {
     // Oracle: with no airbag floor the setting executes exactly as the reference at every
     // truth, so every change is 0 and every cell holds.
     let d = ci_table(Some(&reference()), "0", &[]);
-    let rows = check_cells(&d, &reference(), 2400.0, 200.0).unwrap();
+    let rows = table::check_margin(&d, &reference(), 2400.0, 200.0).unwrap();
     assert_eq!(rows.len(), 24);
     for r in &rows {
         assert!(r.ok, "{r:?}");
@@ -99,7 +99,7 @@ fn a_restraint_too_weak_for_a_crash_fails_where_the_reference_holds_the_occupant
     };
     let d = ci_table(Some(&weak), "0", &[]);
     let hw = physics::RestraintHardware::default();
-    let rows = check_cells(&d, &reference(), 2400.0, 200.0).unwrap();
+    let rows = table::check_margin(&d, &reference(), 2400.0, 200.0).unwrap();
     let mut seen_bottoming = 0;
     for r in &rows {
         let p = Grid::from_table(&d).unwrap().axes.point(r.index).unwrap();
@@ -240,8 +240,8 @@ fn a_grid_with_a_robust_span_builds_cells_that_hold_it_or_hold_it_better() {
     let (r, _) = table::build_table(&robust, Some(2), true).unwrap();
     assert_eq!(margin::stated_span_kg(&p).unwrap(), None);
     assert_eq!(margin::stated_span_kg(&r).unwrap(), Some(2400.0));
-    let rows_p = check_cells(&p, &reference(), 2400.0, margin::DEFAULT_STEP_KG).unwrap();
-    let rows_r = check_cells(&r, &reference(), 2400.0, margin::DEFAULT_STEP_KG).unwrap();
+    let rows_p = table::check_margin(&p, &reference(), 2400.0, margin::DEFAULT_STEP_KG).unwrap();
+    let rows_r = table::check_margin(&r, &reference(), 2400.0, margin::DEFAULT_STEP_KG).unwrap();
     let fails = |x: &margin::MarginRow| x.bottoms_out_alone + x.strikes_deeper;
     let mut changed = 0;
     for ((a, b), (ca, cb)) in rows_p
