@@ -236,9 +236,7 @@ fn verify_margin(d: &Diagram, a: &VerifyArgs) -> Result<Option<String>> {
     {
         bail!("--margin-kg must be ≥ 0 and --margin-step-kg > 0 (finite)");
     }
-    let reference = physics::reference::ReferenceRestraint::builtin()
-        .map_err(anyhow::Error::msg)?
-        .settings();
+    let reference = margin::reference_settings()?;
     let rows = table::check_margin(d, &reference, span_kg, a.margin_step_kg)?;
     let s = margin::MarginSummary::of(&rows);
     let source = match (a.margin_kg, stated) {

@@ -37,6 +37,17 @@ pub const DEFAULT_SPAN_KG: f64 = 2400.0;
 /// Step between the checked true masses [kg].
 pub const DEFAULT_STEP_KG: f64 = 200.0;
 
+/// The reference restraint the margin is judged against: the shipped one
+/// (`data/reference-restraint.toml`, built in).
+///
+/// # Errors
+/// The built-in file does not parse (a build defect).
+pub fn reference_settings() -> Result<RestraintSettings> {
+    Ok(physics::reference::ReferenceRestraint::builtin()
+        .map_err(|e| anyhow!("the built-in reference restraint: {e}"))?
+        .settings())
+}
+
 /// The span a table states in its header, if any.
 ///
 /// # Errors

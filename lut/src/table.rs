@@ -412,9 +412,7 @@ fn hold_margin(
     optimum: optimise::Optimum,
     span_kg: f64,
 ) -> Result<optimise::Optimum> {
-    let reference = physics::reference::ReferenceRestraint::builtin()
-        .map_err(|e| anyhow!("the built-in reference restraint: {e}"))?
-        .settings();
+    let reference = margin::reference_settings()?;
     let floor_kg = grid
         .axes
         .opponent_mass_kg
@@ -799,4 +797,34 @@ pub fn check_margin(
             .judge(&p, &settings_of(c))
         })
         .collect()
+}
+
+/// Checks `d` against the planning margin its header states, if any (`lut build --slurm`'s
+/// collect job; `lut verify` reports more): `Ok(Some(line))` when every cell holds it,
+/// `Ok(None)` when it states none.
+///
+/// # Errors
+/// A cell does not hold the stated span, or the check fails.
+pub fn enforce_stated_margin(d: &Diagram) -> Result<Option<String>> {
+    let Some(span_kg) = margin::stated_span_kg(d)? else {
+        return Ok(None);
+    };
+    let rows = check_margin(
+        d,
+        &margin::reference_settings()?,
+        span_kg,
+        margin::DEFAULT_STEP_KG,
+    )?;
+    let s = margin::MarginSummary::of(&rows);
+    if !s.holds() {
+        bail!(
+            "the table breaks the planning margin of {span_kg:.0} kg its header states in {} of {} cells",
+            s.cells - s.hold,
+            s.cells
+        );
+    }
+    Ok(Some(format!(
+        "planning margin of {span_kg:.0} kg holds in all {} cells",
+        s.cells
+    )))
 }

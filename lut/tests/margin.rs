@@ -275,3 +275,28 @@ fn a_grid_with_a_robust_span_builds_cells_that_hold_it_or_hold_it_better() {
         );
     }
 }
+
+#[test]
+fn the_collect_job_s_check_refuses_a_table_that_breaks_its_stated_span() {
+    let weak = RestraintSettings {
+        load_limiter_n: 1000.0,
+        airbag_force_n: 0.0,
+        pretensioner_time_s: 0.020,
+        airbag_time_s: 0.010,
+    };
+    let breaks = ci_table(Some(&weak), "0", &[(EXTRA_SPAN_KG, "2400")]);
+    let e = table::enforce_stated_margin(&breaks)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("breaks the planning margin of 2400 kg"), "{e}");
+    let holds = ci_table(Some(&reference()), "0", &[(EXTRA_SPAN_KG, "2400")]);
+    assert_eq!(
+        table::enforce_stated_margin(&holds).unwrap().as_deref(),
+        Some("planning margin of 2400 kg holds in all 24 cells")
+    );
+    // A table stating nothing is not checked (the weak one included).
+    assert_eq!(
+        table::enforce_stated_margin(&ci_table(Some(&weak), "0", &[])).unwrap(),
+        None
+    );
+}

@@ -174,6 +174,11 @@ fn distributed_build_and_study_on_a_one_node_slurm_cluster() {
     slow.optimiser.particles = 64;
     slow.optimiser.pso_iterations = 80;
     slow.ego.description = "CI grid axes, high optimiser effort (Slurm kill test)".into();
+    // With a stated planning margin: the array builds the cells that hold it and the collect
+    // job checks every cell against it.
+    slow.robust = Some(lut::table::RobustSpec {
+        lighter_opponent_kg: 2400.0,
+    });
     let slow_grid = tmp.join("slow-grid.toml");
     std::fs::write(&slow_grid, toml::to_string(&slow).unwrap()).unwrap();
     let out = tmp.join("slow.lut");
@@ -254,6 +259,11 @@ fn distributed_build_and_study_on_a_one_node_slurm_cluster() {
     assert!(
         std::fs::read(&out).unwrap() == local,
         "the resumed build differs from the local build\n{}",
+        logs(&work)
+    );
+    assert!(
+        logs(&work).contains("planning margin of 2400 kg holds in all 24 cells"),
+        "{}",
         logs(&work)
     );
 

@@ -35,7 +35,8 @@ impl TableJob {
         Grid::from_spec("grid of the distributed build", self.grid.clone())
     }
 
-    /// Merge, check (checksum, every cell, the grid's identity, spot re-optimisation), write.
+    /// Merge, check (checksum, every cell, the grid's identity, spot re-optimisation, the
+    /// planning margin the header states), write.
     fn collect(&self, identity: &str, shards: &[(String, Vec<u8>)], out: &Path) -> Result<String> {
         let decoded = shards
             .iter()
@@ -63,9 +64,13 @@ impl TableJob {
                 bad.join("; ")
             );
         }
+        let margin = table::enforce_stated_margin(&back)
+            .map_err(|e| anyhow!("merged table: {e}"))?
+            .map(|line| format!("; {line}"))
+            .unwrap_or_default();
         diagram::write_atomically(out, &bytes).map_err(|e| anyhow!("{e}"))?;
         Ok(format!(
-            "table {name}: {} cells, LUT id 0x{:04x}, CRC-32C 0x{:08x}; {} cells re-optimised, all within tolerance",
+            "table {name}: {} cells, LUT id 0x{:04x}, CRC-32C 0x{:08x}; {} cells re-optimised, all within tolerance{margin}",
             back.cells().len(),
             back.lut_id(),
             back.checksum(),
