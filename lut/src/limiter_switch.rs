@@ -180,7 +180,7 @@ impl UncertainSet {
         };
         let cost = |x: &[f64]| -> Result<f64> {
             let (plan, outside_sq) = decode(x);
-            let total = self.robust_total(cfg.reserve_m, |p, reserve_m| {
+            let total = self.robust_total(cfg.reserve_m, |_, p, reserve_m| {
                 let pulse = p.pulse.ego();
                 cost_with_late_airbag(
                     &plan.settings,

@@ -17,7 +17,7 @@
 //! must not strike deeper. A static setting: the crash phase's re-planning is the ECU's, tested
 //! closed loop by the offline misreport grids.
 
-use crate::optimise::{self, effective_settings, minimise, Case, OptimiserConfig, SearchSpace};
+use crate::optimise::{OptimiserConfig, SearchSpace};
 use crate::robust_cells::{objective_g, UncertainSet};
 use crate::scenario::Ego;
 use anyhow::{anyhow, Result};
@@ -43,9 +43,17 @@ pub const DEFAULT_STEP_KG: f64 = 200.0;
 /// # Errors
 /// The built-in file does not parse (a build defect).
 pub fn reference_settings() -> Result<RestraintSettings> {
-    Ok(physics::reference::ReferenceRestraint::builtin()
-        .map_err(|e| anyhow!("the built-in reference restraint: {e}"))?
-        .settings())
+    // Parsed once: a build asks for it in every cell.
+    static REFERENCE: std::sync::OnceLock<Result<RestraintSettings, String>> =
+        std::sync::OnceLock::new();
+    REFERENCE
+        .get_or_init(|| {
+            physics::reference::ReferenceRestraint::builtin()
+                .map(|r| r.settings())
+                .map_err(|e| format!("the built-in reference restraint: {e}"))
+        })
+        .clone()
+        .map_err(|e| anyhow!(e))
 }
 
 /// The span a table states in its header, if any.
@@ -247,31 +255,12 @@ impl LighterSet {
     /// # Errors
     /// The optimiser fails.
     pub fn robust_optimum(&self, cfg: &OptimiserConfig) -> Result<(RestraintSettings, u64)> {
-        let hw = RestraintHardware::default();
         let nominal_floor_s = self.earliest_airbag_s.first().copied().unwrap_or(0.0);
         let space = SearchSpace::adaptive().with_earliest_airbag_s(nominal_floor_s);
-        let cost = |x: &[f64]| -> Result<f64> {
-            let (set, outside_sq) = space.decode(x);
-            let set = effective_settings(&set, cfg);
-            let k = std::cell::Cell::new(0usize);
-            let total = self.set.robust_total(cfg.reserve_m, |p, reserve_m| {
-                let i = k.replace(k.get() + 1);
-                optimise::robust_case_cost(
-                    &Case {
-                        pulse: p.pulse.ego(),
-                        occupant: self.set.occupant,
-                    },
-                    &self.executed(&set, i),
-                    &hw,
-                    &OptimiserConfig { reserve_m, ..*cfg },
-                )
-            })?;
-            Ok(total + 1.0e3 * outside_sq)
-        };
-        let min = minimise(space.free_count(), &cost, cfg)?;
-        let (set, _) = space.decode(&min.u);
-        let sims = min.evaluations * 2 * self.set.points.len() as u64;
-        Ok((effective_settings(&set, cfg), sims))
+        let (set, evaluations) = self
+            .set
+            .robust_optimum_in(&space, cfg, |set, k| self.executed(set, k))?;
+        Ok((set, evaluations * 2 * self.set.points.len() as u64))
     }
 }
 

@@ -191,18 +191,33 @@ impl UncertainSet {
     /// # Errors
     /// The optimiser fails.
     pub fn robust_optimum(&self, cfg: &OptimiserConfig) -> Result<RestraintSettings> {
+        let (set, _) = self.robust_optimum_in(&self.search_space(cfg), cfg, |set, _| *set)?;
+        Ok(set)
+    }
+
+    /// The robust objective's optimum within `space`, each point `k` simulated with
+    /// `executed(setting, k)` (how the ECU would execute the setting there); the setting and the
+    /// objective evaluations spent.
+    ///
+    /// # Errors
+    /// The optimiser fails.
+    pub(crate) fn robust_optimum_in(
+        &self,
+        space: &SearchSpace,
+        cfg: &OptimiserConfig,
+        executed: impl Fn(&RestraintSettings, usize) -> RestraintSettings,
+    ) -> Result<(RestraintSettings, u64)> {
         let hw = RestraintHardware::default();
-        let space = self.search_space(cfg);
         let cost = |x: &[f64]| -> Result<f64> {
             let (set, outside_sq) = space.decode(x);
             let set = effective_settings(&set, cfg);
-            let total = self.robust_total(cfg.reserve_m, |p, reserve_m| {
+            let total = self.robust_total(cfg.reserve_m, |k, p, reserve_m| {
                 optimise::robust_case_cost(
                     &Case {
                         pulse: p.pulse.ego(),
                         occupant: self.occupant,
                     },
-                    &set,
+                    &executed(&set, k),
                     &hw,
                     &OptimiserConfig { reserve_m, ..*cfg },
                 )
@@ -211,7 +226,7 @@ impl UncertainSet {
         };
         let min = minimise(space.free_count(), &cost, cfg)?;
         let (set, _) = space.decode(&min.u);
-        Ok(effective_settings(&set, cfg))
+        Ok((effective_settings(&set, cfg), min.evaluations))
     }
 
     /// The adaptive search space with the airbag no earlier than the latest of the points'
@@ -225,8 +240,8 @@ impl UncertainSet {
         )
     }
 
-    /// The robust objective (module docs) from a setting's cost at each point, `cost(point,
-    /// reserve_m)` counted as the optimiser does: the nominal point's cost (held to
+    /// The robust objective (module docs) from a setting's cost at each point, `cost(index,
+    /// point, reserve_m)` counted as the optimiser does: the nominal point's cost (held to
     /// `nominal_reserve_m`, the optimiser's reserve) plus the penalties where another point is
     /// worse than the reference.
     ///
@@ -235,7 +250,7 @@ impl UncertainSet {
     pub(crate) fn robust_total(
         &self,
         nominal_reserve_m: f64,
-        cost: impl Fn(&Point, f64) -> Result<f64>,
+        cost: impl Fn(usize, &Point, f64) -> Result<f64>,
     ) -> Result<f64> {
         let (nominal, others) = self
             .points
@@ -243,9 +258,9 @@ impl UncertainSet {
             .ok_or_else(|| anyhow!("no point"))?;
         // Where the reference keeps the ride-down reserve, so must the cell; where it only
         // avoids bottoming out, so must the cell; where it bottoms out, the cell may too.
-        let mut total = cost(nominal, nominal_reserve_m)?;
-        for p in others {
-            let (cp, r) = (cost(p, p.reserve_m)?, p.reference_cost);
+        let mut total = cost(0, nominal, nominal_reserve_m)?;
+        for (k, p) in others.iter().enumerate() {
+            let (cp, r) = (cost(k + 1, p, p.reserve_m)?, p.reference_cost);
             if cp > r {
                 total += match (cp >= INFEASIBLE_OFFSET, r >= INFEASIBLE_OFFSET) {
                     // Bottoming out (or eating the reserve) where the reference does not.

@@ -279,6 +279,40 @@ impl Grid {
         })
     }
 
+    /// The lighter opponents of grid point `p` for the planning margin (`lut::margin`): from
+    /// its mass down by `span_kg` in `step_kg` steps, never below the mass axis' lightest.
+    ///
+    /// # Errors
+    /// The mass axis is empty, or a pulse / reference simulation fails.
+    pub fn lighter_set(
+        &self,
+        p: &GridPoint,
+        span_kg: f64,
+        step_kg: f64,
+        reference: &RestraintSettings,
+        cfg: &OptimiserConfig,
+    ) -> Result<margin::LighterSet> {
+        let floor_kg = self
+            .axes
+            .opponent_mass_kg
+            .first()
+            .map(|&m| f64::from(m))
+            .ok_or_else(|| anyhow!("no mass axis"))?;
+        let span = margin::Span {
+            lighter_kg: span_kg,
+            step_kg,
+            floor_kg,
+        };
+        margin::LighterSet::new(
+            &self.ego,
+            &p.query,
+            &occupant_at(&p.query),
+            &span,
+            reference,
+            cfg,
+        )
+    }
+
     /// Optimiser configuration of one cell: the base seed mixed with the cell index
     /// (SplitMix64), so a cell's result does not depend on which shard or thread computes it.
     pub fn cell_config(&self, index: usize) -> OptimiserConfig {
@@ -413,23 +447,7 @@ fn hold_margin(
     span_kg: f64,
 ) -> Result<optimise::Optimum> {
     let reference = margin::reference_settings()?;
-    let floor_kg = grid
-        .axes
-        .opponent_mass_kg
-        .first()
-        .map_or(0.0, |&m| f64::from(m));
-    let set = margin::LighterSet::new(
-        &grid.ego,
-        &p.query,
-        &occupant_at(&p.query),
-        &margin::Span {
-            lighter_kg: span_kg,
-            step_kg: margin::DEFAULT_STEP_KG,
-            floor_kg,
-        },
-        &reference,
-        cfg,
-    )?;
+    let set = grid.lighter_set(p, span_kg, margin::DEFAULT_STEP_KG, &reference, cfg)?;
     let before = set.judge(p, &optimum.settings)?;
     if before.ok {
         return Ok(optimum);
@@ -765,12 +783,6 @@ pub fn check_margin(
     step_kg: f64,
 ) -> Result<Vec<margin::MarginRow>> {
     let grid = Grid::from_table(d)?;
-    let floor_kg = grid
-        .axes
-        .opponent_mass_kg
-        .first()
-        .map(|&m| f64::from(m))
-        .ok_or_else(|| anyhow!("no mass axis"))?;
     (0..grid.axes.cell_count())
         .into_par_iter()
         .map(|i| {
@@ -782,19 +794,8 @@ pub fn check_margin(
                 .cells()
                 .get(i)
                 .ok_or_else(|| anyhow!("cell {i} missing"))?;
-            margin::LighterSet::new(
-                &grid.ego,
-                &p.query,
-                &occupant_at(&p.query),
-                &margin::Span {
-                    lighter_kg: span_kg,
-                    step_kg,
-                    floor_kg,
-                },
-                reference,
-                &grid.optimiser,
-            )?
-            .judge(&p, &settings_of(c))
+            grid.lighter_set(&p, span_kg, step_kg, reference, &grid.optimiser)?
+                .judge(&p, &settings_of(c))
         })
         .collect()
 }
