@@ -237,6 +237,12 @@ impl CrashMonitor {
         self.fallback.onset_ns()
     }
 
+    /// Start of the segment of the current event the accelerometer-only algorithm judges, ns
+    /// (`fallback`, "Re-onset").
+    pub fn segment_onset_ns(&self) -> Option<u64> {
+        self.fallback.segment_onset_ns()
+    }
+
     /// What the road's roughness adds to every fire's severity floor now, m/s.
     pub fn floor_lift_mps(&self) -> f64 {
         self.roughness.floor_lift_mps()

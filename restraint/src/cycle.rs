@@ -304,6 +304,14 @@ impl Activity for RestraintCycle<'_> {
         let (cfg, est, inputs) = (&self.cfg, &self.estimate, &self.inputs);
         let situation = est.situation;
         let c = &mut self.counters;
+        // Asked once, in the cycle a crash phase is entered (a table lookup).
+        let entering_crash = self.crash.confirmation().is_some()
+            && matches!(
+                self.decision.phase(),
+                Phase::Monitoring | Phase::PreCrash | Phase::Degraded
+            );
+        let heaviest_fires_airbag = entering_crash
+            && situation.is_some_and(|s| est.heaviest_opponent_fires_airbag(&s, inputs));
         let mut replan = |closing_mps: f64| {
             let sit = situation?;
             plan_for(cfg, est, &sit, closing_mps, inputs, c)
@@ -317,11 +325,13 @@ impl Activity for RestraintCycle<'_> {
             confirmation: self.crash.confirmation(),
             fallback: self.crash.fallback(),
             pretensioner_fallback: self.crash.pretensioner(),
+            segment_onset_ns: self.crash.segment_onset_ns(),
             safing,
             event_in_progress: self.crash.event_in_progress(),
             event_dv_mps: self.crash.event_dv_mps(),
             floor_lift_mps: self.crash.floor_lift_mps(),
             matched_course_broken: self.crash.matcher().course_broken_ns().is_some(),
+            heaviest_fires_airbag,
             replan: &mut replan,
         };
         self.decision.step(now, &mut x);

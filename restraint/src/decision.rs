@@ -91,6 +91,9 @@ pub(crate) struct DecisionInputs<'d> {
     pub fallback: FallbackDecision,
     /// The pretensioner's accelerometer-only decision on the current event.
     pub pretensioner_fallback: FallbackDecision,
+    /// Start of the segment of the current event the accelerometer-only algorithm judges (its
+    /// onset or latest re-onset, `FallbackAlgorithm::segment_onset_ns`), ns.
+    pub segment_onset_ns: Option<u64>,
     /// The safing function agrees in this cycle (`safing`).
     pub safing: bool,
     /// An accelerometer event is still in progress.
@@ -101,6 +104,10 @@ pub(crate) struct DecisionInputs<'d> {
     pub floor_lift_mps: f64,
     /// A matched confirmation's pulse has left its ramp (`PulseMatch::course_broken_ns`).
     pub matched_course_broken: bool,
+    /// The table fires the airbag for this situation with the heaviest opponent it covers
+    /// (`Estimator::heaviest_opponent_fires_airbag`; asked only in the cycle a crash phase is
+    /// entered).
+    pub heaviest_fires_airbag: bool,
     /// The table's plan for an adaptive crash at a closing speed (m/s): `None` when that
     /// severity is below the no-fire line (`crash::plan_for`).
     pub replan: &'d mut dyn FnMut(f64) -> Option<RestraintPlan>,
@@ -390,6 +397,21 @@ impl Decision {
         }
         self.airbag_fire_at_ns = (gate == AirbagGate::Decided && plan.airbag_fires())
             .then(|| at(contact, plan.airbag_time_ms).max(confirm_ns));
+        // A belt-only plan made so by the opponent's mass — the table fires the airbag for
+        // the same crash against its heaviest opponent — rests on the object list's mass,
+        // which one object fault (a truck reported as a car, a mass misreported within its
+        // bound) gets wrong. The measured event still decides the airbag: its
+        // accelerometer-only must-fire adds the reference airbag, as it would without any
+        // prediction. A plan belt-only for the occupant (a light one) stays belt-only.
+        if gate == AirbagGate::Decided
+            && !plan.airbag_fires()
+            && x.heaviest_fires_airbag
+            && c.kind != ConfirmKind::Backup
+            && self.reference.airbag_fires()
+        {
+            self.crash_plan = plan.with_airbag_of(&self.reference);
+            self.gate = AirbagGate::Fallback;
+        }
         self.phase = Phase::Crash;
     }
 
@@ -407,15 +429,30 @@ impl Decision {
         }
     }
 
+    /// The accelerometer-only decision window of the crash phase's event has passed: one ms
+    /// after [`WINDOW_MS`] from the contact, or from the segment being judged when the event
+    /// re-onset later (`fallback`, "Re-onset").
+    fn window_over(&self, now: u64, segment_onset_ns: Option<u64>) -> bool {
+        let contact = self.contact_ns.unwrap_or(now);
+        let from = segment_onset_ns.map_or(contact, |s| s.max(contact));
+        now > at(from, (WINDOW_MS + 1.0) as f32)
+    }
+
     /// The conventional path: the reference airbag when the accelerometer-only algorithm says
     /// must-fire for the confirmed event (and only for it); no airbag when it says no-fire,
     /// or its window has passed.
-    fn gate_airbag(&mut self, now: u64, fallback: FallbackDecision, event_dv_mps: f64) {
+    fn gate_airbag(
+        &mut self,
+        now: u64,
+        fallback: FallbackDecision,
+        event_dv_mps: f64,
+        segment_onset_ns: Option<u64>,
+    ) {
         if self.gate != AirbagGate::Fallback {
             return;
         }
         let contact = self.contact_ns.unwrap_or(now);
-        let window_over = now > at(contact, (WINDOW_MS + 1.0) as f32);
+        let window_over = self.window_over(now, segment_onset_ns);
         let below_low_speed = self
             .low_speed_dv_limit_mps
             .is_some_and(|limit| !(event_dv_mps > limit));
@@ -443,12 +480,18 @@ impl Decision {
     /// otherwise. Why the airbag's too: its floor is lower than the pretensioner's
     /// (`pretensioner_min_dv_mps`), and a crash that needs the airbag needs the belt at the
     /// same instant, never after it.
-    fn gate_pretensioner(&mut self, now: u64, own: FallbackDecision, airbag: FallbackDecision) {
+    fn gate_pretensioner(
+        &mut self,
+        now: u64,
+        own: FallbackDecision,
+        airbag: FallbackDecision,
+        segment_onset_ns: Option<u64>,
+    ) {
         if self.pt_gate != AirbagGate::Fallback {
             return;
         }
         let contact = self.contact_ns.unwrap_or(now);
-        let window_over = now > at(contact, (WINDOW_MS + 1.0) as f32);
+        let window_over = self.window_over(now, segment_onset_ns);
         let onset = self.event_onset_ns;
         let pending = own == FallbackDecision::Pending || airbag == FallbackDecision::Pending;
         match own.fire_of(onset).or_else(|| airbag.fire_of(onset)) {
@@ -520,8 +563,8 @@ impl Decision {
             self.hand_over_to_the_conventional_path();
         }
         if self.phase == Phase::Crash {
-            self.gate_airbag(now, x.fallback, x.event_dv_mps);
-            self.gate_pretensioner(now, x.pretensioner_fallback, x.fallback);
+            self.gate_airbag(now, x.fallback, x.event_dv_mps, x.segment_onset_ns);
+            self.gate_pretensioner(now, x.pretensioner_fallback, x.fallback, x.segment_onset_ns);
         }
         match self.phase {
             Phase::Monitoring => {

@@ -16,6 +16,17 @@
 //! restraint/README.md, "Crash phase"), so crashes below the no-fire line stay under it
 //! and crashes above the must-fire line cross it in time.
 //!
+//! **Re-onset.** An event lasts until the deceleration has stayed under the wake threshold for
+//! the quiet gap (10 ms), so a crash that follows a kerb strike, a pothole or a rough road
+//! within it belongs to the earlier event. It is not judged from that event's onset: the
+//! boundary would be read at the earlier event's τ (higher) and the loading rule against its
+//! crest. When the deceleration rises through the wake threshold again after at least
+//! [`RE_ONSET_GAP_MS`] below it and the event has not decided must-fire, the judged segment
+//! starts anew there (Δv, τ, loading, persistence), and a closed no-fire is pending again.
+//! The decision still belongs to the event ([`FallbackDecision::Fire`]'s `onset_ns`); what it
+//! adds is bounded by what it judges — one lobe of the signal, from rest, against the same
+//! boundary and floors as a first event.
+//!
 //! It sees what a conventional sensor sees: the opponent's mass does not show in the first
 //! tens of ms (see `crash_match`), so for car-to-car crashes it discriminates by closing
 //! speed and structure; a light opponent's crash ends early and stays under the boundary.
@@ -30,6 +41,12 @@ pub const KNOTS: usize = 16;
 pub const KNOT_SPACING_MS: f64 = 4.0;
 /// The decision window after the onset, ms (the last knot).
 pub const WINDOW_MS: f64 = KNOT_SPACING_MS * (KNOTS - 1) as f64;
+
+/// How long the deceleration must stay under the wake threshold inside an event before a new
+/// rise is judged from its own start, ms (module docs, "Re-onset"). Shorter than the quiet
+/// gap that ends the event; longer than the dips of a crash pulse's own noise.
+pub const RE_ONSET_GAP_MS: f64 = 2.0;
+const RE_ONSET_GAP_NS: u64 = (RE_ONSET_GAP_MS * 1e6) as u64;
 
 /// Default boundary, m/s at 0, 4, … 60 ms after the onset: the upper envelope (+10 %) of the
 /// Δv(τ) curves of every no-fire crash of the calibration sweep as this algorithm measures
@@ -133,6 +150,14 @@ pub struct FallbackAlgorithm {
     loading: Loading,
     run: u32,
     decision: FallbackDecision,
+    /// Start of the judged segment of the event (its onset, or the latest re-onset), ns.
+    segment_onset_ns: u64,
+    /// Δv since the segment's start, m/s.
+    segment_dv_mps: f64,
+    /// Since when the deceleration has been under the wake threshold inside the event, ns.
+    dip_since_ns: Option<u64>,
+    /// The previous sample's deceleration (the segment's trapezoid).
+    prev_decel_mps2: f64,
 }
 
 impl FallbackAlgorithm {
@@ -145,13 +170,28 @@ impl FallbackAlgorithm {
             loading: Loading::default(),
             run: 0,
             decision: FallbackDecision::Pending,
+            segment_onset_ns: 0,
+            segment_dv_mps: 0.0,
+            dip_since_ns: None,
+            prev_decel_mps2: 0.0,
         }
+    }
+
+    /// Starts the judged segment at sample `s` (the event's wake-up, or a re-onset; `prev`:
+    /// the sample before it), its Δv from the interval that ends at `s`, as [`Onset`]'s.
+    fn start_segment(&mut self, s: &AccelSample, prev: f64) {
+        self.segment_onset_ns = s.t_ns;
+        self.segment_dv_mps = 0.5 * (prev + s.decel_mps2) * s.dt_s;
+        self.dip_since_ns = None;
+        self.loading.start(s.decel_mps2);
+        self.decision = FallbackDecision::Pending;
     }
 
     /// Feeds one plausible sample (`p`: the wake threshold and quiet gap of the onset;
     /// `floor_lift_mps`: what the road's roughness adds to the severity floor now,
     /// [`crate::roughness`]).
     pub fn push(&mut self, p: &ConfirmParams, s: &AccelSample, floor_lift_mps: f64) {
+        let prev = core::mem::replace(&mut self.prev_decel_mps2, s.decel_mps2);
         match self.onset.push(p, s) {
             OnsetStep::Quiet => return,
             OnsetStep::Reset => {
@@ -160,14 +200,32 @@ impl FallbackAlgorithm {
                     self.decision = FallbackDecision::NoFire(s.t_ns);
                 }
                 self.run = 0;
+                self.dip_since_ns = None;
                 return;
             }
             OnsetStep::Woke => {
-                self.decision = FallbackDecision::Pending;
                 self.run = 0;
-                self.loading.start(s.decel_mps2);
+                self.start_segment(s, prev);
             }
-            OnsetStep::Awake => self.loading.push(s.decel_mps2, s.dt_s),
+            OnsetStep::Awake => {
+                let above = s.decel_mps2 >= p.wake_mps2;
+                let re_onset = above
+                    && self
+                        .dip_since_ns
+                        .is_some_and(|d| s.t_ns.saturating_sub(d) >= RE_ONSET_GAP_NS)
+                    && !matches!(self.decision, FallbackDecision::Fire { .. });
+                if re_onset {
+                    self.start_segment(s, prev);
+                } else {
+                    self.segment_dv_mps += 0.5 * (prev + s.decel_mps2) * s.dt_s;
+                    self.loading.push(s.decel_mps2, s.dt_s);
+                    if above {
+                        self.dip_since_ns = None;
+                    } else if self.dip_since_ns.is_none() {
+                        self.dip_since_ns = Some(s.t_ns);
+                    }
+                }
+            }
         }
         self.run = if s.decel_mps2 >= self.floor.decel_mps2 {
             self.run.saturating_add(1)
@@ -180,8 +238,8 @@ impl FallbackAlgorithm {
         let Some(onset) = self.onset.onset_ns() else {
             return;
         };
-        let tau_ms = s.t_ns.saturating_sub(onset) as f64 * 1e-6;
-        let dv = self.onset.delta_v_mps();
+        let tau_ms = s.t_ns.saturating_sub(self.segment_onset_ns) as f64 * 1e-6;
+        let dv = self.segment_dv_mps;
         if tau_ms > WINDOW_MS {
             self.decision = FallbackDecision::NoFire(s.t_ns);
         } else if dv >= threshold_mps(&self.thresholds, tau_ms)
@@ -206,6 +264,12 @@ impl FallbackAlgorithm {
         self.onset.onset_ns()
     }
 
+    /// Start of the segment of the event in progress that is being judged (its onset, or the
+    /// latest re-onset), ns: the decision window runs from here.
+    pub fn segment_onset_ns(&self) -> Option<u64> {
+        self.onset.awake().then_some(self.segment_onset_ns)
+    }
+
     /// The velocity change of the current event since its onset, m/s (0 when quiet).
     pub fn event_dv_mps(&self) -> f64 {
         self.onset.delta_v_mps()
@@ -219,6 +283,7 @@ impl FallbackAlgorithm {
     /// See [`Onset::note_quiet`](crate::confirm::Onset::note_quiet).
     pub fn note_quiet(&mut self, decel_mps2: f64) {
         self.onset.note_quiet(decel_mps2);
+        self.prev_decel_mps2 = decel_mps2;
     }
 }
 
@@ -456,6 +521,40 @@ mod tests {
         };
         assert_eq!(ramp(floor()), ramp(no_rule));
         assert!(matches!(ramp(floor()), FallbackDecision::Fire { .. }));
+    }
+
+    #[test]
+    fn a_crash_after_an_earlier_lobe_of_the_same_event_is_judged_from_its_own_start() {
+        // A 25 g × 2 ms lobe (1 kHz; Δv 0.37 m/s, under the 1.0 m/s floor), 3 ms at 1 g (under
+        // the 1.5 g wake, inside the 10 ms quiet gap: one event), then 20 g. Judged from the
+        // lobe's onset the 20 g plateau never reaches 85 % of the lobe's 25 g crest and the
+        // crash is missed; judged from its own rise it fires as from rest. Oracle: Δv after the
+        // re-onset = ½(1 + 20) g·1 ms + n·20 g·1 ms ≥ 1.0 m/s first at n = 5 (the boundary is
+        // lower), 5 ms after the rise at 5 ms.
+        let mut f = FallbackAlgorithm::new(DEFAULT_DV_MPS, floor());
+        run_fn(&mut f, 30, |k| match k {
+            0..=1 => 25.0,
+            2..=4 => 1.0,
+            _ => 20.0,
+        });
+        assert_eq!(
+            f.decision(),
+            FallbackDecision::Fire {
+                at_ns: 1_000_000_000 + 10_000_000,
+                onset_ns: 1_000_000_000
+            },
+            "fires 5 ms after the re-onset, the decision belongs to the event"
+        );
+        assert_eq!(f.segment_onset_ns(), Some(1_000_000_000 + 5_000_000));
+        // A dip shorter than the re-onset gap (1 ms) keeps the lobe's onset, and its crest.
+        let mut f = FallbackAlgorithm::new(DEFAULT_DV_MPS, floor());
+        run_fn(&mut f, 30, |k| match k {
+            0..=1 => 25.0,
+            2 => 1.0,
+            _ => 20.0,
+        });
+        assert_eq!(f.decision(), FallbackDecision::Pending);
+        assert_eq!(f.segment_onset_ns(), Some(1_000_000_000));
     }
 
     #[test]

@@ -105,6 +105,15 @@ impl RestraintPlan {
         self
     }
 
+    /// The same belt settings with `other`'s airbag (level, stage and time): the airbag a
+    /// belt-only plan gets when the measured pulse proves the crash must-fire.
+    pub fn with_airbag_of(mut self, other: &Self) -> Self {
+        self.airbag_stage = other.airbag_stage;
+        self.airbag_level_kn = other.airbag_level_kn;
+        self.airbag_time_ms = other.airbag_time_ms;
+        self
+    }
+
     /// True if the airbag is to be fired.
     pub fn airbag_fires(&self) -> bool {
         self.airbag_stage != AirbagStage::NoFire

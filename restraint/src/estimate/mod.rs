@@ -516,6 +516,45 @@ impl<'a> Estimator<'a> {
         } else {
             sit.opponent_mass_kg
         };
+        self.lookup_at(sit, mass, inputs, counters)
+    }
+
+    /// Whether the table fires the airbag for the situation with the heaviest opponent it
+    /// covers (`false` without a table or where it does not cover the situation): a belt-only
+    /// plan that this answers `true` for was made belt-only by the opponent's mass — what one
+    /// object fault can get wrong — not by the occupant.
+    /// Not counted in the lookup counters: a question about the table, not a plan.
+    pub(crate) fn heaviest_opponent_fires_airbag(
+        &self,
+        sit: &Situation,
+        inputs: &InputMonitor,
+    ) -> bool {
+        let Some(lut) = self.lut.as_ref() else {
+            return false;
+        };
+        let heaviest = lut.view.axes()[1]
+            .last()
+            .map_or(f64::NAN, |m| f64::from(*m));
+        let plan = self.lookup_at(sit, heaviest, inputs, &mut CycleCounters::default());
+        plan.source == crate::plan::PlanSource::Adaptive && plan.airbag_fires()
+    }
+
+    /// The table's plan for the situation with the opponent mass `mass_kg` (the reference
+    /// restraint where the table does not cover it).
+    fn lookup_at(
+        &self,
+        sit: &Situation,
+        mass: f64,
+        inputs: &InputMonitor,
+        counters: &mut CycleCounters,
+    ) -> RestraintPlan {
+        let Some(lut) = self.lut.as_ref() else {
+            return self.reference;
+        };
+        let occ = inputs.occupant;
+        if !(occ.buckled && occ.adult) {
+            return self.reference;
+        }
         let q = Query {
             closing_speed_kph: (sit.closing_speed_mps * 3.6) as f32,
             opponent_mass_kg: mass as f32,

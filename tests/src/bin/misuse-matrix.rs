@@ -315,6 +315,10 @@ struct Outcome {
     stuck_in_crash: bool,
     /// Largest crash-minus-safing Δv of a confirmed event, m/s.
     severity_excess_mps: Option<f64>,
+    /// The clean twin's (the crash without what the family added) airbag fire − required,
+    /// ms; `None` without a twin or when the twin fired no airbag.
+    #[serde(default)]
+    clean_margin_ms: Option<f64>,
 }
 
 /// "127 mm − 30 ms": when the free-flying occupant has moved 127 mm relative to the car.
@@ -337,6 +341,15 @@ fn required_ms(truth: &world::Truth) -> Option<f64> {
 const UNFINISHED_MS: f64 = 150.0;
 
 fn run_variant(cfg: &OfflineConfig, text: &str) -> Result<Outcome> {
+    let mut outcome = run_one(cfg, text)?;
+    if let Some(clean) = misuse::clean_twin(text) {
+        let twin = run_one(cfg, clean)?;
+        outcome.clean_margin_ms = twin.airbag_ms.zip(twin.required_ms).map(|(t, r)| t - r);
+    }
+    Ok(outcome)
+}
+
+fn run_one(cfg: &OfflineConfig, text: &str) -> Result<Outcome> {
     let scenario =
         world::Scenario::parse("matrix", text).map_err(|e| anyhow::anyhow!("{e}\n{text}"))?;
     let r = run(&scenario, cfg)?;
@@ -367,6 +380,7 @@ fn run_variant(cfg: &OfflineConfig, text: &str) -> Result<Outcome> {
             m.1 == "CrashDetected" && end_ms - m.0 >= UNFINISHED_MS
         }),
         severity_excess_mps: r.severity_excess_mps,
+        clean_margin_ms: None,
     })
 }
 
@@ -499,8 +513,8 @@ fn run_matrix() -> Result<()> {
     let mut failures = Vec::new();
     writeln!(
         out,
-        "{:<32} {:>8} {:>8} {:>8} {:>8} {:>6} {:>6}  fire − required (127 mm − 30 ms), ms: p50 / worst",
-        "family", "variants", "airbag!", "pretens!", "missed", "stuck", "errors"
+        "{:<34} {:>8} {:>8} {:>8} {:>8} {:>6} {:>6} {:>6}  fire − required (127 mm − 30 ms), ms: p50 / worst [worst − clean twin's]",
+        "family", "variants", "airbag!", "pretens!", "missed", "late", "stuck", "errors"
     )?;
     let mut json_rows = Vec::new();
     // Two healthy sensors on real crashes: the must-fire families' largest crash − safing Δv.
@@ -511,6 +525,8 @@ fn run_matrix() -> Result<()> {
         let rows: Vec<_> = results.iter().filter(|r| r.0 == f).collect();
         let (mut bad_bag, mut bad_pt, mut missed, mut errors, mut stuck) = (0, 0, 0, 0, 0);
         let mut margins = Vec::new();
+        // Fire − required less the clean twin's, where the family has twins.
+        let (mut late, mut vs_clean) = (0, f64::NEG_INFINITY);
         for (_, i, o) in &rows {
             let o = match o {
                 Ok(o) => o,
@@ -532,7 +548,7 @@ fn run_matrix() -> Result<()> {
                     family.variant(*i, cli.seed)
                 ))
             };
-            if req == Requirement::MustFire {
+            if req == Requirement::MustFire && !misuse::FAULTY_SENSOR_FAMILIES.contains(&name) {
                 if let Some(x) = o.severity_excess_mps {
                     healthy_excess = healthy_excess.max(x);
                 }
@@ -565,7 +581,20 @@ fn run_matrix() -> Result<()> {
                     }
                 }
                 Requirement::MustFire => match (o.airbag_ms, o.required_ms) {
-                    (Some(t), Some(req)) => margins.push(t - req),
+                    (Some(t), Some(req)) => {
+                        margins.push(t - req);
+                        if let Some(clean) = o.clean_margin_ms {
+                            let d = t - req - clean;
+                            vs_clean = vs_clean.max(d);
+                            if d > misuse::LATE_VS_CLEAN_MS + 1e-3 {
+                                late += 1;
+                                fail(&format!(
+                                    "airbag {d:+.1} ms later than the clean crash's (bound +{:.0} ms)",
+                                    misuse::LATE_VS_CLEAN_MS
+                                ));
+                            }
+                        }
+                    }
                     (Some(_), None) => {}
                     (None, _) => {
                         missed += 1;
@@ -579,19 +608,25 @@ fn run_matrix() -> Result<()> {
             "—".to_owned()
         } else {
             format!(
-                "{:+.1} / {:+.1}",
+                "{:+.1} / {:+.1}{}",
                 margins[margins.len() / 2],
-                margins[margins.len() - 1]
+                margins[margins.len() - 1],
+                if vs_clean.is_finite() {
+                    format!(" [{vs_clean:+.1}]")
+                } else {
+                    String::new()
+                }
             )
         };
         if req == Requirement::Report {
             writeln!(
                 out,
-                "{:<32} {:>8} {:>8} {:>8} {:>8} {:>6} {:>6}  (report, not judged: airbag / pretensioner fires)",
+                "{:<34} {:>8} {:>8} {:>8} {:>8} {:>6} {:>6} {:>6}  (report, not judged: airbag / pretensioner fires)",
                 name,
                 rows.len(),
                 bad_bag,
                 bad_pt,
+                "—",
                 "—",
                 "—",
                 errors
@@ -599,12 +634,13 @@ fn run_matrix() -> Result<()> {
         } else {
             writeln!(
                 out,
-                "{:<32} {:>8} {:>8} {:>8} {:>8} {:>6} {:>6}  {timing}{}",
+                "{:<34} {:>8} {:>8} {:>8} {:>8} {:>6} {:>6} {:>6}  {timing}{}",
                 name,
                 rows.len(),
                 bad_bag,
                 bad_pt,
                 missed,
+                late,
                 stuck,
                 errors,
                 if open { "  (open: not gated yet)" } else { "" }
@@ -614,6 +650,8 @@ fn run_matrix() -> Result<()> {
             "family": name, "variants": rows.len(), "airbag_where_none_may": bad_bag,
             "pretensioner_where_none_may": bad_pt, "must_fire_missed": missed, "errors": errors,
             "stuck_in_crash": stuck, "judged": req != Requirement::Report && !open,
+            "later_than_clean_twin": late,
+            "worst_minus_clean_twin_ms": vs_clean.is_finite().then_some(vs_clean),
             "fire_minus_required_ms_p50": margins.get(margins.len() / 2),
             "fire_minus_required_ms_worst": margins.last(),
         }));
@@ -627,8 +665,8 @@ fn run_matrix() -> Result<()> {
             c.severity_tolerance_fraction * 100.0
         )?;
     }
-    writeln!(out, "{} variants in {:.1} s (seed {}); airbag! / pretens! = fired where none may (must be 0), missed = must-fire crashes without airbag (must be 0), stuck = crash phases that fired nothing and never ended (must be 0)",
-        results.len(), start.elapsed().as_secs_f64(), cli.seed)?;
+    writeln!(out, "{} variants in {:.1} s (seed {}); airbag! / pretens! = fired where none may (must be 0), missed = must-fire crashes without airbag (must be 0), late = must-fire airbags over {:.0} ms later than their clean twin's (must be 0), stuck = crash phases that fired nothing and never ended (must be 0)",
+        results.len(), start.elapsed().as_secs_f64(), cli.seed, misuse::LATE_VS_CLEAN_MS)?;
     print!("{out}");
     if let Some(path) = &cli.json {
         std::fs::write(
