@@ -45,6 +45,14 @@
 //! crashes (with a misreported opponent, with a dead safing sensor) keep their ranges of issue 20
 //! (table in [`FAMILIES`]' docs).
 //!
+//! ## Must-fire crashes with one thing before or inside them (`crash_with`)
+//! | family | what | requirement |
+//! |---|---|---|
+//! | must-fire-after-event | a must-fire barrier or equal-car crash, tracked, with one misuse event of the table above 0–200 ms before or 0–5 ms into contact (kerb, pothole, rough road, ABS braking, a shunt from behind, a door slam on a standing car struck at 70–110 km/h) | airbag, no more than 2 ms later than its clean twin's against "127 mm − 30 ms" |
+//! | must-fire-sensor-fault | the same crashes with one unflagged fault of one sensor (noise 0.5–10 g rms, a 10–200 g spike, a ±2–8 g offset) | as above |
+//! | must-fire-heavy-opponent | 5–10 t opponents (the world's range), standing or moving, at an EBS of 35–56 km/h, tracked true, misreported by ±1 200 kg or reported as a car | airbag |
+//! | low-speed-crash-and-kerb-untracked | low-speed-crash-and-kerb with the object list dead, at low confidence or its mass over-reported | no airbag |
+//!
 //! Required fire time of a must-fire crash: the classic "127 mm − 30 ms" criterion — the
 //! instant a free-flying (unbelted) occupant has moved 127 mm relative to the compartment in
 //! the TRUE pulse, minus 30 ms.
