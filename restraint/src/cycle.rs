@@ -304,14 +304,9 @@ impl Activity for RestraintCycle<'_> {
         let (cfg, est, inputs) = (&self.cfg, &self.estimate, &self.inputs);
         let situation = est.situation;
         let c = &mut self.counters;
-        // Asked once, in the cycle a crash phase is entered (a table lookup).
-        let entering_crash = self.crash.confirmation().is_some()
-            && matches!(
-                self.decision.phase(),
-                Phase::Monitoring | Phase::PreCrash | Phase::Degraded
-            );
-        let heaviest_fires_airbag = entering_crash
-            && situation.is_some_and(|s| est.heaviest_opponent_fires_airbag(&s, inputs));
+        // A table lookup, asked only when a crash phase is entered with a belt-only plan.
+        let heaviest_fires_airbag =
+            || situation.is_some_and(|s| est.heaviest_opponent_fires_airbag(&s, inputs));
         let mut replan = |closing_mps: f64| {
             let sit = situation?;
             plan_for(cfg, est, &sit, closing_mps, inputs, c)
@@ -331,7 +326,7 @@ impl Activity for RestraintCycle<'_> {
             event_dv_mps: self.crash.event_dv_mps(),
             floor_lift_mps: self.crash.floor_lift_mps(),
             matched_course_broken: self.crash.matcher().course_broken_ns().is_some(),
-            heaviest_fires_airbag,
+            heaviest_fires_airbag: &heaviest_fires_airbag,
             replan: &mut replan,
         };
         self.decision.step(now, &mut x);

@@ -104,10 +104,10 @@ pub(crate) struct DecisionInputs<'d> {
     pub floor_lift_mps: f64,
     /// A matched confirmation's pulse has left its ramp (`PulseMatch::course_broken_ns`).
     pub matched_course_broken: bool,
-    /// The table fires the airbag for this situation with the heaviest opponent it covers
-    /// (`Estimator::heaviest_opponent_fires_airbag`; asked only in the cycle a crash phase is
-    /// entered).
-    pub heaviest_fires_airbag: bool,
+    /// Whether the table fires the airbag for this situation with the heaviest opponent it
+    /// covers (`Estimator::heaviest_opponent_fires_airbag`: a lookup, asked only when a crash
+    /// phase is entered with a belt-only plan).
+    pub heaviest_fires_airbag: &'d dyn Fn() -> bool,
     /// The table's plan for an adaptive crash at a closing speed (m/s): `None` when that
     /// severity is below the no-fire line (`crash::plan_for`).
     pub replan: &'d mut dyn FnMut(f64) -> Option<RestraintPlan>,
@@ -405,9 +405,9 @@ impl Decision {
         // prediction. A plan belt-only for the occupant (a light one) stays belt-only.
         if gate == AirbagGate::Decided
             && !plan.airbag_fires()
-            && x.heaviest_fires_airbag
             && c.kind != ConfirmKind::Backup
             && self.reference.airbag_fires()
+            && (x.heaviest_fires_airbag)()
         {
             self.crash_plan = plan.with_airbag_of(&self.reference);
             self.gate = AirbagGate::Fallback;

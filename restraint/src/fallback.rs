@@ -152,12 +152,11 @@ pub struct FallbackAlgorithm {
     decision: FallbackDecision,
     /// Start of the judged segment of the event (its onset, or the latest re-onset), ns.
     segment_onset_ns: u64,
-    /// Δv since the segment's start, m/s.
-    segment_dv_mps: f64,
+    /// The event's Δv before the segment's first interval, m/s: the segment's Δv is the
+    /// event's less this (one integral for both).
+    segment_base_dv_mps: f64,
     /// Since when the deceleration has been under the wake threshold inside the event, ns.
     dip_since_ns: Option<u64>,
-    /// The previous sample's deceleration (the segment's trapezoid).
-    prev_decel_mps2: f64,
 }
 
 impl FallbackAlgorithm {
@@ -171,17 +170,17 @@ impl FallbackAlgorithm {
             run: 0,
             decision: FallbackDecision::Pending,
             segment_onset_ns: 0,
-            segment_dv_mps: 0.0,
+            segment_base_dv_mps: 0.0,
             dip_since_ns: None,
-            prev_decel_mps2: 0.0,
         }
     }
 
-    /// Starts the judged segment at sample `s` (the event's wake-up, or a re-onset; `prev`:
-    /// the sample before it), its Δv from the interval that ends at `s`, as [`Onset`]'s.
-    fn start_segment(&mut self, s: &AccelSample, prev: f64) {
+    /// Starts the judged segment at sample `s` (the event's wake-up, or a re-onset; `base`:
+    /// the event's Δv before `s`'s interval), its Δv from the interval that ends at `s` on, as
+    /// [`Onset`]'s.
+    fn start_segment(&mut self, s: &AccelSample, base_dv_mps: f64) {
         self.segment_onset_ns = s.t_ns;
-        self.segment_dv_mps = 0.5 * (prev + s.decel_mps2) * s.dt_s;
+        self.segment_base_dv_mps = base_dv_mps;
         self.dip_since_ns = None;
         self.loading.start(s.decel_mps2);
         self.decision = FallbackDecision::Pending;
@@ -191,7 +190,7 @@ impl FallbackAlgorithm {
     /// `floor_lift_mps`: what the road's roughness adds to the severity floor now,
     /// [`crate::roughness`]).
     pub fn push(&mut self, p: &ConfirmParams, s: &AccelSample, floor_lift_mps: f64) {
-        let prev = core::mem::replace(&mut self.prev_decel_mps2, s.decel_mps2);
+        let before_dv = self.onset.delta_v_mps();
         match self.onset.push(p, s) {
             OnsetStep::Quiet => return,
             OnsetStep::Reset => {
@@ -205,7 +204,7 @@ impl FallbackAlgorithm {
             }
             OnsetStep::Woke => {
                 self.run = 0;
-                self.start_segment(s, prev);
+                self.start_segment(s, 0.0);
             }
             OnsetStep::Awake => {
                 let above = s.decel_mps2 >= p.wake_mps2;
@@ -215,9 +214,8 @@ impl FallbackAlgorithm {
                         .is_some_and(|d| s.t_ns.saturating_sub(d) >= RE_ONSET_GAP_NS)
                     && !matches!(self.decision, FallbackDecision::Fire { .. });
                 if re_onset {
-                    self.start_segment(s, prev);
+                    self.start_segment(s, before_dv);
                 } else {
-                    self.segment_dv_mps += 0.5 * (prev + s.decel_mps2) * s.dt_s;
                     self.loading.push(s.decel_mps2, s.dt_s);
                     if above {
                         self.dip_since_ns = None;
@@ -239,7 +237,7 @@ impl FallbackAlgorithm {
             return;
         };
         let tau_ms = s.t_ns.saturating_sub(self.segment_onset_ns) as f64 * 1e-6;
-        let dv = self.segment_dv_mps;
+        let dv = self.onset.delta_v_mps() - self.segment_base_dv_mps;
         if tau_ms > WINDOW_MS {
             self.decision = FallbackDecision::NoFire(s.t_ns);
         } else if dv >= threshold_mps(&self.thresholds, tau_ms)
@@ -283,7 +281,6 @@ impl FallbackAlgorithm {
     /// See [`Onset::note_quiet`](crate::confirm::Onset::note_quiet).
     pub fn note_quiet(&mut self, decel_mps2: f64) {
         self.onset.note_quiet(decel_mps2);
-        self.prev_decel_mps2 = decel_mps2;
     }
 }
 
