@@ -225,6 +225,10 @@ pub struct SeverityAgreement {
     /// each cycle then interpolates only near the newest samples.
     start: Option<(u64, f64, f64)>,
     disagreements: u64,
+    /// The event (onset, ns) in which the safing sensor measured more than the crash sensor
+    /// allows, by the same tolerance: it vetoes nothing (a safing sensor reading more cannot
+    /// make the crash path fire), but the pair disagrees ([`SeverityAgreement::pair_disagrees`]).
+    safing_reads_more: Option<u64>,
     /// Largest `Δv_c − Δv_s` seen in a judged event, m/s (diagnostics: the tolerance's
     /// margin on the runs at hand).
     worst_excess_mps: f64,
@@ -240,8 +244,17 @@ impl SeverityAgreement {
             event: None,
             start: None,
             disagreements: 0,
+            safing_reads_more: None,
             worst_excess_mps: f64::NEG_INFINITY,
         }
+    }
+
+    /// Whether the two sensors disagree on the event that began at `onset_ns` in either
+    /// direction, as far as [`SeverityAgreement::agrees`] has judged it this cycle: the crash
+    /// sensor measured more than the safing sensor allows, or the safing sensor more than the
+    /// crash sensor allows. Two sensors cannot say which of them is wrong.
+    pub fn pair_disagrees(&self, onset_ns: u64) -> bool {
+        self.event == Some((onset_ns, true)) || self.safing_reads_more == Some(onset_ns)
     }
 
     /// Whether the pair agrees on the event that began at `onset_ns` so far (module docs).
@@ -290,6 +303,9 @@ impl SeverityAgreement {
         let excess = dv_crash - dv_safing;
         self.worst_excess_mps = self.worst_excess_mps.max(excess);
         let p = self.params;
+        if -excess > p.tolerance_dv_mps + p.tolerance_fraction * dv_safing.max(0.0) {
+            self.safing_reads_more = Some(onset_ns);
+        }
         // NaN (cannot come from plausible samples) counts as a disagreement.
         if excess <= p.tolerance_dv_mps + p.tolerance_fraction * dv_crash.max(0.0) {
             return true;

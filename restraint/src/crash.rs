@@ -207,11 +207,10 @@ impl CrashMonitor {
         if self.confirmation.is_some() || !accel_faulty {
             return;
         }
-        let (Some(sit), Some((decel, rx_ns))) = (situation, inputs.vehicle_decel(now)) else {
+        let Some(sit) = situation else {
             return;
         };
-        let in_window = rx_ns.abs_diff(sit.contact_ns) <= self.window_ns;
-        if !sit.low_speed && in_window && decel >= self.backup_decel_mps2 {
+        if let Some(rx_ns) = self.backup_evidence(now, sit, inputs) {
             self.confirmation = Some(Confirmation {
                 at_ns: rx_ns,
                 contact_ns: sit.contact_ns,
@@ -219,6 +218,21 @@ impl CrashMonitor {
                 kind: ConfirmKind::Backup,
             });
         }
+    }
+
+    /// The backup path's evidence at `now`: a crash predicted above the no-fire line
+    /// (`sit`) and a fresh vehicle frame received within ± the match window of its contact
+    /// whose deceleration reaches `backup_confirm_g` — the frame's receive time. Two sources
+    /// independent of the crash accelerometer: the object list and the vehicle dynamics.
+    pub(crate) fn backup_evidence(
+        &self,
+        now: u64,
+        sit: &Situation,
+        inputs: &InputMonitor,
+    ) -> Option<u64> {
+        let (decel, rx_ns) = inputs.vehicle_decel(now)?;
+        let in_window = rx_ns.abs_diff(sit.contact_ns) <= self.window_ns;
+        (!sit.low_speed && in_window && decel >= self.backup_decel_mps2).then_some(rx_ns)
     }
 
     /// The latched confirmation.

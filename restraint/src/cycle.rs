@@ -290,11 +290,25 @@ impl Activity for RestraintCycle<'_> {
         // event (module `agreement`) — also once the crash sensor is found faulty (a stuck
         // sensor's first 20 ms were plausible); the backup path (confirmed by the vehicle
         // deceleration) has no crash-sensor event to compare.
+        let mut pair_disagrees = false;
         if let Some(c) = self.crash.confirmation() {
             if !safing_faulty && c.kind != crate::crash::ConfirmKind::Backup {
                 safing &= self.agreement.agrees(c.onset_ns);
+                pair_disagrees = self.agreement.pair_disagrees(c.onset_ns);
             }
         }
+        // Two accelerometers that disagree on the confirmed event cannot say which of them is
+        // wrong (a crash sensor reading high, or a safing sensor reading low): the event is
+        // then decided by the backup path's two other sources, a predicted crash and the
+        // vehicle deceleration on CAN (`Decision`, "backup for a disagreeing pair").
+        let backup_for_disagreement = if pair_disagrees {
+            self.estimate
+                .situation
+                .as_ref()
+                .and_then(|s| self.crash.backup_evidence(now, s, &self.inputs))
+        } else {
+            None
+        };
         self.crash.end_cycle(
             now,
             accel_faulty,
@@ -322,6 +336,7 @@ impl Activity for RestraintCycle<'_> {
             pretensioner_fallback: self.crash.pretensioner(),
             segment_onset_ns: self.crash.segment_onset_ns(),
             safing,
+            backup_for_disagreement,
             event_in_progress: self.crash.event_in_progress(),
             event_dv_mps: self.crash.event_dv_mps(),
             floor_lift_mps: self.crash.floor_lift_mps(),

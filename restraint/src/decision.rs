@@ -96,6 +96,9 @@ pub(crate) struct DecisionInputs<'d> {
     pub segment_onset_ns: Option<u64>,
     /// The safing function agrees in this cycle (`safing`).
     pub safing: bool,
+    /// The two accelerometers disagree on the confirmed event and the backup path's evidence
+    /// holds (`CrashMonitor::backup_evidence`): the vehicle frame's receive time, ns.
+    pub backup_for_disagreement: Option<u64>,
     /// An accelerometer event is still in progress.
     pub event_in_progress: bool,
     /// The velocity change of the current accelerometer event since its onset, m/s.
@@ -180,6 +183,9 @@ pub struct Decision {
     pretensioner_floor_mps: f64,
     /// Matched fires dropped because their event ended below the floor.
     held_below_floor: u64,
+    /// The crash phase was handed to the backup path because the accelerometers disagree:
+    /// its fires stand on the vehicle deceleration instead of the safing agreement.
+    backup_stands_in: bool,
 }
 
 fn time_ms_to_ns(t_ms: f32) -> i64 {
@@ -247,6 +253,7 @@ impl Decision {
             // path, where a rough road's first lobe has no prediction to be refuted by.
             pretensioner_floor_mps: cfg.pretensioner_min_dv_mps.min(cfg.fallback_min_dv_mps),
             held_below_floor: 0,
+            backup_stands_in: false,
         }
     }
 
@@ -373,6 +380,7 @@ impl Decision {
 
     fn enter_crash(&mut self, c: Confirmation, x: &mut DecisionInputs<'_>) {
         self.low_speed_dv_limit_mps = None;
+        self.backup_stands_in = false;
         let (plan, gate) = self.crash_plan_for(&c, x);
         let (confirm_ns, contact) = (c.at_ns, c.contact_ns);
         self.before_crash = self.phase;
@@ -426,6 +434,35 @@ impl Decision {
         // A pending pretensioner fire is one not yet fired (scheduled only while not fired).
         if self.pt_gate == AirbagGate::Decided && self.pretensioner_at_ns.take().is_some() {
             self.pt_gate = AirbagGate::Fallback;
+        }
+    }
+
+    /// Backup for a disagreeing pair: the crash sensor and the safing sensor disagree on the
+    /// confirmed event, so neither the crash sensor's decisions nor the safing agreement can
+    /// be trusted — one of them is wrong, and two sensors cannot say which. Before anything
+    /// of the crash phase fired, the backup path's own evidence (a crash predicted above the
+    /// no-fire line, the vehicle deceleration on CAN ≥ `backup_confirm_g` within the match
+    /// window of its contact: two sources independent of both accelerometers) decides the
+    /// event as it does for a faulty crash sensor: the reference restraint, the vehicle
+    /// deceleration standing in for the safing agreement. Without a predicted crash nothing
+    /// fires, as with a dead crash sensor.
+    fn hand_over_to_the_backup(&mut self, now: u64, rx_ns: u64) {
+        if self.backup_stands_in || self.crash_fired || self.airbag_fired {
+            return;
+        }
+        self.backup_stands_in = true;
+        let contact = self.contact_ns.unwrap_or(rx_ns);
+        self.crash_plan = self.reference;
+        self.crash_kind = Some(ConfirmKind::Backup);
+        self.gate = AirbagGate::Decided;
+        self.pt_gate = AirbagGate::Decided;
+        self.airbag_fire_at_ns = self
+            .reference
+            .airbag_fires()
+            .then(|| at(contact, self.reference.airbag_time_ms).max(now));
+        if self.pretensioner != Pretensioner::Fired {
+            self.pretensioner_at_ns =
+                Some(at(contact, self.reference.pretensioner_time_ms).max(now));
         }
     }
 
@@ -562,6 +599,9 @@ impl Decision {
         {
             self.hand_over_to_the_conventional_path();
         }
+        if let (Phase::Crash, Some(rx_ns)) = (self.phase, x.backup_for_disagreement) {
+            self.hand_over_to_the_backup(now, rx_ns);
+        }
         if self.phase == Phase::Crash {
             self.gate_airbag(now, x.fallback, x.event_dv_mps, x.segment_onset_ns);
             self.gate_pretensioner(now, x.pretensioner_fallback, x.fallback, x.segment_onset_ns);
@@ -634,6 +674,9 @@ impl Decision {
         // time (a crash fire is never scheduled before its confirmation, which is past).
         // A crash-phase fire also needs the safing function (module `safing`).
         let in_crash = self.phase == Phase::Crash;
+        // Handed to the backup: the vehicle deceleration that confirmed it stands in for the
+        // safing agreement (`hand_over_to_the_backup`).
+        let safing = x.safing || (in_crash && self.backup_stands_in);
         if in_crash && matches!(self.crash_kind, Some(ConfirmKind::Matched(_))) {
             let airbag =
                 Self::hold_below_floor(&mut self.airbag_fire_at_ns, self.airbag_floor_mps, now, x);
@@ -646,7 +689,7 @@ impl Decision {
             self.held_below_floor += u64::from(airbag) + u64::from(pretensioner);
         }
         if let Some(t) = self.pretensioner_at_ns {
-            if let Some(go) = self.release(t, now, x.half_period_ns, x.safing) {
+            if let Some(go) = self.release(t, now, x.half_period_ns, safing) {
                 if go {
                     self.pretensioner = Pretensioner::Fired;
                     self.crash_fired |= in_crash;
@@ -655,7 +698,7 @@ impl Decision {
             }
         }
         if let Some(t) = self.airbag_fire_at_ns {
-            if let Some(go) = self.release(t, now, x.half_period_ns, x.safing) {
+            if let Some(go) = self.release(t, now, x.half_period_ns, safing) {
                 if go {
                     self.airbag_fired = true;
                     self.crash_fired |= in_crash;

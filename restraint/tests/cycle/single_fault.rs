@@ -375,3 +375,64 @@ fn a_crash_on_a_smooth_road_is_not_delayed_by_the_roughness_measure() {
     assert!(with.is_some(), "the crash fired no airbag");
     assert_eq!(with, fire_at(0.0));
 }
+
+/// A predicted crash (20 m/s towards contact `C`, 20 g from `C`) in which one accelerometer
+/// reads `offset_g` more (crash sensor, `crash_sensor` true) or less (safing sensor) than the
+/// car; the gateway's EgoLongAccel shows `vehicle_g` from `C` on.
+fn crash_with_one_sensor_off(crash_sensor: bool, offset_g: f32, vehicle_g: f32) -> Bench {
+    let mut b = Bench::new(Some(test_lut()));
+    idle_until(&mut b, T0 + 100 * MS);
+    while b.now < C + 150 * MS {
+        if (b.now - T0).is_multiple_of(10 * MS) && b.now < C {
+            b.push_approach(C, 20.0, 1500.0, 100.0);
+        }
+        if b.now >= C {
+            b.ego_long_accel_mps2 = -vehicle_g * G;
+            b.push_accel(-20.0 * G);
+            if crash_sensor {
+                b.push_crash_sensor_fault(-(20.0 + offset_g) * G);
+            } else {
+                b.push_safing_sensor_fault(-(20.0 - offset_g) * G);
+            }
+        }
+        b.step();
+    }
+    b
+}
+
+#[test]
+fn a_disagreeing_pair_in_a_predicted_crash_is_decided_by_the_vehicle_deceleration() {
+    // Two sensors that disagree cannot say which of them is wrong; the object list's predicted
+    // crash and the vehicle frame's 15 g are two further sources, and the reference restraint
+    // fires on them — whichever sensor is off.
+    for (crash_sensor, what) in [
+        (true, "crash sensor 10 g high"),
+        (false, "safing sensor 15 g low"),
+    ] {
+        let offset = if crash_sensor { 10.0 } else { 15.0 };
+        let b = crash_with_one_sensor_off(crash_sensor, offset, 15.0);
+        assert!(
+            b.ecu.agreement().disagreements() >= 1 || !crash_sensor,
+            "{what}"
+        );
+        let (t, cmd) = b
+            .first_airbag_fire()
+            .unwrap_or_else(|| panic!("{what}: no airbag"));
+        assert_eq!(
+            cmd.cmd_source(),
+            bus::codec::AirbagStageCmdCmdSource::Reference,
+            "{what}"
+        );
+        // Not before the reference time (contact + 10 ms), and at the latest one vehicle frame
+        // period after the first frame that shows the crash (at C, every 10 ms) and the cycle.
+        assert!((C + 10 * MS..=C + 21 * MS).contains(&t), "{what}: {t}");
+        assert!(pretensioner_fired(&b), "{what}");
+        // The vehicle frame showing only braking (1 g): nothing fires — the faulty sensor's
+        // event alone decides nothing.
+        let b = crash_with_one_sensor_off(crash_sensor, offset, 1.0);
+        assert!(
+            !airbag_fired(&b),
+            "{what}: airbag without the vehicle deceleration"
+        );
+    }
+}
