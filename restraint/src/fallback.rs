@@ -48,6 +48,15 @@ pub const WINDOW_MS: f64 = KNOT_SPACING_MS * (KNOTS - 1) as f64;
 pub const RE_ONSET_GAP_MS: f64 = 2.0;
 const RE_ONSET_GAP_NS: u64 = (RE_ONSET_GAP_MS * 1e6) as u64;
 
+/// From this Δv of the judged segment on, the loading rule no longer applies, m/s. The rule
+/// separates a crested misuse pulse (≤ 1.2 m/s: the matrix's envelope × 1.5) from a crash near
+/// the severity floor; far above it, a crest seen earlier is ringing or a spike on top of a
+/// crash (a kerb strike's ringing running into it, one wild sample at contact), and holding the
+/// decision to that crest misses the crash. Not lower: a crash below the no-fire line with a
+/// kerb strike in it carries up to ≈ 5 m/s in the window (16 km/h and 1.2 m/s), and at 2.5 m/s
+/// the `low-speed-crash-and-kerb-untracked` family fired 23 more airbags of 445 (seed 7).
+pub const LOADING_EXEMPT_DV_MPS: f64 = 5.0;
+
 /// Default boundary, m/s at 0, 4, … 60 ms after the onset: the upper envelope (+10 %) of the
 /// Δv(τ) curves of every no-fire crash of the calibration sweep as this algorithm measures
 /// them, from `lut study fallback --derive` (restraint/README.md, "Crash phase";
@@ -243,7 +252,7 @@ impl FallbackAlgorithm {
         } else if dv >= threshold_mps(&self.thresholds, tau_ms)
             && dv >= self.floor.min_dv_mps + floor_lift_mps
             && self.run >= self.floor.samples
-            && self.loading.holds(self.floor.loading_fraction)
+            && (dv >= LOADING_EXEMPT_DV_MPS || self.loading.holds(self.floor.loading_fraction))
         {
             self.decision = FallbackDecision::Fire {
                 at_ns: s.t_ns,
@@ -396,7 +405,12 @@ mod tests {
 
     /// Feeds `g(k)` for sample k = 0.. at 1 kHz from t = 1 s.
     fn run_fn(f: &mut FallbackAlgorithm, ms: u64, g: impl Fn(u64) -> f64) {
-        for k in 0..ms {
+        run_fn_from(f, 0, ms, g);
+    }
+
+    /// Feeds `g(k)` for samples k = `from`.. (`ms` of them) at 1 kHz, sample k at 1 s + k ms.
+    fn run_fn_from(f: &mut FallbackAlgorithm, from: u64, ms: u64, g: impl Fn(u64) -> f64) {
+        for k in from..from + ms {
             f.push(
                 &params(),
                 &AccelSample {
@@ -543,15 +557,26 @@ mod tests {
             "fires 5 ms after the re-onset, the decision belongs to the event"
         );
         assert_eq!(f.segment_onset_ns(), Some(1_000_000_000 + 5_000_000));
-        // A dip shorter than the re-onset gap (1 ms) keeps the lobe's onset, and its crest.
+        // A dip shorter than the re-onset gap (1 ms) keeps the lobe's onset, and its crest: the
+        // plateau cannot load until the segment's Δv passes LOADING_EXEMPT_DV_MPS (5.0 m/s).
+        // Oracle: Δv = ½·25 g·1 ms + 25 g·1 ms + ½·26 g·1 ms + ½·21 g·1 ms + n·20 g·1 ms
+        // ≥ 5.0 first at n = 23, the sample at 26 ms (the boundary there is 3.7 m/s).
         let mut f = FallbackAlgorithm::new(DEFAULT_DV_MPS, floor());
-        run_fn(&mut f, 30, |k| match k {
+        run_fn(&mut f, 26, |k| match k {
             0..=1 => 25.0,
             2 => 1.0,
             _ => 20.0,
         });
         assert_eq!(f.decision(), FallbackDecision::Pending);
         assert_eq!(f.segment_onset_ns(), Some(1_000_000_000));
+        run_fn_from(&mut f, 26, 1, |_| 20.0);
+        assert_eq!(
+            f.decision(),
+            FallbackDecision::Fire {
+                at_ns: 1_000_000_000 + 26_000_000,
+                onset_ns: 1_000_000_000
+            }
+        );
     }
 
     #[test]
