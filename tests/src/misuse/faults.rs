@@ -18,7 +18,10 @@ pub(super) fn offset(r: &mut ChaCha8Rng, name: &str, i: u64, sensor: &str) -> St
     let len = r.gen_range(0.05..0.5);
     let ev = offset_event(t0, g, t0 + len, sensor);
     let v = drive_kph(r);
-    driving(name, i, &ego(v, None), 1.0, "", &ev)
+    // The run goes on JUDGED_AFTER_S after the offset: a run that ends inside the event cannot
+    // say whether its crash phase ends.
+    let duration_s = (t0 + len + JUDGED_AFTER_S).max(1.0);
+    driving(name, i, &ego(v, None), duration_s, "", &ev)
 }
 
 pub(super) fn crash_sensor_offset(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
