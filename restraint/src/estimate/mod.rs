@@ -491,16 +491,10 @@ impl<'a> Estimator<'a> {
         inputs: &InputMonitor,
         counters: &mut CycleCounters,
     ) -> RestraintPlan {
-        let Some(lut) = self.lut.as_ref() else {
+        let Some(lut) = self.table_for(inputs) else {
             return self.reference;
         };
-        let occ = inputs.occupant;
-        if !(occ.buckled && occ.adult) {
-            return self.reference;
-        }
-        let heaviest = lut.view.axes()[1]
-            .last()
-            .map_or(f64::NAN, |m| f64::from(*m));
+        let heaviest = heaviest_opponent_kg(lut);
         let robust = match sit.v2x_mass_kg {
             // f64::max: a NaN estimate yields the station's mass.
             Some(station_kg) => {
@@ -516,7 +510,14 @@ impl<'a> Estimator<'a> {
         } else {
             sit.opponent_mass_kg
         };
-        self.lookup_at(sit, mass, inputs, counters)
+        self.query(lut, sit, mass, inputs, counters)
+    }
+
+    /// The table, where it covers the occupant (a belted adult); `None`: the reference
+    /// restraint's situation (no table, or an occupant the table was not built for).
+    fn table_for(&self, inputs: &InputMonitor) -> Option<&Lut<'a>> {
+        let occ = inputs.occupant;
+        self.lut.as_ref().filter(|_| occ.buckled && occ.adult)
     }
 
     /// Whether the table fires the airbag for the situation with the heaviest opponent it
@@ -529,32 +530,25 @@ impl<'a> Estimator<'a> {
         sit: &Situation,
         inputs: &InputMonitor,
     ) -> bool {
-        let Some(lut) = self.lut.as_ref() else {
+        let Some(lut) = self.table_for(inputs) else {
             return false;
         };
-        let heaviest = lut.view.axes()[1]
-            .last()
-            .map_or(f64::NAN, |m| f64::from(*m));
-        let plan = self.lookup_at(sit, heaviest, inputs, &mut CycleCounters::default());
+        let heaviest = heaviest_opponent_kg(lut);
+        let plan = self.query(lut, sit, heaviest, inputs, &mut CycleCounters::default());
         plan.source == crate::plan::PlanSource::Adaptive && plan.airbag_fires()
     }
 
-    /// The table's plan for the situation with the opponent mass `mass_kg` (the reference
-    /// restraint where the table does not cover it).
-    fn lookup_at(
+    /// `lut`'s plan for the situation with the opponent mass `mass` (kg; the reference
+    /// restraint where an axis is out of the table's range).
+    fn query(
         &self,
+        lut: &Lut<'a>,
         sit: &Situation,
         mass: f64,
         inputs: &InputMonitor,
         counters: &mut CycleCounters,
     ) -> RestraintPlan {
-        let Some(lut) = self.lut.as_ref() else {
-            return self.reference;
-        };
         let occ = inputs.occupant;
-        if !(occ.buckled && occ.adult) {
-            return self.reference;
-        }
         let q = Query {
             closing_speed_kph: (sit.closing_speed_mps * 3.6) as f32,
             opponent_mass_kg: mass as f32,
@@ -572,6 +566,14 @@ impl<'a> Estimator<'a> {
         }
         RestraintPlan::from_lookup(&l, &lut.view.thresholds())
     }
+}
+
+/// The heaviest opponent the table covers, kg (its mass axis' last knot; NaN for an empty
+/// axis).
+fn heaviest_opponent_kg(lut: &Lut<'_>) -> f64 {
+    lut.view.axes()[1]
+        .last()
+        .map_or(f64::NAN, |m| f64::from(*m))
 }
 
 #[cfg(test)]
