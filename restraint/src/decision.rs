@@ -394,17 +394,15 @@ impl Decision {
         // The conventional path's pretensioner has its own boundary (like the airbag); the
         // adaptive and backup paths fire it as planned. Either way only with safing.
         self.pt_gate = AirbagGate::Decided;
-        if self.pretensioner != Pretensioner::Fired {
-            if gate == AirbagGate::Fallback {
+        if gate == AirbagGate::Fallback {
+            if self.pretensioner != Pretensioner::Fired {
                 self.pt_gate = AirbagGate::Fallback;
                 self.pretensioner_at_ns = None;
-            } else {
-                self.pretensioner_at_ns =
-                    Some(at(contact, plan.pretensioner_time_ms).max(confirm_ns));
             }
+            self.airbag_fire_at_ns = None;
+        } else {
+            self.schedule(&plan, contact, confirm_ns);
         }
-        self.airbag_fire_at_ns = (gate == AirbagGate::Decided && plan.airbag_fires())
-            .then(|| at(contact, plan.airbag_time_ms).max(confirm_ns));
         // A belt-only plan made so by the opponent's mass — the table fires the airbag for
         // the same crash against its heaviest opponent — rests on the object list's mass,
         // which one object fault (a truck reported as a car, a mass misreported within its
@@ -456,14 +454,20 @@ impl Decision {
         self.crash_kind = Some(ConfirmKind::Backup);
         self.gate = AirbagGate::Decided;
         self.pt_gate = AirbagGate::Decided;
-        self.airbag_fire_at_ns = self
-            .reference
-            .airbag_fires()
-            .then(|| at(contact, self.reference.airbag_time_ms).max(now));
+        let reference = self.reference;
+        self.schedule(&reference, contact, now);
+    }
+
+    /// Schedules a decided plan's crash-phase fires: the pyrotechnic pretensioner (unless the
+    /// belt is already fired) and the airbag (if the plan fires it), each at its time after
+    /// `contact`, never before `not_before` (the confirmation or hand-over: the past).
+    fn schedule(&mut self, plan: &RestraintPlan, contact: u64, not_before: u64) {
         if self.pretensioner != Pretensioner::Fired {
-            self.pretensioner_at_ns =
-                Some(at(contact, self.reference.pretensioner_time_ms).max(now));
+            self.pretensioner_at_ns = Some(at(contact, plan.pretensioner_time_ms).max(not_before));
         }
+        self.airbag_fire_at_ns = plan
+            .airbag_fires()
+            .then(|| at(contact, plan.airbag_time_ms).max(not_before));
     }
 
     /// The accelerometer-only decision window of the crash phase's event has passed: one ms

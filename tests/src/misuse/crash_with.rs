@@ -33,10 +33,7 @@ fn must_fire_base(r: &mut ChaCha8Rng, name: &str, i: u64, tc: f64, min_kph: f64)
     if r.gen_bool(0.5) {
         barrier(name, i, v, tc, "", "")
     } else {
-        head_on(name, i, v, 1785.0, tc, None, tc + 0.25, "", "").replace(
-            "[opponent]\nkind = \"vehicle\"\n",
-            "[opponent]\nkind = \"vehicle\"\nclass = 4\n",
-        )
+        equal_class(head_on(name, i, v, 1785.0, tc, None, tc + 0.25, "", ""))
     }
 }
 

@@ -26,10 +26,7 @@ pub(super) fn must_fire_crash(r: &mut ChaCha8Rng, name: &str, i: u64) -> String 
 pub(super) fn must_fire_car(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let (v, tc) = (r.gen_range(35.0..56.0), r.gen_range(0.35..0.5));
     let v2x = v2x_station(r, true);
-    head_on(name, i, v, 1785.0, tc, None, tc + 0.25, "", &v2x).replace(
-        "[opponent]\nkind = \"vehicle\"\n",
-        "[opponent]\nkind = \"vehicle\"\nclass = 4\n",
-    )
+    equal_class(head_on(name, i, v, 1785.0, tc, None, tc + 0.25, "", &v2x))
 }
 
 pub(super) fn must_fire_misreported(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {

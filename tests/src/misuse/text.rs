@@ -58,6 +58,14 @@ pub(super) fn head_on(
     )
 }
 
+/// `text` with its opponent vehicle in the ego's stiffness class (4): an equal car.
+pub(super) fn equal_class(text: String) -> String {
+    text.replace(
+        "[opponent]\nkind = \"vehicle\"\n",
+        "[opponent]\nkind = \"vehicle\"\nclass = 4\n",
+    )
+}
+
 /// A `[v2x]` table half the time (drawn last, so a family's other draws stay what they were):
 /// a station that reports the opponent's true mass, or — `forged` — half of those a station
 /// that reports any mass from 0 to 40 t (a forged or misconfigured one).
