@@ -82,6 +82,11 @@ impl PlausibleBatch {
         self.sum_accel_mps2 += b * self.readings.len() as f32;
     }
 
+    /// The readings' sum, m/s² (negative = deceleration), and their number.
+    pub fn sum_and_len(&self) -> (f64, u32) {
+        (f64::from(self.sum_accel_mps2), self.readings.len() as u32)
+    }
+
     /// Number of plausible samples.
     pub fn len(&self) -> usize {
         self.readings.len()
@@ -224,6 +229,12 @@ impl AccelMonitor {
 
     fn implausible(&mut self, now: u64) {
         self.invalid_until_ns = Some(now.saturating_add(self.hold_ns));
+    }
+
+    /// Another check found the sensor's readings implausible at `now` (`pair_monitor`): held
+    /// as the monitor's own findings are.
+    pub(crate) fn flag_implausible(&mut self, now: u64) {
+        self.implausible(now);
     }
 
     /// Checks one batch received at `now` (`first_ns`, `period_ns`, samples in m/s²,

@@ -18,6 +18,7 @@ use crate::decision::{Decision, DecisionInputs, Phase, Pretensioner};
 use crate::estimate::{check_lut, Estimator, Lut, LutMismatch, Situation};
 use crate::inputs::InputMonitor;
 use crate::outputs::{publish_diagnostics, Outputs};
+use crate::pair_monitor::{CycleMean, PairMonitor};
 use crate::plan::{ReferenceSettings, RestraintPlan};
 use crate::safing::Safing;
 use crate::settings::ConfigError;
@@ -45,6 +46,8 @@ pub struct RestraintCycle<'lut> {
     safing: Safing,
     /// The two accelerometers' Δv over the same window (issue 31 item 1).
     agreement: SeverityAgreement,
+    /// The two accelerometers against each other and the vehicle frame (offset, noise).
+    pair: PairMonitor,
     /// The deceleration the car's braking explains, m/s², held while an accelerometer event
     /// is in progress (`braking_compensation_max_g`).
     braking_decel_mps2: f64,
@@ -85,6 +88,7 @@ impl<'lut> RestraintCycle<'lut> {
             crash: CrashMonitor::new(&cfg),
             safing: Safing::new(cfg.safing_params()),
             agreement: cfg.severity_agreement(),
+            pair: PairMonitor::new(),
             braking_decel_mps2: 0.0,
             outputs: Outputs::new(lut_id),
             reasons: Degraded::empty(),
@@ -225,8 +229,10 @@ impl Activity for RestraintCycle<'_> {
         let crash = &mut self.crash;
         let agreement = &mut self.agreement;
         let mut plausible = crate::accel::PlausibleBatch::new();
+        let (mut crash_mean, mut safing_mean) = (CycleMean::default(), CycleMean::default());
         io.drain_accel(&mut |a| {
             inputs.on_accel(a, now, c, &mut plausible);
+            crash_mean.add(&plausible);
             // The agreement and the road's roughness take the readings as they are.
             agreement.crash.on_batch(&plausible);
             crash.on_raw_batch(&plausible);
@@ -238,10 +244,19 @@ impl Activity for RestraintCycle<'_> {
         let mut safing_batch = crate::accel::PlausibleBatch::new();
         io.drain_safing(&mut |a| {
             inputs.on_safing(a, now, &mut safing_batch);
+            safing_mean.add(&safing_batch);
             safing.on_batch(&safing_batch);
             agreement.safing.on_batch(&safing_batch);
         });
         inputs.on_receive_errors(io.receive_errors(), now);
+        let vehicle = inputs.vehicle_decel(now).map(|(d, _)| d);
+        let pair = self.pair.on_cycle(now, &crash_mean, &safing_mean, vehicle);
+        if pair.crash_faulty {
+            inputs.accel.flag_implausible(now);
+        }
+        if pair.safing_faulty {
+            inputs.safing.flag_implausible(now);
+        }
         let lut_present = self.estimate.lut().is_some();
         self.reasons = self.inputs.reasons(now, io.can_enabled(), lut_present);
         let c = &mut self.counters;
@@ -300,12 +315,19 @@ impl Activity for RestraintCycle<'_> {
         // Two accelerometers that disagree on the confirmed event cannot say which of them is
         // wrong (a crash sensor reading high, or a safing sensor reading low): the event is
         // then decided by the backup path's two other sources, a predicted crash and the
-        // vehicle deceleration on CAN (`Decision`, "backup for a disagreeing pair").
-        let backup_for_disagreement = if pair_disagrees {
-            self.estimate
-                .situation
-                .as_ref()
-                .and_then(|s| self.crash.backup_evidence(now, s, &self.inputs))
+        // vehicle deceleration on CAN (`Decision`, "backup for a disagreeing pair"). So is an
+        // event the crash sensor confirmed while the pair check holds it faulty.
+        let crash_flagged = self.pair.crash_flagged(now)
+            && self
+                .crash
+                .confirmation()
+                .is_some_and(|c| c.kind != crate::crash::ConfirmKind::Backup);
+        let safing_onset_ns = (!safing_faulty).then(|| self.safing.onset_ns()).flatten();
+        let backup_for_disagreement = if pair_disagrees || crash_flagged {
+            self.estimate.situation.as_ref().and_then(|s| {
+                self.crash
+                    .backup_evidence(now, s, &self.inputs, safing_onset_ns)
+            })
         } else {
             None
         };
@@ -314,6 +336,7 @@ impl Activity for RestraintCycle<'_> {
             accel_faulty,
             self.estimate.situation.as_ref(),
             &self.inputs,
+            safing_onset_ns,
         );
         let (cfg, est, inputs) = (&self.cfg, &self.estimate, &self.inputs);
         let situation = est.situation;

@@ -27,7 +27,7 @@
 //! phase, the active plan and the pretensioner/airbag commands ([`Decision`]'s accessors).
 
 use crate::config::CycleConfig;
-use crate::crash::{ConfirmKind, Confirmation};
+use crate::crash::{BackupEvidence, ConfirmKind, Confirmation};
 use crate::estimate::Situation;
 use crate::fallback::{FallbackDecision, WINDOW_MS};
 use crate::plan::RestraintPlan;
@@ -97,8 +97,8 @@ pub(crate) struct DecisionInputs<'d> {
     /// The safing function agrees in this cycle (`safing`).
     pub safing: bool,
     /// The two accelerometers disagree on the confirmed event and the backup path's evidence
-    /// holds (`CrashMonitor::backup_evidence`): the vehicle frame's receive time, ns.
-    pub backup_for_disagreement: Option<u64>,
+    /// holds (`CrashMonitor::backup_evidence`).
+    pub backup_for_disagreement: Option<BackupEvidence>,
     /// An accelerometer event is still in progress.
     pub event_in_progress: bool,
     /// The velocity change of the current accelerometer event since its onset, m/s.
@@ -444,12 +444,13 @@ impl Decision {
     /// event as it does for a faulty crash sensor: the reference restraint, the vehicle
     /// deceleration standing in for the safing agreement. Without a predicted crash nothing
     /// fires, as with a dead crash sensor.
-    fn hand_over_to_the_backup(&mut self, now: u64, rx_ns: u64) {
+    fn hand_over_to_the_backup(&mut self, now: u64, evidence: BackupEvidence) {
         if self.backup_stands_in || self.crash_fired || self.airbag_fired {
             return;
         }
         self.backup_stands_in = true;
-        let contact = self.contact_ns.unwrap_or(rx_ns);
+        let contact = evidence.contact_ns;
+        self.contact_ns = Some(contact);
         self.crash_plan = self.reference;
         self.crash_kind = Some(ConfirmKind::Backup);
         self.gate = AirbagGate::Decided;
@@ -603,8 +604,8 @@ impl Decision {
         {
             self.hand_over_to_the_conventional_path();
         }
-        if let (Phase::Crash, Some(rx_ns)) = (self.phase, x.backup_for_disagreement) {
-            self.hand_over_to_the_backup(now, rx_ns);
+        if let (Phase::Crash, Some(b)) = (self.phase, x.backup_for_disagreement) {
+            self.hand_over_to_the_backup(now, b);
         }
         if self.phase == Phase::Crash {
             self.gate_airbag(now, x.fallback, x.event_dv_mps, x.segment_onset_ns);

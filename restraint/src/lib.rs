@@ -18,6 +18,7 @@
 //! | [`crash_match`] | prediction-matched confirmation and the in-crash severity estimate |
 //! | [`fallback`] | the accelerometer-only airbag algorithm (no usable prediction) |
 //! | [`roughness`] | road roughness: the recent forward velocity excursion, added to every fire's floor |
+//! | [`pair_monitor`] | the two accelerometers' plausibility against each other and the vehicle frame: offset, noise |
 //! | [`agreement`] | the two accelerometers' severity agreement (velocity traces over the same window) |
 //! | [`crash`] | the crash phase's evidence: which path confirmed, the backup, the re-plan |
 //! | [`estimate`] | track filter ([`estimate::track`]), situation, closed-form collision prediction, LUT query, diagnostics pulse |
@@ -53,6 +54,7 @@ pub mod estimate;
 pub mod fallback;
 pub mod inputs;
 pub mod outputs;
+pub mod pair_monitor;
 pub mod plan;
 pub mod roughness;
 pub mod safing;

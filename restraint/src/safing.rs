@@ -122,6 +122,11 @@ impl Safing {
         })
     }
 
+    /// Onset of the safing channel's event in progress, ns (`None` when quiet).
+    pub fn onset_ns(&self) -> Option<u64> {
+        self.onset.onset_ns()
+    }
+
     /// Δv since the onset of the safing channel's event in progress, m/s (0 when quiet).
     pub fn delta_v_mps(&self) -> f64 {
         self.onset.delta_v_mps()

@@ -436,3 +436,91 @@ fn a_disagreeing_pair_in_a_predicted_crash_is_decided_by_the_vehicle_deceleratio
         );
     }
 }
+
+/// The degraded reasons the cycle at `t` published.
+fn reasons_at(b: &Bench, t: u64) -> Degraded {
+    let i = b
+        .step_times
+        .iter()
+        .position(|&s| s == t)
+        .expect("a cycle at t");
+    Degraded::from_bits_truncate(b.diagnostics[i].degraded_reasons)
+}
+
+/// From `C − 50 ms` the crash accelerometer alone reads `offset_g` more deceleration than the
+/// car (negative: it reads the car pushed forward) — an offset every per-sensor check passes;
+/// with `crash`, a predicted crash (as above) with 20 g from `C` and the vehicle frame showing
+/// 15 g from `C`; without, the car cruises on.
+fn crash_sensor_offset_from_before_contact(offset_g: f32, crash: bool) -> Bench {
+    let mut b = Bench::new(Some(test_lut()));
+    idle_until(&mut b, T0 + 100 * MS);
+    while b.now < C + 150 * MS {
+        if crash && (b.now - T0).is_multiple_of(10 * MS) && b.now < C {
+            b.push_approach(C, 20.0, 1500.0, 100.0);
+        }
+        let car_g = if crash && b.now >= C { 20.0 } else { 0.0 };
+        if crash && b.now >= C {
+            b.ego_long_accel_mps2 = -15.0 * G;
+        }
+        b.push_accel(-car_g * G);
+        if b.now >= C - 50 * MS {
+            // A live sensor's noise: never bit-identical (the stuck check stays quiet).
+            let noise_mps2 = if (b.now / MS).is_multiple_of(2) {
+                0.05
+            } else {
+                -0.05
+            };
+            b.push_crash_sensor_fault(-(car_g + offset_g) * G + noise_mps2);
+        }
+        b.step();
+    }
+    b
+}
+
+#[test]
+fn a_crash_sensor_offset_before_contact_is_flagged_and_the_backup_fires_in_time() {
+    for offset_g in [-6.0, -2.0, 3.0, 8.0] {
+        let b = crash_sensor_offset_from_before_contact(offset_g, true);
+        // The pair check attributes a step 13 ms after it appears (`pair_monitor` oracle);
+        // the fault is on the bus at the next status frame.
+        let flagged = b
+            .status_frames()
+            .into_iter()
+            .find(|(t, s)| *t >= C - 50 * MS && s.fault_accel_sensor())
+            .map(|(t, _)| t);
+        assert!(
+            flagged.is_some_and(|t| t <= C - 20 * MS),
+            "{offset_g} g: flagged at {flagged:?}"
+        );
+        assert!(!reasons_at(&b, C - 10 * MS).contains(Degraded::SAFING_INVALID));
+        // The backup path, timed from the safing sensor's onset at C: the reference airbag at
+        // C + 10 ms (the vehicle frame at C confirms), whatever the crash sensor reads.
+        let (t, cmd) = b
+            .first_airbag_fire()
+            .unwrap_or_else(|| panic!("{offset_g} g: no airbag"));
+        assert_eq!(
+            cmd.cmd_source(),
+            bus::codec::AirbagStageCmdCmdSource::Reference
+        );
+        assert!(
+            (C + 10 * MS..=C + 11 * MS).contains(&t),
+            "{offset_g} g: {t}"
+        );
+        assert!(pretensioner_fired(&b), "{offset_g} g");
+    }
+}
+
+#[test]
+fn a_flagged_crash_sensor_fires_nothing_without_a_crash() {
+    // The same offsets on a car cruising on: flagged, and nothing fires — the flag only takes
+    // a path away (the backup path needs a predicted crash and the vehicle deceleration).
+    for offset_g in [-6.0, 3.0, 8.0, 30.0] {
+        let b = crash_sensor_offset_from_before_contact(offset_g, false);
+        assert!(
+            reasons_at(&b, C).contains(Degraded::ACCEL_INVALID),
+            "{offset_g} g: not flagged"
+        );
+        assert!(!airbag_fired(&b), "{offset_g} g: airbag");
+        assert!(!pretensioner_fired(&b), "{offset_g} g: pretensioner");
+    }
+}
