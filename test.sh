@@ -4,7 +4,7 @@
 #   vcan run inside a QEMU guest with a real Debian kernel when this kernel has no SocketCAN; a small
 #   characteristic diagram is built end to end), fuzzes every decoder and parser briefly,
 #   and checks the deterministic instruction-count budget of the worst-case ECU cycle.
-# Wall-clock budgets are a separate command (README, "Timing"): this VM is too noisy
+# Wall-clock budgets are a separate command (docs/results.md, "Timing"): this VM is too noisy
 # for a test to fail on them.
 set -euo pipefail
 cd "$(dirname "$0")"

@@ -19,7 +19,7 @@
 //! | no margins | no ride-down reserve (10 mm), no fire-delay tolerance (3 ms), the airbag free to fire from contact (no crash-confirmation floor) |
 //!
 //! The lever that moves a_max / a\* most is what limits the optimum in this model; the
-//! figures are in the main README ("Towards the bound").
+//! figures are in docs/results.md ("Towards the bound").
 
 use crate::optimise::{OptimiserConfig, SearchSpace, Var};
 use crate::table::{optimise_query, sample_cells, Grid};

@@ -36,7 +36,7 @@ pub const RUN_MF4: &str = "run.mf4";
 /// The run summary's line for `path`.
 pub fn summary_line(path: &Path, s: &Mf4Summary) -> String {
     format!(
-        "recording (MDF 4.1): {} ({} CAN frames, {} diagnostics records, {:.0} kB; open in asammdf or CANape, README \"Recordings\"){}",
+        "recording (MDF 4.1): {} ({} CAN frames, {} diagnostics records, {:.0} kB; open in asammdf or CANape, docs/using.md \"Recordings\"){}",
         path.display(),
         s.can_frames,
         s.diagnostics,

@@ -72,7 +72,7 @@ fn read_note(path: &Path) -> Result<Pending> {
 /// The run summary's line for a recording.
 pub fn summary_line(dir: &Path, s: &WriteSummary, cost: &str) -> String {
     format!(
-        "recording: {} ({} messages on {} topics, {:.0} kB, {cost}; open in Foxglove, README \"Recordings\")",
+        "recording: {} ({} messages on {} topics, {:.0} kB, {cost}; open in Foxglove, docs/using.md \"Recordings\")",
         dir.join(RUN_MCAP).display(),
         s.messages.values().sum::<u64>(),
         s.messages.len(),

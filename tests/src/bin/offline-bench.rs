@@ -170,7 +170,7 @@ fn run_all() -> Result<bool> {
     say("(! = bottomed out; confirm = first ECU cycle in mode crash; airbag = ms after the true contact, plan = its FireTime; action lines: ms after the true contact, or after the start without one; times on the simulated 1 kHz grid, no CAN latency)");
     if let Some(dir) = &cli.record {
         say(&format!(
-            "recordings: {recorded} runs in {}/<scenario>/run.mcap ({:.1} MB; simulated clock, no bus latency; README \"Recordings\")",
+            "recordings: {recorded} runs in {}/<scenario>/run.mcap ({:.1} MB; simulated clock, no bus latency; docs/using.md \"Recordings\")",
             dir.display(),
             recorded_bytes as f64 / 1e6
         ));

@@ -247,7 +247,7 @@ fn with_v2x_the_nominal_benefit_is_within_4_points_of_no_margin() {
     let shipped = cfg();
     let mut no_margin = cfg();
     no_margin.cycle.mass_misreport_kg = 0.0;
-    // The six the margin studies average over (README, "Robust cells").
+    // The six the margin studies average over (docs/results.md, "Robust cells").
     let cases = lut::robust_cells::LIBRARY_CASES.map(|c| c.0);
     let change = |s: &Scenario, c: &OfflineConfig| {
         let r = run(s, c).expect("offline run");
