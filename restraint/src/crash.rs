@@ -286,6 +286,11 @@ impl CrashMonitor {
         self.pretensioner.decision()
     }
 
+    /// The accelerometer event in progress is still loading (`FallbackAlgorithm::loading`).
+    pub fn event_loading(&self) -> bool {
+        self.fallback.loading()
+    }
+
     /// An accelerometer event is in progress on any detector (the conventional algorithms
     /// track every event, also after a confirmation).
     pub fn event_in_progress(&self) -> bool {

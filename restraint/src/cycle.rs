@@ -342,6 +342,8 @@ impl Activity for RestraintCycle<'_> {
         let situation = est.situation;
         let c = &mut self.counters;
         // A table lookup, asked only when a crash phase is entered with a belt-only plan.
+        let crash = &self.crash;
+        let event_loading = || crash.event_loading();
         let heaviest_fires_airbag =
             || situation.is_some_and(|s| est.heaviest_opponent_fires_airbag(&s, inputs));
         let mut replan = |closing_mps: f64| {
@@ -362,6 +364,7 @@ impl Activity for RestraintCycle<'_> {
             backup_for_disagreement,
             event_in_progress: self.crash.event_in_progress(),
             event_dv_mps: self.crash.event_dv_mps(),
+            event_loading: &event_loading,
             floor_lift_mps: self.crash.floor_lift_mps(),
             matched_course_broken: self.crash.matcher().course_broken_ns().is_some(),
             heaviest_fires_airbag: &heaviest_fires_airbag,

@@ -103,6 +103,9 @@ pub(crate) struct DecisionInputs<'d> {
     pub event_in_progress: bool,
     /// The velocity change of the current accelerometer event since its onset, m/s.
     pub event_dv_mps: f64,
+    /// Whether the current accelerometer event is still loading (`CrashMonitor::event_loading`;
+    /// asked only where a matched fire held below its floor has the Δv).
+    pub event_loading: &'d dyn Fn() -> bool,
     /// What the road's roughness adds to every severity floor, m/s (`roughness`).
     pub floor_lift_mps: f64,
     /// A matched confirmation's pulse has left its ramp (`PulseMatch::course_broken_ns`).
@@ -548,12 +551,14 @@ impl Decision {
     }
 
     /// A matched crash's fire that is due waits until its event has carried `floor_mps` since
-    /// the onset (issue 31, near misses): a pothole or kerb strike at the predicted contact of
-    /// a collision that does not happen can follow the predicted ramp for the few ms before a
-    /// planned fire, but carries at most the misuse envelope's Δv (1.2 m/s at 1.5 × the
-    /// pothole's), which the floors exceed; a crash of the table's range carries it 4–9 ms
-    /// after contact. Postponed to the next cycle while below; dropped (`true`) when the event
-    /// ended without it.
+    /// the onset while it is still loading (near misses): a pothole or kerb strike at the
+    /// predicted contact of a collision that does not happen can follow the predicted ramp for
+    /// the few ms before a planned fire, but carries at most the misuse envelope's net Δv (1.2
+    /// m/s at 1.5 × the pothole's), which the floors exceed — only its ringing's overshoot can
+    /// pass a floor for a moment, on its falling flank, where the loading rule (the smoothed
+    /// deceleration at ≥ 85 % of its peak, as for the accelerometer-only decision) says no; a
+    /// crash of the table's range carries the floor 4–9 ms after contact, still loading.
+    /// Postponed to the next cycle while not; dropped (`true`) when the event ended without it.
     fn hold_below_floor(
         slot: &mut Option<u64>,
         floor_mps: f64,
@@ -562,7 +567,7 @@ impl Decision {
     ) -> bool {
         let Some(t) = *slot else { return false };
         if now.saturating_add(x.half_period_ns) < t
-            || x.event_dv_mps >= floor_mps + x.floor_lift_mps
+            || (x.event_dv_mps >= floor_mps + x.floor_lift_mps && (x.event_loading)())
         {
             return false;
         }

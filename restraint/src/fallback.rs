@@ -282,6 +282,14 @@ impl FallbackAlgorithm {
         self.onset.delta_v_mps()
     }
 
+    /// The event is still loading (its judged segment's smoothed deceleration at least
+    /// `loading_fraction` of its peak, or the segment past [`LOADING_EXEMPT_DV_MPS`]): what the
+    /// loading rule asks of a deciding sample, asked of the newest one.
+    pub fn loading(&self) -> bool {
+        let dv = self.onset.delta_v_mps() - self.segment_base_dv_mps;
+        dv >= LOADING_EXEMPT_DV_MPS || self.loading.holds(self.floor.loading_fraction)
+    }
+
     /// Whether an event is in progress.
     pub fn awake(&self) -> bool {
         self.onset.awake()
@@ -421,6 +429,30 @@ mod tests {
                 0.0,
             );
         }
+    }
+
+    #[test]
+    fn an_event_is_loading_while_its_deceleration_holds_near_its_crest() {
+        // 2 g/ms up to 20 g, 5 ms at 20 g, then down at 2 g/ms: loading on the ramp and the
+        // plateau; three samples into the fall (14 g, 70 % of the crest; the smoothing's 0.25 ms
+        // lags it by < 1 g) it is not, as every sample after.
+        let g = |k: u64| match k {
+            0..=9 => 2.0 * (k + 1) as f64,
+            10..=14 => 20.0,
+            _ => (20.0 - 2.0 * (k - 14) as f64).max(0.0),
+        };
+        let mut f = FallbackAlgorithm::new([f64::INFINITY; KNOTS], floor());
+        for k in 0..15 {
+            run_fn_from(&mut f, k, 1, g);
+            assert!(f.loading(), "sample {k}: {} g", g(k));
+        }
+        run_fn_from(&mut f, 15, 3, g);
+        assert!(!f.loading());
+        // A segment past LOADING_EXEMPT_DV_MPS is loading whatever its deceleration: 20 g for
+        // 30 ms carries 5.9 m/s, then 3 g.
+        let mut f = FallbackAlgorithm::new([f64::INFINITY; KNOTS], floor());
+        run_fn(&mut f, 40, |k| if k < 30 { 20.0 } else { 3.0 });
+        assert!(f.loading());
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! previous record's buffer without clearing it (the shell's triple buffer, `SimIo`).
 
 use crate::cycle_support::{Bench, MS, T0};
-use restraint::{Activity as _, EcuDiagnostics, PULSE_POINTS};
+use restraint::{EcuDiagnostics, PULSE_POINTS};
 
 /// A record whose every field differs from anything the cycle writes in these runs.
 fn garbage() -> EcuDiagnostics {
@@ -81,13 +81,7 @@ fn every_field_is_written_with_and_without_a_prediction() {
 }
 
 fn counter(b: &crate::cycle_support::Bench, name: &str) -> u64 {
-    let mut v = None;
-    b.ecu.report_counters(&mut |n, x| {
-        if n == name {
-            v = Some(x);
-        }
-    });
-    v.unwrap_or_else(|| panic!("no counter {name}"))
+    b.counter(name)
 }
 
 /// The wait for the first object is counted as stale but not as lost: a bench asking "did the

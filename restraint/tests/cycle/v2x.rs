@@ -10,7 +10,6 @@
 use crate::cycle_support::*;
 use bus::codec::{BeltLimiterCmdPretensionerCmd, V2xOpponentMassStationStatus};
 use bus::V2xOpponentMass;
-use restraint::Activity;
 
 /// Contact of the approach.
 const C: u64 = T0 + 1_000 * MS;
@@ -80,16 +79,7 @@ fn preset_belt_kn(station: Option<Station>) -> (f32, u64) {
         .iter()
         .find(|(_, f)| f.pretensioner_cmd() == BeltLimiterCmdPretensionerCmd::Fire)
         .expect("pretensioner fired before contact");
-    let mut v2x_lookups = None;
-    b.ecu.report_counters(&mut |n, x| {
-        if n == "v2x_lookups" {
-            v2x_lookups = Some(x);
-        }
-    });
-    (
-        f.load_limiter_level(),
-        v2x_lookups.expect("counter reported"),
-    )
+    (f.load_limiter_level(), b.counter("v2x_lookups"))
 }
 
 /// The belt level the test LUT gives at 90 km/h for `planning_kg`, as the DBC carries it.

@@ -346,6 +346,18 @@ impl Bench {
             .collect()
     }
 
+    /// The reports' counter `name` (`Activity::report_counters`).
+    pub fn counter(&self, name: &str) -> u64 {
+        use restraint::Activity;
+        let mut v = None;
+        self.ecu.report_counters(&mut |n, x| {
+            if n == name {
+                v = Some(x);
+            }
+        });
+        v.unwrap_or_else(|| panic!("no counter {name}"))
+    }
+
     /// The first AirbagStageCmd that fires, with its time.
     pub fn first_airbag_fire(&self) -> Option<(u64, bus::AirbagStageCmd)> {
         self.airbag_frames()
