@@ -227,10 +227,16 @@ fn generate_meta(dbc: &Dbc) -> String {
             let raw_max = ((max - s.offset) / s.factor + 1e-6).floor() as i128;
             let scaled = s.factor != 1.0 || s.offset != 0.0;
             let has_vt = dbc.value_descriptions_for_signal(msg.id, &s.name).is_some();
+            let values = if has_vt {
+                format!("Self::{}_VALUES", s.name.to_snake_case().to_uppercase())
+            } else {
+                "&[]".to_owned()
+            };
             writeln!(
                 sig_rows,
                 "    SignalInfo {{ name: {:?}, start_bit: {}, size: {}, signed: {signed}, factor: {:?}, \
-                 offset: {:?}, min: {min:?}, max: {max:?}, raw_min: {raw_min}, raw_max: {raw_max}, unit: {:?} }},",
+                 offset: {:?}, min: {min:?}, max: {max:?}, raw_min: {raw_min}, raw_max: {raw_max}, unit: {:?}, \
+                 values: {values} }},",
                 s.name, s.start_bit, s.size, s.factor, s.offset, s.unit
             )
             .unwrap();

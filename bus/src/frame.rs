@@ -46,6 +46,8 @@ pub struct SignalInfo {
     pub raw_max: i64,
     /// DBC unit.
     pub unit: &'static str,
+    /// The signal's value table (`VAL_`: raw value → DBC name; empty when it has none).
+    pub values: &'static [(i64, &'static str)],
 }
 
 impl SignalInfo {

@@ -16,6 +16,12 @@
 //!   followed by an `AirbagStageAuth` with freshness `F` and a MAC the attacker has to guess —
 //!   exactly what someone with the public DBC but without the key can put on the bus.
 //!
+//! * `bus-inject encode MESSAGE SIGNAL=VALUE … [--counter N] [--count K] [--candump]` prints a
+//!   frame the ECU accepts — every signal but the E2E ones given (a physical value in the DBC's
+//!   unit, or a value name such as `BrakeState=Released`), the alive counter `N` and the CRC
+//!   filled in — as a `cansend` argument (`0A0#…`), or `K` consecutive frames (counters
+//!   N, N+1, … mod 16) one per line, or as candump `-L` lines (`--candump`, for `canplayer`).
+//!
 //! E2E positions come from the DBC, through `bus::RawFrame`'s `corrupt_crc`,
 //! `set_e2e_counter` and `reseal`: nothing here types a byte position.
 
@@ -62,6 +68,35 @@ enum Cmd {
         /// Delay of the copies in `delay` mode, ms.
         #[arg(long, default_value_t = 200.0)]
         delay_ms: f64,
+    },
+    /// Print a frame the ECU accepts: signals from the command line, the E2E counter and CRC
+    /// filled in (cansend `ID#HEX`, or candump -L lines with --candump).
+    Encode {
+        /// The message: its DBC name (`EgoVehicleState`), or its id (0x0A0 / 160).
+        #[arg(value_name = "MESSAGE", value_parser = parse_message)]
+        message: u32,
+        /// `SIGNAL=VALUE` for every signal of the message but `Crc` and `AliveCounter`: a
+        /// physical value in the DBC's unit (`EgoSpeed=13.9`) or a value name
+        /// (`BrakeState=Released`).
+        #[arg(value_name = "SIGNAL=VALUE")]
+        signals: Vec<String>,
+        /// Alive counter of the (first) frame, 0..=15: one more than the sender's last, for a
+        /// stream the receiver already follows.
+        #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u8).range(0..=15))]
+        counter: u8,
+        /// Print this many consecutive frames (the counter advancing mod 16), one per line.
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+        count: u32,
+        /// Print candump `-L` lines (`(seconds) IFACE ID#HEX`, one per --period-ms) for
+        /// `canplayer`, instead of `cansend` arguments.
+        #[arg(long)]
+        candump: bool,
+        /// Interface named in the candump lines.
+        #[arg(long, default_value = "vcan0")]
+        can: String,
+        /// Spacing of the candump lines' time stamps, ms (default: the DBC's cycle time).
+        #[arg(long, value_name = "MS")]
+        period_ms: Option<f64>,
     },
     /// Print a forged Armed+Fire AirbagStageCmd and a guessed authenticator as `cansend` args.
     ForgeFire {
@@ -152,8 +187,108 @@ fn forge_fire(counter: u8, freshness: u32, mac: u64) -> Result<(RawFrame, RawFra
     Ok((cmd, auth))
 }
 
+/// The frame of message `id` with `assignments` (`SIGNAL=VALUE`), alive counter `counter` and
+/// its CRC (an unprotected message: as given).
+fn encode(id: u32, assignments: &[String], counter: u8) -> Result<RawFrame> {
+    let info = bus::message_info(id).with_context(|| format!("0x{id:03X} is not in the DBC"))?;
+    let sigs = bus::signals_of(id).with_context(|| format!("{} has no signals", info.name))?;
+    let e2e = info.e2e_data_id.is_some();
+    let computed = |n: &str| e2e && (n == "Crc" || n == "AliveCounter");
+    let mut values: Vec<Option<f64>> = vec![None; sigs.len()];
+    for a in assignments {
+        let (name, value) = a
+            .split_once('=')
+            .with_context(|| format!("{a:?} is not SIGNAL=VALUE"))?;
+        let Some(i) = sigs.iter().position(|s| s.name == name) else {
+            let names: Vec<&str> = sigs
+                .iter()
+                .map(|s| s.name)
+                .filter(|n| !computed(n))
+                .collect();
+            bail!(
+                "{} has no signal {name:?} (its signals: {})",
+                info.name,
+                names.join(", ")
+            );
+        };
+        let s = &sigs[i];
+        if computed(s.name) {
+            bail!("{} is computed here (the alive counter: --counter)", s.name);
+        }
+        let v = match s.values.iter().find(|(_, n)| *n == value) {
+            Some(&(raw, _)) => raw as f64 * s.factor + s.offset,
+            None => value.parse::<f64>().map_err(|_| {
+                let names: Vec<&str> = s.values.iter().map(|(_, n)| *n).collect();
+                let hint = if names.is_empty() {
+                    format!("a number in {} … {} {}", s.min, s.max, s.unit)
+                } else {
+                    format!("one of {} or its number", names.join(", "))
+                };
+                anyhow::anyhow!("{}.{}: {value:?} is not {hint}", info.name, s.name)
+            })?,
+        };
+        if values[i].replace(v).is_some() {
+            bail!("{}.{} is given twice", info.name, s.name);
+        }
+    }
+    let missing: Vec<&str> = sigs
+        .iter()
+        .zip(&values)
+        .filter(|(s, v)| v.is_none() && !computed(s.name))
+        .map(|(s, _)| s.name)
+        .collect();
+    if !missing.is_empty() {
+        bail!("{} needs a value for {}", info.name, missing.join(", "));
+    }
+    let raw: Vec<f64> = values.iter().map(|v| v.unwrap_or(0.0)).collect();
+    let mut f = bus::encode_values(id, &raw).map_err(|e| {
+        let s = sigs.iter().find(|s| s.name == e.signal);
+        match s {
+            Some(s) => anyhow::anyhow!(
+                "{}.{} is outside the DBC's {} … {} {}",
+                e.message,
+                e.signal,
+                s.min,
+                s.max,
+                s.unit
+            ),
+            None => anyhow::anyhow!("{e}"),
+        }
+    })?;
+    if e2e {
+        f.set_e2e_counter(counter);
+    }
+    Ok(f)
+}
+
 fn run(cli: Cli) -> Result<()> {
     match cli.cmd {
+        Cmd::Encode {
+            message,
+            signals,
+            counter,
+            count,
+            candump,
+            can,
+            period_ms,
+        } => {
+            let period_s = period_ms
+                .or_else(|| bus::message_info(message)?.cycle_time_ms.map(f64::from))
+                .unwrap_or(10.0)
+                * 1e-3;
+            if !(period_s.is_finite() && period_s > 0.0) {
+                bail!("--period-ms must be positive");
+            }
+            for k in 0..count {
+                let f = encode(message, &signals, ((u32::from(counter) + k) % 16) as u8)?;
+                if candump {
+                    println!("({:.6}) {can} {}", f64::from(k) * period_s, cansend_arg(&f));
+                } else {
+                    println!("{}", cansend_arg(&f));
+                }
+            }
+            Ok(())
+        }
         Cmd::ForgeFire {
             counter,
             freshness,

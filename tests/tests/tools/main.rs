@@ -3,6 +3,7 @@
 //! this package links the whole bench (iceoryx2, SocketCAN, plotters …), 30–60 s of the suite's
 //! build apiece, and these four need nothing of their own.
 
+mod bus_encode;
 mod docs_check;
 mod matrix_cli;
 mod matrix_slurm;
