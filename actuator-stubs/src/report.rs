@@ -53,7 +53,7 @@ pub struct Judged {
 }
 
 /// An action with its time on the run's two time bases — the same two keys, with the same
-/// meaning, as `offline-bench --json` (issue 32).
+/// meaning, as `offline-bench --json`.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct TimedAction {
     /// The action.

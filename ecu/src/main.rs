@@ -58,7 +58,7 @@ fn load_lut(cfg: &EcuConfig, no_lut: bool) -> anyhow::Result<Option<diagram::Dia
     })
 }
 
-/// The SecOC sender. Fail closed (issue 22): without usable keys the ECU's fire commands would
+/// The SecOC sender. Fail closed: without usable keys the ECU's fire commands would
 /// go out unauthenticated, so it does not start unless the user asked for that with
 /// `--no-secoc` (then `EcuStatus.FaultConfig` is set and the start-up line says so).
 fn load_secoc(cfg: &EcuConfig, no_secoc: bool) -> anyhow::Result<Option<bus::secoc::SecOcTx>> {

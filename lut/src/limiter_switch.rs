@@ -1,4 +1,4 @@
-//! A two-level load limiter switched on what the pulse shows (issue 24 item 4): can it win
+//! A two-level load limiter switched on what the pulse shows: can it win
 //! back the benefit the +1 200 kg planning margin costs, and keep the guarantee?
 //!
 //! The margin exists because the opponent's mass does not show in the ego pulse before the

@@ -1,4 +1,4 @@
-//! The planning margin as a property of the table (issue 24): every cell's setting, planned for
+//! The planning margin as a property of the table: every cell's setting, planned for
 //! an opponent of the cell's mass M, judged on the true pulse of every opponent from M down to
 //! M − `span_kg` — no worse than the reference restraint, and no bottoming-out where the
 //! reference does not bottom out.

@@ -14,7 +14,7 @@
 //! reported `bottoming_out` flag is the physical one (excursion beyond the available ride-down),
 //! never hidden; an optimum that only eats into the reserve is reported with its excursion.
 //!
-//! **Plan = fire** (issue 30): the ECU fires a crash-phase airbag only once its event has
+//! **Plan = fire**: the ECU fires a crash-phase airbag only once its event has
 //! carried the airbag's severity floor (no misuse event does), so each cell's airbag time is
 //! searched from [`OptimiserConfig::earliest_airbag_s`] on — the instant the cell's own pulse
 //! carries the floor, plus the ECU's latency — and the bus's FireTime is when the bag fires.
@@ -209,7 +209,7 @@ pub struct OptimiserConfig {
     /// A firing airbag is also evaluated this much later; the worse cost counts [s]
     /// (see module docs, "Fire-delay robustness"). 0 disables it.
     pub fire_delay_tolerance_s: f64,
-    /// Plan = fire (issue 30): the ECU's crash-phase airbag waits until the event has carried
+    /// Plan = fire: the ECU's crash-phase airbag waits until the event has carried
     /// this velocity change since its onset [m/s] (`restraint`'s `fallback_min_dv_mps`, which
     /// the matched path's fires wait for too: no misuse event carries it), so a cell's airbag is
     /// planned no earlier than its own pulse reaches it plus [`Self::ecu_latency_s`]. 0 = off.

@@ -1,4 +1,4 @@
-//! Robust cells (issue 24 item 1), measured before they are built: what a cell optimised for the
+//! Robust cells, measured before they are built: what a cell optimised for the
 //! whole uncertainty set the ECU can be in would give on the library's nominal cases, against
 //! the two settings the ECU can use today.
 //!

@@ -263,7 +263,7 @@ impl Grid {
             no_fire_below_n: get(EXTRA_NO_FIRE)?.parse::<f64>()? * 1e3,
             reserve_m: get(EXTRA_RESERVE)?.parse::<f64>()? * 1e-3,
             fire_delay_tolerance_s: get(EXTRA_FIRE_DELAY)?.parse::<f64>()? * 1e-3,
-            // Tables built before plan = fire (issue 30) have no floor: 0 rebuilds them as built.
+            // Tables built before plan = fire have no floor: 0 rebuilds them as built.
             airbag_floor_dv_mps: get(EXTRA_AIRBAG_FLOOR).map_or(Ok(0.0), |v| v.parse())?,
             ecu_latency_s: get(EXTRA_ECU_LATENCY).map_or(Ok(0.0), |v| v.parse::<f64>())? * 1e-3,
         };

@@ -1,4 +1,4 @@
-//! Occupant model sanity (issue 2): physical orderings and limits, not model-computed numbers.
+//! Occupant model sanity: physical orderings and limits, not model-computed numbers.
 
 use physics::{
     collision::{simulate_collision, CollisionInput, DefaultPulseBuffer},
@@ -167,7 +167,7 @@ fn constant_pulse_ideal_bound_closed_form() {
     assert!((bound / oracle - 1.0).abs() < 0.01, "{bound} {oracle}");
 }
 
-// Two-level load limiter (issue 24 item 4): the switched model reduces to the single-level one
+// Two-level load limiter: the switched model reduces to the single-level one
 // at both ends, and meets a closed-form oracle in between.
 
 fn settings(limiter_kn: f64) -> RestraintSettings {

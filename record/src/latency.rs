@@ -1,6 +1,6 @@
 //! `record latency`: how long after the start of the ECU cycle that sent it, and after the
 //! newest crash-accelerometer sample that cycle had, each command frame arrived on the bus, from
-//! a recording's own times (issue 23 item 4).
+//! a recording's own times.
 //!
 //! A frame's cycle is the latest cycle started at or before its arrival: the cycles' start
 //! times are the diagnostics records' `timestamp_ns` (the cycle's wake time on

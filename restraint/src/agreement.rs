@@ -1,5 +1,5 @@
 //! Severity agreement: the safing sensor must have measured the crash sensor's velocity change
-//! over the same window, not merely seen an event (issue 31 item 1).
+//! over the same window, not merely seen an event.
 //!
 //! **Why.** The safing channel closes on any event of its own that reaches 0.2 m/s; a real
 //! misuse event (a door slam's ringing, a pothole) does that. If the crash sensor fails during

@@ -182,7 +182,7 @@ pub struct CycleConfig {
     /// onset is this much later than the contact that caused it, so the crash phase dates
     /// the contact this much earlier and the plan's fire times keep their meaning.
     pub accel_delay_ms: f64,
-    /// One object fault must not move a crash across the no-fire line (issue 31): a crash
+    /// One object fault must not move a crash across the no-fire line: a crash
     /// the prediction matched fires before the measured pulse confirms it only when it would
     /// be above the no-fire line even with the lightest opponent on the road
     /// (`lightest_opponent_kg`, *default* 800 kg: a mass the object sensor misreports can be

@@ -44,7 +44,7 @@ pub struct RestraintCycle<'lut> {
     decision: Decision,
     crash: CrashMonitor,
     safing: Safing,
-    /// The two accelerometers' Δv over the same window (issue 31 item 1).
+    /// The two accelerometers' Δv over the same window.
     agreement: SeverityAgreement,
     /// The two accelerometers against each other and the vehicle frame (offset, noise).
     pair: PairMonitor,

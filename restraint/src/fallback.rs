@@ -457,7 +457,7 @@ mod tests {
 
     #[test]
     fn a_spike_never_decides_and_a_decision_ends_with_its_event() {
-        // Reproduction (issue 20): one 15 g sample (Δv 0.147 m/s ≥ T(1 ms) = 0.1375) used to
+        // Reproduction: one 15 g sample (Δv 0.147 m/s ≥ T(1 ms) = 0.1375) used to
         // latch a must-fire for good; a 4.5 g × 40 ms bump 0.5 s later then fired the airbag.
         for spike_g in [15.0, 25.0, 40.0, 60.0, 150.0] {
             let mut f = FallbackAlgorithm::new(DEFAULT_DV_MPS, floor());

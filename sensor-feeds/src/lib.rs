@@ -4,7 +4,7 @@
 //! hands the same records to the ECU core under a simulated clock.
 //!
 //! The world's modules and types are re-exported under their old paths
-//! (`sensor_feeds::scenario`, `sensor_feeds::Truth`, …): they moved to `world` (issue 21),
+//! (`sensor_feeds::scenario`, `sensor_feeds::Truth`, …): they moved to `world`,
 //! unchanged.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]

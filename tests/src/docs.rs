@@ -1,4 +1,4 @@
-//! The docs check (issue 22 item 6): every command in a README is run, or — where running it
+//! The docs check: every command in a README is run, or — where running it
 //! takes a bench, root or an hour — its tool and flags are checked against the tool's own
 //! `--help`; every number a command prints is the command's output, regenerated and compared,
 //! never retyped.

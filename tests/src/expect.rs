@@ -1,4 +1,4 @@
-//! The one judge of a scenario's `[expect]` block (issue 32 item 1): the offline bench and the
+//! The one judge of a scenario's `[expect]` block: the offline bench and the
 //! real bench read a run into [`Observed`] their own way, and [`check`] compares it with every
 //! key the file sets. `offline-bench` and `hil-bench` exit non-zero on any mismatch (unless
 //! `--no-expect`), naming the scenario, the key, the expected and the measured value; the

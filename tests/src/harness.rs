@@ -156,7 +156,7 @@ pub fn deal<T: Clone>(items: &[T], n: usize) -> Vec<Vec<T>> {
 /// in the repository root; prints each guest's stdout and stderr under a `--- WHAT, guest k
 /// of n ---` header and returns their outputs in the same order. `out` is the folder the
 /// runs write under, made here and shared into the guest read-write (`VCAN_GUEST_RW`), as a
-/// user's `--out` anywhere is (issue 22 item 2).
+/// user's `--out` anywhere is.
 pub fn run_in_guests(
     what: &str,
     out: &Path,

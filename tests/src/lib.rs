@@ -93,7 +93,7 @@ pub fn fell_back_after_normal(modes: &[(f64, String)]) -> Option<f64> {
 
 /// The repository a bench tool works on when `--repo` is not given: the checkout the user is
 /// in (walking up from the current folder, then from the tool's own folder), never the folder
-/// the tool was built in (issue 22).
+/// the tool was built in.
 pub fn repo_or_default(given: Option<PathBuf>) -> Result<PathBuf> {
     match given {
         Some(r) => Ok(r),

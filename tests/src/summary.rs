@@ -143,7 +143,7 @@ pub fn summarise(
             .collect();
         let _ = writeln!(s, "  ECU faults (EcuStatus): {}", faults.join(" → "));
     }
-    // Which opponent mass the ECU's plans were for (issue 24), from its counters.
+    // Which opponent mass the ECU's plans were for, from its counters.
     let counter = |k: &str| crate::ecu_counter(ecu, k);
     if let (Some(lookups @ 1..), Some(v2x)) = (counter("lut_lookups"), counter("v2x_lookups")) {
         let _ = writeln!(

@@ -335,7 +335,7 @@ fn candump_log_decodes_with_cantools_and_the_dbc() {
 /// (record/check_mcap.py: Foxglove's `mcap` package and cantools): every candump frame with its
 /// bytes and time, every DBC message decoded as cantools decodes it, the stubs' commands,
 /// actions and verdict — on the bench's CLOCK_MONOTONIC (the offset measured from the run) and
-/// ≤ 20 MB (issue 23). And, asked for with `--mf4`, a `run.mf4` that asammdf reads as CAN bus
+/// ≤ 20 MB. And, asked for with `--mf4`, a `run.mf4` that asammdf reads as CAN bus
 /// logging and decodes with the DBC as cantools does, its diagnostics equal to the MCAP's
 /// (record/check_mf4.py, all runs in one Python process).
 #[test]

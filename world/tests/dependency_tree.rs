@@ -54,7 +54,7 @@ fn the_world_depends_on_no_io_crate() {
 }
 
 /// The transport carries the `signals` records and does not link the restraint core: the
-/// feeds and the stubs, which use `ipc`, never compile the ECU's logic (issue 21 item 2).
+/// feeds and the stubs, which use `ipc`, never compile the ECU's logic.
 /// (Here, not in `ipc`'s own tests: a test binary of `ipc` would link iceoryx2 for a
 /// `cargo tree` call.)
 #[test]

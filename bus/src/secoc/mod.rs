@@ -1,4 +1,4 @@
-//! AUTOSAR-SecOC-style authentication of the two fire-command streams (issue 8).
+//! AUTOSAR-SecOC-style authentication of the two fire-command streams.
 //!
 //! E2E protection (CRC + alive counter) detects corruption, but anyone on the bus can compute a
 //! CRC: `cansend vcan0 030#…` with a correct CRC would fire an airbag. SecOC adds what E2E lacks,

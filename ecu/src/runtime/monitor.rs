@@ -73,7 +73,7 @@ pub fn format_line(d: &EcuDiagnostics, rx_rate_hz: f64) -> String {
         format_estimate(d),
         d.predicted_delta_v_mps,
         d.predicted_a_max_mps2,
-        // kN and ms, as the rest of the bench says them (issue 22 item 5).
+        // kN and ms, as the rest of the bench says them.
         d.belt_force_limit_n / 1e3,
         d.pretensioner_time_s * 1e3,
         d.airbag_stage,

@@ -313,7 +313,7 @@ fn started_from_another_folder_the_ecu_finds_its_table_and_keys() {
 
 #[test]
 fn missing_keys_or_table_stop_the_ecu_unless_it_is_asked_to_run_without_them() {
-    // Fail closed (issue 22): one clear line naming the file and the flag; exit != 0.
+    // Fail closed: one clear line naming the file and the flag; exit != 0.
     let here = tmpdir("failclosed");
     let (ok, err) = short_run(&here, "nokeys", &["--secoc-keys", "/nonexistent/keys.toml"]);
     assert!(!ok, "started without keys: {err}");

@@ -1,4 +1,4 @@
-//! The ECU shell's safing-accelerometer port (`IceoryxIo::drain_safing`, issue 20): it receives
+//! The ECU shell's safing-accelerometer port (`IceoryxIo::drain_safing`): it receives
 //! the safing service's batches in order, never the crash accelerometer's, counts its receive
 //! errors apart, and — a cycle-path call — neither allocates nor blocks.
 

@@ -1,4 +1,4 @@
-//! `bus-inject`: a bus attacker / faulty node for the fault campaign (issue 8).
+//! `bus-inject`: a bus attacker / faulty node for the fault campaign.
 //!
 //! * `bus-inject mirror --mode crc|counter|replay|delay --message EgoVehicleState --epoch-ns N --from-s A --to-s B`
 //!   watches a message on the live bus and, for every genuine frame seen inside the window

@@ -1,5 +1,5 @@
 //! `docs-check`: runs every command of the repository's Markdown files and compares every
-//! printed number with what the command prints now (issue 22 item 6; markers and rules in
+//! printed number with what the command prints now (markers and rules in
 //! `e2e_tests::docs`). `./test.sh` runs it; `docs-check --fix` rewrites stale output blocks.
 //!
 //! Exit 0 when every block holds, 1 naming each one that does not (file:line, command, the

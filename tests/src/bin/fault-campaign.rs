@@ -1,4 +1,4 @@
-//! `fault-campaign`: the fault-injection campaign and the robustness report (issue 8).
+//! `fault-campaign`: the fault-injection campaign and the robustness report.
 //!
 //! * `fault-campaign run [--out DIR] [--case NAME …]` runs the cases (tests/src/faults/) on a
 //!   CAN interface that must exist — start it through

@@ -63,7 +63,7 @@ fn main() -> std::process::ExitCode {
 /// One scenario run; where the route's timing is emulated, a run the machine starved
 /// ([`e2e_tests::route::starved_run`]) is run again, up to the route's allowance — but never a
 /// run whose fire / no-fire outcome contradicts the scenario's `[expect] airbag_fires`: that
-/// verdict stands as measured (issue 30). Every retry is in the summary, in `report.json`
+/// verdict stands as measured. Every retry is in the summary, in `report.json`
 /// (`retries`: why each earlier run was not taken) and on the `--brief` line. With real
 /// timers: one run, judged as it is.
 fn run_until_measured(cfg: &RunConfig) -> Result<(e2e_tests::RunResult, Vec<String>)> {

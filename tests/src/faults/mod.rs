@@ -1,4 +1,4 @@
-//! The fault-injection campaign (issue 8): real bench processes on vcan (a QEMU guest with a
+//! The fault-injection campaign: real bench processes on vcan (a QEMU guest with a
 //! real Debian kernel where the host has no SocketCAN), one fault per run, judged against a
 //! clean baseline run.
 //!

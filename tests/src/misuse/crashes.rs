@@ -1,4 +1,4 @@
-//! Crashes (issue 20): below the no-fire line, must-fire, misreported, and the beyond-physics sweep.
+//! Crashes: below the no-fire line, must-fire, misreported, and the beyond-physics sweep.
 
 use super::text::*;
 use super::*;

@@ -1,4 +1,4 @@
-//! Misuse as physics makes it (issue 30): the families of mechanical events.
+//! Misuse as physics makes it: the families of mechanical events.
 
 use super::text::*;
 use super::*;

@@ -1,4 +1,4 @@
-//! Single sensor faults (issue 20), alone and inside real events (issue 31).
+//! Single sensor faults, alone and inside real events.
 
 use super::text::*;
 use super::*;

@@ -2,7 +2,7 @@
 //! seeded families of scenarios, each built in code from the documented scenario schema and
 //! judged by what its family requires.
 //!
-//! ## Misuse as physics makes it (issue 30)
+//! ## Misuse as physics makes it
 //! A mechanical event changes the car's speed by the impulse its contact can carry,
 //! Δv = J / m (J = ∫F dt); what the tunnel-mounted ECU measures on top is zero-mean structural
 //! ringing, which can be large while its integral is zero. Each misuse family is therefore a
@@ -28,7 +28,7 @@
 //! a 15 g × 20 ms "pothole" is Δv 1.87 m/s, a 260 kN longitudinal peak) stays as the
 //! **beyond-physics** report: printed, where each floor sits, not a gate.
 //!
-//! ## Single faults inside real events (issue 31)
+//! ## Single faults inside real events
 //! | family | what | requirement |
 //! |---|---|---|
 //! | stuck-crash-sensor-in-door-slam | door slam (as above) on a standing car while the crash sensor sticks for 100 ms | no fire |
@@ -40,7 +40,7 @@
 //! | braking-and-pothole | ABS braking at 0.6–1 g with a 0.72–0.76 m/s pothole with rebound (× 1.5: up to 1.14), or with a 0.5–1.3 g crash-sensor offset | no fire |
 //! | near-miss | closing 40–110 km/h (and 30 + 30), the opponent evading 1–50 ms before the predicted contact, a 0.4–0.8 m/s pothole (× 1.5) within ±20 ms of it; also: the ECU must not stay in CrashDetected | no fire, back to Normal |
 //!
-//! ## Faults and must-fire crashes (issue 20)
+//! ## Faults and must-fire crashes
 //! Spikes, offsets, dead / stuck / noisy sensors, crashes below the no-fire line and must-fire
 //! crashes (with a misreported opponent, with a dead safing sensor) keep their ranges of issue 20
 //! (table in [`FAMILIES`]' docs).
@@ -110,7 +110,7 @@ pub struct Family {
     make: fn(&mut ChaCha8Rng, &str, u64) -> String,
 }
 
-/// 1.5 × the envelope: every physical bound is sampled up to this multiple (issue 30).
+/// 1.5 × the envelope: every physical bound is sampled up to this multiple.
 pub const MARGIN: f64 = 1.5;
 const G: f64 = 9.806_65;
 /// Ego wheelbase [m] (the rear axle meets an edge a wheelbase / v after the front).

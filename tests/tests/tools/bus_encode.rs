@@ -2,19 +2,11 @@
 //! byte for byte what cantools encodes from the DBC with an independently written CRC
 //! (`bus/tests/cantools_check.py`).
 
-use std::process::Command;
-
 fn encode(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_bus-inject"))
-        .arg("encode")
-        .args(args)
-        .output()
-        .expect("run bus-inject");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let args: Vec<&str> = std::iter::once("encode")
+        .chain(args.iter().copied())
+        .collect();
+    crate::run_tool(env!("CARGO_BIN_EXE_bus-inject"), &args)
 }
 
 /// `ID#HEX` → (id, bytes).
@@ -92,19 +84,16 @@ fn cantools_encodes_the_same_bytes_from_the_dbc() {
     )
     .unwrap();
     let root = e2e_tests::repo_root();
-    let py = Command::new(e2e_tests::harness::python3())
-        .arg(root.join("bus/tests/cantools_check.py"))
-        .arg("encode")
-        .arg(root.join("bus/restraint.dbc"))
-        .arg(&req)
-        .output()
-        .expect("run python3 with cantools");
-    assert!(
-        py.status.success(),
-        "cantools: {}",
-        String::from_utf8_lossy(&py.stderr)
+    let path = |p: std::path::PathBuf| p.to_string_lossy().into_owned();
+    let (script, dbc, req) = (
+        path(root.join("bus/tests/cantools_check.py")),
+        path(root.join("bus/restraint.dbc")),
+        path(req),
     );
-    assert_eq!(out.trim(), String::from_utf8_lossy(&py.stdout).trim());
+    let python = path(e2e_tests::harness::python3());
+    let (code, cantools, err) = crate::run_tool(&python, &[&script, "encode", &dbc, &req]);
+    assert_eq!(code, 0, "cantools: {err}");
+    assert_eq!(out.trim(), cantools.trim());
 }
 
 #[test]

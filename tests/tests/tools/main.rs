@@ -10,3 +10,16 @@ mod matrix_slurm;
 mod offline;
 mod one_build;
 mod recording;
+
+/// Runs the binary `exe` with `args`: its exit code (−1 when killed), stdout and stderr.
+fn run_tool(exe: &str, args: &[&str]) -> (i32, String, String) {
+    let out = std::process::Command::new(exe)
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("{exe} does not run: {e}"));
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}

@@ -1,4 +1,4 @@
-//! `misuse-matrix`'s own interface (issue 32 item 5): `--list` names every family with its
+//! `misuse-matrix`'s own interface: `--list` names every family with its
 //! requirement and what it samples, an unknown name lists the valid ones, `--quiet` prints the
 //! table only.
 
@@ -6,15 +6,7 @@ use e2e_tests::misuse::FAMILIES;
 use std::process::Command;
 
 fn matrix(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_misuse-matrix"))
-        .args(args)
-        .output()
-        .expect("misuse-matrix runs");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    crate::run_tool(env!("CARGO_BIN_EXE_misuse-matrix"), args)
 }
 
 #[test]

@@ -1,4 +1,4 @@
-//! `misuse-matrix --slurm N` on a real scheduler (issue 30 item 4): a one-node Slurm cluster
+//! `misuse-matrix --slurm N` on a real scheduler: a one-node Slurm cluster
 //! (`tests/slurm-cluster.sh`, `lut::slurm::OneNodeCluster`) runs the matrix as a job array and
 //! the table it prints is the local run's, row for row; run again, it resubmits only the
 //! tasks without a whole outcomes file. The cluster must start: if it cannot

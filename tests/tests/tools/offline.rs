@@ -7,7 +7,7 @@
 //!   restraint (the judge's verdict), but for the costs the safety order of issue 30 accepts,
 //!   each named with its bound and reason (`e2e_tests::offline::ACCEPTED_COSTS`);
 //! * an adaptive airbag fires within 1 ms of its plan whenever the plan is later than the
-//!   confirmation (issue 14; plan = fire, issue 30), a misreported crash's within the table's
+//!   confirmation (plan = fire), a misreported crash's within the table's
 //!   fire-delay tolerance after it;
 //! * the opponent's mass misreported by up to ±1 200 kg, and its closing speed by up to
 //!   ±5 m/s, never makes the outcome worse than the reference restraint, nor bottoms out where
