@@ -249,8 +249,12 @@ impl Activity for RestraintCycle<'_> {
             agreement.safing.on_batch(&safing_batch);
         });
         inputs.on_receive_errors(io.receive_errors(), now);
-        let vehicle = inputs.vehicle_decel(now).map(|(d, _)| d);
-        let pair = self.pair.on_cycle(now, &crash_mean, &safing_mean, vehicle);
+        // The fresh vehicle frame's deceleration: the pair check's reference and, for a faulty
+        // safing sensor, the safing function's stand-in (no CAN frame is read after this).
+        let vehicle = inputs.vehicle_decel(now);
+        let pair = self
+            .pair
+            .on_cycle(now, &crash_mean, &safing_mean, vehicle.map(|(d, _)| d));
         if pair.crash_faulty {
             inputs.accel.flag_implausible(now);
         }
@@ -298,9 +302,7 @@ impl Activity for RestraintCycle<'_> {
         let safing_faulty = self
             .reasons
             .intersects(Degraded::SAFING_STALE | Degraded::SAFING_INVALID);
-        let mut safing = self
-            .safing
-            .agrees(now, safing_faulty, self.inputs.vehicle_decel(now));
+        let mut safing = self.safing.agrees(now, safing_faulty, vehicle);
         // With a healthy safing sensor, safing must also agree in severity on the confirmed
         // event (module `agreement`) — also once the crash sensor is found faulty (a stuck
         // sensor's first 20 ms were plausible); the backup path (confirmed by the vehicle

@@ -252,7 +252,7 @@ impl FallbackAlgorithm {
         } else if dv >= threshold_mps(&self.thresholds, tau_ms)
             && dv >= self.floor.min_dv_mps + floor_lift_mps
             && self.run >= self.floor.samples
-            && (dv >= LOADING_EXEMPT_DV_MPS || self.loading.holds(self.floor.loading_fraction))
+            && self.loading()
         {
             self.decision = FallbackDecision::Fire {
                 at_ns: s.t_ns,

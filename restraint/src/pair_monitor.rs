@@ -54,6 +54,11 @@ pub const PAIR_LIMIT_G: f64 = 1.0;
 /// this, g (ordinary driving and braking; a crash lags on the 10 ms frame).
 pub const ATTRIBUTE_BELOW_G: f64 = 2.0;
 
+/// [`PAIR_LIMIT_G`] squared, (m/s²)² (the averaged square difference is compared with it).
+const PAIR_LIMIT_SQ_MPS2: f64 = (PAIR_LIMIT_G * G_MPS2) * (PAIR_LIMIT_G * G_MPS2);
+/// [`ATTRIBUTE_BELOW_G`] in m/s².
+const ATTRIBUTE_BELOW_MPS2: f64 = ATTRIBUTE_BELOW_G * G_MPS2;
+
 /// One sensor's readings over a cycle: their sum and count (m/s², negative = deceleration).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct CycleMean {
@@ -88,8 +93,6 @@ pub struct PairVerdict {
 /// State of the pair plausibility check.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PairMonitor {
-    limit_sq_mps2: f64,
-    attribute_below_mps2: f64,
     /// Averaged square of the pair's difference, (m/s²)².
     p: f64,
     /// Averaged square departure of the crash and the safing sensor from the vehicle frame.
@@ -98,10 +101,6 @@ pub struct PairMonitor {
     last_ns: Option<u64>,
     /// The crash sensor was last flagged at this time + the hold, ns.
     crash_until_ns: Option<u64>,
-    /// Cycles in which a sensor was flagged (diagnostics).
-    pub crash_flagged_cycles: u64,
-    /// As `crash_flagged_cycles`, for the safing sensor.
-    pub safing_flagged_cycles: u64,
 }
 
 impl Default for PairMonitor {
@@ -113,17 +112,12 @@ impl Default for PairMonitor {
 impl PairMonitor {
     /// Two agreeing sensors so far.
     pub const fn new() -> Self {
-        let limit = PAIR_LIMIT_G * G_MPS2;
         Self {
-            limit_sq_mps2: limit * limit,
-            attribute_below_mps2: ATTRIBUTE_BELOW_G * G_MPS2,
             p: 0.0,
             e_crash: 0.0,
             e_safing: 0.0,
             last_ns: None,
             crash_until_ns: None,
-            crash_flagged_cycles: 0,
-            safing_flagged_cycles: 0,
         }
     }
 
@@ -154,14 +148,14 @@ impl PairMonitor {
         let ae = (dt_ms * (1.0 / DEPARTURE_AVERAGE_MS)).min(1.0);
         let d = c - s;
         self.p += a * (d * d - self.p);
-        let quiet = |x: f64| x.abs() < self.attribute_below_mps2;
+        let quiet = |x: f64| x.abs() < ATTRIBUTE_BELOW_MPS2;
         let attribute = vehicle_decel_mps2.filter(|&v| quiet(v) && (quiet(c) || quiet(s)));
         if let Some(v) = attribute {
             self.e_crash += ae * ((c - v) * (c - v) - self.e_crash);
             self.e_safing += ae * ((s - v) * (s - v) - self.e_safing);
         }
         // The common answer first: the pair agrees.
-        if self.p <= self.limit_sq_mps2 {
+        if self.p <= PAIR_LIMIT_SQ_MPS2 {
             return PairVerdict::default();
         }
         // Plausible samples are finite and within full scale, and so are the averages; a NaN
@@ -185,8 +179,6 @@ impl PairMonitor {
         if verdict.crash_faulty {
             self.crash_until_ns = Some(now.saturating_add(ms_to_ns(INVALID_HOLD_MS)));
         }
-        self.crash_flagged_cycles += u64::from(verdict.crash_faulty);
-        self.safing_flagged_cycles += u64::from(verdict.safing_faulty);
         verdict
     }
 }

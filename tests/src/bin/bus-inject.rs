@@ -279,8 +279,11 @@ fn run(cli: Cli) -> Result<()> {
             if !(period_s.is_finite() && period_s > 0.0) {
                 bail!("--period-ms must be positive");
             }
+            // The signals are parsed and checked once; each frame of the stream differs only in
+            // its alive counter (and so its CRC).
+            let mut f = encode(message, &signals, counter)?;
             for k in 0..count {
-                let f = encode(message, &signals, ((u32::from(counter) + k) % 16) as u8)?;
+                f.set_e2e_counter(((u32::from(counter) + k) % 16) as u8);
                 if candump {
                     println!("({:.6}) {can} {}", f64::from(k) * period_s, cansend_arg(&f));
                 } else {
