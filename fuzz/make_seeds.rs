@@ -365,8 +365,51 @@ fn cycle_seeds(frames: &[RawFrame]) {
     write("ecu_cycle", "lut-stuck-accel", &stuck);
 }
 
+/// A PSI5 frame of data code `code`: 10-bit two's complement with even parity in bit 10
+/// (the encoding `signals::psi5::encode` implements; written out here because the seed
+/// generator builds without the ECU).
+fn psi5_frame(code: i16) -> u16 {
+    let data = (code as u16) & 0x3FF;
+    data | (u16::from(data.count_ones() % 2 == 1) << 10)
+}
+
+fn satellite_seeds() {
+    // satellite_frames: records [side][count][period][w0 LE][w1 LE] (+ f32 tunnel Δv with bit 2).
+    let record = |side: u8, code: i16, dv: Option<f32>| {
+        let w = psi5_frame(code).to_le_bytes();
+        let mut r = vec![side | if dv.is_some() { 4 } else { 0 }, 2, 10, w[0], w[1], w[0], w[1]];
+        if let Some(dv) = dv {
+            r.extend_from_slice(&dv.to_le_bytes());
+        }
+        r
+    };
+    // A crash: both satellites at 120 g (code 240) over a tunnel at 10 g, 10 cycles.
+    let mut crash = Vec::new();
+    for _ in 0..10 {
+        crash.extend(record(0, 240, None));
+        crash.extend(record(1 | 2, 240, Some(0.098)));
+    }
+    write("satellite_frames", "crash", &crash);
+    // A pothole the whole car feels: satellites and tunnel alike.
+    let mut pothole = Vec::new();
+    for _ in 0..10 {
+        pothole.extend(record(0, 40, None));
+        pothole.extend(record(1 | 2, 40, Some(0.196)));
+    }
+    write("satellite_frames", "pothole", &pothole);
+    // One satellite saturated, the other at rest, a corrupt word.
+    let mut one = Vec::new();
+    for _ in 0..10 {
+        one.extend(record(0, 480, None));
+        one.extend(record(1 | 2, 0, Some(0.0)));
+    }
+    one.extend_from_slice(&[2, 2, 10, 0x01, 0x00, 0x01, 0x00]);
+    write("satellite_frames", "one-sided", &one);
+}
+
 fn main() {
     let f = frames();
+    satellite_seeds();
     bus_seeds(&f);
     secoc_seeds();
     lut_seeds();

@@ -82,7 +82,9 @@ def check_sensors(topics, bench, full):
     topic's sequences rising, a batch's samples before its publish and after the previous
     batch's, and every accelerometer batch a diagnostics record names as read is on the topic."""
     n = int(bench.get("feeds_records") or 0)
-    got = sum(len(topics.get(t, [])) for t in ("/sensors/object", "/sensors/crash_accel", "/sensors/safing_accel"))
+    satellites = ("/sensors/satellite_left", "/sensors/satellite_right")
+    got = sum(len(topics.get(t, [])) for t in ("/sensors/object", "/sensors/crash_accel", "/sensors/safing_accel")
+              + satellites)
     if got != n:
         fail(f"/sensors/*: {got} messages, metadata says {n} feed records")
     if full and not topics.get("/sensors/crash_accel"):
@@ -99,6 +101,27 @@ def check_sensors(topics, bench, full):
                 fail(f"{topic}: batch {m['sequence']}: samples {m['first_timestamp_ns']}…{m['newest_sample_ns']} "
                      f"not after the previous ({last_sample}) and before the publish ({log_t})")
             last_seq, last_sample = m["sequence"], m["newest_sample_ns"]
+    frames = 0
+    for topic in satellites:
+        last_seq, last_sample = 0, -1
+        for log_t, pub_t, m, _ in topics.get(topic, []):
+            if m["sequence"] <= last_seq or m["count"] != len(m["frames"]) or \
+                    m["newest_sample_ns"] != m["first_timestamp_ns"] + (m["count"] - 1) * m["sample_period_ns"]:
+                fail(f"{topic}: batch {m['sequence']} after {last_seq}: count / newest sample inconsistent")
+            # A frame travels one sync slot after its sample.
+            if m["first_timestamp_ns"] <= last_sample or \
+                    m["newest_sample_ns"] + m["sample_period_ns"] > log_t or pub_t != log_t:
+                fail(f"{topic}: batch {m['sequence']}: frames not after the previous or not a slot before the publish")
+            for word, code in zip(m["frames"], m["decel_codes"]):
+                # PSI5 10-bit data with even parity in bit 10, decoded here on its own.
+                data = word & 0x3FF
+                parity_ok = word < 0x800 and bin(word).count("1") % 2 == 0
+                value = data - 0x400 if data & 0x200 else data
+                expect = value if parity_ok and abs(value) <= 480 else None
+                if code != expect:
+                    fail(f"{topic}: batch {m['sequence']}: frame {word:#05x} decodes to {expect}, recorded {code}")
+            frames += len(m["frames"])
+            last_seq, last_sample = m["sequence"], m["newest_sample_ns"]
     last_seq = 0
     for log_t, _, m, _ in topics.get("/sensors/object", []):
         if m["sequence"] <= last_seq or m["timestamp_ns"] > log_t:
@@ -110,7 +133,7 @@ def check_sensors(topics, bench, full):
         if not named <= crash:
             fail(f"/ecu/diagnostics: batches read but never published: {sorted(named - crash)[:5]}")
     print(f"check_mcap: /sensors: {n} publications of the feeds in order, samples before their publish; "
-          f"every crash batch the ECU read is among them")
+          f"every crash batch the ECU read is among them; {frames} satellite frames, parity and codes decoded alike")
 
 
 def main():

@@ -9,6 +9,7 @@
 //! | `ecu/in/object_state` | `ObjectState` | sensor feeds → ECU | [`OBJECT_STATE_PORTS`] |
 //! | `ecu/in/crash_accel` | `CrashAccelSample` (≤ 8 samples a batch) | sensor feeds → ECU (crash accelerometer) | [`CRASH_ACCEL_PORTS`] |
 //! | `ecu/in/safing_accel` | `CrashAccelSample` (≤ 8 samples a batch) | sensor feeds → ECU (safing accelerometer, the independent second channel) | [`SAFING_ACCEL_PORTS`] |
+//! | `ecu/in/satellite_left`, `ecu/in/satellite_right` | `SatelliteFrames` (≤ 8 PSI5 frames a batch) | sensor feeds → ECU (crush-zone satellites, one service each) | [`SATELLITE_PORTS`] |
 //! | `ecu/out/diagnostics` | `EcuDiagnostics` | ECU → monitors | [`DIAGNOSTICS_PORTS`] |
 //! | `bench/truth` | [`BenchTruth`] | sensor feeds → actuator stubs, tests (never the ECU) | [`BENCH_TRUTH_PORTS`] |
 //! Keeping the payload layouts, the service names and **all** port settings in
@@ -44,6 +45,6 @@ pub use payload::{BenchTruth, Shm, ShmRecord, SCENARIO_NAME_CAPACITY};
 #[cfg(feature = "transport")]
 pub use port::*;
 pub use signals::{
-    CrashAccelSample, Degraded, EcuDiagnostics, EcuMode, ObjectState, ACCEL_BATCH_CAPACITY,
-    PULSE_POINTS, VALID,
+    CrashAccelSample, Degraded, EcuDiagnostics, EcuMode, ObjectState, SatelliteFrames,
+    ACCEL_BATCH_CAPACITY, PULSE_POINTS, SATELLITE_BATCH_CAPACITY, VALID,
 };

@@ -15,6 +15,9 @@ pub const CRASH_ACCEL_SUFFIX: &str = "ecu/in/crash_accel";
 /// acceleration channel every Fire needs (SPEC "Single-fault tolerance"), on its own service
 /// so that nothing of the crash accelerometer's transport is shared with it.
 pub const SAFING_ACCEL_SUFFIX: &str = "ecu/in/safing_accel";
+/// Suffixes of the left and the right crush-zone satellite's services (sensor feeds → ECU):
+/// each satellite's PSI5 frames on its own service, as each has its own PSI5 channel.
+pub const SATELLITE_SUFFIXES: [&str; 2] = ["ecu/in/satellite_left", "ecu/in/satellite_right"];
 /// Suffix of the ECU diagnostics service (ECU → monitors).
 pub const DIAGNOSTICS_SUFFIX: &str = "ecu/out/diagnostics";
 /// Suffix of the bench-truth service (sensor feeds → actuator stubs; never read by the ECU).
@@ -65,6 +68,11 @@ pub const CRASH_ACCEL_PORTS: PortSettings = PortSettings {
 /// ~64 ms of a stalled ECU (one batch per ms whatever the rate).
 pub const SAFING_ACCEL_PORTS: PortSettings = CRASH_ACCEL_PORTS;
 
+/// A satellite's frame batches: one batch per ms (two frames at the 500 µs sync period),
+/// every frame matters for the crush Δv, so the queue covers the same ~64 ms of a stalled ECU
+/// as the accelerometers'.
+pub const SATELLITE_PORTS: PortSettings = CRASH_ACCEL_PORTS;
+
 /// Diagnostics are published every ECU cycle; monitors only show the newest.
 pub const DIAGNOSTICS_PORTS: PortSettings = PortSettings {
     subscriber_buffer: 16,
@@ -95,6 +103,10 @@ pub struct ServiceNames {
     pub crash_accel: String,
     /// Safing accelerometer service.
     pub safing_accel: String,
+    /// Left satellite service.
+    pub satellite_left: String,
+    /// Right satellite service.
+    pub satellite_right: String,
     /// ECU diagnostics service.
     pub diagnostics: String,
     /// Bench-truth service (sensor feeds → actuator stubs).
@@ -109,6 +121,8 @@ impl ServiceNames {
             object_state: format!("{p}/{OBJECT_STATE_SUFFIX}"),
             crash_accel: format!("{p}/{CRASH_ACCEL_SUFFIX}"),
             safing_accel: format!("{p}/{SAFING_ACCEL_SUFFIX}"),
+            satellite_left: format!("{p}/{}", SATELLITE_SUFFIXES[0]),
+            satellite_right: format!("{p}/{}", SATELLITE_SUFFIXES[1]),
             diagnostics: format!("{p}/{DIAGNOSTICS_SUFFIX}"),
             bench_truth: format!("{p}/{BENCH_TRUTH_SUFFIX}"),
         }
@@ -131,6 +145,8 @@ mod tests {
         assert_eq!(n.object_state, "x/ecu/in/object_state");
         assert_eq!(n.crash_accel, "x/ecu/in/crash_accel");
         assert_eq!(n.safing_accel, "x/ecu/in/safing_accel");
+        assert_eq!(n.satellite_left, "x/ecu/in/satellite_left");
+        assert_eq!(n.satellite_right, "x/ecu/in/satellite_right");
         assert_eq!(n.diagnostics, "x/ecu/out/diagnostics");
         assert_eq!(n.bench_truth, "x/bench/truth");
     }

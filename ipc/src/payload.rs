@@ -5,7 +5,7 @@
 use core::fmt;
 
 use iceoryx2::prelude::ZeroCopySend;
-use signals::{CrashAccelSample, EcuDiagnostics, ObjectState};
+use signals::{CrashAccelSample, EcuDiagnostics, ObjectState, SatelliteFrames};
 
 /// The core's plain records that may live in shared memory: `#[repr(C)]`, `Copy`,
 /// pointer-free, every bit pattern of every field valid (flags are `u8`). Sealed: only the
@@ -17,11 +17,13 @@ mod sealed {
     impl Sealed for signals::ObjectState {}
     impl Sealed for signals::CrashAccelSample {}
     impl Sealed for signals::EcuDiagnostics {}
+    impl Sealed for signals::SatelliteFrames {}
 }
 
 impl ShmRecord for ObjectState {}
 impl ShmRecord for CrashAccelSample {}
 impl ShmRecord for EcuDiagnostics {}
+impl ShmRecord for SatelliteFrames {}
 
 /// A core record as iceoryx2 carries it (same layout: `repr(transparent)`).
 #[repr(transparent)]

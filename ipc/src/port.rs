@@ -7,11 +7,11 @@ use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubFactory;
-use signals::{CrashAccelSample, EcuDiagnostics, ObjectState};
+use signals::{CrashAccelSample, EcuDiagnostics, ObjectState, SatelliteFrames};
 
 use crate::names::{
     PortSettings, ServiceNames, BENCH_TRUTH_PORTS, CRASH_ACCEL_PORTS, DIAGNOSTICS_PORTS,
-    OBJECT_STATE_PORTS, SAFING_ACCEL_PORTS,
+    OBJECT_STATE_PORTS, SAFING_ACCEL_PORTS, SATELLITE_PORTS,
 };
 use crate::payload::{BenchTruth, Shm};
 
@@ -197,6 +197,14 @@ shm_topic!(
     SafingTopic, CrashAccelSample, SAFING_ACCEL_PORTS, safing_accel
 );
 shm_topic!(
+    /// The left crush-zone satellite's PSI5 frames (sensor feeds → ECU).
+    SatelliteLeftTopic, SatelliteFrames, SATELLITE_PORTS, satellite_left
+);
+shm_topic!(
+    /// The right crush-zone satellite's PSI5 frames (sensor feeds → ECU).
+    SatelliteRightTopic, SatelliteFrames, SATELLITE_PORTS, satellite_right
+);
+shm_topic!(
     /// ECU diagnostics (ECU → monitors).
     DiagnosticsTopic, EcuDiagnostics, DIAGNOSTICS_PORTS, diagnostics
 );
@@ -343,6 +351,10 @@ pub type ObjectSubscriber = PolledSubscriber<ObjectTopic>;
 pub type AccelSubscriber = PolledSubscriber<AccelTopic>;
 /// Safing accelerometer subscriber (ECU side).
 pub type SafingSubscriber = PolledSubscriber<SafingTopic>;
+/// Left satellite subscriber (ECU side).
+pub type SatelliteLeftSubscriber = PolledSubscriber<SatelliteLeftTopic>;
+/// Right satellite subscriber (ECU side).
+pub type SatelliteRightSubscriber = PolledSubscriber<SatelliteRightTopic>;
 /// Diagnostics subscriber (monitor side).
 pub type DiagnosticsSubscriber = PolledSubscriber<DiagnosticsTopic>;
 /// Bench-truth subscriber (actuator stubs, tests).
@@ -429,6 +441,10 @@ pub type ObjectPublisher = ZeroCopyPublisher<ObjectTopic>;
 pub type AccelPublisher = ZeroCopyPublisher<AccelTopic>;
 /// Safing accelerometer publisher (sensor-feed / test side).
 pub type SafingPublisher = ZeroCopyPublisher<SafingTopic>;
+/// Left satellite publisher (sensor-feed / test side).
+pub type SatelliteLeftPublisher = ZeroCopyPublisher<SatelliteLeftTopic>;
+/// Right satellite publisher (sensor-feed / test side).
+pub type SatelliteRightPublisher = ZeroCopyPublisher<SatelliteRightTopic>;
 /// Bench-truth publisher (sensor-feed side).
 pub type BenchTruthPublisher = ZeroCopyPublisher<BenchTruthTopic>;
 

@@ -256,7 +256,12 @@ pub fn measure(cfg: &CycleConfig, samples: &[AccelSample], contact_ns: u64) -> M
     for s in samples {
         generic.push(&p, s);
         roughness.push(s.decel_mps2 * s.dt_s, s.dt_s);
-        algo.push(&p, s, roughness.floor_lift_mps());
+        // Central-only: the study calibrates the boundary a car without satellites needs.
+        let now = algo.thresholds_now(
+            roughness.floor_lift_mps(),
+            restraint::satellites::Relief::NONE,
+        );
+        algo.push(&p, s, now);
         match onset.push(&p, s) {
             OnsetStep::Reset => first_event = false,
             OnsetStep::Woke | OnsetStep::Awake if first_event => {

@@ -10,7 +10,7 @@
 //! | `/stubs/actions` | `report.json` | action of a module (airbag fire, pretensioner fire / release …) |
 //! | `/stubs/verdict` | `report.json` | run: the occupant outcome and the modes |
 //! | `/ecu/diagnostics`, `/ecu/predicted_pulse` | `diagnostics.postcard` (the stubs' log) | cycle; change of the prediction |
-//! | `/sensors/object`, `/sensors/crash_accel`, `/sensors/safing_accel` | `feeds.postcard` (`sensor-feeds --log`) | publication |
+//! | `/sensors/object`, `/sensors/crash_accel`, `/sensors/safing_accel`, `/sensors/satellite_left`, `/sensors/satellite_right` | `feeds.postcard` (`sensor-feeds --log`) | publication |
 //! | `/truth/world` | the scenario file | ms of the scenario |
 //!
 //! **One clock.** Every message's `log_time` is CLOCK_MONOTONIC of the bench, ns — the clock

@@ -221,6 +221,55 @@ pub fn accel_batch(b: &CrashAccelSample) -> AccelBatchMessage<'_> {
     }
 }
 
+/// Schema name of `/sensors/satellite_left` and `/sensors/satellite_right`.
+pub const SATELLITE_SCHEMA: &str = "restraint_bench.SatelliteFrames";
+
+/// A satellite batch as the feeds published it: the raw PSI5 frames (10-bit data + even
+/// parity) and their data codes decoded (`null`: corrupt or a status word).
+#[derive(serde::Serialize)]
+pub struct SatelliteMessage<'a> {
+    first_timestamp_ns: u64,
+    newest_sample_ns: u64,
+    sequence: u64,
+    sample_period_ns: u32,
+    count: u32,
+    frames: &'a [u16],
+    decel_codes: Vec<Option<i16>>,
+}
+
+/// The `/sensors/satellite_…` message of a batch.
+pub fn satellite_batch(b: &signals::SatelliteFrames) -> SatelliteMessage<'_> {
+    let n = b.frames().len() as u64;
+    SatelliteMessage {
+        first_timestamp_ns: b.first_timestamp_ns,
+        newest_sample_ns: b.first_timestamp_ns
+            + n.saturating_sub(1) * u64::from(b.sample_period_ns),
+        sequence: b.sequence,
+        sample_period_ns: b.sample_period_ns,
+        count: b.count,
+        frames: b.frames(),
+        decel_codes: b
+            .frames()
+            .iter()
+            .map(|f| match signals::psi5::decode(*f) {
+                signals::psi5::Psi5Word::Data(c) => Some(c),
+                _ => None,
+            })
+            .collect(),
+    }
+}
+
+/// JSON Schema of the satellite topics.
+pub fn satellite_schema() -> Value {
+    let mut b = signals::SatelliteFrames::EMPTY;
+    b.count = 1;
+    titled(
+        schema_of(&serde_json::to_value(satellite_batch(&b)).unwrap_or(Value::Null)),
+        SATELLITE_SCHEMA,
+        "One batch of a crush-zone satellite's PSI5 frames the sensor feeds published on iceoryx2 (log time: the publish; frame k sampled at first_timestamp_ns + k·sample_period_ns, CLOCK_MONOTONIC; frames: 10-bit data + even parity in bit 10; decel_codes: data codes, + = deceleration, null = corrupt or status)",
+    )
+}
+
 /// JSON Schema of `/sensors/object`.
 pub fn object_schema() -> Value {
     titled(

@@ -278,6 +278,7 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
     // What the sensor feeds published, at the publish time (the measurement's own time is in
     // the message).
     let (object_schema, accel_schema) = (schema::object_schema(), schema::accel_batch_schema());
+    let satellite_schema = schema::satellite_schema();
     for r in &feeds.0 {
         let t = r.published_ns;
         match &r.item {
@@ -304,6 +305,18 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
                 t,
                 t,
                 &schema::accel_batch(b),
+            )?,
+            FeedItem::SatelliteLeft(b) | FeedItem::SatelliteRight(b) => rec.write(
+                if matches!(r.item, FeedItem::SatelliteLeft(_)) {
+                    "/sensors/satellite_left"
+                } else {
+                    "/sensors/satellite_right"
+                },
+                schema::SATELLITE_SCHEMA,
+                &satellite_schema,
+                t,
+                t,
+                &schema::satellite_batch(b),
             )?,
         }
     }

@@ -260,6 +260,39 @@ pub struct CycleConfig {
     /// accelerometer's (`accel_timeout_ms`, `accel_stuck_ms`).
     pub safing_full_scale_g: f64,
 
+    /// The car has the two crush-zone satellites (`satellites`; *default* true). `false`:
+    /// central-only decisions, nothing expected on their ports.
+    pub satellites: bool,
+    /// Satellites' measuring range, g (*default* 240: an MMA5124-class ±240 g part): the
+    /// ±480 data codes of a PSI5 frame span ±this.
+    pub satellite_full_scale_g: f64,
+    /// A satellite without a frame for this long grants nothing, ms (*default* 50, the crash
+    /// accelerometer's timeout and for its reason).
+    pub satellite_timeout_ms: f64,
+    /// The crush Δv window: a satellite's velocity change over this less the tunnel's, ms
+    /// (*default* 4: at 56 km/h a rigid barrier's crush Δv passes 2 m/s 3–4 ms after contact,
+    /// a body motion's stays ≤ 0.1 m/s because both move alike).
+    pub satellite_window_ms: f64,
+    /// Frontal severity (the smaller crush Δv of the two) from which the satellites begin to
+    /// lower the tunnel's thresholds, m/s (*default* 1.0: the library's no-fire crashes, 14–16
+    /// km/h barriers, peak at 0.45–0.52, misuse at ≤ 0.41 — a factor 2 below).
+    pub satellite_relief_from_mps: f64,
+    /// Frontal severity of the whole relief, m/s (*default* 2.0: a 31 + 31 km/h car crash's
+    /// peak; every must-fire crash of the library passes it within 4–6 ms of contact).
+    pub satellite_relief_full_mps: f64,
+    /// The whole relief brings the airbag's and the pyrotechnic pretensioner's severity
+    /// floors down to this, m/s (*default* 0.5: above a door slam's or hammer blow's Δv, which
+    /// cannot crush the front end anyway).
+    pub satellite_floor_mps: f64,
+    /// The whole relief scales the accelerometer-only boundary by this (*default* 1.0: the
+    /// boundary is not lowered). Why: the satellites measure how fast the front end crushes,
+    /// which is the closing speed's share, not the ego's velocity change; a light opponent at a
+    /// high closing speed crushes the front like a must-fire crash and stays below the no-fire
+    /// line (14–16 km/h EBS). The boundary is what still tells them apart: at 0.5 the matrix's
+    /// `misreported-low-speed` family fired 35 airbags of 445 (seed 7), at 0.75 21; the must-fire
+    /// families' fire times are the same at 1.0 — the floor is what held them.
+    pub satellite_boundary_scale: f64,
+
     /// Crash accelerometer: no batch for this long → `ACCEL_STALE`, ms (*default* 50: batches
     /// come every ms, so 50 missed ones are a dead sensor; with one 20 ms `EcuStatus` period the
     /// fault is on the bus within 70 ms. Tighter limits trip on the emulated bench's scheduling
@@ -344,6 +377,14 @@ impl Default for CycleConfig {
             roughness_k: 2.0,
             roughness_hold_ms: 500.0,
             safing_full_scale_g: 50.0,
+            satellites: true,
+            satellite_full_scale_g: 240.0,
+            satellite_timeout_ms: 50.0,
+            satellite_window_ms: 4.0,
+            satellite_relief_from_mps: 1.0,
+            satellite_relief_full_mps: 2.0,
+            satellite_floor_mps: 0.5,
+            satellite_boundary_scale: 1.0,
             accel_timeout_ms: 50.0,
             accel_stuck_ms: 20.0,
             accel_full_scale_g: 200.0,
@@ -451,6 +492,38 @@ impl CycleConfig {
             0.0,
             2.0,
         )?;
+        range(
+            "satellite_full_scale_g",
+            self.satellite_full_scale_g,
+            50.0,
+            1_000.0,
+        )?;
+        range(
+            "satellite_timeout_ms",
+            self.satellite_timeout_ms,
+            1.0,
+            1_000.0,
+        )?;
+        range("satellite_window_ms", self.satellite_window_ms, 1.0, 10.0)?;
+        range(
+            "satellite_relief_from_mps",
+            self.satellite_relief_from_mps,
+            0.2,
+            10.0,
+        )?;
+        range(
+            "satellite_relief_full_mps",
+            self.satellite_relief_full_mps,
+            self.satellite_relief_from_mps,
+            20.0,
+        )?;
+        range("satellite_floor_mps", self.satellite_floor_mps, 0.2, 5.0)?;
+        range(
+            "satellite_boundary_scale",
+            self.satellite_boundary_scale,
+            0.2,
+            1.0,
+        )?;
         range("safing_wake_g", self.safing_wake_g, 0.1, 50.0)?;
         range("safing_dv_mps", self.safing_dv_mps, 0.01, 5.0)?;
         range("safing_hold_ms", self.safing_hold_ms, 0.0, 1_000.0)?;
@@ -549,6 +622,21 @@ impl CycleConfig {
         FireFloor {
             min_dv_mps: self.pretensioner_min_dv_mps,
             ..self.fallback_floor()
+        }
+    }
+
+    /// The satellite fusion's settings (`satellite_*`) in its units.
+    pub fn satellite_params(&self) -> crate::satellites::SatelliteParams {
+        crate::satellites::SatelliteParams {
+            enabled: self.satellites,
+            lsb_mps2: self.satellite_full_scale_g * G_MPS2
+                / f64::from(crate::signals::psi5::DATA_LIMIT),
+            timeout_ns: ms_to_ns(self.satellite_timeout_ms),
+            window_ns: ms_to_ns(self.satellite_window_ms),
+            relief_from_mps: self.satellite_relief_from_mps,
+            relief_full_mps: self.satellite_relief_full_mps,
+            floor_mps: self.satellite_floor_mps,
+            boundary_scale: self.satellite_boundary_scale,
         }
     }
 

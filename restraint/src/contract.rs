@@ -9,7 +9,9 @@
 
 use bus::RawFrame;
 
-use crate::signals::{CrashAccelSample, EcuDiagnostics, ObjectState};
+use crate::signals::{
+    CrashAccelSample, EcuDiagnostics, ObjectState, SatelliteFrames, SatelliteSide,
+};
 
 /// Timing facts of the current cycle, handed to [`Activity::step`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -121,6 +123,13 @@ pub trait CycleIo {
     /// Hands every batch of the independent safing accelerometer received since the last
     /// call to `f` (same record as the crash accelerometer, its own sensor and port).
     fn drain_safing(&mut self, f: &mut dyn FnMut(&CrashAccelSample)) -> usize;
+    /// Hands every batch of the crush-zone satellites' PSI5 frames received since the last
+    /// call to `f`, with the satellite it came from. An I/O without satellites hands none
+    /// (the default): the cycle then decides on its own sensors, as it does when they fail.
+    fn drain_satellites(&mut self, f: &mut dyn FnMut(SatelliteSide, &SatelliteFrames)) -> usize {
+        let _ = f;
+        0
+    }
     /// Hands every CAN frame received since the last call to `f` (none when CAN is off).
     fn drain_can(&mut self, f: &mut dyn FnMut(&RawFrame)) -> usize;
     /// Queues one CAN frame for sending.

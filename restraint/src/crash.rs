@@ -22,10 +22,11 @@ use crate::confirm::{ConfirmParams, CrashDetector};
 use crate::counters::CycleCounters;
 use crate::crash_match::{MatchState, PulseMatch, SeverityEstimate};
 use crate::estimate::{equivalent_barrier_speed_kph, Estimator, Situation};
-use crate::fallback::{FallbackAlgorithm, FallbackDecision};
+use crate::fallback::{FallbackAlgorithm, FallbackDecision, Thresholds};
 use crate::inputs::InputMonitor;
 use crate::plan::RestraintPlan;
 use crate::roughness::Roughness;
+use crate::satellites::Relief;
 use crate::settings::{ms_to_ns, G_MPS2};
 
 /// Which path confirmed the crash.
@@ -108,8 +109,15 @@ impl CrashMonitor {
     /// The plausible samples of one accelerometer batch, in time order, for all three
     /// detectors. A quiet batch (every sample below the wake threshold, no event in progress)
     /// only updates their integrators' previous value with its last sample: the common case,
-    /// every cycle of a drive, and what each detector would do sample by sample.
-    pub(crate) fn on_batch(&mut self, batch: &PlausibleBatch, ctx: &FreezeContext<'_, '_>) {
+    /// every cycle of a drive, and what each detector would do sample by sample. `relief`:
+    /// what the crush-zone satellites take off the thresholds now ([`crate::satellites`]),
+    /// asked only for a batch that is judged (a quiet one needs none).
+    pub(crate) fn on_batch(
+        &mut self,
+        batch: &PlausibleBatch,
+        ctx: &FreezeContext<'_, '_>,
+        relief: impl FnOnce() -> Relief,
+    ) {
         let wake = self.onset_params.wake_mps2;
         if !(self.matcher.awake()
             || self.generic.awake()
@@ -125,22 +133,40 @@ impl CrashMonitor {
             }
             return;
         }
+        let relief = relief();
         let lift = self.roughness.floor_lift_mps();
+        let airbag = self.fallback.thresholds_now(lift, relief);
+        let pretensioner = self.pretensioner.thresholds_now(lift, relief);
+        // A rough road's lobes are no crash evidence for the generic confirmation either (nor
+        // for the CrashDetected it puts on the bus, which body ECUs act on): its Δv threshold
+        // carries the roughness lift too. On a smooth road the lift is 0; on a rough one every
+        // fire needs floor + lift, more than this, so no fire waits for it.
+        let generic = ConfirmParams {
+            delta_v_mps: relief.floor_mps(self.onset_params.delta_v_mps, lift),
+            ..self.onset_params
+        };
         for s in batch.iter() {
-            self.on_sample(&s, ctx, lift);
+            self.on_sample(&s, ctx, &generic, airbag, pretensioner);
         }
     }
 
-    /// The road-roughness measure's batch: the readings as the sensor gave them, before the
-    /// braking compensation (braking only slows the car, so it never lifts the measure; a
-    /// compensation that runs ahead of the sensor's own braking ramp would read as forward).
-    pub(crate) fn on_raw_batch(&mut self, batch: &PlausibleBatch) {
-        let (dv_mps, span_s) = batch.decel_integral_mps();
+    /// The road-roughness measure's batch (its `decel_integral_mps`): the readings as the sensor
+    /// gave them, before the braking compensation (braking only slows the car, so it never lifts
+    /// the measure; a compensation that runs ahead of the sensor's own braking ramp would read
+    /// as forward).
+    pub(crate) fn on_raw_batch(&mut self, dv_mps: f64, span_s: f64) {
         self.roughness.push(dv_mps, span_s);
     }
 
     /// One plausible accelerometer sample for all three detectors.
-    fn on_sample(&mut self, s: &AccelSample, ctx: &FreezeContext<'_, '_>, lift: f64) {
+    fn on_sample(
+        &mut self,
+        s: &AccelSample,
+        ctx: &FreezeContext<'_, '_>,
+        generic: &ConfirmParams,
+        airbag: Thresholds,
+        pretensioner: Thresholds,
+    ) {
         self.matcher.push(s, &mut |slot| {
             let Some(sit) = ctx.situation.filter(|_| ctx.armed) else {
                 return false;
@@ -156,17 +182,9 @@ impl CrashMonitor {
                 sit.contact_ns,
             )
         });
-        // A rough road's lobes are no crash evidence for the generic confirmation either (nor
-        // for the CrashDetected it puts on the bus, which body ECUs act on): its Δv threshold
-        // carries the roughness lift too. On a smooth road the lift is 0; on a rough one every
-        // fire needs floor + lift, more than this, so no fire waits for it.
-        let generic = ConfirmParams {
-            delta_v_mps: self.onset_params.delta_v_mps + lift,
-            ..self.onset_params
-        };
-        self.generic.push(&generic, s);
-        self.fallback.push(&self.onset_params, s, lift);
-        self.pretensioner.push(&self.onset_params, s, lift);
+        self.generic.push(generic, s);
+        self.fallback.push(&self.onset_params, s, airbag);
+        self.pretensioner.push(&self.onset_params, s, pretensioner);
         if self.confirmation.is_some() {
             return;
         }

@@ -21,6 +21,7 @@ use crate::outputs::{publish_diagnostics, Outputs};
 use crate::pair_monitor::{CycleMean, PairMonitor};
 use crate::plan::{ReferenceSettings, RestraintPlan};
 use crate::safing::Safing;
+use crate::satellites::{Relief, Satellites};
 use crate::settings::ConfigError;
 use crate::settings::G_MPS2;
 use crate::signals::Degraded;
@@ -48,6 +49,11 @@ pub struct RestraintCycle<'lut> {
     agreement: SeverityAgreement,
     /// The two accelerometers against each other and the vehicle frame (offset, noise).
     pair: PairMonitor,
+    /// The crush-zone satellites: the frontal severity that lowers the tunnel's thresholds.
+    satellites: Satellites,
+    /// Their relief as the newest judged accelerometer batch had it (none while the batches
+    /// are quiet: no event, nothing to relieve).
+    relief: Relief,
     /// The deceleration the car's braking explains, m/s², held while an accelerometer event
     /// is in progress (`braking_compensation_max_g`).
     braking_decel_mps2: f64,
@@ -89,6 +95,8 @@ impl<'lut> RestraintCycle<'lut> {
             safing: Safing::new(cfg.safing_params()),
             agreement: cfg.severity_agreement(),
             pair: PairMonitor::new(),
+            satellites: Satellites::new(cfg.satellite_params()),
+            relief: Relief::NONE,
             braking_decel_mps2: 0.0,
             outputs: Outputs::new(lut_id),
             reasons: Degraded::empty(),
@@ -152,6 +160,10 @@ impl<'lut> RestraintCycle<'lut> {
     /// Crash-phase fires the safing function vetoed (`fires_vetoed_by_safing`).
     pub fn vetoed_fires(&self) -> u64 {
         self.decision.vetoed_fires()
+    }
+    /// The crush-zone satellites' fusion.
+    pub fn satellites(&self) -> &Satellites {
+        &self.satellites
     }
     /// The safing function's state.
     pub fn safing(&self) -> &Safing {
@@ -226,18 +238,30 @@ impl Activity for RestraintCycle<'_> {
             };
         }
         let braking = self.braking_decel_mps2;
+        // The satellites first: their crush Δv up to now relieves this cycle's samples.
+        let satellites = &mut self.satellites;
+        satellites.begin_cycle(now);
+        io.drain_satellites(&mut |side, b| satellites.on_frames(side, b, now));
         let crash = &mut self.crash;
         let agreement = &mut self.agreement;
+        let relief = &mut self.relief;
         let mut plausible = crate::accel::PlausibleBatch::new();
         let (mut crash_mean, mut safing_mean) = (CycleMean::default(), CycleMean::default());
         io.drain_accel(&mut |a| {
             inputs.on_accel(a, now, c, &mut plausible);
             crash_mean.add(&plausible);
-            // The agreement and the road's roughness take the readings as they are.
+            // The agreement, the road's roughness and the satellites' crush Δv take the
+            // readings as they are.
             agreement.crash.on_batch(&plausible);
-            crash.on_raw_batch(&plausible);
+            let (dv_mps, span_s) = plausible.decel_integral_mps();
+            crash.on_raw_batch(dv_mps, span_s);
+            satellites.on_tunnel_dv(dv_mps);
             plausible.remove_decel(braking);
-            crash.on_batch(&plausible, &freeze);
+            *relief = Relief::NONE;
+            crash.on_batch(&plausible, &freeze, || {
+                *relief = satellites.relief(now);
+                *relief
+            });
         });
         // The independent safing channel: its own monitor, its own function.
         let safing = &mut self.safing;
@@ -368,6 +392,7 @@ impl Activity for RestraintCycle<'_> {
             event_dv_mps: self.crash.event_dv_mps(),
             event_loading: &event_loading,
             floor_lift_mps: self.crash.floor_lift_mps(),
+            relief: self.relief,
             matched_course_broken: self.crash.matcher().course_broken_ns().is_some(),
             heaviest_fires_airbag: &heaviest_fires_airbag,
             replan: &mut replan,
@@ -431,6 +456,19 @@ impl Activity for RestraintCycle<'_> {
             (
                 "safing_stuck_events",
                 self.inputs.safing.faults.stuck_events,
+            ),
+            (
+                "satellite_corrupt_frames",
+                self.satellites.faults.corrupt_frames,
+            ),
+            (
+                "satellite_status_frames",
+                self.satellites.faults.status_frames,
+            ),
+            ("satellite_bad_batches", self.satellites.faults.bad_batches),
+            (
+                "satellite_relieved_batches",
+                self.satellites.relieved_batches,
             ),
             ("fires_vetoed_by_safing", self.decision.vetoed_fires()),
             ("fires_below_floor", self.decision.fires_below_floor()),

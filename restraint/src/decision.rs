@@ -31,6 +31,7 @@ use crate::crash::{BackupEvidence, ConfirmKind, Confirmation};
 use crate::estimate::Situation;
 use crate::fallback::{FallbackDecision, WINDOW_MS};
 use crate::plan::RestraintPlan;
+use crate::satellites::Relief;
 use crate::settings::ms_to_ns;
 use crate::signals::EcuMode;
 
@@ -108,6 +109,9 @@ pub(crate) struct DecisionInputs<'d> {
     pub event_loading: &'d dyn Fn() -> bool,
     /// What the road's roughness adds to every severity floor, m/s (`roughness`).
     pub floor_lift_mps: f64,
+    /// What the crush-zone satellites take off the severity floors and the lift now
+    /// (`satellites`).
+    pub relief: Relief,
     /// A matched confirmation's pulse has left its ramp (`PulseMatch::course_broken_ns`).
     pub matched_course_broken: bool,
     /// Whether the table fires the airbag for this situation with the heaviest opponent it
@@ -567,7 +571,8 @@ impl Decision {
     ) -> bool {
         let Some(t) = *slot else { return false };
         if now.saturating_add(x.half_period_ns) < t
-            || (x.event_dv_mps >= floor_mps + x.floor_lift_mps && (x.event_loading)())
+            || (x.event_dv_mps >= x.relief.floor_mps(floor_mps, x.floor_lift_mps)
+                && (x.event_loading)())
         {
             return false;
         }

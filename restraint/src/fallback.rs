@@ -33,6 +33,7 @@
 
 use crate::accel::AccelSample;
 use crate::confirm::{ConfirmParams, Loading, Onset, OnsetStep};
+use crate::satellites::Relief;
 use crate::settings::ConfigError;
 
 /// Number of threshold knots (0, 4, … 60 ms).
@@ -149,6 +150,17 @@ pub struct FireFloor {
     pub loading_fraction: f64,
 }
 
+/// What a sample's decision is judged against now besides the boundary's shape: the severity
+/// floor with the road's lift and the satellites' relief, and the boundary's scale — fixed for a
+/// batch ([`FallbackAlgorithm::thresholds_now`]), so a sample pays one compare for each.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Thresholds {
+    /// Δv since the onset at least this, m/s.
+    pub min_dv_mps: f64,
+    /// The boundary's values times this.
+    pub boundary_scale: f64,
+}
+
 /// State of the accelerometer-only algorithm (one event at a time; the decision belongs to
 /// the event and is forgotten when the next one begins).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -195,10 +207,19 @@ impl FallbackAlgorithm {
         self.decision = FallbackDecision::Pending;
     }
 
-    /// Feeds one plausible sample (`p`: the wake threshold and quiet gap of the onset;
-    /// `floor_lift_mps`: what the road's roughness adds to the severity floor now,
-    /// [`crate::roughness`]).
-    pub fn push(&mut self, p: &ConfirmParams, s: &AccelSample, floor_lift_mps: f64) {
+    /// The thresholds of the samples to come: the floor with `floor_lift_mps` (what the road's
+    /// roughness adds to it now, [`crate::roughness`]) and `relief` (what the crush-zone
+    /// satellites take off the floor, the lift and the boundary now, [`crate::satellites`]).
+    pub fn thresholds_now(&self, floor_lift_mps: f64, relief: Relief) -> Thresholds {
+        Thresholds {
+            min_dv_mps: relief.floor_mps(self.floor.min_dv_mps, floor_lift_mps),
+            boundary_scale: relief.boundary_mps(1.0),
+        }
+    }
+
+    /// Feeds one plausible sample (`p`: the wake threshold and quiet gap of the onset; `t`:
+    /// [`Self::thresholds_now`]).
+    pub fn push(&mut self, p: &ConfirmParams, s: &AccelSample, t: Thresholds) {
         let before_dv = self.onset.delta_v_mps();
         match self.onset.push(p, s) {
             OnsetStep::Quiet => return,
@@ -249,8 +270,8 @@ impl FallbackAlgorithm {
         let dv = self.onset.delta_v_mps() - self.segment_base_dv_mps;
         if tau_ms > WINDOW_MS {
             self.decision = FallbackDecision::NoFire(s.t_ns);
-        } else if dv >= threshold_mps(&self.thresholds, tau_ms)
-            && dv >= self.floor.min_dv_mps + floor_lift_mps
+        } else if dv >= t.boundary_scale * threshold_mps(&self.thresholds, tau_ms)
+            && dv >= t.min_dv_mps
             && self.run >= self.floor.samples
             && self.loading()
         {
@@ -343,7 +364,7 @@ mod tests {
                     dt_s: 1e-3,
                     decel_mps2: g * G_MPS2,
                 },
-                0.0,
+                f.thresholds_now(0.0, Relief::NONE),
             );
         }
     }
@@ -426,7 +447,7 @@ mod tests {
                     dt_s: 1e-3,
                     decel_mps2: g(k) * G_MPS2,
                 },
-                0.0,
+                f.thresholds_now(0.0, Relief::NONE),
             );
         }
     }
@@ -497,7 +518,7 @@ mod tests {
                     dt_s: 125e-6,
                     decel_mps2: g_at(k as f64 * 0.125) * G_MPS2,
                 },
-                0.0,
+                f.thresholds_now(0.0, Relief::NONE),
             );
         }
         f.decision()

@@ -19,6 +19,7 @@
 //! | [`fallback`] | the accelerometer-only airbag algorithm (no usable prediction) |
 //! | [`roughness`] | road roughness: the recent forward velocity excursion, added to every fire's floor |
 //! | [`pair_monitor`] | the two accelerometers' plausibility against each other and the vehicle frame: offset, noise |
+//! | [`satellites`] | the crush-zone satellites' PSI5 frames → the frontal severity that lowers the tunnel's thresholds (never a fire of its own) |
 //! | [`agreement`] | the two accelerometers' severity agreement (velocity traces over the same window) |
 //! | [`crash`] | the crash phase's evidence: which path confirmed, the backup, the re-plan |
 //! | [`estimate`] | track filter ([`estimate::track`]), situation, closed-form collision prediction, LUT query, diagnostics pulse |
@@ -58,6 +59,7 @@ pub mod pair_monitor;
 pub mod plan;
 pub mod roughness;
 pub mod safing;
+pub mod satellites;
 pub mod settings;
 /// The records shared with the transport: the `signals` crate, under the core's name for it.
 pub use ::signals;

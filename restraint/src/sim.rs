@@ -10,7 +10,9 @@ use bus::RawFrame;
 use heapless::{Deque, HistoryBuf};
 
 use crate::contract::{Activity, CycleInfo, CycleIo, IoError, ReceiveErrors};
-use crate::signals::{CrashAccelSample, EcuDiagnostics, ObjectState};
+use crate::signals::{
+    CrashAccelSample, EcuDiagnostics, ObjectState, SatelliteFrames, SatelliteSide,
+};
 
 /// Capacity of every queue of [`SimIo`].
 pub const SIM_QUEUE: usize = 64;
@@ -33,6 +35,8 @@ pub struct SimIo {
     pub accel: Deque<CrashAccelSample, SIM_QUEUE>,
     /// Safing-accelerometer batches delivered on the next drain.
     pub safing: Deque<CrashAccelSample, SIM_QUEUE>,
+    /// The left and the right satellite's frame batches delivered on the next drain.
+    pub satellites: [Deque<SatelliteFrames, SIM_QUEUE>; 2],
     /// CAN frames delivered on the next drain.
     pub can_rx: Deque<RawFrame, SIM_QUEUE>,
     /// The newest frames sent (a ring that overwrites its oldest entry).
@@ -64,6 +68,7 @@ impl SimIo {
             objects: Deque::new(),
             accel: Deque::new(),
             safing: Deque::new(),
+            satellites: [Deque::new(), Deque::new()],
             can_rx: Deque::new(),
             can_tx: HistoryBuf::new(),
             can_tx_total: 0,
@@ -92,6 +97,16 @@ impl SimIo {
     /// Queues a safing-accelerometer batch for the next cycle.
     pub fn push_safing(&mut self, a: CrashAccelSample) {
         push_dropping_oldest(&mut self.safing, a, &mut self.dropped);
+    }
+
+    /// Queues a batch of `side`'s satellite frames for the next cycle.
+    pub fn push_satellite(&mut self, side: SatelliteSide, f: SatelliteFrames) {
+        let [left, right] = &mut self.satellites;
+        let q = match side {
+            SatelliteSide::Left => left,
+            SatelliteSide::Right => right,
+        };
+        push_dropping_oldest(q, f, &mut self.dropped);
     }
 
     /// Queues the same batch on the crash and the safing accelerometer: a car whose two
@@ -140,6 +155,20 @@ impl CycleIo for SimIo {
         while let Some(a) = self.safing.pop_front() {
             f(&a);
             n += 1;
+        }
+        n
+    }
+
+    fn drain_satellites(&mut self, f: &mut dyn FnMut(SatelliteSide, &SatelliteFrames)) -> usize {
+        let mut n = 0;
+        for (side, q) in SatelliteSide::BOTH
+            .into_iter()
+            .zip(self.satellites.iter_mut())
+        {
+            while let Some(b) = q.pop_front() {
+                f(side, &b);
+                n += 1;
+            }
         }
         n
     }

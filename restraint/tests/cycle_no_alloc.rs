@@ -4,6 +4,8 @@
 //! and ≥ 10 000 cycles through the prediction-matched crash confirmation (the frozen
 //! closed-form prediction, the ramp fit, the re-plan from the table), airbag fire and
 //! POST-CRASH with the predicted crash pulse in 8-sample batches every cycle.
+//! Both crush-zone satellites send their PSI5 frames every cycle (a crushing front end after
+//! the contact: the fusion grants its relief inside the counted cycles).
 //! SecOC is on (the example key file): every command frame is followed by its AES-CMAC
 //! authenticator, computed inside the counted cycles.
 //! The com layer of this test ([`SimIo`]) is itself allocation-free (fixed-capacity queues).
@@ -17,7 +19,8 @@ mod cycle_support;
 use cycle_support::{MS, REFERENCE, T0};
 use physics::{CombinedSpring, ExactCollision, MassClass};
 use restraint::crash::ConfirmKind;
-use restraint::{CrashAccelSample, CycleConfig, Phase, RestraintCycle, SimIo, SimLoop};
+use restraint::signals::{psi5, SatelliteFrames, SatelliteSide};
+use restraint::{CrashAccelSample, CycleConfig, Phase, RestraintCycle, SimIo, SimLoop, G_MPS2};
 
 #[test]
 fn no_allocation_in_precrash_and_crash_cycles() {
@@ -87,6 +90,20 @@ fn no_allocation_in_precrash_and_crash_cycles() {
             *s = (pulse + dither) as f32;
         }
         io.push_both_accel(a);
+        // Both satellites: two PSI5 frames per ms, the body's deceleration before the contact
+        // and a crushing front end (the body's + 60 g) after it.
+        let crush_g = if now >= contact_ns { 60.0 } else { 0.0 };
+        let decel_g = -f64::from(a.accel_mps2[7]) / G_MPS2 + crush_g;
+        let code = psi5::encode(psi5::code_of(decel_g * G_MPS2, 240.0 * G_MPS2));
+        let frames = SatelliteFrames {
+            first_timestamp_ns: now - 500_000,
+            sequence: k + 1,
+            sample_period_ns: 500_000,
+            count: 2,
+            frames: [code; 8],
+        };
+        io.push_satellite(SatelliteSide::Left, frames);
+        io.push_satellite(SatelliteSide::Right, frames);
         if ms.is_multiple_of(10) {
             io.push_can(bench.vehicle_frame(25.0));
         }
@@ -121,6 +138,10 @@ fn no_allocation_in_precrash_and_crash_cycles() {
     );
     assert!(crash_cycles >= 10_000, "crash / post-crash: {crash_cycles}");
     assert!(ecu.airbag_fired());
+    assert!(
+        ecu.satellites().relieved_batches > 0,
+        "the satellites' relief ran"
+    );
     assert!(
         matches!(ecu.crash_kind(), Some(ConfirmKind::Matched(_))),
         "the matched path ran: {:?}",

@@ -3,14 +3,16 @@
 //!
 //! One 1 ms tick grid (absolute deadlines, no drift): object list over iceoryx2 at the
 //! scenario's period, EgoVehicleState (10 ms) and OccupantClassification (100 ms) over CAN with
-//! E2E, the compartment (crash) accelerometer and the independent safing accelerometer in 1 ms
+//! E2E, the compartment (crash) accelerometer, the independent safing accelerometer and the two
+//! crush-zone satellites' PSI5 frames in 1 ms
 //! batches on their own services (≥ 1 kHz samples; the TRUE crash pulse after contact, plus the
 //! scenario's `[[accel_event]]`s), and BenchTruth every 10 ms for the actuator stubs.
 
 use anyhow::{Context, Result};
 use clap::Parser;
 use ipc::{
-    AccelPublisher, BenchTruth, BenchTruthPublisher, ObjectPublisher, SafingPublisher, ServiceNames,
+    AccelPublisher, BenchTruth, BenchTruthPublisher, ObjectPublisher, SafingPublisher,
+    SatelliteLeftPublisher, SatelliteRightPublisher, ServiceNames,
 };
 use sensor_feeds::player::TICK_NS;
 use sensor_feeds::{monotonic_ns, sleep_until_ns, Player, Scenario, TickOutput, Truth};
@@ -158,6 +160,8 @@ fn run(cli: &Cli) -> Result<()> {
     let mut objects = ObjectPublisher::new(&node, &names)?;
     let mut accel = AccelPublisher::new(&node, &names)?;
     let mut safing = SafingPublisher::new(&node, &names)?;
+    let mut satellite_left = SatelliteLeftPublisher::new(&node, &names)?;
+    let mut satellite_right = SatelliteRightPublisher::new(&node, &names)?;
     let mut truth_pub = BenchTruthPublisher::new(&node, &names)?;
     let mut can = if cli.no_can {
         None
@@ -246,6 +250,21 @@ fn run(cli: &Cli) -> Result<()> {
                 log.write(FeedItem::SafingAccel(*b));
             }
         }
+        let [left, right] = &out.satellites;
+        for b in left {
+            if satellite_left.publish(*b).is_err() {
+                counts.ipc_errors += 1;
+            } else {
+                log.write(FeedItem::SatelliteLeft(*b));
+            }
+        }
+        for b in right {
+            if satellite_right.publish(*b).is_err() {
+                counts.ipc_errors += 1;
+            } else {
+                log.write(FeedItem::SatelliteRight(*b));
+            }
+        }
         // Every 10 ms: a feed killed mid-run (the fault campaign does) loses ≤ 10 ms of its log.
         if tick % 10 == 0 {
             log.flush();
@@ -286,8 +305,8 @@ fn run(cli: &Cli) -> Result<()> {
     }
     let p = player.counts();
     eprintln!(
-        "sensor-feeds: done: {} objects ({} dropped, {} stale repeats), {} accel samples ({} faulty), {} safing samples ({} faulty), {} spikes, {} CAN frames, {} CAN errors, {} IPC errors",
-        p.objects, p.objects_dropped, p.objects_frozen, p.accel_samples, p.accel_faulty, p.safing_samples, p.safing_faulty, p.spikes, counts.can_frames, counts.can_errors, counts.ipc_errors
+        "sensor-feeds: done: {} objects ({} dropped, {} stale repeats), {} accel samples ({} faulty), {} safing samples ({} faulty), {} satellite frames, {} spikes, {} CAN frames, {} CAN errors, {} IPC errors",
+        p.objects, p.objects_dropped, p.objects_frozen, p.accel_samples, p.accel_faulty, p.safing_samples, p.safing_faulty, p.satellite_frames, p.spikes, counts.can_frames, counts.can_errors, counts.ipc_errors
     );
     log.finish();
     // Keep the publishers alive a moment so subscribers can read the last samples.

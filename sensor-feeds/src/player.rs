@@ -1,7 +1,8 @@
 //! What the feeds publish, tick by tick, without a clock: the object list (period, latency,
 //! dropouts, stuck windows), the crash and the safing accelerometer, each in batches of ≤ 8
-//! samples with its own sequence (dropouts, fault windows, spikes) and the E2E-sealed CAN
-//! frames. The `sensor-feeds` binary sleeps to each tick and publishes what [`Player::tick`]
+//! samples with its own sequence (dropouts, fault windows, spikes), the two crush-zone
+//! satellites' PSI5 frames (the same sensor model, quantised to data codes with parity, each
+//! frame one sync slot after its sample) and the E2E-sealed CAN frames. The `sensor-feeds` binary sleeps to each tick and publishes what [`Player::tick`]
 //! produced; the offline bench (`e2e-tests`' `offline-bench`) hands the same records to the ECU
 //! core under a simulated clock, so both run one model of the sensors.
 
@@ -9,7 +10,8 @@ use crate::scenario::{AccelFaultKind, AccelSensor, DropoutTarget, SensorModel};
 use crate::sensors::SensorModelSim;
 use crate::truth::Truth;
 use bus::{E2eProtector, RawFrame};
-use ipc::{CrashAccelSample, ObjectState, ACCEL_BATCH_CAPACITY};
+use ipc::{CrashAccelSample, ObjectState, SatelliteFrames, ACCEL_BATCH_CAPACITY};
+use signals::psi5;
 
 /// The feed grid: one tick per ms of scenario time.
 pub const TICK_NS: u64 = 1_000_000;
@@ -24,6 +26,9 @@ pub struct TickOutput {
     /// Safing accelerometer batches (iceoryx2 `CrashAccelSample`,
     /// `ServiceNames::safing_accel`).
     pub safing: Vec<CrashAccelSample>,
+    /// The left and the right satellite's PSI5 frames (iceoryx2 `SatelliteFrames`,
+    /// `ServiceNames::satellites`); empty for a car without satellites.
+    pub satellites: [Vec<SatelliteFrames>; 2],
     /// E2E-sealed `EgoVehicleState` / `OccupantClassification` frames.
     pub can: Vec<RawFrame>,
 }
@@ -46,7 +51,9 @@ pub struct PlayCounts {
     /// Safing accelerometer samples altered by a fault window (`accel_faults`, `sensor =
     /// "safing"`).
     pub safing_faulty: u64,
-    /// Samples (of either sensor) replaced by a spike `[[accel_event]]`.
+    /// Satellite frames produced (both satellites).
+    pub satellite_frames: u64,
+    /// Samples (of any sensor) replaced by a spike `[[accel_event]]`.
     pub spikes: u64,
     /// CAN frames produced.
     pub can_frames: u64,
@@ -57,6 +64,8 @@ struct AccelChannel {
     sensor: AccelSensor,
     /// Sample period [s of scenario time].
     dt_s: f64,
+    /// How long after its instant a sample is delivered [s] (a satellite's one PSI5 slot).
+    latency_s: f64,
     /// Measuring range [m/s²] (what a saturated sensor reads, negated).
     full_scale_mps2: f64,
     /// Index of the next sample (instant `k · dt_s`).
@@ -78,6 +87,7 @@ impl AccelChannel {
         AccelChannel {
             sensor,
             dt_s,
+            latency_s: if sensor.is_satellite() { dt_s } else { 0.0 },
             full_scale_mps2: full_scale_g * physics::defaults::STANDARD_GRAVITY_MPS2,
             next_k: (t0_s / dt_s - 1e-9).ceil().max(0.0) as u64,
             last: 0.0,
@@ -116,6 +126,10 @@ pub struct Player {
     last_object: Option<ObjectState>,
     crash: AccelChannel,
     safing: AccelChannel,
+    /// The left and the right satellite (`None`: the car has none).
+    satellites: Option<[AccelChannel; 2]>,
+    /// Scratch for a satellite's readings before they become PSI5 frames.
+    satellite_readings: Vec<CrashAccelSample>,
     protector: E2eProtector,
     counts: PlayCounts,
 }
@@ -138,6 +152,10 @@ impl Player {
             next_occ_s: first_at(sensor.occupant_period_ms * 1e-3),
             crash: AccelChannel::new(AccelSensor::Crash, &sensor, t0_s),
             safing: AccelChannel::new(AccelSensor::Safing, &sensor, t0_s),
+            satellites: sensor
+                .satellites
+                .then(|| AccelSensor::SATELLITES.map(|s| AccelChannel::new(s, &sensor, t0_s))),
+            satellite_readings: Vec::new(),
             model: SensorModelSim::new(truth),
             sensor,
             time: TimeBase { start_ns, scale },
@@ -159,6 +177,10 @@ impl Player {
             accel_faulty: self.crash.faulty,
             safing_samples: self.safing.samples,
             safing_faulty: self.safing.faulty,
+            satellite_frames: self
+                .satellites
+                .as_ref()
+                .map_or(0, |chs| chs.iter().map(|c| c.samples).sum()),
             ..self.counts
         }
     }
@@ -176,6 +198,7 @@ impl Player {
         out.objects.clear();
         out.accel.clear();
         out.safing.clear();
+        out.satellites.iter_mut().for_each(Vec::clear);
         out.can.clear();
         let t = tick as f64 * 1e-3;
         self.objects(t, out);
@@ -193,6 +216,24 @@ impl Player {
             spikes: &mut self.counts.spikes,
         };
         feed.play(&mut self.safing, t, &mut out.safing);
+        if let Some(channels) = self.satellites.as_mut() {
+            for (ch, frames) in channels.iter_mut().zip(out.satellites.iter_mut()) {
+                self.satellite_readings.clear();
+                let feed = Feed {
+                    model: &mut self.model,
+                    sensor: &self.sensor,
+                    time: self.time,
+                    spikes: &mut self.counts.spikes,
+                };
+                feed.play(ch, t, &mut self.satellite_readings);
+                let full_scale = ch.full_scale_mps2;
+                frames.extend(
+                    self.satellite_readings
+                        .iter()
+                        .map(|b| psi5_frames(b, full_scale)),
+                );
+            }
+        }
         self.can(t, out)
     }
 
@@ -281,7 +322,7 @@ impl Feed<'_> {
             return;
         }
         let mut batch = CrashAccelSample::EMPTY;
-        while (ch.next_k as f64) * dt_s <= t + 1e-9 {
+        while (ch.next_k as f64) * dt_s + ch.latency_s <= t + 1e-9 {
             let ts = ch.next_k as f64 * dt_s;
             ch.next_k += 1;
             // The noise is drawn for every sample (a spike replaces the value, not the draw).
@@ -319,6 +360,22 @@ impl Feed<'_> {
             push_batch(ch, &mut batch, out);
         }
     }
+}
+
+/// A satellite's readings as PSI5 frames: each reading (m/s², − = deceleration) as the data
+/// code of its deceleration, with parity; the same instants and sequence.
+fn psi5_frames(b: &CrashAccelSample, full_scale_mps2: f64) -> SatelliteFrames {
+    let mut f = SatelliteFrames {
+        first_timestamp_ns: b.first_timestamp_ns,
+        sequence: b.sequence,
+        sample_period_ns: b.sample_period_ns,
+        count: b.count,
+        ..SatelliteFrames::EMPTY
+    };
+    for (slot, a) in f.frames.iter_mut().zip(b.samples()) {
+        *slot = psi5::encode(psi5::code_of(-f64::from(*a), full_scale_mps2));
+    }
+    f
 }
 
 fn push_batch(
@@ -645,9 +702,11 @@ mod tests {
                     None => assert!(hits.is_empty(), "{sensor}"),
                 }
             }
+            // A mechanical spike (`all`) reaches the two satellites too.
+            let satellites = if sensor == "all" { 2 } else { 0 };
             assert_eq!(
                 p.counts().spikes,
-                [crash_at, safing_at].iter().flatten().count() as u64
+                [crash_at, safing_at].iter().flatten().count() as u64 + satellites
             );
         }
         // On a sample instant: that sample. Beyond the range: the range (safing 50 g).

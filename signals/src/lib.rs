@@ -3,8 +3,8 @@
 //! feeds and the actuator stubs need not link the restraint core, and the core never links
 //! the transport. `no_std`, no allocation, no dependency beyond `bitflags` and `strum`.
 //!
-//! What the cycle reads and writes besides CAN: the opponent object, the crash accelerometer
-//! and the diagnostics record, plus the mode and degraded-reason vocabulary they use.
+//! What the cycle reads and writes besides CAN: the opponent object, the crash accelerometer,
+//! the crush-zone satellites' PSI5 frames ([`psi5`]) and the diagnostics record, plus the mode and degraded-reason vocabulary they use.
 
 #![no_std]
 #![warn(missing_docs)]
@@ -16,6 +16,9 @@
 //! shared memory (the `ipc` crate wraps each in its transport type), a microcontroller port
 //! would fill them from its drivers. Flags are `u8`, not `bool`: a producer in another process
 //! could write any byte, and a `bool` other than 0/1 is undefined behaviour in Rust.
+
+pub mod psi5;
+pub use psi5::{SatelliteFrames, SatelliteSide, SATELLITE_BATCH_CAPACITY};
 
 /// `valid` flag value meaning "the producer vouches for this object".
 pub const VALID: u8 = 1;
@@ -231,6 +234,10 @@ pub enum FeedItem {
     CrashAccel(CrashAccelSample),
     /// On the safing accelerometer's service.
     SafingAccel(CrashAccelSample),
+    /// On the left crush-zone satellite's service.
+    SatelliteLeft(SatelliteFrames),
+    /// On the right crush-zone satellite's service.
+    SatelliteRight(SatelliteFrames),
 }
 
 /// ECU diagnostics, published every cycle (predicted pulse, chosen settings, mode, timing).

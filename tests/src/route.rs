@@ -209,6 +209,8 @@ fn injected_flags(scenario: &sensor_feeds::Scenario) -> Vec<&'static str> {
             // Optional equipment: a silent V2X receiver raises no fault, it only takes the
             // second mass source away.
             DropoutTarget::V2x => &[],
+            // A silent satellite takes only its relief away; it has no EcuStatus bit.
+            DropoutTarget::SatelliteLeft | DropoutTarget::SatelliteRight => &[],
             DropoutTarget::All => &[
                 "object_input",
                 "vehicle_input",
@@ -231,7 +233,7 @@ fn injected_flags(scenario: &sensor_feeds::Scenario) -> Vec<&'static str> {
         match e.sensor {
             EventSensor::Crash => v.push("accel_sensor"),
             EventSensor::Safing => v.push("safing_sensor"),
-            EventSensor::All => {}
+            EventSensor::All | EventSensor::SatelliteLeft | EventSensor::SatelliteRight => {}
         }
     }
     v

@@ -1,7 +1,8 @@
 //! The bench's world, without I/O: scenario files ([`scenario`]: schema, validation, where an
 //! error is in the file), the true world ([`truth`]: closed-form pre-crash kinematics + the
 //! true collision physics after contact), the sensor models ([`sensors`]: noise, bias,
-//! latency, range; the crash and the safing accelerometer) and what the acceleration sensors
+//! latency, range; the crash and the safing accelerometer, the crush-zone satellites over
+//! [`crush_zone`]) and what the acceleration sensors
 //! see besides a crash ([`events`]: `[[accel_event]]`).
 //!
 //! No transport, clock or thread: `sensor-feeds` plays this world in real time over iceoryx2
@@ -10,6 +11,7 @@
 #![warn(missing_docs)]
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod crush_zone;
 pub mod events;
 pub mod lowpass;
 mod noise;

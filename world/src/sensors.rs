@@ -35,15 +35,21 @@ pub const SAFING_STREAM: u64 = 1;
 /// without `[v2x]` draws the same object-list and accelerometer noise).
 pub const V2X_STREAM: u64 = 2;
 
+/// ChaCha8 streams of the left and the right satellite's noise (their own, so a car with and
+/// without satellites draws the same noise for every other sensor).
+pub const SATELLITE_STREAMS: [u64; 2] = [3, 4];
+
 /// Seeded sensor model over a solved [`Truth`].
 pub struct SensorModelSim {
     truth: Truth,
     rng: ChaCha8Rng,
     safing_rng: ChaCha8Rng,
     v2x_rng: ChaCha8Rng,
+    satellite_rngs: [ChaCha8Rng; 2],
     events: AccelEvents,
-    /// The anti-alias filters of the crash and the safing accelerometer.
-    lowpass: [AntiAlias; 2],
+    /// The anti-alias filters of the crash and the safing accelerometer and of the left and
+    /// the right satellite.
+    lowpass: [AntiAlias; 4],
     object_sequence: u64,
 }
 
@@ -55,10 +61,24 @@ impl SensorModelSim {
         safing_rng.set_stream(SAFING_STREAM);
         let mut v2x_rng = ChaCha8Rng::seed_from_u64(seed);
         v2x_rng.set_stream(V2X_STREAM);
+        let satellite_rngs = SATELLITE_STREAMS.map(|stream| {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            rng.set_stream(stream);
+            rng
+        });
+        let sensor = &truth.scenario().sensor;
+        let lowpass = [
+            AccelSensor::Crash,
+            AccelSensor::Safing,
+            AccelSensor::SatelliteLeft,
+            AccelSensor::SatelliteRight,
+        ]
+        .map(|s| AntiAlias::new(sensor.lowpass_hz(s)));
         SensorModelSim {
             v2x_rng,
+            satellite_rngs,
             events: AccelEvents::new(truth.scenario()),
-            lowpass: [(); 2].map(|_| AntiAlias::new(truth.scenario().sensor.accel_lowpass_hz)),
+            lowpass,
             truth,
             rng: ChaCha8Rng::seed_from_u64(seed),
             safing_rng,
@@ -142,15 +162,24 @@ impl SensorModelSim {
     /// restarts its filter, as a restarted feed does).
     pub fn reading_mps2(&mut self, sensor: AccelSensor, t_s: f64) -> f64 {
         let (_, noise_sd, full_scale_g) = self.truth.scenario().sensor.accel_params(sensor);
+        let [lp_crash, lp_safing, lp_left, lp_right] = &mut self.lowpass;
+        let [rng_left, rng_right] = &mut self.satellite_rngs;
         let (rng, filter) = match sensor {
-            AccelSensor::Crash => (&mut self.rng, &mut self.lowpass[0]),
-            AccelSensor::Safing => (&mut self.safing_rng, &mut self.lowpass[1]),
+            AccelSensor::Crash => (&mut self.rng, lp_crash),
+            AccelSensor::Safing => (&mut self.safing_rng, lp_safing),
+            AccelSensor::SatelliteLeft => (rng_left, lp_left),
+            AccelSensor::SatelliteRight => (rng_right, lp_right),
         };
         let full_scale = full_scale_g * physics::defaults::STANDARD_GRAVITY_MPS2;
         let noise = noise_sd * gauss(rng);
         let (truth, events) = (&self.truth, &self.events);
+        let satellite = sensor.is_satellite();
         let input = |t: f64| {
-            let a = truth.ego_accel_mps2(t);
+            let a = if satellite {
+                truth.satellite_accel_mps2(t)
+            } else {
+                truth.ego_accel_mps2(t)
+            };
             // Only when an event is active: otherwise the sum is the one it always was.
             match events.added_mps2(sensor, t) {
                 Some(e) => a + e,

@@ -86,6 +86,9 @@ pub struct Truth {
     pub collision: Option<CollisionSummary>,
     /// True compartment pulses from first contact (0.1 ms steps).
     pub pulse: Box<DefaultPulseBuffer>,
+    /// A crush-zone satellite's acceleration relative to the body, on the pulse's grid
+    /// ([`crate::crush_zone`]; empty without contact).
+    satellite_rel_mps2: Vec<f64>,
 }
 
 impl Truth {
@@ -98,6 +101,7 @@ impl Truth {
             opp_speed_at_contact_mps: 0.0,
             collision: None,
             pulse: Box::new(DefaultPulseBuffer::new()),
+            satellite_rel_mps2: Vec::new(),
         };
         // After an evasive manoeuvre the opponent is out of the path: no contact afterwards.
         let end = scenario
@@ -135,6 +139,11 @@ impl Truth {
         let summary = physics::simulate_collision(&input, &mut truth.pulse)
             .map_err(|e| format!("true collision physics: {e:?}"))?;
         truth.collision = Some(summary);
+        truth.satellite_rel_mps2 = crate::crush_zone::relative_accel_mps2(
+            truth.pulse.ego_crush_m(),
+            truth.pulse.step_s(),
+            scenario.sensor.satellite_depth_m,
+        );
         Ok(truth)
     }
 
@@ -216,6 +225,19 @@ impl Truth {
         match self.contact_s {
             Some(tc) if t_s >= tc => self.pulse_at(self.pulse.ego_accel_mps2(), t_s - tc),
             _ => self.ego_motion(t_s).2,
+        }
+    }
+
+    /// What a crush-zone satellite feels at `t_s` [m/s²]: the body's acceleration and, from
+    /// contact, the crush of the structure ahead of it ([`crate::crush_zone`]). Both
+    /// satellites feel the same (a full-width frontal impact).
+    pub fn satellite_accel_mps2(&self, t_s: f64) -> f64 {
+        let body = self.ego_accel_mps2(t_s);
+        match self.contact_s {
+            Some(tc) if t_s >= tc && t_s - tc < self.pulse.len() as f64 * self.pulse.step_s() => {
+                body + self.pulse_at(&self.satellite_rel_mps2, t_s - tc)
+            }
+            _ => body,
         }
     }
 

@@ -141,6 +141,7 @@ pub fn run_ecu(
         io.safing_counters(),
         io.diagnostics_counters(),
     );
+    let sat = io.satellite_counters();
     let ipc_status = IpcStatus {
         service_prefix: cfg.ipc.service_prefix.clone(),
         stale_nodes_cleaned: cleanup.cleaned,
@@ -151,6 +152,8 @@ pub fn run_ecu(
         accel_rx_errors: a.errors,
         safing_rx: sf.received,
         safing_rx_errors: sf.errors,
+        satellite_rx: sat.map(|c| c.received),
+        satellite_rx_errors: sat.map(|c| c.errors),
         diagnostics_written: io.diagnostics_written(),
         diagnostics_tx: d.sent,
         diagnostics_tx_errors: d.errors,

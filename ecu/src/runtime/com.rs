@@ -1,6 +1,6 @@
 //! The real com layer: iceoryx2 subscribers (object list, crash accelerometer, safing
-//! accelerometer — each on its own service), the diagnostics publisher and an optional CAN
-//! port.
+//! accelerometer, the two crush-zone satellites — each on its own service), the diagnostics
+//! publisher and an optional CAN port.
 //!
 //! Inputs are polled on the cycle thread (iceoryx2 `receive()` does not allocate).
 //! Diagnostics are *not* loaned on the cycle thread: iceoryx2 0.10's `loan_uninit`
@@ -19,11 +19,13 @@ use std::time::Duration;
 
 use ipc::{
     AccelSubscriber, CrashAccelSample, DiagnosticsPublisher, EcuDiagnostics, IpcError, IpcNode,
-    ObjectState, ObjectSubscriber, RxCounters, SafingSubscriber, ServiceNames, TxCounters,
+    ObjectState, ObjectSubscriber, RxCounters, SafingSubscriber, SatelliteFrames,
+    SatelliteLeftSubscriber, SatelliteRightSubscriber, ServiceNames, TxCounters,
 };
 use triple_buffer::triple_buffer;
 
 use bus::RawFrame;
+use restraint::signals::SatelliteSide;
 use restraint::{CycleIo, IoError, ReceiveErrors};
 
 /// A non-blocking CAN port, implemented by [`crate::can_port::SocketCanPort`] over the bus
@@ -145,6 +147,9 @@ pub struct IceoryxIo {
     /// The safing accelerometer: an independent sensor on its own service (never merged with
     /// the crash accelerometer's).
     safing: SafingSubscriber,
+    /// The crush-zone satellites, each on its own service.
+    satellite_left: SatelliteLeftSubscriber,
+    satellite_right: SatelliteRightSubscriber,
     diagnostics: triple_buffer::Input<EcuDiagnostics>,
     offload: DiagnosticsOffload,
     diagnostics_written: u64,
@@ -165,6 +170,8 @@ impl IceoryxIo {
         let objects = ObjectSubscriber::new(node, names)?;
         let accel = AccelSubscriber::new(node, names)?;
         let safing = SafingSubscriber::new(node, names)?;
+        let satellite_left = SatelliteLeftSubscriber::new(node, names)?;
+        let satellite_right = SatelliteRightSubscriber::new(node, names)?;
         let (input, output) = triple_buffer(&EcuDiagnostics::ZERO);
         let offload = DiagnosticsOffload::spawn(
             format!("{}-diag", node.name().as_str()),
@@ -176,6 +183,8 @@ impl IceoryxIo {
             objects,
             accel,
             safing,
+            satellite_left,
+            satellite_right,
             diagnostics: input,
             offload,
             diagnostics_written: 0,
@@ -197,6 +206,14 @@ impl IceoryxIo {
     /// Safing accelerometer receive counters.
     pub fn safing_counters(&self) -> RxCounters {
         self.safing.counters()
+    }
+
+    /// The left and the right satellite's receive counters.
+    pub fn satellite_counters(&self) -> [RxCounters; 2] {
+        [
+            self.satellite_left.counters(),
+            self.satellite_right.counters(),
+        ]
     }
 
     /// Records written by the cycle (every call of `publish_diagnostics`).
@@ -237,6 +254,16 @@ impl CycleIo for IceoryxIo {
         // The same poll-only drain as the crash accelerometer's: no allocation, no lock, no
         // wait; a receive error ends the drain and is counted (`receive_errors().safing`).
         self.safing.drain(f)
+    }
+
+    fn drain_satellites(&mut self, f: &mut dyn FnMut(SatelliteSide, &SatelliteFrames)) -> usize {
+        // Poll-only as the accelerometers'; a receive error ends that satellite's drain and is
+        // counted in its port's counters (a missing satellite only takes its relief away).
+        self.satellite_left
+            .drain(|b: &SatelliteFrames| f(SatelliteSide::Left, b))
+            + self
+                .satellite_right
+                .drain(|b: &SatelliteFrames| f(SatelliteSide::Right, b))
     }
 
     fn drain_can(&mut self, f: &mut dyn FnMut(&RawFrame)) -> usize {

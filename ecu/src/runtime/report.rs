@@ -110,6 +110,10 @@ pub struct IpcStatus {
     pub safing_rx: u64,
     /// Safing accelerometer receive errors.
     pub safing_rx_errors: u64,
+    /// Satellite frame batches received (left, right).
+    pub satellite_rx: [u64; 2],
+    /// Satellite receive errors (left, right).
+    pub satellite_rx_errors: [u64; 2],
     /// Diagnostics records written by the cycle.
     pub diagnostics_written: u64,
     /// Diagnostics records sent over iceoryx2 (newest-wins; ≤ written).
@@ -229,7 +233,7 @@ impl<'a> TimingReport<'a> {
         if let Some(ipc) = &self.ipc {
             let _ = writeln!(
                 s,
-                "  iceoryx2 [{}]: objects rx {} (err {}), accel rx {} (err {}), safing rx {} (err {}), diagnostics written {} tx {} (err {}), stale nodes cleaned {}",
+                "  iceoryx2 [{}]: objects rx {} (err {}), accel rx {} (err {}), safing rx {} (err {}), satellites rx {}/{} (err {}/{}), diagnostics written {} tx {} (err {}), stale nodes cleaned {}",
                 ipc.service_prefix,
                 ipc.object_rx,
                 ipc.object_rx_errors,
@@ -237,6 +241,10 @@ impl<'a> TimingReport<'a> {
                 ipc.accel_rx_errors,
                 ipc.safing_rx,
                 ipc.safing_rx_errors,
+                ipc.satellite_rx[0],
+                ipc.satellite_rx[1],
+                ipc.satellite_rx_errors[0],
+                ipc.satellite_rx_errors[1],
                 ipc.diagnostics_written,
                 ipc.diagnostics_tx,
                 ipc.diagnostics_tx_errors,

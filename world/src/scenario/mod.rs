@@ -197,6 +197,10 @@ pub enum DropoutTarget {
     Safing,
     /// The V2X receiver's `V2xOpponentMass` frame.
     V2x,
+    /// The left crush-zone satellite's PSI5 frames.
+    SatelliteLeft,
+    /// The right crush-zone satellite's PSI5 frames.
+    SatelliteRight,
     /// Everything.
     All,
 }
@@ -236,7 +240,7 @@ pub enum AccelFaultKind {
     Saturated,
 }
 
-/// One of the ECU's two acceleration sensors.
+/// One of the car's acceleration sensors: the ECU's two and the two crush-zone satellites.
 #[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum AccelSensor {
@@ -245,15 +249,34 @@ pub enum AccelSensor {
     Crash,
     /// The safing accelerometer (the safing function's independent sensor).
     Safing,
+    /// The left crush-zone satellite (left rail tip).
+    SatelliteLeft,
+    /// The right crush-zone satellite (right rail tip).
+    SatelliteRight,
 }
 
 impl AccelSensor {
-    /// The name used in scenario files (`crash`, `safing`).
+    /// The two crush-zone satellites, left first.
+    pub const SATELLITES: [AccelSensor; 2] =
+        [AccelSensor::SatelliteLeft, AccelSensor::SatelliteRight];
+
+    /// The name used in scenario files (`crash`, `safing`, `satellite-left`,
+    /// `satellite-right`).
     pub fn name(self) -> &'static str {
         match self {
             AccelSensor::Crash => "crash",
             AccelSensor::Safing => "safing",
+            AccelSensor::SatelliteLeft => "satellite-left",
+            AccelSensor::SatelliteRight => "satellite-right",
         }
+    }
+
+    /// A crush-zone satellite (on the front structure, not in the ECU).
+    pub fn is_satellite(self) -> bool {
+        matches!(
+            self,
+            AccelSensor::SatelliteLeft | AccelSensor::SatelliteRight
+        )
     }
 }
 
@@ -324,15 +347,22 @@ pub enum EventSensor {
     Crash,
     /// A fault of the safing accelerometer alone.
     Safing,
+    /// A fault of the left crush-zone satellite alone.
+    SatelliteLeft,
+    /// A fault of the right crush-zone satellite alone.
+    SatelliteRight,
 }
 
 impl EventSensor {
-    /// The name used in scenario files (`all`, `crash`, `safing`).
+    /// The name used in scenario files (`all`, `crash`, `safing`, `satellite-left`,
+    /// `satellite-right`).
     pub fn name(self) -> &'static str {
         match self {
             EventSensor::All => "all",
             EventSensor::Crash => "crash",
             EventSensor::Safing => "safing",
+            EventSensor::SatelliteLeft => "satellite-left",
+            EventSensor::SatelliteRight => "satellite-right",
         }
     }
 
@@ -342,6 +372,8 @@ impl EventSensor {
             EventSensor::All => true,
             EventSensor::Crash => sensor == AccelSensor::Crash,
             EventSensor::Safing => sensor == AccelSensor::Safing,
+            EventSensor::SatelliteLeft => sensor == AccelSensor::SatelliteLeft,
+            EventSensor::SatelliteRight => sensor == AccelSensor::SatelliteRight,
         }
     }
 }
@@ -432,6 +464,22 @@ pub struct SensorModel {
     /// third-order Bessel, as the ADXL180 airbag accelerometer's default (`world::lowpass`);
     /// 0 = an ideal sampler without filter.
     pub accel_lowpass_hz: f64,
+    /// The car has the two crush-zone satellites (left and right rail tip); `false`: the
+    /// ECU's own sensors only, as a car without upfront sensors.
+    pub satellites: bool,
+    /// Where the satellites sit behind the fascia [m] (rail tips: bumper beam and crash boxes
+    /// ahead of them; `world::truth`, "Crush-zone satellites").
+    pub satellite_depth_m: f64,
+    /// Satellite sample rate [Hz]: one PSI5 synchronous frame per sync pulse (2000 = 500 µs),
+    /// delivered one slot (1 / rate) after its sample.
+    pub satellite_rate_hz: f64,
+    /// Gaussian noise of each satellite [m/s², 1σ] (own random streams).
+    pub satellite_noise_mps2: f64,
+    /// Measuring range of the satellites [g]: ±480 PSI5 data codes span ±this.
+    pub satellite_full_scale_g: f64,
+    /// −3 dB corner of the satellites' low-pass before sampling [Hz] (the same third-order
+    /// Bessel model as the ECU's sensors; 0 = none).
+    pub satellite_lowpass_hz: f64,
     /// Feed dropouts.
     pub dropouts: Vec<Dropout>,
     /// Stuck object-list windows (stale data: the last sample repeated).
@@ -464,6 +512,12 @@ impl Default for SensorModel {
             safing_noise_mps2: 1.0,
             safing_full_scale_g: 50.0,
             accel_lowpass_hz: 400.0,
+            satellites: true,
+            satellite_depth_m: 0.2,
+            satellite_rate_hz: 2000.0,
+            satellite_noise_mps2: 2.0,
+            satellite_full_scale_g: 240.0,
+            satellite_lowpass_hz: 400.0,
             dropouts: Vec::new(),
             freezes: Vec::new(),
             accel_faults: Vec::new(),
@@ -516,6 +570,8 @@ impl SensorModel {
         match sensor {
             AccelSensor::Crash => DropoutTarget::Accel,
             AccelSensor::Safing => DropoutTarget::Safing,
+            AccelSensor::SatelliteLeft => DropoutTarget::SatelliteLeft,
+            AccelSensor::SatelliteRight => DropoutTarget::SatelliteRight,
         }
     }
 
@@ -546,6 +602,20 @@ impl SensorModel {
                 self.safing_noise_mps2,
                 self.safing_full_scale_g,
             ),
+            AccelSensor::SatelliteLeft | AccelSensor::SatelliteRight => (
+                self.satellite_rate_hz,
+                self.satellite_noise_mps2,
+                self.satellite_full_scale_g,
+            ),
+        }
+    }
+
+    /// −3 dB corner of `sensor`'s low-pass before sampling [Hz] (0 = none).
+    pub fn lowpass_hz(&self, sensor: AccelSensor) -> f64 {
+        if sensor.is_satellite() {
+            self.satellite_lowpass_hz
+        } else {
+            self.accel_lowpass_hz
         }
     }
 

@@ -286,6 +286,43 @@ impl Scenario {
                 "Hz (or 0: no filter)",
             )?;
         }
+        range(
+            "sensor.satellite_depth_m",
+            s.satellite_depth_m,
+            0.05,
+            0.5,
+            "m",
+        )?;
+        range(
+            "sensor.satellite_rate_hz",
+            s.satellite_rate_hz,
+            1000.0,
+            8000.0,
+            "Hz",
+        )?;
+        range(
+            "sensor.satellite_noise_mps2",
+            s.satellite_noise_mps2,
+            0.0,
+            50.0,
+            "m/s²",
+        )?;
+        range(
+            "sensor.satellite_full_scale_g",
+            s.satellite_full_scale_g,
+            50.0,
+            1000.0,
+            "g",
+        )?;
+        if s.satellite_lowpass_hz != 0.0 {
+            range(
+                "sensor.satellite_lowpass_hz",
+                s.satellite_lowpass_hz,
+                50.0,
+                2000.0,
+                "Hz (or 0: no filter)",
+            )?;
+        }
         let windows = s
             .dropouts
             .iter()

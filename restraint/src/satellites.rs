@@ -1,0 +1,508 @@
+//! The crush-zone satellites: evidence that lets the tunnel's decisions come down to the
+//! crash's time, never a path to Fire of their own.
+//!
+//! **What they measure.** Two upfront accelerometers at the rail tips (PSI5 frames,
+//! `signals::psi5`) sit in the structure that crushes first. A body motion — braking, a
+//! pothole, a kerb, a rough road, a door slam — moves them with the body, so over a few ms they
+//! gain the tunnel's velocity change; a crash folds the structure ahead of them and they lose
+//! speed metres per second faster than the body (`world::crush_zone`: `v²·t/(0.7·depth)` at a
+//! crush rate v). The **crush Δv** of a satellite is its velocity change over the last
+//! `satellite_window_ms` less the tunnel accelerometer's over the same window.
+//!
+//! **The rule.** The frontal severity is the *smaller* of the two satellites' crush Δv: a
+//! full-width crash loads both, and no single satellite — spiking, stuck, saturated, mounted
+//! backwards, or replaced by a forged frame — can raise the smaller of two. From
+//! `satellite_relief_from_mps` to `satellite_relief_full_mps` it grants a relief fraction
+//! r ∈ [0, 1] (held [`RELIEF_HOLD_MS`] after the severity last reached the lower line, at the
+//! event's peak), which lowers what the tunnel's decisions ask by r of a capped range:
+//!
+//! * the airbag's and the pyrotechnic pretensioner's severity floors towards
+//!   `satellite_floor_mps` (never below it, never raised);
+//! * the accelerometer-only boundary towards `satellite_boundary_scale` × itself;
+//! * the road-roughness lift towards 0 (a crushed front end is not a rough road).
+//!
+//! Every Fire still needs the tunnel's own event to cross the lowered boundary and floor, the
+//! persistence and loading rules, and the safing channel's agreement: **the satellites alone
+//! never fire.** A satellite that is stale, or whose frames are corrupt or say "sensor defect",
+//! grants nothing — the tunnel's central-only logic, unchanged. Below the lower line (a 16 km/h
+//! barrier reaches ≈ 0.5 m/s, misuse ≤ 0.4 m/s) nothing changes at all.
+
+use crate::settings::ms_to_ns;
+use crate::signals::psi5::{self, Psi5Word};
+use crate::signals::{SatelliteFrames, SatelliteSide};
+
+/// How long a relief is held after the severity last reached the lower line, ms: the
+/// accelerometer-only decision window (`fallback::WINDOW_MS`), so a crash is judged to its end
+/// with the evidence its first milliseconds gave.
+pub const RELIEF_HOLD_MS: f64 = 60.0;
+
+/// How long a satellite's status or corrupt frame keeps it out of the fusion, ms (as an
+/// accelerometer's implausible reading: `accel::INVALID_HOLD_MS`).
+pub const FAULT_HOLD_MS: f64 = 500.0;
+
+/// Cycle bins kept: the window is at most this many cycles (a power of two).
+const BINS: usize = 16;
+
+/// What the satellites grant the tunnel's decisions now.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Relief {
+    /// 0 = nothing (central-only), 1 = the whole capped range.
+    pub fraction: f64,
+    /// The floor the whole range brings a severity floor down to, m/s.
+    pub floor_mps: f64,
+    /// The factor the whole range scales the boundary by.
+    pub boundary_scale: f64,
+}
+
+impl Relief {
+    /// No relief: the tunnel's own thresholds.
+    pub const NONE: Self = Self {
+        fraction: 0.0,
+        floor_mps: 0.0,
+        boundary_scale: 1.0,
+    };
+
+    /// A severity floor `floor_mps` with the road's `lift_mps`, as relieved: the floor moves
+    /// towards the relief's (never up) and the lift towards 0, both by the fraction.
+    #[inline]
+    pub fn floor_mps(self, floor_mps: f64, lift_mps: f64) -> f64 {
+        let r = self.fraction;
+        let target = if self.floor_mps < floor_mps {
+            self.floor_mps
+        } else {
+            floor_mps
+        };
+        floor_mps - r * (floor_mps - target) + (1.0 - r) * lift_mps
+    }
+
+    /// A boundary value `threshold_mps`, as relieved.
+    #[inline]
+    pub fn boundary_mps(self, threshold_mps: f64) -> f64 {
+        threshold_mps * (1.0 - self.fraction * (1.0 - self.boundary_scale))
+    }
+}
+
+/// Settings in the fusion's units (`satellite_*` keys: `CycleConfig::satellite_params`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SatelliteParams {
+    /// The car has satellites (`false`: the fusion is off and nothing is expected).
+    pub enabled: bool,
+    /// One data code, m/s² (full scale / 480).
+    pub lsb_mps2: f64,
+    /// No frame for this long → the satellite is stale, ns.
+    pub timeout_ns: u64,
+    /// The crush Δv window, ns.
+    pub window_ns: u64,
+    /// Severity from which a relief begins, m/s.
+    pub relief_from_mps: f64,
+    /// Severity of the whole relief, m/s.
+    pub relief_full_mps: f64,
+    /// The floor of the whole relief, m/s.
+    pub floor_mps: f64,
+    /// The boundary scale of the whole relief.
+    pub boundary_scale: f64,
+}
+
+/// Index mask of the ring of bins.
+const BIN_MASK: usize = BINS - 1;
+const _: () = assert!(BINS.is_power_of_two());
+
+/// Velocity changes per cycle of the three channels (left, right, tunnel), with the cycle's
+/// time: a window sum without per-sample state, one ring for all three.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Bins {
+    dv_mps: [[f64; 3]; BINS],
+    at_ns: [u64; BINS],
+    head: usize,
+}
+
+/// The tunnel's column in [`Bins`].
+const TUNNEL: usize = 2;
+
+impl Bins {
+    const EMPTY: Self = Self {
+        dv_mps: [[0.0; 3]; BINS],
+        at_ns: [0; BINS],
+        head: 0,
+    };
+
+    /// Opens the bins of the cycle at `now` (once: a second call in the same cycle keeps them).
+    fn open(&mut self, now: u64) {
+        if self.at_ns.get(self.head) == Some(&now) {
+            return;
+        }
+        self.head = (self.head + 1) & BIN_MASK;
+        if let (Some(dv), Some(at)) = (
+            self.dv_mps.get_mut(self.head),
+            self.at_ns.get_mut(self.head),
+        ) {
+            *dv = [0.0; 3];
+            *at = now;
+        }
+    }
+
+    /// Whether the bins of the cycle at `now` are open.
+    fn open_at(&self, now: u64) -> bool {
+        self.at_ns.get(self.head) == Some(&now)
+    }
+
+    fn add(&mut self, column: usize, dv_mps: f64) {
+        if let Some(dv) = self
+            .dv_mps
+            .get_mut(self.head)
+            .and_then(|r| r.get_mut(column))
+        {
+            *dv += dv_mps;
+        }
+    }
+
+    /// Sums of the bins opened within `window_ns` before `now` (the current one included).
+    fn sums(&self, now: u64, window_ns: u64) -> [f64; 3] {
+        let mut sum = [0.0; 3];
+        for (dv, at) in self.dv_mps.iter().zip(self.at_ns.iter()) {
+            if *at != 0 && now.saturating_sub(*at) < window_ns {
+                for (s, v) in sum.iter_mut().zip(dv) {
+                    *s += v;
+                }
+            }
+        }
+        sum
+    }
+}
+
+/// One satellite's receive state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Channel {
+    rx_ns: Option<u64>,
+    faulty_until_ns: Option<u64>,
+}
+
+impl Channel {
+    const NEW: Self = Self {
+        rx_ns: None,
+        faulty_until_ns: None,
+    };
+
+    fn usable(&self, now: u64, timeout_ns: u64) -> bool {
+        let fresh = self
+            .rx_ns
+            .is_some_and(|t| now.saturating_sub(t) <= timeout_ns);
+        let faulty = self.faulty_until_ns.is_some_and(|t| now <= t);
+        fresh && !faulty
+    }
+}
+
+/// Counters of what the satellites sent that the fusion could not use.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SatelliteFaults {
+    /// Frames whose parity failed or that had bits beyond the frame set.
+    pub corrupt_frames: u64,
+    /// Status words (|code| > 480: e.g. sensor defect).
+    pub status_frames: u64,
+    /// Batches with a sample period out of range or without frames.
+    pub bad_batches: u64,
+}
+
+/// The fusion's state: both satellites, the tunnel's velocity change per cycle, the relief.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Satellites {
+    params: SatelliteParams,
+    channels: [Channel; 2],
+    bins: Bins,
+    /// The current cycle's time, ns.
+    now_ns: u64,
+    /// The peak severity of the current relief, m/s.
+    peak_mps: f64,
+    /// The relief holds until, ns.
+    hold_until_ns: Option<u64>,
+    /// What was not usable.
+    pub faults: SatelliteFaults,
+    /// Accelerometer batches judged with a relief (fraction > 0).
+    pub relieved_batches: u64,
+}
+
+impl Satellites {
+    /// No frames yet, no relief.
+    pub fn new(params: SatelliteParams) -> Self {
+        Self {
+            params,
+            channels: [Channel::NEW; 2],
+            bins: Bins::EMPTY,
+            now_ns: 0,
+            peak_mps: 0.0,
+            hold_until_ns: None,
+            faults: SatelliteFaults::default(),
+            relieved_batches: 0,
+        }
+    }
+
+    /// Starts the cycle at `now`. Its bins open with the cycle's first satellite batch: a
+    /// cycle without satellite frames (a car without them, dead ones) costs nothing more.
+    pub fn begin_cycle(&mut self, now: u64) {
+        self.now_ns = now;
+    }
+
+    /// One batch of `side`'s frames received at `now`: data codes add their velocity change
+    /// to the cycle's bin; a corrupt frame or a status word is counted and takes the satellite
+    /// out of the fusion for [`FAULT_HOLD_MS`].
+    pub fn on_frames(&mut self, side: SatelliteSide, b: &SatelliteFrames, now: u64) {
+        if !self.params.enabled {
+            return;
+        }
+        let Some(ch) = self.channels.get_mut(side as usize) else {
+            return;
+        };
+        let dt_s = f64::from(b.sample_period_ns) * 1e-9;
+        if !(dt_s > 0.0 && dt_s <= 0.01) || b.frames().is_empty() {
+            self.faults.bad_batches = self.faults.bad_batches.saturating_add(1);
+            return;
+        }
+        let mut dv = 0.0;
+        let mut bad = false;
+        for f in b.frames() {
+            match psi5::decode(*f) {
+                Psi5Word::Data(code) => dv += f64::from(code) * self.params.lsb_mps2 * dt_s,
+                Psi5Word::Status(_) => {
+                    self.faults.status_frames = self.faults.status_frames.saturating_add(1);
+                    bad = true;
+                }
+                Psi5Word::Corrupt => {
+                    self.faults.corrupt_frames = self.faults.corrupt_frames.saturating_add(1);
+                    bad = true;
+                }
+            }
+        }
+        if bad {
+            ch.faulty_until_ns = Some(now.saturating_add(ms_to_ns(FAULT_HOLD_MS)));
+        }
+        ch.rx_ns = Some(now);
+        self.bins.open(self.now_ns);
+        self.bins.add(side as usize, dv);
+    }
+
+    /// The tunnel accelerometer's velocity change over its plausible samples of this cycle
+    /// (m/s, + = slowing down), as read before any braking compensation.
+    pub fn on_tunnel_dv(&mut self, dv_mps: f64) {
+        if self.bins.open_at(self.now_ns) && dv_mps.is_finite() {
+            self.bins.add(TUNNEL, dv_mps);
+        }
+    }
+
+    /// The frontal severity at `now`: the smaller of the two satellites' crush Δv, m/s
+    /// (`None`: a satellite is stale or faulty, or the fusion is off).
+    pub fn severity_mps(&self, now: u64) -> Option<f64> {
+        let p = &self.params;
+        if !p.enabled || !self.channels.iter().all(|c| c.usable(now, p.timeout_ns)) {
+            return None;
+        }
+        // A tunnel reading forward (a shunt from behind, or a faulty one) is no crush ahead:
+        // the satellites are measured against a tunnel that at most stands still.
+        let [left, right, tunnel] = self.bins.sums(now, p.window_ns);
+        let tunnel = tunnel.max(0.0);
+        let s = (left - tunnel).min(right - tunnel);
+        s.is_finite().then_some(s)
+    }
+
+    /// Updates the relief with the severity at `now` and returns it.
+    pub fn relief(&mut self, now: u64) -> Relief {
+        let p = self.params;
+        if !p.enabled {
+            return Relief::NONE;
+        }
+        if self.hold_until_ns.is_some_and(|t| now > t) {
+            self.hold_until_ns = None;
+            self.peak_mps = 0.0;
+        }
+        if let Some(s) = self.severity_mps(now).filter(|s| *s >= p.relief_from_mps) {
+            self.peak_mps = self.peak_mps.max(s);
+            self.hold_until_ns = Some(now.saturating_add(ms_to_ns(RELIEF_HOLD_MS)));
+        }
+        if self.hold_until_ns.is_none() {
+            return Relief::NONE;
+        }
+        let span = p.relief_full_mps - p.relief_from_mps;
+        let fraction = if span > 0.0 {
+            ((self.peak_mps - p.relief_from_mps) / span).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        if fraction > 0.0 {
+            self.relieved_batches = self.relieved_batches.saturating_add(1);
+        }
+        Relief {
+            fraction,
+            floor_mps: p.floor_mps,
+            boundary_scale: p.boundary_scale,
+        }
+    }
+
+    /// Whether `side` is missing or faulty at `now` (for the status; `false` when the car has
+    /// no satellites).
+    pub fn faulty(&self, side: SatelliteSide, now: u64) -> bool {
+        self.params.enabled
+            && self
+                .channels
+                .get(side as usize)
+                .is_none_or(|c| !c.usable(now, self.params.timeout_ns))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::signals::psi5::{code_of, encode, SENSOR_DEFECT};
+
+    const G: f64 = 9.806_65;
+    const MS: u64 = 1_000_000;
+
+    fn params() -> SatelliteParams {
+        SatelliteParams {
+            enabled: true,
+            lsb_mps2: 240.0 * G / 480.0,
+            timeout_ns: 5 * MS,
+            window_ns: 4 * MS,
+            relief_from_mps: 1.0,
+            relief_full_mps: 2.0,
+            floor_mps: 0.5,
+            boundary_scale: 0.5,
+        }
+    }
+
+    /// Two frames (500 µs) of `decel_g` each.
+    fn frames(decel_g: f64) -> SatelliteFrames {
+        let code = encode(code_of(decel_g * G, 240.0 * G));
+        SatelliteFrames {
+            sample_period_ns: 500_000,
+            count: 2,
+            frames: [code; 8],
+            ..SatelliteFrames::EMPTY
+        }
+    }
+
+    /// Runs `ms` cycles of 1 ms with the left/right satellites at `l`, `r` g and the tunnel at
+    /// `tunnel` g; returns the last relief.
+    fn run(s: &mut Satellites, from_ms: u64, ms: u64, l: f64, r: f64, tunnel: f64) -> Relief {
+        let mut relief = Relief::NONE;
+        for k in from_ms..from_ms + ms {
+            let now = k * MS;
+            s.begin_cycle(now);
+            s.on_frames(SatelliteSide::Left, &frames(l), now);
+            s.on_frames(SatelliteSide::Right, &frames(r), now);
+            s.on_tunnel_dv(tunnel * G * 1e-3);
+            relief = s.relief(now);
+        }
+        relief
+    }
+
+    #[test]
+    fn a_body_motion_moves_satellites_and_tunnel_alike_and_grants_nothing() {
+        let mut s = Satellites::new(params());
+        // A 20 g pothole lobe the whole car feels: crush Δv 0.
+        assert_eq!(run(&mut s, 1, 20, 20.0, 20.0, 20.0), Relief::NONE);
+        assert!(s.severity_mps(20 * MS).is_some_and(|v| v.abs() < 0.05));
+    }
+
+    /// Closed form: both satellites at a g above the tunnel for ≥ 4 ms give a crush Δv of
+    /// a·g·4 ms; the relief fraction is (Δv − 1)/(2 − 1).
+    #[test]
+    fn the_relief_grows_with_the_smaller_crush_velocity_and_is_capped() {
+        let mut s = Satellites::new(params());
+        // 40 g above the tunnel: 40·9.81·0.004 = 1.57 m/s → fraction 0.57 (codes: 0.5 g).
+        let r = run(&mut s, 1, 10, 50.0, 45.0, 5.0);
+        let expected = (40.0 * G * 0.004 - 1.0) / 1.0;
+        assert!((r.fraction - expected).abs() < 0.03, "{r:?} vs {expected}");
+        // A floor of 1.25 with a lift of 0.4 is brought 57 % of the way to 0.5, the lift 57 %
+        // of the way to 0; the boundary 57 % of the way to half.
+        let f = r.floor_mps(1.25, 0.4);
+        assert!((f - (1.25 - r.fraction * 0.75 + (1.0 - r.fraction) * 0.4)).abs() < 1e-12);
+        assert!((r.boundary_mps(1.0) - (1.0 - r.fraction * 0.5)).abs() < 1e-12);
+        // Far more crush: capped at the whole range; a floor already below the relief's is
+        // never raised.
+        let r = run(&mut s, 11, 10, 150.0, 150.0, 10.0);
+        assert_eq!(r.fraction, 1.0);
+        assert_eq!(r.floor_mps(1.25, 0.0), 0.5);
+        assert_eq!(r.floor_mps(0.3, 0.0), 0.3);
+        assert_eq!(r.boundary_mps(2.0), 1.0);
+    }
+
+    #[test]
+    fn one_satellite_alone_grants_nothing_whatever_it_reads() {
+        let mut s = Satellites::new(params());
+        // The left satellite saturated (a stuck or spiking one), the right one at rest.
+        assert_eq!(run(&mut s, 1, 30, 240.0, 0.0, 0.0), Relief::NONE);
+        // Mounted backwards: its crush reads as forward acceleration.
+        let mut s = Satellites::new(params());
+        assert_eq!(run(&mut s, 1, 30, -150.0, 150.0, 0.0), Relief::NONE);
+    }
+
+    #[test]
+    fn a_tunnel_reading_forward_makes_no_crush() {
+        // The tunnel pushed forward at 60 g (a shunt from behind or a faulty sensor), both
+        // satellites at rest: nothing ahead crushes.
+        let mut s = Satellites::new(params());
+        assert_eq!(run(&mut s, 1, 20, 0.0, 0.0, -60.0), Relief::NONE);
+    }
+
+    #[test]
+    fn a_relief_is_held_at_its_peak_then_ends() {
+        let mut s = Satellites::new(params());
+        let r = run(&mut s, 1, 5, 100.0, 100.0, 0.0);
+        assert_eq!(r.fraction, 1.0);
+        // The crush is over (satellites back with the body): still held…
+        let r = run(&mut s, 6, 50, 10.0, 10.0, 10.0);
+        assert_eq!(r.fraction, 1.0);
+        // …until 60 ms after the severity last reached the lower line.
+        let r = run(&mut s, 56, 20, 10.0, 10.0, 10.0);
+        assert_eq!(r, Relief::NONE);
+    }
+
+    #[test]
+    fn stale_corrupt_or_defective_satellites_grant_nothing() {
+        // Stale: only the left one sends.
+        let mut s = Satellites::new(params());
+        for k in 1..10u64 {
+            s.begin_cycle(k * MS);
+            s.on_frames(SatelliteSide::Left, &frames(150.0), k * MS);
+            assert_eq!(s.relief(k * MS), Relief::NONE);
+        }
+        assert!(s.faulty(SatelliteSide::Right, 9 * MS));
+        assert!(!s.faulty(SatelliteSide::Left, 9 * MS));
+        // One corrupt frame takes the right satellite out for the hold.
+        let mut s = Satellites::new(params());
+        let mut bad = frames(150.0);
+        bad.frames[1] ^= 1;
+        s.begin_cycle(MS);
+        s.on_frames(SatelliteSide::Right, &bad, MS);
+        assert_eq!(s.faults.corrupt_frames, 1);
+        assert_eq!(run(&mut s, 2, 20, 150.0, 150.0, 0.0), Relief::NONE);
+        assert!(s.faulty(SatelliteSide::Right, 21 * MS));
+        // A status word (sensor defect) likewise.
+        let mut s = Satellites::new(params());
+        let mut defect = frames(150.0);
+        defect.frames[0] = encode(SENSOR_DEFECT);
+        s.begin_cycle(MS);
+        s.on_frames(SatelliteSide::Left, &defect, MS);
+        assert_eq!(s.faults.status_frames, 1);
+        assert_eq!(run(&mut s, 2, 20, 150.0, 150.0, 0.0), Relief::NONE);
+        // Garbage batches are counted, never used.
+        let mut s = Satellites::new(params());
+        let garbage = SatelliteFrames {
+            sample_period_ns: 0,
+            count: u32::MAX,
+            ..frames(150.0)
+        };
+        s.begin_cycle(MS);
+        s.on_frames(SatelliteSide::Left, &garbage, MS);
+        assert_eq!(s.faults.bad_batches, 1);
+    }
+
+    #[test]
+    fn a_car_without_satellites_never_reports_them_faulty() {
+        let mut s = Satellites::new(SatelliteParams {
+            enabled: false,
+            ..params()
+        });
+        assert_eq!(run(&mut s, 1, 10, 150.0, 150.0, 0.0), Relief::NONE);
+        assert!(!s.faulty(SatelliteSide::Left, 10 * MS));
+    }
+}
