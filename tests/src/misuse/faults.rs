@@ -250,3 +250,49 @@ pub(super) fn low_speed_crash_and_kerb(r: &mut ChaCha8Rng, name: &str, i: u64) -
         )
     }
 }
+
+/// One crush-zone satellite faulty while the whole car takes a pothole: saturated or stuck, a
+/// 60–200 g spike, or a 20–200 g offset (a deceleration, the direction a crush reads), on either
+/// satellite, starting within ±20 ms of the pothole. The other satellite sees only the body.
+pub(super) fn satellite_fault_in_pothole(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
+    let t0 = r.gen_range(0.3..0.5);
+    let dv = r.gen_range(0.6..0.8) * MARGIN;
+    let mut ev = pothole_with_rebound(r, t0, dv);
+    let sat = ["satellite-left", "satellite-right"][r.gen_range(0..2)];
+    let tf = t0 + r.gen_range(-0.02..0.02);
+    let len = r.gen_range(0.02..0.3);
+    let mut keys = String::new();
+    match r.gen_range(0..3) {
+        0 => {
+            let kind = ["stuck", "saturated"][r.gen_range(0..2)];
+            keys = format!(
+                "accel_faults = [{{ start_s = {tf}, end_s = {}, kind = \"{kind}\", sensor = \"{sat}\" }}]\n",
+                tf + len
+            );
+        }
+        1 => ev += &spike_event(tf, r.gen_range(60.0..200.0), sat),
+        _ => ev += &offset_event(tf, r.gen_range(20.0..200.0), tf + len, sat),
+    }
+    let v = drive_kph(r);
+    let duration_s = (tf + len + JUDGED_AFTER_S).max(0.8);
+    driving(name, i, &ego(v, None), duration_s, &keys, &ev)
+}
+
+/// A must-fire barrier crash with one crush-zone satellite dead, stuck at rest from before the
+/// crash, or saturated from 50 ms before contact: the fusion grants nothing, the tunnel's own
+/// logic must still fire.
+pub(super) fn must_fire_satellite_fault(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
+    let (v, tc) = (r.gen_range(35.0..56.0), r.gen_range(0.35..0.5));
+    let sat = ["satellite-left", "satellite-right"][r.gen_range(0..2)];
+    let keys = match r.gen_range(0..3) {
+        0 => format!("dropouts = [{{ start_s = 0.2, end_s = 100.0, target = \"{sat}\" }}]\n"),
+        1 => format!(
+            "accel_faults = [{{ start_s = 0.2, end_s = 100.0, kind = \"stuck\", sensor = \"{sat}\" }}]\n"
+        ),
+        _ => format!(
+            "accel_faults = [{{ start_s = {}, end_s = 100.0, kind = \"saturated\", sensor = \"{sat}\" }}]\n",
+            tc - 0.05
+        ),
+    };
+    barrier(name, i, v, tc, &keys, "")
+}

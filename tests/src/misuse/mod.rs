@@ -34,6 +34,7 @@
 //! | stuck-crash-sensor-in-door-slam | door slam (as above) on a standing car while the crash sensor sticks for 100 ms | no fire |
 //! | spike-in-pothole | one 150–199 g crash-sensor sample inside a 0.6–0.8 m/s pothole with rebound | no fire |
 //! | offset-with-pothole | a +8 g crash-sensor offset (0.1–0.5 s) starting with a 0.3 m/s pothole | no fire |
+//! | satellite-fault-in-pothole | one crush-zone satellite saturated or stuck, a 60–200 g spike or a 20–200 g offset on it, within ±20 ms of a 0.6–0.8 m/s pothole with rebound (× 1.5) | no fire |
 //! | misreported-low-speed | a crash below the no-fire line with one object fault: 14.5 + 14.5 km/h equal cars reported 4 000 kg; 16 + 16 km/h reported 2 800 kg; 1 000–1 300 kg opponents reported 3 000–4 000 kg at an EBS of 13–16 km/h; a 15.5 km/h barrier with the speed reported 5 m/s high | no airbag |
 //! | aliased-ringing | zero-mean ringing near 4 kHz in phase with the samples (±30–49 g × 1.5, 3–4 ms), at 3.95–4.05 kHz (±30–45 g × 1.5, 20–30 ms), or at a multiple of either sampling rate (2, 4, 8, 12, 16 kHz) | no fire |
 //! | low-speed-crash-and-kerb | a 12–16 km/h barrier or 12 + 12 to 15 + 15 km/h cars, tracked, with a kerb strike of 0.5–0.8 m/s (× 1.5) 0–10 ms after contact | no airbag |
@@ -42,8 +43,8 @@
 //!
 //! ## Faults and must-fire crashes
 //! Spikes, offsets, dead / stuck / noisy sensors, crashes below the no-fire line and must-fire
-//! crashes (with a misreported opponent, with a dead safing sensor) keep their ranges of issue 20
-//! (table in [`FAMILIES`]' docs).
+//! crashes (with a misreported opponent, with a dead safing sensor, with one crush-zone
+//! satellite dead, stuck or saturated) keep their ranges (table in [`FAMILIES`]' docs).
 //!
 //! ## Must-fire crashes with one thing before or inside them (`crash_with`)
 //! | family | what | requirement |
@@ -245,6 +246,12 @@ pub const FAMILIES: &[Family] = &[
         make: offset_with_pothole,
     },
     Family {
+        name: "satellite-fault-in-pothole",
+        envelope: "one crush-zone satellite saturated or stuck, a 60–200 g spike or a 20–200 g offset on it, within ±20 ms of a 0.9–1.2 m/s pothole with rebound, driving",
+        requirement: Requirement::NoFire,
+        make: satellite_fault_in_pothole,
+    },
+    Family {
         name: "aliased-ringing",
         envelope: "zero-mean ringing near 4 kHz in phase with the samples (45–73.5 g, 3–4 ms), at 3.95–4.05 kHz (45–67.5 g, 20–30 ms), or at 2–16 kHz multiples (15–75 g, 3–30 ms)",
         requirement: Requirement::NoFire,
@@ -303,6 +310,12 @@ pub const FAMILIES: &[Family] = &[
         envelope: "barrier 35–56 km/h with the safing sensor dead",
         requirement: Requirement::MustFire,
         make: must_fire_safing_dead,
+    },
+    Family {
+        name: "must-fire-satellite-fault",
+        envelope: "barrier 35–56 km/h with one crush-zone satellite dead, stuck or saturated (the tunnel's own logic, without the satellites' relief)",
+        requirement: Requirement::MustFire,
+        make: must_fire_satellite_fault,
     },
     Family {
         name: "must-fire-after-event",
