@@ -207,13 +207,21 @@ pub struct AccelBatchMessage<'a> {
     accel_mps2: &'a [f32],
 }
 
+/// The sample time of the newest of `n` samples `period_ns` apart from `first_ns`: what a
+/// cycle that read the batch knew last.
+fn newest_sample_ns(first_ns: u64, n: usize, period_ns: u32) -> u64 {
+    first_ns + (n as u64).saturating_sub(1) * u64::from(period_ns)
+}
+
 /// The `/sensors/…_accel` message of a batch.
 pub fn accel_batch(b: &CrashAccelSample) -> AccelBatchMessage<'_> {
-    let n = b.samples().len() as u64;
     AccelBatchMessage {
         first_timestamp_ns: b.first_timestamp_ns,
-        newest_sample_ns: b.first_timestamp_ns
-            + n.saturating_sub(1) * u64::from(b.sample_period_ns),
+        newest_sample_ns: newest_sample_ns(
+            b.first_timestamp_ns,
+            b.samples().len(),
+            b.sample_period_ns,
+        ),
         sequence: b.sequence,
         sample_period_ns: b.sample_period_ns,
         count: b.count,
@@ -239,11 +247,13 @@ pub struct SatelliteMessage<'a> {
 
 /// The `/sensors/satellite_…` message of a batch.
 pub fn satellite_batch(b: &signals::SatelliteFrames) -> SatelliteMessage<'_> {
-    let n = b.frames().len() as u64;
     SatelliteMessage {
         first_timestamp_ns: b.first_timestamp_ns,
-        newest_sample_ns: b.first_timestamp_ns
-            + n.saturating_sub(1) * u64::from(b.sample_period_ns),
+        newest_sample_ns: newest_sample_ns(
+            b.first_timestamp_ns,
+            b.frames().len(),
+            b.sample_period_ns,
+        ),
         sequence: b.sequence,
         sample_period_ns: b.sample_period_ns,
         count: b.count,

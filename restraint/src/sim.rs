@@ -101,12 +101,9 @@ impl SimIo {
 
     /// Queues a batch of `side`'s satellite frames for the next cycle.
     pub fn push_satellite(&mut self, side: SatelliteSide, f: SatelliteFrames) {
-        let [left, right] = &mut self.satellites;
-        let q = match side {
-            SatelliteSide::Left => left,
-            SatelliteSide::Right => right,
-        };
-        push_dropping_oldest(q, f, &mut self.dropped);
+        if let Some(q) = self.satellites.get_mut(side as usize) {
+            push_dropping_oldest(q, f, &mut self.dropped);
+        }
     }
 
     /// Queues the same batch on the crash and the safing accelerometer: a car whose two
