@@ -99,6 +99,7 @@ impl Lever {
             cfg.reserve_m = 0.0;
             cfg.fire_delay_tolerance_s = 0.0;
             cfg.airbag_floor_dv_mps = 0.0;
+            cfg.accel_only_below_mps = f64::NEG_INFINITY;
         }
         cfg
     }

@@ -155,6 +155,11 @@ impl Crash {
         Ok(Self { spec, pulse })
     }
 
+    /// The predicted collision (the ego's pulse and crush).
+    pub fn pulse(&self) -> &Pulse {
+        &self.pulse
+    }
+
     /// Ego equivalent barrier speed Δv / (1 + e), km/h.
     pub fn ebs_kph(&self) -> f64 {
         self.pulse.summary.vehicle.delta_v_mps * 3.6 / (1.0 + physics::defaults::RESTITUTION)

@@ -4,6 +4,8 @@
 //! * [`reference`] — the FMVSS 208 load cases of the conventional reference restraint; its file
 //!   schema + loader is `physics::reference` (re-exported here).
 //! * [`scenario`] — predict the ego compartment pulse of a situation once.
+//! * [`fire_floor`] — plan = fire: the earliest airbag the ECU can fire on a cell's pulse, with
+//!   the crush-zone satellites' relief of its severity floor.
 //! * [`optimise`] — particle swarm + Nelder–Mead over the four restraint variables, penalty
 //!   method for the no-bottoming-out constraint.
 //! * [`table`] — grid files, cell optimisation, build / shard / merge / verify.
@@ -26,6 +28,7 @@ pub mod bound;
 pub mod distributed;
 pub mod estimation;
 pub mod fallback_study;
+pub mod fire_floor;
 pub mod limiter_switch;
 pub mod margin;
 pub mod optimise;

@@ -161,7 +161,7 @@ impl LighterSet {
         let earliest_airbag_s = set
             .points
             .iter()
-            .map(|p| cfg.earliest_airbag_s(&p.pulse.ego()))
+            .map(|p| cfg.earliest_airbag_s(&p.pulse))
             .collect();
         Ok(Self {
             set,
@@ -171,12 +171,16 @@ impl LighterSet {
     }
 
     /// `set` as the ECU executes it at truth `k`: the airbag no earlier than that truth's
-    /// pulse carries the floor.
+    /// pulse lets the ECU fire it, and none where it never does.
     fn executed(&self, set: &RestraintSettings, k: usize) -> RestraintSettings {
         let mut s = *set;
         if s.airbag_force_n > 0.0 {
             let floor_s = self.earliest_airbag_s.get(k).copied().unwrap_or(0.0);
-            s.airbag_time_s = s.airbag_time_s.max(floor_s);
+            if floor_s.is_finite() {
+                s.airbag_time_s = s.airbag_time_s.max(floor_s);
+            } else {
+                s.airbag_force_n = 0.0;
+            }
         }
         s
     }

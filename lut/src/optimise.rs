@@ -15,17 +15,18 @@
 //! never hidden; an optimum that only eats into the reserve is reported with its excursion.
 //!
 //! **Plan = fire**: the ECU fires a crash-phase airbag only once its event has
-//! carried the airbag's severity floor (no misuse event does), so each cell's airbag time is
-//! searched from [`OptimiserConfig::earliest_airbag_s`] on — the instant the cell's own pulse
-//! carries the floor, plus the ECU's latency — and the bus's FireTime is when the bag fires.
+//! carried the airbag's severity floor (no misuse event does), lowered by the crush-zone
+//! satellites while the front end crushes, so each cell's airbag time is searched from
+//! [`OptimiserConfig::earliest_airbag_s`] on — the instant the cell's own pulse carries the
+//! floor as relieved by its own crush, plus the ECU's latency ([`crate::fire_floor`]) — and the
+//! bus's FireTime is when the bag fires.
 //!
 //! **Fire-delay robustness**: what is left between plan and fire (a lighter opponent than the
 //! planning mass carries the floor later, the batch is read a cycle later, the CAN transfer):
 //! every setting that fires the airbag is also evaluated with the airbag
 //! [`OptimiserConfig::fire_delay_tolerance_s`] (*default* 3 ms) later, and the worse of the two
 //! costs counts: the optimum must stay free of bottoming-out when the bag comes that much late.
-//! (8 ms while the ECU confirmed on its generic thresholds, 5 ms with the matched path's 0.3 m/s
-//! floor of issue 20.) The reported outcomes are those at the planned times. The conventional
+//! The reported outcomes are those at the planned times. The conventional
 //! reference restraint (`lut reference`) keeps the paper's fixed definition (tolerance 0).
 //!
 //! **Search space**: the optimisers work on the unit cube (one coordinate per free variable,
@@ -122,8 +123,18 @@ impl SearchSpace {
 
     /// This space with the airbag fired no earlier than `earliest_s` after contact (plan =
     /// fire: [`OptimiserConfig::earliest_airbag_s`]); a free airbag time keeps its upper bound,
-    /// and is held there when `earliest_s` lies beyond it.
+    /// and is held there when `earliest_s` lies beyond it. An infinite `earliest_s` (the ECU
+    /// never fires an airbag on this pulse) plans none: 0 N.
     pub fn with_earliest_airbag_s(self, earliest_s: f64) -> Self {
+        if earliest_s == f64::INFINITY {
+            if let Var::Free { max, .. } = self.airbag_time_s {
+                return SearchSpace {
+                    airbag_force_n: Var::Fixed(0.0),
+                    airbag_time_s: Var::Fixed(max),
+                    ..self
+                };
+            }
+        }
         let airbag_time_s = match self.airbag_time_s {
             Var::Free { min, max } if earliest_s > min => {
                 if earliest_s >= max {
@@ -217,6 +228,13 @@ pub struct OptimiserConfig {
     /// What the ECU adds to the instant the floor is reached [s]: the accelerometer's
     /// anti-alias group delay (`accel_delay_ms`) and one 1 ms cycle until the decision runs.
     pub ecu_latency_s: f64,
+    /// How the crush-zone satellites lower [`Self::airbag_floor_dv_mps`] while the front end
+    /// crushes (`SatelliteRelief::OFF`: the floor alone).
+    pub satellite_relief: crate::fire_floor::SatelliteRelief,
+    /// Below this closing speed [m/s] the ECU's matched airbag also waits for its
+    /// accelerometer-only decision (`restraint::CycleConfig::unguarded_closing_mps`: one object
+    /// fault must not move a crash over the no-fire line; [`crate::fire_floor`]). −∞ = never.
+    pub accel_only_below_mps: f64,
 }
 
 /// *Default* airbag floor of the plan [m/s]: the ECU's (`restraint::CycleConfig`).
@@ -231,32 +249,44 @@ pub fn default_ecu_latency_s() -> f64 {
 
 impl OptimiserConfig {
     /// The earliest airbag time the ECU can execute on `pulse` [s after contact]: the first
-    /// instant its velocity change reaches [`Self::airbag_floor_dv_mps`], plus
-    /// [`Self::ecu_latency_s`]; `f64::INFINITY` when the pulse never carries the floor, 0
-    /// when the floor is off.
-    pub fn earliest_airbag_s(&self, pulse: &CompartmentPulse<'_>) -> f64 {
-        // NaN counts as off, like 0.
-        if self.airbag_floor_dv_mps.is_nan() || self.airbag_floor_dv_mps <= 0.0 {
-            return 0.0;
+    /// instant its velocity change reaches [`Self::airbag_floor_dv_mps`] as the satellites
+    /// relieve it ([`Self::satellite_relief`]), plus [`Self::ecu_latency_s`]. Below
+    /// [`Self::accel_only_below_mps`] the ECU waits for its accelerometer-only decision, and the
+    /// plan takes that decision as a car without satellites reaches it (the later of the two:
+    /// the plan stays executable when the evidence the relief needs is weaker than this cell's
+    /// own crush). `f64::INFINITY` when the pulse never carries the floor or never decides, 0
+    /// when the floor is off ([`crate::fire_floor`]).
+    pub fn earliest_airbag_s(&self, pulse: &crate::scenario::Pulse) -> f64 {
+        use crate::fire_floor::{accel_only_fire_s, earliest_airbag_s, SatelliteRelief};
+        let ego = pulse.ego();
+        let crush = pulse.ego_crush_m();
+        let guarded = pulse.closing_mps < self.accel_only_below_mps;
+        let relief = if guarded {
+            SatelliteRelief::OFF
+        } else {
+            self.satellite_relief
+        };
+        let floor_s = earliest_airbag_s(
+            &ego,
+            crush,
+            self.airbag_floor_dv_mps,
+            &relief,
+            self.ecu_latency_s,
+        );
+        if floor_s > 0.0 && guarded {
+            let cycle = restraint::CycleConfig::default();
+            let accel_only_s = accel_only_fire_s(&ego, crush, &relief, &cycle);
+            floor_s.max(accel_only_s + self.ecu_latency_s)
+        } else {
+            floor_s
         }
-        let mut dv_mps = 0.0;
-        let mut prev = 0.0;
-        for (i, &a) in pulse.accel_mps2.iter().enumerate() {
-            // Deceleration is negative acceleration; trapezoidal rule.
-            dv_mps -= 0.5 * (prev + a) * pulse.step_s;
-            prev = a;
-            if dv_mps >= self.airbag_floor_dv_mps {
-                return i as f64 * pulse.step_s + self.ecu_latency_s;
-            }
-        }
-        f64::INFINITY
     }
 }
 
 /// *Default* fire-delay tolerance [s]: how late the ECU can execute the table's plans now that
 /// each plan waits for its cell's pulse to carry the airbag's floor (plan = fire,
 /// [`OptimiserConfig::airbag_floor_dv_mps`]): a lighter opponent than the planning mass carries
-/// it later, the batch is read up to a cycle later — 1.3 ms worst against the shipped table —
+/// it later, the batch is read up to a cycle later — 1.7 ms worst against the shipped table —
 /// plus the CAN transfer, rounded up (`lut/tests/optimiser.rs` recomputes it with the ECU core's
 /// matcher and floor against the shipped table's plans).
 pub const DEFAULT_FIRE_DELAY_TOLERANCE_S: f64 = 0.003;
@@ -279,6 +309,8 @@ impl Default for OptimiserConfig {
             fire_delay_tolerance_s: DEFAULT_FIRE_DELAY_TOLERANCE_S,
             airbag_floor_dv_mps: default_airbag_floor_dv_mps(),
             ecu_latency_s: default_ecu_latency_s(),
+            satellite_relief: crate::fire_floor::SatelliteRelief::ecu_default(),
+            accel_only_below_mps: restraint::CycleConfig::default().unguarded_closing_mps(),
         }
     }
 }
@@ -537,6 +569,6 @@ pub fn optimise_situation(
         pulse: pulse.ego(),
         occupant,
     };
-    let space = space.with_earliest_airbag_s(cfg.earliest_airbag_s(&case.pulse));
+    let space = space.with_earliest_airbag_s(cfg.earliest_airbag_s(pulse));
     optimise(&[case], &space, hw, cfg)
 }

@@ -230,12 +230,14 @@ impl UncertainSet {
     }
 
     /// The adaptive search space with the airbag no earlier than the latest of the points'
-    /// own earliest fire times: the airbag must wait for its floor wherever the truth lies.
+    /// own earliest fire times: the airbag must wait for its floor wherever the truth lies
+    /// (a point where the ECU never fires one does not hold the others' back).
     pub(crate) fn search_space(&self, cfg: &OptimiserConfig) -> SearchSpace {
         SearchSpace::adaptive().with_earliest_airbag_s(
             self.points
                 .iter()
-                .map(|p| cfg.earliest_airbag_s(&p.pulse.ego()))
+                .map(|p| cfg.earliest_airbag_s(&p.pulse))
+                .filter(|t| t.is_finite())
                 .fold(0.0, f64::max),
         )
     }

@@ -51,6 +51,8 @@ pub struct Pulse {
     buf: Box<DefaultPulseBuffer>,
     /// Collision summary of the prediction.
     pub summary: CollisionSummary,
+    /// The closing speed it was predicted for [m/s].
+    pub closing_mps: f64,
 }
 
 impl Pulse {
@@ -78,11 +80,20 @@ impl Pulse {
         let mut buf = Box::new(DefaultPulseBuffer::new());
         let summary = simulate_collision(&input, &mut buf)
             .with_context(|| format!("collision at {closing_kph} km/h against {opponent:?}"))?;
-        Ok(Pulse { buf, summary })
+        Ok(Pulse {
+            buf,
+            summary,
+            closing_mps: kph_to_mps(closing_kph),
+        })
     }
 
     /// The ego compartment pulse.
     pub fn ego(&self) -> CompartmentPulse<'_> {
         self.buf.ego_pulse()
+    }
+
+    /// The ego's crush at each sample of [`Self::ego`] [m].
+    pub fn ego_crush_m(&self) -> &[f64] {
+        self.buf.ego_crush_m()
     }
 }

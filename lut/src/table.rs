@@ -5,6 +5,7 @@
 //! grid seed and the cell index only. Hence a build is byte-identical whatever the thread count
 //! or sharding, and `lut merge` of shards equals a full build.
 
+use crate::fire_floor::SatelliteRelief;
 use crate::margin;
 use crate::optimise::{self, Case, OptimiserConfig, SearchSpace};
 use crate::progress::Progress;
@@ -124,6 +125,14 @@ const EXTRA_RESERVE: &str = "optimiser.ride_down_reserve_mm";
 const EXTRA_FIRE_DELAY: &str = "optimiser.fire_delay_tolerance_ms";
 const EXTRA_AIRBAG_FLOOR: &str = "optimiser.airbag_floor_dv_mps";
 const EXTRA_ECU_LATENCY: &str = "optimiser.ecu_latency_ms";
+const EXTRA_SAT_FLOOR: &str = "optimiser.satellite_floor_dv_mps";
+const EXTRA_SAT_FROM: &str = "optimiser.satellite_relief_from_mps";
+const EXTRA_SAT_FULL: &str = "optimiser.satellite_relief_full_mps";
+const EXTRA_SAT_WINDOW: &str = "optimiser.satellite_window_ms";
+const EXTRA_SAT_LAG: &str = "optimiser.satellite_lag_ms";
+const EXTRA_SAT_DEPTH: &str = "optimiser.satellite_depth_m";
+const EXTRA_SAT_BOUNDARY: &str = "optimiser.satellite_boundary_scale";
+const EXTRA_ACCEL_ONLY: &str = "optimiser.accel_only_below_kph";
 
 impl Grid {
     /// Parse and validate grid TOML; `origin` names the source in errors.
@@ -217,6 +226,22 @@ impl Grid {
             EXTRA_ECU_LATENCY.into(),
             format!("{}", o.ecu_latency_s * 1e3),
         );
+        let r = &o.satellite_relief;
+        if r.is_on() {
+            extra.insert(EXTRA_SAT_FLOOR.into(), format!("{}", r.floor_mps));
+            extra.insert(EXTRA_SAT_FROM.into(), format!("{}", r.from_mps));
+            extra.insert(EXTRA_SAT_FULL.into(), format!("{}", r.full_mps));
+            extra.insert(EXTRA_SAT_WINDOW.into(), format!("{}", r.window_s * 1e3));
+            extra.insert(EXTRA_SAT_LAG.into(), format!("{}", r.lag_s * 1e3));
+            extra.insert(EXTRA_SAT_DEPTH.into(), format!("{}", r.depth_m));
+            extra.insert(EXTRA_SAT_BOUNDARY.into(), format!("{}", r.boundary_scale));
+        }
+        if o.accel_only_below_mps.is_finite() {
+            extra.insert(
+                EXTRA_ACCEL_ONLY.into(),
+                format!("{}", o.accel_only_below_mps * 3.6),
+            );
+        }
         extra.insert(
             "occupant".into(),
             "belted; seat friction and hardware: physics::defaults".into(),
@@ -266,6 +291,27 @@ impl Grid {
             // Tables built before plan = fire have no floor: 0 rebuilds them as built.
             airbag_floor_dv_mps: get(EXTRA_AIRBAG_FLOOR).map_or(Ok(0.0), |v| v.parse())?,
             ecu_latency_s: get(EXTRA_ECU_LATENCY).map_or(Ok(0.0), |v| v.parse::<f64>())? * 1e-3,
+            // Tables built without the satellites' relief have none of its keys.
+            satellite_relief: match h.build.extra.get(EXTRA_SAT_FLOOR) {
+                None => SatelliteRelief::OFF,
+                Some(floor) => SatelliteRelief {
+                    floor_mps: floor.parse()?,
+                    from_mps: get(EXTRA_SAT_FROM)?.parse()?,
+                    full_mps: get(EXTRA_SAT_FULL)?.parse()?,
+                    window_s: get(EXTRA_SAT_WINDOW)?.parse::<f64>()? * 1e-3,
+                    lag_s: get(EXTRA_SAT_LAG)?.parse::<f64>()? * 1e-3,
+                    depth_m: get(EXTRA_SAT_DEPTH)?.parse()?,
+                    boundary_scale: get(EXTRA_SAT_BOUNDARY)?.parse()?,
+                },
+            },
+            // Tables built before the accelerometer-only wait have no key: never.
+            accel_only_below_mps: h
+                .build
+                .extra
+                .get(EXTRA_ACCEL_ONLY)
+                .map_or(Ok(f64::NEG_INFINITY), |v| {
+                    v.parse::<f64>().map(|kph| kph / 3.6)
+                })?,
         };
         Ok(Grid {
             ego: Ego {

@@ -8,6 +8,8 @@
 //!   cheap summary, any-instant states, sampled pulses. The integrator stays as its oracle.
 //! * [`occupant`] — one rigid occupant body with belt, airbag + column, seat friction,
 //!   bottoming-out detection, and the ideal constant-force bound a*.
+//! * [`crush_zone`] (feature `std`) — what a crush-zone (upfront) satellite feels ahead of the
+//!   body: the front structure's graded fold from the ego's crush.
 //! * [`j211`] — SAE J211 CFC filter (phaseless, in place, no allocation).
 //! * [`derive`] (feature `std`) — force-deflection curve from a rigid-barrier accelerometer trace.
 //! * [`defaults`] — every modelling default in one place.
@@ -22,6 +24,8 @@
 #![warn(missing_docs)]
 
 pub mod collision;
+#[cfg(feature = "std")]
+pub mod crush_zone;
 pub mod defaults;
 #[cfg(feature = "std")]
 pub mod derive;

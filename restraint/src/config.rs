@@ -577,6 +577,24 @@ impl CycleConfig {
         self.track.validate()
     }
 
+    /// The closing speed [m/s] from which a matched crash fires on its plan without waiting
+    /// for the accelerometer-only boundary: above the no-fire line even with the lightest
+    /// opponent (`lightest_opponent_kg`) and a closing speed `speed_misreport_mps` lower than
+    /// measured — the EBS v·m/(m_ego + m) solved for v
+    /// (`estimate::equivalent_barrier_speed_kph`), plus the misreport. −∞ when the line is at 0
+    /// (every crash is above it).
+    pub fn unguarded_closing_mps(&self) -> f64 {
+        if self.no_fire_ebs_kph <= 0.0 {
+            return f64::NEG_INFINITY;
+        }
+        let per_mps_kph = crate::estimate::equivalent_barrier_speed_kph(
+            1.0,
+            self.ego_mass_kg,
+            self.lightest_opponent_kg,
+        );
+        self.speed_misreport_mps + self.no_fire_ebs_kph / per_mps_kph
+    }
+
     /// The generic crash confirmation's thresholds (`confirm_*`) in the detector's units.
     pub fn confirm_params(&self) -> ConfirmParams {
         ConfirmParams {

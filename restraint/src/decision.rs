@@ -157,7 +157,7 @@ pub struct Decision {
     /// The closing speed from which one object fault (any opponent mass down to
     /// `lightest_opponent_kg`, the closing speed `speed_misreport_mps` high) cannot have lifted
     /// a crash over the no-fire line, m/s: a matched crash slower than this waits for the
-    /// measured pulse ([`unguarded_closing_mps`]).
+    /// measured pulse ([`CycleConfig::unguarded_closing_mps`]).
     unguarded_closing_mps: f64,
     /// `CycleConfig::low_speed_misuse_dv_mps`, `low_speed_dv_factor`.
     low_speed_misuse_dv_mps: f64,
@@ -199,22 +199,6 @@ fn time_ms_to_ns(t_ms: f32) -> i64 {
     (f64::from(t_ms) * 1.0e6) as i64
 }
 
-/// The closing speed [m/s] at which a crash is above the no-fire line even with the lightest
-/// opponent (`lightest_opponent_kg`) and a closing speed `speed_misreport_mps` lower than
-/// measured: the EBS v·m/(m_ego + m) solved for v (`estimate::equivalent_barrier_speed_kph`),
-/// plus the misreport. −∞ when the line is at 0 (every crash is above it).
-fn unguarded_closing_mps(cfg: &CycleConfig) -> f64 {
-    if cfg.no_fire_ebs_kph <= 0.0 {
-        return f64::NEG_INFINITY;
-    }
-    let per_mps_kph = crate::estimate::equivalent_barrier_speed_kph(
-        1.0,
-        cfg.ego_mass_kg,
-        cfg.lightest_opponent_kg,
-    );
-    cfg.speed_misreport_mps + cfg.no_fire_ebs_kph / per_mps_kph
-}
-
 fn at(base_ns: u64, offset_ms: f32) -> u64 {
     base_ns.saturating_add_signed(time_ms_to_ns(offset_ms))
 }
@@ -239,7 +223,7 @@ impl Decision {
             contact_ns: None,
             event_onset_ns: 0,
             low_speed_dv_limit_mps: None,
-            unguarded_closing_mps: unguarded_closing_mps(cfg),
+            unguarded_closing_mps: cfg.unguarded_closing_mps(),
             low_speed_misuse_dv_mps: cfg.low_speed_misuse_dv_mps,
             low_speed_dv_factor: cfg.low_speed_dv_factor,
             ego_mass_kg: cfg.ego_mass_kg,

@@ -5,7 +5,7 @@
 //! `signals::psi5`) sit in the structure that crushes first. A body motion — braking, a
 //! pothole, a kerb, a rough road, a door slam — moves them with the body, so over a few ms they
 //! gain the tunnel's velocity change; a crash folds the structure ahead of them and they lose
-//! speed metres per second faster than the body (`world::crush_zone`: `v²·t/(0.7·depth)` at a
+//! speed metres per second faster than the body (`physics::crush_zone`: `v²·t/(0.7·depth)` at a
 //! crush rate v). The **crush Δv** of a satellite is its velocity change over the last
 //! `satellite_window_ms` less the tunnel accelerometer's over the same window.
 //!

@@ -2,7 +2,7 @@
 //! error is in the file), the true world ([`truth`]: closed-form pre-crash kinematics + the
 //! true collision physics after contact), the sensor models ([`sensors`]: noise, bias,
 //! latency, range; the crash and the safing accelerometer, the crush-zone satellites over
-//! [`crush_zone`]) and what the acceleration sensors
+//! `physics::crush_zone`) and what the acceleration sensors
 //! see besides a crash ([`events`]: `[[accel_event]]`).
 //!
 //! No transport, clock or thread: `sensor-feeds` plays this world in real time over iceoryx2
@@ -11,7 +11,6 @@
 #![warn(missing_docs)]
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-pub mod crush_zone;
 pub mod events;
 pub mod lowpass;
 mod noise;

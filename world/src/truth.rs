@@ -87,7 +87,7 @@ pub struct Truth {
     /// True compartment pulses from first contact (0.1 ms steps).
     pub pulse: Box<DefaultPulseBuffer>,
     /// A crush-zone satellite's acceleration relative to the body, on the pulse's grid
-    /// ([`crate::crush_zone`]; empty without contact).
+    /// ([`physics::crush_zone`]; empty without contact).
     satellite_rel_mps2: Vec<f64>,
 }
 
@@ -139,7 +139,7 @@ impl Truth {
         let summary = physics::simulate_collision(&input, &mut truth.pulse)
             .map_err(|e| format!("true collision physics: {e:?}"))?;
         truth.collision = Some(summary);
-        truth.satellite_rel_mps2 = crate::crush_zone::relative_accel_mps2(
+        truth.satellite_rel_mps2 = physics::crush_zone::relative_accel_mps2(
             truth.pulse.ego_crush_m(),
             truth.pulse.step_s(),
             scenario.sensor.satellite_depth_m,
@@ -229,7 +229,7 @@ impl Truth {
     }
 
     /// What a crush-zone satellite feels at `t_s` [m/s²]: the body's acceleration and, from
-    /// contact, the crush of the structure ahead of it ([`crate::crush_zone`]). Both
+    /// contact, the crush of the structure ahead of it ([`physics::crush_zone`]). Both
     /// satellites feel the same (a full-width frontal impact).
     pub fn satellite_accel_mps2(&self, t_s: f64) -> f64 {
         let body = self.ego_accel_mps2(t_s);

@@ -513,7 +513,7 @@ impl Default for SensorModel {
             safing_full_scale_g: 50.0,
             accel_lowpass_hz: 400.0,
             satellites: true,
-            satellite_depth_m: 0.2,
+            satellite_depth_m: physics::crush_zone::DEFAULT_DEPTH_M,
             satellite_rate_hz: 2000.0,
             satellite_noise_mps2: 2.0,
             satellite_full_scale_g: 240.0,

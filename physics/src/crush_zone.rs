@@ -33,6 +33,11 @@
 //! folds reach it (here it moves with the face), and the side-to-side difference of offset and
 //! angular impacts (both satellites see the same full-width crush).
 
+/// *Default* depth of a satellite behind the fascia [m]: at the rail tips, ahead of it only the
+/// fascia, the foam, the bumper beam and the crash boxes (Bosch, Continental and ZF upfront
+/// sensors sit on the front-end carrier or the rail tips).
+pub const DEFAULT_DEPTH_M: f64 = 0.2;
+
 /// Fraction of a crash box's length that folding can use before the folds are packed
 /// (stroke efficiency): square and octagonal steel and aluminium crash boxes reach 70–75 %
 /// (Abramowicz & Jones, "Dynamic progressive buckling of circular and square tubes", 1986;
