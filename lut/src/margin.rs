@@ -157,12 +157,18 @@ impl LighterSet {
             span.floor_kg,
         );
         let points: Vec<(f64, f64)> = masses_kg.iter().map(|&m| (v, m)).collect();
-        let set = UncertainSet::from_points(ego, occupant, &points, reference, cfg.reserve_m)?;
-        let earliest_airbag_s = set
+        let mut set = UncertainSet::from_points(ego, occupant, &points, reference, cfg.reserve_m)?;
+        let earliest_airbag_s: Vec<f64> = set
             .points
             .iter()
             .map(|p| cfg.earliest_airbag_s(&p.pulse))
             .collect();
+        // Where the ECU never fires an airbag it fires the reference's neither.
+        for (p, t) in set.points.iter_mut().zip(&earliest_airbag_s) {
+            if !t.is_finite() {
+                p.reference_without_airbag(occupant, reference, cfg.reserve_m)?;
+            }
+        }
         Ok(Self {
             set,
             masses_kg,

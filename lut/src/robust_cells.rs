@@ -122,6 +122,35 @@ pub(crate) struct Point {
     reference_cost: f64,
 }
 
+impl Point {
+    /// The reference restraint here as the ECU executes it where it never fires an airbag
+    /// (`OptimiserConfig::earliest_airbag_s` infinite): the same belt, no airbag.
+    pub(crate) fn reference_without_airbag(
+        &mut self,
+        occupant: &OccupantInput,
+        reference: &RestraintSettings,
+        reserve_m: f64,
+    ) -> Result<()> {
+        let set = RestraintSettings {
+            airbag_force_n: 0.0,
+            ..*reference
+        };
+        let r = simulate_occupant(
+            &self.pulse.ego(),
+            occupant,
+            &set,
+            &RestraintHardware::default(),
+        )?;
+        let keeps = optimise::case_cost(&r, reserve_m) < INFEASIBLE_OFFSET;
+        self.reserve_m = if keeps { reserve_m } else { 0.0 };
+        self.reference_g = objective_g(&r);
+        self.reference_bottoms_out = r.bottomed_out;
+        self.reference_excursion_m = r.max_excursion_m;
+        self.reference_cost = optimise::case_cost(&r, self.reserve_m);
+        Ok(())
+    }
+}
+
 /// a_max + a_mean [g] of an outcome.
 pub fn objective_g(o: &OccupantOutcome) -> f64 {
     mps2_to_g(o.max_decel_mps2) + mps2_to_g(o.mean_decel_mps2)
