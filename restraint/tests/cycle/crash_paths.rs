@@ -228,7 +228,10 @@ fn without_a_prediction_a_bump_fires_nothing_and_a_severe_crash_fires_the_refere
     );
     let (t, f) = first_fire(&b).expect("reference airbag");
     assert_eq!(f.cmd_source(), AirbagStageCmdCmdSource::Reference);
-    assert_eq!(t, C + 10 * MS);
+    // The reference fires when the accelerometer-only algorithm decides: 20 g carries the
+    // airbag's floor in the 7th ms, well before the paper's nominal 10 ms.
+    assert_eq!(t, floor_reached_at(C, 20.0));
+    assert!(t < C + 10 * MS);
 }
 
 #[test]

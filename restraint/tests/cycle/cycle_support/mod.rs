@@ -440,6 +440,17 @@ pub fn run_scenario(
     }
 }
 
+/// When a constant `decel_g` from `crash` on has carried the airbag's severity floor
+/// (`fallback_min_dv_mps`), as the ECU integrates 1 kHz samples that each count their whole
+/// 1 ms: the first sample k with (k + 1) · a · 1 ms ≥ floor. The reference restraint fires in
+/// that cycle when its boundary is already crossed and the safing function agrees.
+pub fn floor_reached_at(crash: u64, decel_g: f64) -> u64 {
+    let floor_mps = restraint::CycleConfig::default().fallback_min_dv_mps;
+    let per_sample_mps = decel_g * f64::from(G) * 1e-3;
+    let k = (floor_mps / per_sample_mps).ceil() as u64 - 1;
+    crash + k * MS
+}
+
 /// Standard gravity as the tests type it, m/s².
 pub const G: f32 = 9.806_65;
 
