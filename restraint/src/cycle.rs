@@ -466,6 +466,7 @@ impl Activity for RestraintCycle<'_> {
                 self.satellites.faults.status_frames,
             ),
             ("satellite_bad_batches", self.satellites.faults.bad_batches),
+            ("satellite_implausible", self.satellites.faults.implausible),
             (
                 "satellite_relieved_batches",
                 self.satellites.relieved_batches,

@@ -9,9 +9,16 @@
 //! crush rate v). The **crush Δv** of a satellite is its velocity change over the last
 //! `satellite_window_ms` less the tunnel accelerometer's over the same window.
 //!
-//! **The rule.** The frontal severity is the *smaller* of the two satellites' crush Δv: a
-//! full-width crash loads both, and no single satellite — spiking, stuck, saturated, mounted
-//! backwards, or replaced by a forged frame — can raise the smaller of two. From
+//! **The rule.** The frontal severity is the *smaller* of the usable satellites' crush Δv: a
+//! full-width crash loads both, and no single satellite — spiking, stuck, saturated, or
+//! replaced by a forged frame — can raise the smaller of two. A satellite is out of the fusion
+//! while it is stale, sends corrupt frames or status words, or is **implausible**: slowing by
+//! [`IMPLAUSIBLE_LAG_MPS`] less than the body over the window while its twin does not (the
+//! structure ahead of the body cannot lag it in a frontal event: a satellite dead at rest,
+//! stuck or mounted backwards in a crash; both lagging accuse the tunnel, not them). The other
+//! one then decides alone: one fault has taken its twin
+//! out, so it is the healthy one, and it grants a relief only when it sees the front end fold
+//! — a body motion moves it with the body. Neither usable: no relief. From
 //! `satellite_relief_from_mps` to `satellite_relief_full_mps` it grants a relief fraction
 //! r ∈ [0, 1] (held [`RELIEF_HOLD_MS`] after the severity last reached the lower line, at the
 //! event's peak), which lowers what the tunnel's decisions ask by r of a capped range:
@@ -23,9 +30,9 @@
 //!
 //! Every Fire still needs the tunnel's own event to cross the lowered boundary and floor, the
 //! persistence and loading rules, and the safing channel's agreement: **the satellites alone
-//! never fire.** A satellite that is stale, or whose frames are corrupt or say "sensor defect",
-//! grants nothing — the tunnel's central-only logic, unchanged. Below the lower line (a 16 km/h
-//! barrier reaches ≈ 0.5 m/s, misuse ≤ 0.4 m/s) nothing changes at all.
+//! never fire.** With both satellites out of the fusion the tunnel's central-only logic
+//! decides, unchanged. Below the lower line (a 16 km/h barrier reaches ≈ 0.5 m/s, misuse
+//! ≤ 0.4 m/s) nothing changes at all.
 
 use crate::settings::ms_to_ns;
 use crate::signals::psi5::{self, Psi5Word};
@@ -36,9 +43,15 @@ use crate::signals::{SatelliteFrames, SatelliteSide};
 /// with the evidence its first milliseconds gave.
 pub const RELIEF_HOLD_MS: f64 = 60.0;
 
-/// How long a satellite's status or corrupt frame keeps it out of the fusion, ms (as an
-/// accelerometer's implausible reading: `accel::INVALID_HOLD_MS`).
+/// How long a satellite's status or corrupt frame, or an implausible crush, keeps it out of
+/// the fusion, ms (as an accelerometer's implausible reading: `accel::INVALID_HOLD_MS`).
 pub const FAULT_HOLD_MS: f64 = 500.0;
+
+/// A satellite whose velocity change over the window falls this far below the tunnel's is
+/// implausible, m/s: 30 × what its noise and quantisation can do over the window (2 m/s² rms
+/// and half a 0.47 g code per 500 µs frame: ≤ 0.01 m/s), and what a satellite stuck at rest
+/// shows ≈ 2 ms into a 15 g crash.
+pub const IMPLAUSIBLE_LAG_MPS: f64 = 0.3;
 
 /// Cycle bins kept: the window is at most this many cycles (a power of two).
 const BINS: usize = 16;
@@ -201,6 +214,8 @@ pub struct SatelliteFaults {
     pub status_frames: u64,
     /// Batches with a sample period out of range or without frames.
     pub bad_batches: u64,
+    /// Times a satellite lagged the body by more than [`IMPLAUSIBLE_LAG_MPS`].
+    pub implausible: u64,
 }
 
 /// The fusion's state: both satellites, the tunnel's velocity change per cycle, the relief.
@@ -288,19 +303,53 @@ impl Satellites {
         }
     }
 
-    /// The frontal severity at `now`: the smaller of the two satellites' crush Δv, m/s
-    /// (`None`: a satellite is stale or faulty, or the fusion is off).
+    /// The frontal severity at `now`: the smaller crush Δv of the usable satellites, m/s
+    /// (`None`: neither is usable, or the fusion is off).
     pub fn severity_mps(&self, now: u64) -> Option<f64> {
         let p = &self.params;
-        if !p.enabled || !self.channels.iter().all(|c| c.usable(now, p.timeout_ns)) {
+        if !p.enabled {
             return None;
         }
         // A tunnel reading forward (a shunt from behind, or a faulty one) is no crush ahead:
         // the satellites are measured against a tunnel that at most stands still.
         let [left, right, tunnel] = self.bins.sums(now, p.window_ns);
         let tunnel = tunnel.max(0.0);
-        let s = (left - tunnel).min(right - tunnel);
-        s.is_finite().then_some(s)
+        let crush = [left - tunnel, right - tunnel];
+        let s = self
+            .channels
+            .iter()
+            .zip(crush)
+            .filter(|(c, _)| c.usable(now, p.timeout_ns))
+            .map(|(_, s)| s)
+            .fold(None, |m: Option<f64>, s| Some(m.map_or(s, |m| m.min(s))));
+        s.filter(|s| s.is_finite())
+    }
+
+    /// Takes a usable satellite that lags the body out of the fusion — only one: when both
+    /// lag the tunnel, the tunnel is the suspect (a spike, a body motion forward it reads and
+    /// they read alike is no lag at all), and neither is taken out.
+    fn check_plausible(&mut self, now: u64) {
+        let p = self.params;
+        let [left, right, tunnel] = self.bins.sums(now, p.window_ns);
+        let lags = [left - tunnel, right - tunnel].map(|d| d < -IMPLAUSIBLE_LAG_MPS);
+        let usable = self.channels.map(|c| c.usable(now, p.timeout_ns));
+        for i in 0..2 {
+            let other = 1 - i;
+            let (Some(&lag), Some(&ok), Some(&other_lags), Some(&other_ok)) = (
+                lags.get(i),
+                usable.get(i),
+                lags.get(other),
+                usable.get(other),
+            ) else {
+                continue;
+            };
+            if ok && lag && !(other_ok && other_lags) {
+                if let Some(ch) = self.channels.get_mut(i) {
+                    ch.faulty_until_ns = Some(now.saturating_add(ms_to_ns(FAULT_HOLD_MS)));
+                }
+                self.faults.implausible = self.faults.implausible.saturating_add(1);
+            }
+        }
     }
 
     /// Updates the relief with the severity at `now` and returns it.
@@ -313,6 +362,7 @@ impl Satellites {
             self.hold_until_ns = None;
             self.peak_mps = 0.0;
         }
+        self.check_plausible(now);
         if let Some(s) = self.severity_mps(now).filter(|s| *s >= p.relief_from_mps) {
             self.peak_mps = self.peak_mps.max(s);
             self.hold_until_ns = Some(now.saturating_add(ms_to_ns(RELIEF_HOLD_MS)));
@@ -426,13 +476,48 @@ mod tests {
     }
 
     #[test]
-    fn one_satellite_alone_grants_nothing_whatever_it_reads() {
+    fn one_lying_satellite_cannot_raise_the_severity() {
         let mut s = Satellites::new(params());
         // The left satellite saturated (a stuck or spiking one), the right one at rest.
         assert_eq!(run(&mut s, 1, 30, 240.0, 0.0, 0.0), Relief::NONE);
-        // Mounted backwards: its crush reads as forward acceleration.
+        // Mounted backwards in a 10 g body motion: its crush reads as forward acceleration,
+        // which takes it out of the fusion; the right one moves with the body.
         let mut s = Satellites::new(params());
-        assert_eq!(run(&mut s, 1, 30, -150.0, 150.0, 0.0), Relief::NONE);
+        assert_eq!(run(&mut s, 1, 30, -10.0, 10.0, 10.0), Relief::NONE);
+        assert_eq!(s.faults.implausible, 1);
+        assert!(s.faulty(SatelliteSide::Left, 30 * MS));
+        assert!(!s.faulty(SatelliteSide::Right, 30 * MS));
+    }
+
+    /// A satellite that lags the body by more than the implausibility line (dead at rest in a
+    /// crash) is out for the hold; the other one's crush decides alone. Closed form: the right
+    /// satellite at 60 g above a 15 g tunnel gives 60·g·4 ms = 2.35 m/s, the whole relief.
+    #[test]
+    fn a_satellite_lagging_the_body_is_out_and_the_other_decides() {
+        let mut s = Satellites::new(params());
+        // The first cycle of a 15 g tunnel: the stuck one lags by 0.15 m/s, still plausible,
+        // and the smaller crush (its own) grants nothing.
+        assert_eq!(run(&mut s, 1, 1, 0.0, 75.0, 15.0), Relief::NONE);
+        assert!(!s.faulty(SatelliteSide::Left, MS));
+        // From the second: 0.29 m/s… and the third 0.44 m/s below the tunnel: out.
+        let r = run(&mut s, 2, 4, 0.0, 75.0, 15.0);
+        assert!(s.faulty(SatelliteSide::Left, 5 * MS));
+        assert_eq!(s.faults.implausible, 1);
+        assert_eq!(r.fraction, 1.0, "{r:?}");
+        // Both lagging the tunnel (a 100 g tunnel spike, both at rest): the tunnel is the
+        // suspect, neither is taken out.
+        let mut s = Satellites::new(params());
+        assert_eq!(run(&mut s, 1, 3, 0.0, 0.0, 100.0), Relief::NONE);
+        assert_eq!(s.faults.implausible, 0);
+        assert!(!s.faulty(SatelliteSide::Left, 3 * MS) && !s.faulty(SatelliteSide::Right, 3 * MS));
+        // Both out (the right one stale too): nothing.
+        let mut s = Satellites::new(params());
+        for k in 1..10u64 {
+            s.begin_cycle(k * MS);
+            s.on_frames(SatelliteSide::Left, &frames(0.0), k * MS);
+            s.on_tunnel_dv(15.0 * G * 1e-3);
+            assert_eq!(s.relief(k * MS), Relief::NONE);
+        }
     }
 
     #[test]
@@ -456,25 +541,36 @@ mod tests {
         assert_eq!(r, Relief::NONE);
     }
 
+    /// Out of the fusion: stale, corrupt or defective. The other satellite decides alone —
+    /// nothing for a body motion it shares with the tunnel, the relief for a crush it sees.
     #[test]
-    fn stale_corrupt_or_defective_satellites_grant_nothing() {
-        // Stale: only the left one sends.
+    fn a_stale_corrupt_or_defective_satellite_leaves_the_other_to_decide() {
+        // Stale: only the left one sends; a 20 g body motion grants nothing, a crush does.
         let mut s = Satellites::new(params());
         for k in 1..10u64 {
             s.begin_cycle(k * MS);
-            s.on_frames(SatelliteSide::Left, &frames(150.0), k * MS);
+            s.on_frames(SatelliteSide::Left, &frames(20.0), k * MS);
+            s.on_tunnel_dv(20.0 * G * 1e-3);
             assert_eq!(s.relief(k * MS), Relief::NONE);
         }
         assert!(s.faulty(SatelliteSide::Right, 9 * MS));
         assert!(!s.faulty(SatelliteSide::Left, 9 * MS));
-        // One corrupt frame takes the right satellite out for the hold.
+        let mut r = Relief::NONE;
+        for k in 10..15u64 {
+            s.begin_cycle(k * MS);
+            s.on_frames(SatelliteSide::Left, &frames(150.0), k * MS);
+            r = s.relief(k * MS);
+        }
+        assert_eq!(r.fraction, 1.0);
+        // One corrupt frame takes the right satellite out for the hold: the left one's crush
+        // decides, and it is at rest.
         let mut s = Satellites::new(params());
         let mut bad = frames(150.0);
         bad.frames[1] ^= 1;
         s.begin_cycle(MS);
         s.on_frames(SatelliteSide::Right, &bad, MS);
         assert_eq!(s.faults.corrupt_frames, 1);
-        assert_eq!(run(&mut s, 2, 20, 150.0, 150.0, 0.0), Relief::NONE);
+        assert_eq!(run(&mut s, 2, 20, 0.0, 150.0, 0.0), Relief::NONE);
         assert!(s.faulty(SatelliteSide::Right, 21 * MS));
         // A status word (sensor defect) likewise.
         let mut s = Satellites::new(params());
@@ -483,7 +579,7 @@ mod tests {
         s.begin_cycle(MS);
         s.on_frames(SatelliteSide::Left, &defect, MS);
         assert_eq!(s.faults.status_frames, 1);
-        assert_eq!(run(&mut s, 2, 20, 150.0, 150.0, 0.0), Relief::NONE);
+        assert_eq!(run(&mut s, 2, 20, 150.0, 0.0, 0.0), Relief::NONE);
         // Garbage batches are counted, never used.
         let mut s = Satellites::new(params());
         let garbage = SatelliteFrames {

@@ -591,7 +591,6 @@ pub const ACCEPTED_COSTS: &[(&str, f64, &str)] = &[(
 /// comes first in the safety order (no misuse may fire it); these are the cases where a plan
 /// made for a heavier opponent than the truth is earlier than the floor.
 pub const ACCEPTED_LATE_AIRBAGS: &[(&str, f64, &str)] = &[
-    ("fault-satellite-dead-in-crash", 4.5, LATE_SATELLITE_DEAD),
     ("fault-safing-sensor-dead", 1.5, LATE_SAFING_DEAD),
     (
         "taurus-31-31-abs-eba-true1300-rep1900-v2x",
@@ -604,12 +603,6 @@ pub const ACCEPTED_LATE_AIRBAGS: &[(&str, f64, &str)] = &[
         LATE_31_31_1300_KG,
     ),
 ];
-
-/// Why a crash with one crush-zone satellite dead fires after its plan.
-const LATE_SATELLITE_DEAD: &str = "one satellite dead: the fusion grants no relief (a single \
-     satellite could be the faulty one) and the airbag waits for the tunnel's own 1.25 m/s \
-     floor, as in a car without satellites — +11.8 ms against the plan's +7.7 ms, which the \
-     table makes for both satellites healthy; −14.1 % against the reference, no bottoming-out";
 
 /// Why a crash with the safing sensor dead fires after its plan.
 const LATE_SAFING_DEAD: &str = "the safing sensor dead: the vehicle deceleration on CAN \

@@ -279,8 +279,9 @@ pub(super) fn satellite_fault_in_pothole(r: &mut ChaCha8Rng, name: &str, i: u64)
 }
 
 /// A must-fire barrier crash with one crush-zone satellite dead, stuck at rest from before the
-/// crash, or saturated from 50 ms before contact: the fusion grants nothing, the tunnel's own
-/// logic must still fire.
+/// crash, or saturated from 50 ms before contact: the faulty one is out of the fusion (stale,
+/// or lagging the body once the crash begins) or cannot raise the smaller crush Δv; the other
+/// one's relief decides.
 pub(super) fn must_fire_satellite_fault(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let (v, tc) = (r.gen_range(35.0..56.0), r.gen_range(0.35..0.5));
     let sat = ["satellite-left", "satellite-right"][r.gen_range(0..2)];

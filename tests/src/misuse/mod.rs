@@ -313,7 +313,7 @@ pub const FAMILIES: &[Family] = &[
     },
     Family {
         name: "must-fire-satellite-fault",
-        envelope: "barrier 35–56 km/h with one crush-zone satellite dead, stuck or saturated (the tunnel's own logic, without the satellites' relief)",
+        envelope: "barrier 35–56 km/h with one crush-zone satellite dead, stuck or saturated (the other satellite's relief alone)",
         requirement: Requirement::MustFire,
         make: must_fire_satellite_fault,
     },
