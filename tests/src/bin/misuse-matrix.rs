@@ -513,8 +513,8 @@ fn run_matrix() -> Result<()> {
     let mut failures = Vec::new();
     writeln!(
         out,
-        "{:<34} {:>8} {:>8} {:>8} {:>8} {:>6} {:>6} {:>6}  fire − required (127 mm − 30 ms), ms: p50 / worst [worst − clean twin's]",
-        "family", "variants", "airbag!", "pretens!", "missed", "late", "stuck", "errors"
+        "{:<34} {:>8} {:>8} {:>8} {:>8} {:>6} {:>6} {:>6} {:>6}  fire − required (127 mm − 30 ms), ms: p50 / worst [worst − clean twin's]",
+        "family", "variants", "airbag!", "pretens!", "missed", "late", "after", "stuck", "errors"
     )?;
     let mut json_rows = Vec::new();
     // Two healthy sensors on real crashes: the must-fire families' largest crash − safing Δv.
@@ -522,11 +522,15 @@ fn run_matrix() -> Result<()> {
     for (f, family) in families.iter().enumerate() {
         let (name, req) = (family.name, family.requirement);
         let open = cli.gate && misuse::OPEN.contains(&name);
+        // Gated on "127 mm − 30 ms" as well (`misuse::IN_TIME`).
+        let in_time = cli.gate && !open && misuse::IN_TIME.contains(&name);
         let rows: Vec<_> = results.iter().filter(|r| r.0 == f).collect();
         let (mut bad_bag, mut bad_pt, mut missed, mut errors, mut stuck) = (0, 0, 0, 0, 0);
         let mut margins = Vec::new();
         // Fire − required less the clean twin's, where the family has twins.
         let (mut late, mut vs_clean) = (0, f64::NEG_INFINITY);
+        // Airbags after their required time.
+        let mut after = 0;
         for (_, i, o) in &rows {
             let o = match o {
                 Ok(o) => o,
@@ -583,6 +587,15 @@ fn run_matrix() -> Result<()> {
                 Requirement::MustFire => match (o.airbag_ms, o.required_ms) {
                     (Some(t), Some(req)) => {
                         margins.push(t - req);
+                        if t > req {
+                            after += 1;
+                            if in_time {
+                                fail(&format!(
+                                    "airbag {:+.1} ms after its required time (127 mm − 30 ms, {req:+.1} ms)",
+                                    t - req
+                                ));
+                            }
+                        }
                         if let Some(clean) = o.clean_margin_ms {
                             let d = t - req - clean;
                             vs_clean = vs_clean.max(d);
@@ -621,11 +634,12 @@ fn run_matrix() -> Result<()> {
         if req == Requirement::Report {
             writeln!(
                 out,
-                "{:<34} {:>8} {:>8} {:>8} {:>8} {:>6} {:>6} {:>6}  (report, not judged: airbag / pretensioner fires)",
+                "{:<34} {:>8} {:>8} {:>8} {:>8} {:>6} {:>6} {:>6} {:>6}  (report, not judged: airbag / pretensioner fires)",
                 name,
                 rows.len(),
                 bad_bag,
                 bad_pt,
+                "—",
                 "—",
                 "—",
                 "—",
@@ -634,23 +648,31 @@ fn run_matrix() -> Result<()> {
         } else {
             writeln!(
                 out,
-                "{:<34} {:>8} {:>8} {:>8} {:>8} {:>6} {:>6} {:>6}  {timing}{}",
+                "{:<34} {:>8} {:>8} {:>8} {:>8} {:>6} {:>6} {:>6} {:>6}  {timing}{}",
                 name,
                 rows.len(),
                 bad_bag,
                 bad_pt,
                 missed,
                 late,
+                after,
                 stuck,
                 errors,
-                if open { "  (open: not gated yet)" } else { "" }
+                if open {
+                    "  (open: not gated yet)"
+                } else if in_time {
+                    "  (in time: gated)"
+                } else {
+                    ""
+                }
             )?;
         }
         json_rows.push(serde_json::json!({
             "family": name, "variants": rows.len(), "airbag_where_none_may": bad_bag,
             "pretensioner_where_none_may": bad_pt, "must_fire_missed": missed, "errors": errors,
             "stuck_in_crash": stuck, "judged": req != Requirement::Report && !open,
-            "later_than_clean_twin": late,
+            "later_than_clean_twin": late, "after_required": after,
+            "gated_in_time": in_time,
             "worst_minus_clean_twin_ms": vs_clean.is_finite().then_some(vs_clean),
             "fire_minus_required_ms_p50": margins.get(margins.len() / 2),
             "fire_minus_required_ms_worst": margins.last(),
@@ -665,7 +687,7 @@ fn run_matrix() -> Result<()> {
             c.severity_tolerance_fraction * 100.0
         )?;
     }
-    writeln!(out, "{} variants in {:.1} s (seed {}); airbag! / pretens! = fired where none may (must be 0), missed = must-fire crashes without airbag (must be 0), late = must-fire airbags over {:.0} ms later than their clean twin's (must be 0), stuck = crash phases that fired nothing and never ended (must be 0)",
+    writeln!(out, "{} variants in {:.1} s (seed {}); airbag! / pretens! = fired where none may (must be 0), missed = must-fire crashes without airbag (must be 0), late = must-fire airbags over {:.0} ms later than their clean twin's (must be 0), after = must-fire airbags after their \"127 mm − 30 ms\" time (must be 0 where gated in time), stuck = crash phases that fired nothing and never ended (must be 0)",
         results.len(), start.elapsed().as_secs_f64(), cli.seed, misuse::LATE_VS_CLEAN_MS)?;
     print!("{out}");
     if let Some(path) = &cli.json {
