@@ -9,8 +9,9 @@
 //!
 //! Oracles: no panic; every relief fraction lies in [0, 1] and a relieved floor is never above
 //! the unrelieved one; and the property the fusion exists for — **one satellite alone grants
-//! nothing**: a twin fusion that gets the same left frames and tunnel but a right satellite at
-//! rest (data code 0) never grants a relief.
+//! nothing while its twin is in the fusion**: a twin fusion that gets the same left frames and
+//! tunnel but a right satellite at rest (data code 0) grants a relief only once that right
+//! satellite is out of it (it lagged the tunnel: `Satellites::faulty`).
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -74,7 +75,11 @@ fuzz_target!(|data: &[u8]| {
                 assert!((0.0..=1.0).contains(&relief.fraction), "{judged}: {relief:?}");
                 assert!(relief.floor_mps(1.25, 0.3) <= Relief::NONE.floor_mps(1.25, 0.3) + 1e-12);
             }
-            assert_eq!(one_sided.relief(now), Relief::NONE, "one satellite granted a relief");
+            assert!(
+                one_sided.relief(now) == Relief::NONE
+                    || one_sided.faulty(SatelliteSide::Right, now),
+                "one satellite granted a relief while its twin was in the fusion"
+            );
             now += MS;
             cycles += 1;
             fused.begin_cycle(now);

@@ -307,7 +307,8 @@ impl Satellites {
     /// (`None`: neither is usable, or the fusion is off).
     pub fn severity_mps(&self, now: u64) -> Option<f64> {
         let p = &self.params;
-        if !p.enabled {
+        let usable = self.channels.map(|c| c.usable(now, p.timeout_ns));
+        if !p.enabled || usable == [false; 2] {
             return None;
         }
         // A tunnel reading forward (a shunt from behind, or a faulty one) is no crush ahead:
@@ -315,11 +316,10 @@ impl Satellites {
         let [left, right, tunnel] = self.bins.sums(now, p.window_ns);
         let tunnel = tunnel.max(0.0);
         let crush = [left - tunnel, right - tunnel];
-        let s = self
-            .channels
+        let s = usable
             .iter()
             .zip(crush)
-            .filter(|(c, _)| c.usable(now, p.timeout_ns))
+            .filter(|(ok, _)| **ok)
             .map(|(_, s)| s)
             .fold(None, |m: Option<f64>, s| Some(m.map_or(s, |m| m.min(s))));
         s.filter(|s| s.is_finite())
@@ -330,9 +330,12 @@ impl Satellites {
     /// they read alike is no lag at all), and neither is taken out.
     fn check_plausible(&mut self, now: u64) {
         let p = self.params;
+        let usable = self.channels.map(|c| c.usable(now, p.timeout_ns));
+        if usable == [false; 2] {
+            return;
+        }
         let [left, right, tunnel] = self.bins.sums(now, p.window_ns);
         let lags = [left - tunnel, right - tunnel].map(|d| d < -IMPLAUSIBLE_LAG_MPS);
-        let usable = self.channels.map(|c| c.usable(now, p.timeout_ns));
         for i in 0..2 {
             let other = 1 - i;
             let (Some(&lag), Some(&ok), Some(&other_lags), Some(&other_ok)) = (
