@@ -12,6 +12,7 @@
 //!   body: the front structure's graded fold from the ego's crush.
 //! * [`j211`] — SAE J211 CFC filter (phaseless, in place, no allocation).
 //! * [`derive`] (feature `std`) — force-deflection curve from a rigid-barrier accelerometer trace.
+//! * [`deadline`] — the classic required fire time of a frontal airbag, "127 mm − 30 ms".
 //! * [`defaults`] — every modelling default in one place.
 //! * [`paper`] — the published numbers we calibrate against (typed from SPEC.md).
 //!
@@ -26,6 +27,7 @@
 pub mod collision;
 #[cfg(feature = "std")]
 pub mod crush_zone;
+pub mod deadline;
 pub mod defaults;
 #[cfg(feature = "std")]
 pub mod derive;

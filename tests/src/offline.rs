@@ -102,6 +102,9 @@ pub struct OfflineRun {
     /// Lookups the core planned with the V2X station's mass (`v2x_lookups`): the second mass
     /// source was used.
     pub v2x_lookups: u64,
+    /// The airbag's required fire time, "127 mm − 30 ms" of the true pulse [ms after contact]
+    /// (`physics::deadline`; `None`: no contact, or the pulse never moves a free occupant 127 mm).
+    pub required_ms: Option<f64>,
 }
 
 impl OfflineRun {
@@ -362,10 +365,14 @@ pub fn run_traced(
             .map_err(|e| anyhow!("{}: judge: {e}", scenario.name))?,
         None => None,
     };
+    let required_ms = contact_s
+        .and_then(|_| physics::deadline::required_fire_s(&truth.pulse.ego_pulse()))
+        .map(|s| s * 1e3);
     let rel = |t: u64| OfflineRun::rel_ms(contact_s, t);
     Ok(OfflineRun {
         name: scenario.name.clone(),
         contact_s,
+        required_ms,
         crash_mode_ms: crash_mode_ns.map(rel),
         modes: modules
             .ecu_modes
@@ -392,7 +399,7 @@ pub const NAME_WIDTH: usize = 28;
 /// Header of [`table_row`] with a scenario column `width` wide.
 pub fn table_header(width: usize) -> String {
     format!(
-        "{:<width$} confirm  airbag ms (plan)  src   adaptive a_max/a_mean/exc   reference a_max/a_mean/exc   change  verdict",
+        "{:<width$} confirm  airbag ms (plan) required src   adaptive a_max/a_mean/exc   reference a_max/a_mean/exc   change  verdict",
         "scenario"
     )
 }
@@ -437,10 +444,15 @@ pub fn table_row(r: &OfflineRun, width: usize) -> String {
         .filter(|_| r.contact_s.is_some())
         .map_or("    —".to_owned(), |t| format!("{t:+5.1}"));
     let bag = match (r.action("airbag_fire"), r.contact_s) {
-        (Some((t, p, _, _)), Some(_)) => format!("{t:+5.1} ({p:+5.1})     "),
+        (Some((t, p, _, _)), Some(_)) => format!("{t:+5.1} ({p:+5.1})    "),
         (Some(_), None) => "FIRED, no contact".to_owned(),
         (None, _) => "no fire          ".to_owned(),
     };
+    let bag = format!(
+        "{bag}{}",
+        r.required_ms
+            .map_or("       —  ".to_owned(), |q| format!("{q:+8.1}  "))
+    );
     let src = r
         .action("airbag_fire")
         .or_else(|| r.action("pretensioner_fire"))
@@ -549,6 +561,12 @@ pub fn run_json(
         "file": file.display().to_string(),
         "contact_ms": contact_ms,
         "contact_s": r.contact_s,
+        "required_ms": r.required_ms,
+        "margin_ms": r
+            .action("airbag_fire")
+            .zip(r.required_ms)
+            .filter(|_| r.contact_s.is_some())
+            .map(|((t, ..), q)| t - q),
         "crash_mode": r.crash_mode_ms.map(|m| {
             let (t_ms, after) = at(m);
             serde_json::json!({ "t_ms": t_ms, "after_contact_ms": after })

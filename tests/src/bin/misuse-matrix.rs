@@ -321,18 +321,9 @@ struct Outcome {
     clean_margin_ms: Option<f64>,
 }
 
-/// "127 mm − 30 ms": when the free-flying occupant has moved 127 mm relative to the car.
+/// "127 mm − 30 ms" of the true pulse, ms after contact (`physics::deadline`).
 fn required_ms(truth: &world::Truth) -> Option<f64> {
-    let p = truth.pulse.ego_pulse();
-    let (mut v, mut x) = (0.0, 0.0);
-    for (k, a) in p.accel_mps2.iter().enumerate() {
-        v += -a * p.step_s;
-        x += v * p.step_s;
-        if x >= 0.127 {
-            return Some((k as f64 + 1.0) * p.step_s * 1e3 - 30.0);
-        }
-    }
-    None
+    physics::deadline::required_fire_s(&truth.pulse.ego_pulse()).map(|s| s * 1e3)
 }
 
 /// A crash phase entered less than this before the run's end is unfinished, not stuck, ms: the

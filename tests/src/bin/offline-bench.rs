@@ -167,7 +167,7 @@ fn run_all() -> Result<bool> {
         }
         json.push(run_json(&r, file, mismatches.as_deref()));
     }
-    say("(! = bottomed out; confirm = first ECU cycle in mode crash; airbag = ms after the true contact, plan = its FireTime; action lines: ms after the true contact, or after the start without one; times on the simulated 1 kHz grid, no CAN latency)");
+    say("(! = bottomed out; confirm = first ECU cycle in mode crash; airbag = ms after the true contact, plan = its FireTime; required = \"127 mm − 30 ms\" of the true pulse, ms after the contact; action lines: ms after the true contact, or after the start without one; times on the simulated 1 kHz grid, no CAN latency)");
     if let Some(dir) = &cli.record {
         say(&format!(
             "recordings: {recorded} runs in {}/<scenario>/run.mcap ({:.1} MB; simulated clock, no bus latency; docs/using.md \"Recordings\")",
