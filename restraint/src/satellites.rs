@@ -236,6 +236,21 @@ pub struct Satellites {
     pub relieved_batches: u64,
 }
 
+/// The smaller crush Δv of the `usable` satellites from the window's `sums` (left, right,
+/// tunnel), m/s. A tunnel reading forward (a shunt from behind, or a faulty one) is no crush
+/// ahead: the satellites are measured against a tunnel that at most stands still.
+fn severity_of(usable: [bool; 2], sums: [f64; 3]) -> Option<f64> {
+    let [left, right, tunnel] = sums;
+    let tunnel = tunnel.max(0.0);
+    usable
+        .iter()
+        .zip([left - tunnel, right - tunnel])
+        .filter(|(ok, _)| **ok)
+        .map(|(_, s)| s)
+        .fold(None, |m: Option<f64>, s| Some(m.map_or(s, |m| m.min(s))))
+        .filter(|s| s.is_finite())
+}
+
 impl Satellites {
     /// No frames yet, no relief.
     pub fn new(params: SatelliteParams) -> Self {
@@ -306,36 +321,26 @@ impl Satellites {
     /// The frontal severity at `now`: the smaller crush Δv of the usable satellites, m/s
     /// (`None`: neither is usable, or the fusion is off).
     pub fn severity_mps(&self, now: u64) -> Option<f64> {
+        self.window(now)
+            .and_then(|(usable, sums)| severity_of(usable, sums))
+    }
+
+    /// Which satellites are usable at `now` and the window's sums (left, right, tunnel), m/s
+    /// (`None`: neither is usable, or the fusion is off — the sums are not needed then).
+    fn window(&self, now: u64) -> Option<([bool; 2], [f64; 3])> {
         let p = &self.params;
         let usable = self.channels.map(|c| c.usable(now, p.timeout_ns));
-        if !p.enabled || usable == [false; 2] {
-            return None;
-        }
-        // A tunnel reading forward (a shunt from behind, or a faulty one) is no crush ahead:
-        // the satellites are measured against a tunnel that at most stands still.
-        let [left, right, tunnel] = self.bins.sums(now, p.window_ns);
-        let tunnel = tunnel.max(0.0);
-        let crush = [left - tunnel, right - tunnel];
-        let s = usable
-            .iter()
-            .zip(crush)
-            .filter(|(ok, _)| **ok)
-            .map(|(_, s)| s)
-            .fold(None, |m: Option<f64>, s| Some(m.map_or(s, |m| m.min(s))));
-        s.filter(|s| s.is_finite())
+        (p.enabled && usable != [false; 2]).then(|| (usable, self.bins.sums(now, p.window_ns)))
     }
 
     /// Takes a usable satellite that lags the body out of the fusion — only one: when both
     /// lag the tunnel, the tunnel is the suspect (a spike, a body motion forward it reads and
-    /// they read alike is no lag at all), and neither is taken out.
-    fn check_plausible(&mut self, now: u64) {
-        let p = self.params;
-        let usable = self.channels.map(|c| c.usable(now, p.timeout_ns));
-        if usable == [false; 2] {
-            return;
-        }
-        let [left, right, tunnel] = self.bins.sums(now, p.window_ns);
+    /// they read alike is no lag at all), and neither is taken out. Returns which satellites
+    /// are still usable.
+    fn check_plausible(&mut self, now: u64, usable: [bool; 2], sums: [f64; 3]) -> [bool; 2] {
+        let [left, right, tunnel] = sums;
         let lags = [left - tunnel, right - tunnel].map(|d| d < -IMPLAUSIBLE_LAG_MPS);
+        let mut still = usable;
         for i in 0..2 {
             let other = 1 - i;
             let (Some(&lag), Some(&ok), Some(&other_lags), Some(&other_ok)) = (
@@ -347,12 +352,14 @@ impl Satellites {
                 continue;
             };
             if ok && lag && !(other_ok && other_lags) {
-                if let Some(ch) = self.channels.get_mut(i) {
+                if let (Some(ch), Some(u)) = (self.channels.get_mut(i), still.get_mut(i)) {
                     ch.faulty_until_ns = Some(now.saturating_add(ms_to_ns(FAULT_HOLD_MS)));
+                    *u = false;
                 }
                 self.faults.implausible = self.faults.implausible.saturating_add(1);
             }
         }
+        still
     }
 
     /// Updates the relief with the severity at `now` and returns it.
@@ -365,8 +372,11 @@ impl Satellites {
             self.hold_until_ns = None;
             self.peak_mps = 0.0;
         }
-        self.check_plausible(now);
-        if let Some(s) = self.severity_mps(now).filter(|s| *s >= p.relief_from_mps) {
+        // One pass over the window: the plausibility check, then the severity of what is left.
+        let severity = self
+            .window(now)
+            .and_then(|(usable, sums)| severity_of(self.check_plausible(now, usable, sums), sums));
+        if let Some(s) = severity.filter(|s| *s >= p.relief_from_mps) {
             self.peak_mps = self.peak_mps.max(s);
             self.hold_until_ns = Some(now.saturating_add(ms_to_ns(RELIEF_HOLD_MS)));
         }
