@@ -386,22 +386,20 @@ impl Decision {
         // adaptive and backup paths fire it as planned. Either way only with safing.
         self.pt_gate = AirbagGate::Decided;
         if gate == AirbagGate::Fallback {
-            if self.pretensioner != Pretensioner::Fired {
-                self.pt_gate = AirbagGate::Fallback;
-                self.pretensioner_at_ns = None;
-            }
+            self.pt_gate = AirbagGate::Fallback;
+            self.pretensioner_at_ns = None;
             self.airbag_fire_at_ns = None;
         } else {
             self.schedule(&plan, contact, confirm_ns, c.kind != ConfirmKind::Backup);
         }
         // A belt-only plan made so by the opponent's mass — the table fires the airbag for
-        // the same crash against its heaviest opponent — rests on the object list's mass,
+        // the same crash against the heaviest opponent one object fault can hide
+        // (`Estimator::heaviest_opponent_fires_airbag`) — rests on the object list's mass,
         // which one object fault (a truck reported as a car, a mass misreported within its
         // bound) gets wrong. The measured event still decides the airbag: its
         // accelerometer-only must-fire adds the reference airbag, as it would without any
         // prediction. A plan belt-only for the occupant (a light one) stays belt-only.
-        if gate == AirbagGate::Decided
-            && !plan.airbag_fires()
+        if !plan.airbag_fires()
             && c.kind != ConfirmKind::Backup
             && self.reference.airbag_fires()
             && (x.heaviest_fires_airbag)()
@@ -450,27 +448,28 @@ impl Decision {
         self.schedule(&reference, contact, now, false);
     }
 
-    /// Schedules a decided plan's crash-phase fires: the pyrotechnic pretensioner (unless the
-    /// belt is already fired) and the airbag (if the plan fires it), each at its time after
-    /// `contact`, never before `not_before` (the confirmation or hand-over: the past).
+    /// Schedules a decided plan's crash-phase fires: the pyrotechnic pretensioner and the
+    /// airbag (if the plan fires it), each at its time after `contact`, never before
+    /// `not_before` (the confirmation or hand-over: the past). A belt the pre-crash plan
+    /// already tensioned is fired again: the crash's own decision latches it (the crash phase
+    /// then ends in post-crash, never with the reversible belt released as after a near miss).
     /// With `at_decision`, the reference restraint's fires are due at `not_before`, the
     /// decision (see [`Self::conventional_fire_at`]); the backup path keeps the reference's
     /// time after the contact, because its decision can come at the contact itself (a
     /// predicted crash and the first vehicle frame that shows it), where an airbag fired for
     /// the reference's 10 ms would have vented before the occupant reaches it.
     fn schedule(&mut self, plan: &RestraintPlan, contact: u64, not_before: u64, at_decision: bool) {
-        let at_decision = at_decision && plan.source == PlanSource::Reference;
-        let due = |time_ms: f32| {
-            if at_decision {
+        let due = |time_ms: f32, source: PlanSource| {
+            if at_decision && source == PlanSource::Reference {
                 not_before
             } else {
                 at(contact, time_ms).max(not_before)
             }
         };
-        if self.pretensioner != Pretensioner::Fired {
-            self.pretensioner_at_ns = Some(due(plan.pretensioner_time_ms));
-        }
-        self.airbag_fire_at_ns = plan.airbag_fires().then(|| due(plan.airbag_time_ms));
+        self.pretensioner_at_ns = Some(due(plan.pretensioner_time_ms, plan.source));
+        self.airbag_fire_at_ns = plan
+            .airbag_fires()
+            .then(|| due(plan.airbag_time_ms, plan.airbag_source));
     }
 
     /// When the conventional path fires the crash plan's airbag (`airbag`) or pyrotechnic
@@ -484,12 +483,12 @@ impl Decision {
     /// before a wall) can date tens of ms early, while the reference is a fixed restraint.
     fn conventional_fire_at(&self, contact: u64, decided_ns: u64, airbag: bool) -> u64 {
         let plan = &self.crash_plan;
-        let time_ms = if airbag {
-            plan.airbag_time_ms
+        let (time_ms, source) = if airbag {
+            (plan.airbag_time_ms, plan.airbag_source)
         } else {
-            plan.pretensioner_time_ms
+            (plan.pretensioner_time_ms, plan.source)
         };
-        if plan.source == PlanSource::Reference {
+        if source == PlanSource::Reference {
             decided_ns
         } else {
             at(contact, time_ms).max(decided_ns)

@@ -207,7 +207,7 @@ impl Outputs {
             } else {
                 AirbagStageCmdFire::NoFire
             },
-            source: match p.source {
+            source: match p.airbag_source {
                 PlanSource::Adaptive => AirbagStageCmdCmdSource::Adaptive,
                 PlanSource::Reference => AirbagStageCmdCmdSource::Reference,
             },

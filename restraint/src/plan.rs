@@ -29,8 +29,12 @@ pub struct RestraintPlan {
     pub pretensioner_time_ms: f32,
     /// Airbag trigger, ms after contact (never before crash confirmation).
     pub airbag_time_ms: f32,
-    /// Source of the numbers.
+    /// Source of the belt's numbers (pretensioner and load limiter).
     pub source: PlanSource,
+    /// Source of the airbag's numbers: the belt's, or the reference restraint's airbag a
+    /// belt-only plan gets when the measured pulse proves the crash must-fire
+    /// ([`Self::with_airbag_of`]).
+    pub airbag_source: PlanSource,
 }
 
 impl RestraintPlan {
@@ -56,6 +60,7 @@ impl RestraintPlan {
             pretensioner_time_ms,
             airbag_time_ms,
             source: PlanSource::Reference,
+            airbag_source: PlanSource::Reference,
         }
     }
 
@@ -95,6 +100,7 @@ impl RestraintPlan {
             pretensioner_time_ms: l.values.pretensioner_time_ms,
             airbag_time_ms: l.values.airbag_time_ms,
             source: PlanSource::Adaptive,
+            airbag_source: PlanSource::Adaptive,
         }
     }
 
@@ -111,6 +117,7 @@ impl RestraintPlan {
         self.airbag_stage = other.airbag_stage;
         self.airbag_level_kn = other.airbag_level_kn;
         self.airbag_time_ms = other.airbag_time_ms;
+        self.airbag_source = other.airbag_source;
         self
     }
 

@@ -592,17 +592,31 @@ pub fn run_json(
     })
 }
 
-/// Library cases (and variants) allowed to come out worse than the reference restraint, with the most they
-/// may lose (%) and why: the safety order of issue 30 (no inadvertent fire before fire time)
-/// decided against them, with the figures in restraint/README.md ("Severity floors").
-pub const ACCEPTED_COSTS: &[(&str, f64, &str)] = &[(
-    "taurus-52-52-none-speed+5",
-    8.0,
-    "with the closing speed reported 5 m/s high the reversible pre-crash pretensioner \
+/// Library cases (and variants) allowed to come out worse than the reference restraint, with
+/// the most they may lose (%) and why: the safety order (no inadvertent fire before fire time)
+/// or the physics of the pulse decided against them, with the figures in restraint/README.md
+/// ("Severity floors", "a belt-only plan").
+pub const ACCEPTED_COSTS: &[(&str, f64, &str)] = &[
+    (
+        "truck-reported-as-car",
+        170.0,
+        "a standing 9 t truck struck at 50 km/h closing (EBS 42.5 km/h) loads the ego through \
+         both structures' springs as a light car at the same closing speed does for the first \
+         tens of ms (an 800 kg car there is a 15.5 km/h no-fire crash): its soft 18 g pulse \
+         crosses the accelerometer-only boundary at +48.5 ms, where the ECU without a table, or \
+         with the truck tracked at its true mass, fires too (below the unguarded closing speed \
+         one object fault could have made the mass); the reference restraint is a fixed +10 ms \
+         fire. No miss: the belt-only plan gets the reference airbag from the event's must-fire",
+    ),
+    (
+        "taurus-52-52-none-speed+5",
+        8.0,
+        "with the closing speed reported 5 m/s high the reversible pre-crash pretensioner \
          does not fire before contact; in the crash phase it waits for its 1.25 m/s floor \
          (+12.5 ms; +5.8 ms before the floor held matched fires): +6.9 % (+4.6 % with the \
          table before plan = fire)",
-)];
+    ),
+];
 
 /// Variations whose adaptive airbag may come later after its plan than the table's fire-delay
 /// tolerance, by name: (name, the most it may be late, ms, why). The airbag's severity floor

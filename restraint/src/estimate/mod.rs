@@ -520,10 +520,16 @@ impl<'a> Estimator<'a> {
         self.lut.as_ref().filter(|_| occ.buckled && occ.adult)
     }
 
-    /// Whether the table fires the airbag for the situation with the heaviest opponent it
-    /// covers (`false` without a table or where it does not cover the situation): a belt-only
-    /// plan that this answers `true` for was made belt-only by the opponent's mass — what one
-    /// object fault can get wrong — not by the occupant.
+    /// Whether the table fires the airbag for the situation with the heaviest opponent one
+    /// object fault can hide (`false` without a table or where it does not cover the
+    /// occupant): a belt-only plan that this answers `true` for was made belt-only by the
+    /// opponent's mass — what one object fault can get wrong — not by the occupant.
+    ///
+    /// That opponent is a truck or a wall reported as a car: beyond every mass the table
+    /// covers, it gives the ego an equivalent barrier speed equal to the closing speed. The
+    /// table stands in for it with its heaviest opponent at the closing speed that gives the
+    /// same EBS, v·(m + m_ego)/m, capped at the table's fastest knot (a 48 km/h closing
+    /// truck: the 3 000 kg opponent at 76.6 km/h).
     /// Not counted in the lookup counters: a question about the table, not a plan.
     pub(crate) fn heaviest_opponent_fires_airbag(
         &self,
@@ -534,7 +540,21 @@ impl<'a> Estimator<'a> {
             return false;
         };
         let heaviest = heaviest_opponent_kg(lut);
-        let plan = self.query(lut, sit, heaviest, inputs, &mut CycleCounters::default());
+        let fastest_mps = lut.view.axes()[0]
+            .last()
+            .map_or(f64::NAN, |v| f64::from(*v) / 3.6);
+        let barrier_like = Situation {
+            closing_speed_mps: (sit.closing_speed_mps * (heaviest + self.ego_mass_kg) / heaviest)
+                .min(fastest_mps),
+            ..*sit
+        };
+        let plan = self.query(
+            lut,
+            &barrier_like,
+            heaviest,
+            inputs,
+            &mut CycleCounters::default(),
+        );
         plan.source == crate::plan::PlanSource::Adaptive && plan.airbag_fires()
     }
 

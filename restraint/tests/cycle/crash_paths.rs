@@ -533,12 +533,26 @@ fn a_matched_airbag_waits_until_its_crash_carries_the_floor() {
 }
 
 #[test]
-fn a_matched_pulse_that_follows_its_ramp_past_the_plan_below_the_floor_fires_nothing() {
+fn a_matched_pulse_that_follows_its_ramp_past_the_plan_below_the_floor_fires_no_airbag() {
     // The same crash prediction; the pulse follows the predicted ramp past the plan's airbag
-    // time (+15.1 ms) and then stops, as a near miss's pothole or kerb strike would if it
-    // were that long: ≈ 2.2 m/s, below the (raised) 3 m/s floor. The matched airbag is never
-    // commanded and the crash phase ends with the event.
+    // time (+15.1 ms) and then stops: ≈ 2.2 m/s, below the (raised) 3 m/s airbag floor. The
+    // matched airbag is never commanded. The event did carry the pretensioner's 1.5 m/s
+    // floor, so the belt the pre-crash plan tensioned is latched as the crash's pretensioner
+    // fire and the crash phase ends in post-crash (a pretensioner not yet fired would have
+    // fired there too).
     let g = |ms: u64| if ms < 17 { ramp_g(28.0, ms) } else { 0.0 };
+    let b = predicted_28_mps_with_airbag_floor(3.0, C + 200 * MS, &g);
+    assert!(b.first_mode(EcuMode::Crash).is_some(), "matched");
+    assert!(no_airbag_fired(&b), "{:?}", first_fire(&b));
+    assert_eq!(b.ecu.phase(), Phase::PostCrash);
+}
+
+#[test]
+fn a_matched_pulse_below_both_floors_fires_nothing_and_ends_with_its_event() {
+    // As above, stopped at +10 ms: ≈ 0.8 m/s, under the pretensioner's 1.5 m/s floor as a near
+    // miss's pothole is. Nothing of the crash phase fires; the belt the pre-crash plan
+    // tensioned is not latched and the crash phase ends with the event.
+    let g = |ms: u64| if ms < 10 { ramp_g(28.0, ms) } else { 0.0 };
     let b = predicted_28_mps_with_airbag_floor(3.0, C + 200 * MS, &g);
     assert!(b.first_mode(EcuMode::Crash).is_some(), "matched");
     assert!(no_airbag_fired(&b), "{:?}", first_fire(&b));
