@@ -181,6 +181,8 @@ pub fn accel_only_fire_s(
                 fraction,
                 floor_mps: relief.floor_mps,
                 boundary_scale: relief.boundary_scale,
+                // A car without satellites below the unguarded closing speed: no lift.
+                ..Relief::NONE
             },
         );
         let s = AccelSample {

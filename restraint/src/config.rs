@@ -292,6 +292,10 @@ pub struct CycleConfig {
     /// `misreported-low-speed` family fired 35 airbags of 445 (seed 7), at 0.75 21; the must-fire
     /// families' fire times are the same at 1.0 — the floor is what held them.
     pub satellite_boundary_scale: f64,
+    /// While usable satellites see the front end crush less than `satellite_relief_from_mps`,
+    /// the accelerometer-only airbag boundary is lifted by this, m/s, and by less the more
+    /// they relieve (`satellites`, "Low crush"; *default* 1.2: a kerb strike or pothole inside a 12–16 km/h crash, the matrix's envelope × 1.5). 0 = off.
+    pub satellite_low_crush_lift_mps: f64,
 
     /// Crash accelerometer: no batch for this long → `ACCEL_STALE`, ms (*default* 50: batches
     /// come every ms, so 50 missed ones are a dead sensor; with one 20 ms `EcuStatus` period the
@@ -385,6 +389,7 @@ impl Default for CycleConfig {
             satellite_relief_full_mps: 2.0,
             satellite_floor_mps: 0.5,
             satellite_boundary_scale: 1.0,
+            satellite_low_crush_lift_mps: 1.2,
             accel_timeout_ms: 50.0,
             accel_stuck_ms: 20.0,
             accel_full_scale_g: 200.0,
@@ -524,6 +529,12 @@ impl CycleConfig {
             0.2,
             1.0,
         )?;
+        range(
+            "satellite_low_crush_lift_mps",
+            self.satellite_low_crush_lift_mps,
+            0.0,
+            5.0,
+        )?;
         range("safing_wake_g", self.safing_wake_g, 0.1, 50.0)?;
         range("safing_dv_mps", self.safing_dv_mps, 0.01, 5.0)?;
         range("safing_hold_ms", self.safing_hold_ms, 0.0, 1_000.0)?;
@@ -655,6 +666,7 @@ impl CycleConfig {
             relief_full_mps: self.satellite_relief_full_mps,
             floor_mps: self.satellite_floor_mps,
             boundary_scale: self.satellite_boundary_scale,
+            low_crush_lift_mps: self.satellite_low_crush_lift_mps,
         }
     }
 

@@ -135,6 +135,9 @@ impl CrashMonitor {
         }
         let relief = relief();
         let lift = self.roughness.floor_lift_mps();
+        // The satellites' low-crush lift is the airbag's: a crash below its no-fire line may
+        // still need the belt.
+        self.fallback.lift_boundary(relief.boundary_lift_mps);
         let airbag = self.fallback.thresholds_now(lift, relief);
         let pretensioner = self.pretensioner.thresholds_now(lift, relief);
         // A rough road's lobes are no crash evidence for the generic confirmation either (nor

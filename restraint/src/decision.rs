@@ -174,6 +174,10 @@ pub struct Decision {
     safing_wait_ns: u64,
     /// Something fired in the crash phase (it then ends in POST-CRASH).
     crash_fired: bool,
+    /// The crash phase's pretensioner decision latched a belt the pre-crash plan had already
+    /// tensioned (it then ends in POST-CRASH too, but nothing new went out: the backup may
+    /// still take a disagreeing pair's event over).
+    belt_latched: bool,
     /// The phase the crash phase was entered from (returned to when the event ends with
     /// nothing fired).
     before_crash: Phase,
@@ -233,6 +237,7 @@ impl Decision {
             pt_gate: AirbagGate::Decided,
             safing_wait_ns: ms_to_ns(cfg.safing_wait_ms),
             crash_fired: false,
+            belt_latched: false,
             before_crash: Phase::Monitoring,
             abandoned: false,
             vetoed: 0,
@@ -379,6 +384,7 @@ impl Decision {
         self.crash_kind = Some(c.kind);
         self.gate = gate;
         self.crash_fired = false;
+        self.belt_latched = false;
         self.contact_ns = Some(contact);
         self.event_onset_ns = c.onset_ns;
         self.armed = true;
@@ -723,8 +729,12 @@ impl Decision {
         if let Some(t) = self.pretensioner_at_ns {
             if let Some(go) = self.release(t, now, x.half_period_ns, safing) {
                 if go {
+                    if self.pretensioner == Pretensioner::Fired {
+                        self.belt_latched |= in_crash;
+                    } else {
+                        self.crash_fired |= in_crash;
+                    }
                     self.pretensioner = Pretensioner::Fired;
-                    self.crash_fired |= in_crash;
                 }
                 self.pretensioner_at_ns = None;
             }
@@ -744,7 +754,7 @@ impl Decision {
             && self.gate == AirbagGate::Decided
             && self.pt_gate == AirbagGate::Decided
         {
-            if self.crash_fired || self.airbag_fired {
+            if self.crash_fired || self.airbag_fired || self.belt_latched {
                 self.phase = Phase::PostCrash;
             } else if !x.event_in_progress {
                 // The event ended and nothing fired: it was not a crash that needed a

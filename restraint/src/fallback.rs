@@ -178,6 +178,9 @@ pub struct FallbackAlgorithm {
     segment_base_dv_mps: f64,
     /// Since when the deceleration has been under the wake threshold inside the event, ns.
     dip_since_ns: Option<u64>,
+    /// What the boundary is lifted by for the samples to come, m/s
+    /// ([`Self::lift_boundary`]).
+    boundary_lift_mps: f64,
 }
 
 impl FallbackAlgorithm {
@@ -193,7 +196,14 @@ impl FallbackAlgorithm {
             segment_onset_ns: 0,
             segment_base_dv_mps: 0.0,
             dip_since_ns: None,
+            boundary_lift_mps: 0.0,
         }
+    }
+
+    /// Lifts the boundary by `lift_mps` for the samples to come (the satellites' low-crush
+    /// lift, [`crate::satellites::Relief::boundary_lift_mps`]; set once a batch, 0 by default).
+    pub fn lift_boundary(&mut self, lift_mps: f64) {
+        self.boundary_lift_mps = lift_mps;
     }
 
     /// Starts the judged segment at sample `s` (the event's wake-up, or a re-onset; `base`:
@@ -270,7 +280,8 @@ impl FallbackAlgorithm {
         let dv = self.onset.delta_v_mps() - self.segment_base_dv_mps;
         if tau_ms > WINDOW_MS {
             self.decision = FallbackDecision::NoFire(s.t_ns);
-        } else if dv >= t.boundary_scale * threshold_mps(&self.thresholds, tau_ms)
+        } else if dv
+            >= t.boundary_scale * threshold_mps(&self.thresholds, tau_ms) + self.boundary_lift_mps
             && dv >= t.min_dv_mps
             && self.run >= self.floor.samples
             && self.loading()
@@ -416,6 +427,23 @@ mod tests {
         assert_eq!(
             f.decision(),
             FallbackDecision::NoFire(1_000_000_000 + 61_000_000)
+        );
+    }
+
+    #[test]
+    fn a_boundary_lift_moves_the_fire_to_where_the_velocity_line_meets_the_lifted_boundary() {
+        // The same oracle with the boundary lifted by 0.3 m/s: 5 g fires at the first n with
+        // (n − ½)·0.04903 ≥ 0.375 + 0.025 n → n ≥ 16.1, the sample at τ = 16 ms.
+        let lin: [f64; KNOTS] = core::array::from_fn(|i| 0.1 + 0.1 * i as f64);
+        let mut f = FallbackAlgorithm::new(lin, NO_FLOOR);
+        f.lift_boundary(0.3);
+        run(&mut f, 5.0, 80);
+        assert_eq!(
+            f.decision(),
+            FallbackDecision::Fire {
+                at_ns: 1_000_000_000 + 16_000_000,
+                onset_ns: 1_000_000_000
+            }
         );
     }
 

@@ -13,9 +13,10 @@
 //! full-width crash loads both, and no single satellite — spiking, stuck, saturated, or
 //! replaced by a forged frame — can raise the smaller of two. A satellite is out of the fusion
 //! while it is stale, sends corrupt frames or status words, or is **implausible**: slowing by
-//! [`IMPLAUSIBLE_LAG_MPS`] less than the body over the window while its twin does not (the
+//! [`IMPLAUSIBLE_LAG_MPS`] less than the body — and than its twin — over the window (the
 //! structure ahead of the body cannot lag it in a frontal event: a satellite dead at rest,
-//! stuck or mounted backwards in a crash; both lagging accuse the tunnel, not them). The other
+//! stuck or mounted backwards in a crash; both lagging alike accuse the tunnel, or show the
+//! front end unloading at the crash's end, not them). The other
 //! one then decides alone: one fault has taken its twin
 //! out, so it is the healthy one, and it grants a relief only when it sees the front end fold
 //! — a body motion moves it with the body. Neither usable: no relief. From
@@ -27,6 +28,19 @@
 //!   `satellite_floor_mps` (never below it, never raised);
 //! * the accelerometer-only boundary towards `satellite_boundary_scale` × itself;
 //! * the road-roughness lift towards 0 (a crushed front end is not a rough road).
+//!
+//! **Low crush.** The same evidence works the other way: while usable satellites see the
+//! front end crush less than the relief's lower line — a crash below the no-fire line (a
+//! 16 km/h barrier: ≈ 0.5 m/s) or no crash at all — the accelerometer-only airbag boundary
+//! is lifted by `satellite_low_crush_lift_mps`, the most a misuse event of the envelope adds
+//! to the tunnel's Δv (a kerb strike or pothole inside a low-speed crash: ≈ 1.2 m/s). A crash
+//! whose frontal severity reaches the lower line is judged on the boundary itself from then
+//! on, as long as its relief holds: the lift is all or nothing, because a pulse near the
+//! must-fire line rides along the boundary for tens of ms, and any part of the lift left on
+//! it moves its fire to the window's end (30 + 30 km/h against 2 475 kg, relieved 0.75: +35
+//! ms with 0.3 m/s of lift left). With no usable satellite there is no lift (a satellite
+//! fault can only take the lift away, and a missing one leaves the central-only logic
+//! unchanged).
 //!
 //! Every Fire still needs the tunnel's own event to cross the lowered boundary and floor, the
 //! persistence and loading rules, and the safing channel's agreement: **the satellites alone
@@ -65,14 +79,20 @@ pub struct Relief {
     pub floor_mps: f64,
     /// The factor the whole range scales the boundary by.
     pub boundary_scale: f64,
+    /// What the accelerometer-only airbag boundary is lifted by now, m/s:
+    /// `satellite_low_crush_lift_mps` while usable satellites have not seen the front end
+    /// crush as much as the relief's lower line, 0 from then on (while the relief holds) and
+    /// with no usable satellite (module docs, "Low crush").
+    pub boundary_lift_mps: f64,
 }
 
 impl Relief {
-    /// No relief: the tunnel's own thresholds.
+    /// No relief and no lift: the tunnel's own thresholds.
     pub const NONE: Self = Self {
         fraction: 0.0,
         floor_mps: 0.0,
         boundary_scale: 1.0,
+        boundary_lift_mps: 0.0,
     };
 
     /// A severity floor `floor_mps` with the road's `lift_mps`, as relieved: the floor moves
@@ -114,6 +134,8 @@ pub struct SatelliteParams {
     pub floor_mps: f64,
     /// The boundary scale of the whole relief.
     pub boundary_scale: f64,
+    /// The airbag boundary's lift while the front end does not crush, m/s.
+    pub low_crush_lift_mps: f64,
 }
 
 /// Index mask of the ring of bins.
@@ -170,13 +192,20 @@ impl Bins {
     }
 
     /// Sums of the bins opened within `window_ns` before `now` (the current one included).
+    /// The ring opens bins in time order, so the walk goes back from the newest and stops at
+    /// the first one outside the window: a window of w cycles costs w bins, not the ring.
     fn sums(&self, now: u64, window_ns: u64) -> [f64; 3] {
         let mut sum = [0.0; 3];
-        for (dv, at) in self.dv_mps.iter().zip(self.at_ns.iter()) {
-            if *at != 0 && now.saturating_sub(*at) < window_ns {
-                for (s, v) in sum.iter_mut().zip(dv) {
-                    *s += v;
-                }
+        for k in 0..BINS {
+            let i = self.head.wrapping_sub(k) & BIN_MASK;
+            let (Some(dv), Some(&at)) = (self.dv_mps.get(i), self.at_ns.get(i)) else {
+                break;
+            };
+            if at == 0 || now.saturating_sub(at) >= window_ns {
+                break;
+            }
+            for (s, v) in sum.iter_mut().zip(dv) {
+                *s += v;
             }
         }
         sum
@@ -333,25 +362,28 @@ impl Satellites {
         (p.enabled && usable != [false; 2]).then(|| (usable, self.bins.sums(now, p.window_ns)))
     }
 
-    /// Takes a usable satellite that lags the body out of the fusion — only one: when both
-    /// lag the tunnel, the tunnel is the suspect (a spike, a body motion forward it reads and
-    /// they read alike is no lag at all), and neither is taken out. Returns which satellites
-    /// are still usable.
+    /// Takes a usable satellite that lags the body out of the fusion — and, while its twin is
+    /// usable, lags its twin by as much too: when both lag the tunnel alike, the tunnel is the
+    /// suspect (a spike, a body motion forward it reads and they read alike is no lag at
+    /// all), or the front end is unloading (a crash's crush rate falling at its end: both rail
+    /// tips slow less than the body for a few ms), and neither is taken out. Returns which
+    /// satellites are still usable.
     fn check_plausible(&mut self, now: u64, usable: [bool; 2], sums: [f64; 3]) -> [bool; 2] {
         let [left, right, tunnel] = sums;
         let lags = [left - tunnel, right - tunnel].map(|d| d < -IMPLAUSIBLE_LAG_MPS);
+        let behind_twin = [right - left, left - right].map(|d| d > IMPLAUSIBLE_LAG_MPS);
         let mut still = usable;
         for i in 0..2 {
             let other = 1 - i;
-            let (Some(&lag), Some(&ok), Some(&other_lags), Some(&other_ok)) = (
+            let (Some(&lag), Some(&ok), Some(&behind), Some(&other_ok)) = (
                 lags.get(i),
                 usable.get(i),
-                lags.get(other),
+                behind_twin.get(i),
                 usable.get(other),
             ) else {
                 continue;
             };
-            if ok && lag && !(other_ok && other_lags) {
+            if ok && lag && (behind || !other_ok) {
                 if let (Some(ch), Some(u)) = (self.channels.get_mut(i), still.get_mut(i)) {
                     ch.faulty_until_ns = Some(now.saturating_add(ms_to_ns(FAULT_HOLD_MS)));
                     *u = false;
@@ -381,7 +413,15 @@ impl Satellites {
             self.hold_until_ns = Some(now.saturating_add(ms_to_ns(RELIEF_HOLD_MS)));
         }
         if self.hold_until_ns.is_none() {
-            return Relief::NONE;
+            // Usable satellites that see no crush ahead: the whole lift.
+            return Relief {
+                boundary_lift_mps: if severity.is_some() {
+                    p.low_crush_lift_mps
+                } else {
+                    0.0
+                },
+                ..Relief::NONE
+            };
         }
         let span = p.relief_full_mps - p.relief_from_mps;
         let fraction = if span > 0.0 {
@@ -396,6 +436,7 @@ impl Satellites {
             fraction,
             floor_mps: p.floor_mps,
             boundary_scale: p.boundary_scale,
+            boundary_lift_mps: 0.0,
         }
     }
 
@@ -428,6 +469,7 @@ mod tests {
             relief_full_mps: 2.0,
             floor_mps: 0.5,
             boundary_scale: 0.5,
+            low_crush_lift_mps: 0.0,
         }
     }
 
@@ -531,6 +573,56 @@ mod tests {
             s.on_tunnel_dv(15.0 * G * 1e-3);
             assert_eq!(s.relief(k * MS), Relief::NONE);
         }
+    }
+
+    /// At a crash's end the crush rate falls and both rail tips slow less than the body for
+    /// a few ms: both lag the tunnel alike, a lag that accuses neither, even where one is past
+    /// the line and the other not (10 and 13 g under a 20 g tunnel: 0.39 and 0.27 m/s over
+    /// the window, 0.12 m/s apart).
+    #[test]
+    fn both_satellites_lagging_alike_as_the_front_end_unloads_stay_in() {
+        let mut s = Satellites::new(params());
+        run(&mut s, 1, 10, 10.0, 13.0, 20.0);
+        assert_eq!(s.faults.implausible, 0);
+        assert!(
+            !s.faulty(SatelliteSide::Left, 10 * MS) && !s.faulty(SatelliteSide::Right, 10 * MS)
+        );
+        assert!(s.severity_mps(10 * MS).is_some_and(|v| v < -0.35));
+    }
+
+    /// The low-crush lift: whole while usable satellites see no crush ahead (a body motion),
+    /// none from the moment the severity reaches the relief's lower line while the relief
+    /// holds, whole again after it; none with no usable satellite or none at all.
+    #[test]
+    fn the_lift_holds_while_the_front_end_does_not_crush() {
+        let lifted = SatelliteParams {
+            low_crush_lift_mps: 1.2,
+            ..params()
+        };
+        let mut s = Satellites::new(lifted);
+        let r = run(&mut s, 1, 20, 20.0, 20.0, 20.0);
+        assert_eq!((r.fraction, r.boundary_lift_mps), (0.0, 1.2));
+        // 30 g above the tunnel: 30·g·4 ms = 1.18 m/s, past the lower line (fraction 0.18).
+        let r = run(&mut s, 21, 5, 35.0, 35.0, 5.0);
+        assert!(r.fraction > 0.1 && r.fraction < 0.3, "{r:?}");
+        assert_eq!(r.boundary_lift_mps, 0.0);
+        // The crush is over: no lift while the relief holds (60 ms), the whole lift after it.
+        assert_eq!(run(&mut s, 26, 50, 0.0, 0.0, 0.0).boundary_lift_mps, 0.0);
+        assert_eq!(run(&mut s, 76, 20, 0.0, 0.0, 0.0).boundary_lift_mps, 1.2);
+        // Both satellites silent (stale after the 5 ms timeout): no lift.
+        for k in 96..110u64 {
+            s.begin_cycle(k * MS);
+            s.on_tunnel_dv(0.0);
+            let r = s.relief(k * MS);
+            if k > 101 {
+                assert_eq!(r, Relief::NONE, "{k}");
+            }
+        }
+        let mut off = Satellites::new(SatelliteParams {
+            enabled: false,
+            ..lifted
+        });
+        assert_eq!(run(&mut off, 1, 10, 0.0, 0.0, 0.0), Relief::NONE);
     }
 
     #[test]
