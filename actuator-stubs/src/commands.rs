@@ -412,6 +412,8 @@ mod tests {
                 true,
                 false,
                 false,
+                false,
+                false,
                 3,
                 0x2ec7,
             )

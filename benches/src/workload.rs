@@ -204,6 +204,8 @@ impl CommandEncoder {
             c.overruns > 0,
             false,
             false,
+            false,
+            false,
             c.overruns,
             7,
         )?);

@@ -24,7 +24,7 @@ use crate::safing::Safing;
 use crate::satellites::{Relief, Satellites};
 use crate::settings::ConfigError;
 use crate::settings::G_MPS2;
-use crate::signals::Degraded;
+use crate::signals::{Degraded, SatelliteSide};
 
 /// What [`RestraintCycle::new`] found (for start-up messages).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -287,6 +287,17 @@ impl Activity for RestraintCycle<'_> {
         }
         let lut_present = self.estimate.lut().is_some();
         self.reasons = self.inputs.reasons(now, io.can_enabled(), lut_present);
+        // A satellite out of the fusion is reported, never degrading (`EcuStatus`'s
+        // FaultSatelliteLeft / FaultSatelliteRight).
+        let sat = &self.satellites;
+        self.reasons.set(
+            Degraded::SATELLITE_LEFT,
+            sat.faulty(SatelliteSide::Left, now),
+        );
+        self.reasons.set(
+            Degraded::SATELLITE_RIGHT,
+            sat.faulty(SatelliteSide::Right, now),
+        );
         let c = &mut self.counters;
         if self.reasons.contains(Degraded::OBJECT_STALE) {
             c.object_stale_cycles = c.object_stale_cycles.saturating_add(1);

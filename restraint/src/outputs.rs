@@ -80,6 +80,10 @@ pub struct StatusFaults {
     pub config: bool,
     /// `FaultSafingSensor`.
     pub safing_sensor: bool,
+    /// `FaultSatelliteLeft`.
+    pub satellite_left: bool,
+    /// `FaultSatelliteRight`.
+    pub satellite_right: bool,
 }
 
 /// One cyclic frame's schedule: last content sent and when the next repetition is due.
@@ -317,6 +321,8 @@ impl Outputs {
             overrun: info.overruns > 0,
             config: self.secoc_unavailable,
             safing_sensor: reasons.intersects(Degraded::SAFING_STALE | Degraded::SAFING_INVALID),
+            satellite_left: reasons.contains(Degraded::SATELLITE_LEFT),
+            satellite_right: reasons.contains(Degraded::SATELLITE_RIGHT),
         };
         let overruns = u16::try_from(info.overruns).unwrap_or(u16::MAX);
         // On change of mode or fault flags (not of the overrun count: a noisy host would
@@ -335,6 +341,8 @@ impl Outputs {
                 f.overrun,
                 f.config,
                 f.safing_sensor,
+                f.satellite_left,
+                f.satellite_right,
                 overruns,
                 self.lut_id,
             ) {

@@ -193,6 +193,12 @@ bitflags::bitflags! {
         /// Safing accelerometer samples invalid, or receive errors on its port (not
         /// degrading, as `SAFING_STALE`).
         const SAFING_INVALID = 1 << 10;
+        /// The left crush-zone satellite is out of the fusion: missing, stale, corrupt,
+        /// defective or implausible (not degrading: the satellites never fire, they only lower
+        /// the tunnel's thresholds, and without them the central-only logic decides).
+        const SATELLITE_LEFT = 1 << 11;
+        /// The right crush-zone satellite, as `SATELLITE_LEFT`.
+        const SATELLITE_RIGHT = 1 << 12;
     }
 }
 
@@ -413,5 +419,10 @@ mod tests {
         assert_eq!(Degraded::DEGRADING.bits(), 0b1_1111_1111);
         assert_eq!(Degraded::SAFING_STALE.bits(), 0x200);
         assert_eq!(Degraded::SAFING_INVALID.bits(), 0x400);
+        assert_eq!(Degraded::SATELLITE_LEFT.bits(), 0x800);
+        assert_eq!(Degraded::SATELLITE_RIGHT.bits(), 0x1000);
+        assert!(
+            !Degraded::DEGRADING.intersects(Degraded::SATELLITE_LEFT | Degraded::SATELLITE_RIGHT)
+        );
     }
 }

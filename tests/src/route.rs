@@ -209,8 +209,10 @@ fn injected_flags(scenario: &sensor_feeds::Scenario) -> Vec<&'static str> {
             // Optional equipment: a silent V2X receiver raises no fault, it only takes the
             // second mass source away.
             DropoutTarget::V2x => &[],
-            // A silent satellite takes only its relief away; it has no EcuStatus bit.
-            DropoutTarget::SatelliteLeft | DropoutTarget::SatelliteRight => &[],
+            // A silent satellite takes only its relief away (its own EcuStatus bit, no
+            // starved input: `STARVED_INPUT_FLAGS` leaves the satellites out).
+            DropoutTarget::SatelliteLeft => &["satellite_left"],
+            DropoutTarget::SatelliteRight => &["satellite_right"],
             DropoutTarget::All => &[
                 "object_input",
                 "vehicle_input",

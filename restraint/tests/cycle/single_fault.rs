@@ -525,3 +525,66 @@ fn a_flagged_crash_sensor_fires_nothing_without_a_crash() {
         assert!(!pretensioner_fired(&b), "{offset_g} g: pretensioner");
     }
 }
+
+/// Two 500 µs PSI5 frames carrying `code` (0: at rest), measured at `t_ns`.
+fn satellite_frames(t_ns: u64, code: i16) -> restraint::signals::SatelliteFrames {
+    use restraint::signals::{psi5, SatelliteFrames};
+    SatelliteFrames {
+        first_timestamp_ns: t_ns,
+        sample_period_ns: 500_000,
+        count: 2,
+        frames: [psi5::encode(code); 8],
+        ..SatelliteFrames::EMPTY
+    }
+}
+
+#[test]
+fn a_silent_or_defective_satellite_raises_its_own_status_bit_and_degrades_nothing() {
+    use restraint::signals::{psi5::SENSOR_DEFECT, SatelliteSide};
+    let mut b = Bench::new(Some(test_lut()));
+    // Both satellites at rest every cycle; from T0 + 400 ms the left one is silent, from
+    // T0 + 600 ms the right one sends the sensor-defect status word.
+    let silent_from = T0 + 400 * MS;
+    let defect_from = T0 + 600 * MS;
+    while b.now < T0 + 800 * MS {
+        if b.now < silent_from {
+            b.io.push_satellite(SatelliteSide::Left, satellite_frames(b.now, 0));
+        }
+        let right = if b.now < defect_from {
+            0
+        } else {
+            SENSOR_DEFECT
+        };
+        b.io.push_satellite(SatelliteSide::Right, satellite_frames(b.now, right));
+        if (b.now - T0).is_multiple_of(10 * MS) {
+            b.push_object_none();
+        }
+        b.step();
+    }
+    let status = b.status_frames();
+    let first =
+        |f: &dyn Fn(&bus::EcuStatus) -> bool| status.iter().find(|(_, s)| f(s)).map(|(t, _)| *t);
+    // Both healthy from the first frames on: neither bit after the start-up.
+    assert!(status
+        .iter()
+        .filter(|(t, _)| (T0 + 100 * MS..silent_from).contains(t))
+        .all(|(_, s)| !s.fault_satellite_left() && !s.fault_satellite_right()));
+    // Silent: within the satellite timeout (50 ms) + one status period (20 ms) of the last frame.
+    let left = first(&|s| s.fault_satellite_left()).expect("FaultSatelliteLeft");
+    assert!(
+        (silent_from + 40 * MS..=silent_from + 50 * MS + 21 * MS).contains(&left),
+        "{left}"
+    );
+    // Defective: in the cycle of the status word (a change goes out at once).
+    let right = first(&|s| s.fault_satellite_right()).expect("FaultSatelliteRight");
+    assert!(
+        (defect_from..=defect_from + 2 * MS).contains(&right),
+        "{right}"
+    );
+    // Reported, never degrading: the ECU's mode and plan stay.
+    assert!(b
+        .ecu
+        .degraded_reasons()
+        .contains(Degraded::SATELLITE_LEFT | Degraded::SATELLITE_RIGHT));
+    assert!(!b.ecu.degraded_reasons().intersects(Degraded::DEGRADING));
+}
