@@ -398,6 +398,7 @@ fn build_report(
         pretensioner_before_contact: contact_ns != 0 && pre.pretensioner_s.is_some_and(|t| t < 0.0),
         pretensioner_released: modules.action("pretensioner_release").is_some(),
         airbag_fired: modules.airbag_fired,
+        margin_ms: None,
         outcome: None,
         plot: None,
     };
@@ -410,6 +411,11 @@ fn build_report(
     else {
         anyhow::bail!("bench truth reports a contact but the scenario's true physics has none");
     };
+    report.margin_ms = report
+        .action("airbag_fire")
+        .and_then(|a| a.after_contact_ms)
+        .zip(judged.true_crash.required_ms)
+        .map(|(fire, required)| fire - required);
     report.true_crash = Some(judged.true_crash);
     let pulse = t.pulse.ego_pulse();
     let png = cli.out.join("outcome.png");

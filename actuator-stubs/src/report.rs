@@ -18,6 +18,10 @@ pub struct TrueCrash {
     pub a_mean_g: f64,
     /// Ego crush [mm].
     pub crush_mm: f64,
+    /// The airbag's required fire time, "127 mm − 30 ms" of the true pulse [ms after contact]
+    /// (`physics::deadline`; `None`: the pulse never moves a free occupant 127 mm).
+    #[serde(default)]
+    pub required_ms: Option<f64>,
 }
 
 /// One restraint's occupant outcome and time history.
@@ -148,6 +152,10 @@ pub struct Report {
     pub pretensioner_released: bool,
     /// Airbag fired.
     pub airbag_fired: bool,
+    /// The airbag's fire − `true_crash.required_ms` [ms] (negative = in time; `None`: no
+    /// airbag or no required time).
+    #[serde(default)]
+    pub margin_ms: Option<f64>,
     /// Outcome comparison (contact only).
     pub outcome: Option<Outcome>,
     /// Plot file (relative to the report), if drawn.

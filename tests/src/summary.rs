@@ -31,8 +31,9 @@ pub fn summarise(
         Some(c) => {
             let _ = writeln!(
                 s,
-                "true crash: closing {:.1} km/h, ego Δv {:.1} km/h, compartment a_max {:.1} g, a_mean {:.1} g, crush {:.0} mm",
-                c.closing_speed_kph, c.delta_v_kph, c.a_max_g, c.a_mean_g, c.crush_mm
+                "true crash: closing {:.1} km/h, ego Δv {:.1} km/h, compartment a_max {:.1} g, a_mean {:.1} g, crush {:.0} mm; airbag required by {} (127 mm − 30 ms)",
+                c.closing_speed_kph, c.delta_v_kph, c.a_max_g, c.a_mean_g, c.crush_mm,
+                c.required_ms.map_or("—".to_owned(), |t| format!("{t:+.1} ms"))
             );
         }
         None => {
@@ -89,6 +90,14 @@ pub fn summarise(
                 s,
                 "  command latency: airbag command received {:+.1} ms after its planned time",
                 t - a.action.planned_ms
+            );
+        }
+        if let Some(m) = r.margin_ms {
+            let _ = writeln!(
+                s,
+                "  airbag fire − required (127 mm − 30 ms)          {}  ({})",
+                ms(Some(m)),
+                if m <= 0.0 { "in time" } else { "LATE" }
             );
         }
     } else {

@@ -184,6 +184,38 @@ fn pre_crash_cases_preset_before_contact_and_fire_at_the_planned_time() {
 }
 
 #[test]
+fn every_crash_reports_its_required_fire_time_and_the_airbags_margin() {
+    // "127 mm − 30 ms" of the true pulse, as offline-bench and the matrix compute it, in
+    // report.json and the summary; the margin is the airbag's receive time less it.
+    let mut crashes = 0;
+    for (s, r) in all() {
+        if r.contact_ns == 0 {
+            assert!(
+                r.true_crash.is_none() && r.margin_ms.is_none(),
+                "{}",
+                s.name
+            );
+            continue;
+        }
+        crashes += 1;
+        let truth = world::truth::Truth::new(&s).expect("truth");
+        let want = physics::deadline::required_fire_s(&truth.pulse.ego_pulse()).map(|t| t * 1e3);
+        let got = r.true_crash.as_ref().expect("true crash").required_ms;
+        assert_eq!(got, want, "{}", s.name);
+        let fire = r.action("airbag_fire").and_then(|a| a.after_contact_ms);
+        match (fire, got, r.margin_ms) {
+            (Some(f), Some(req), Some(m)) => assert!((m - (f - req)).abs() < 1e-9, "{}", s.name),
+            (None, _, None) | (_, None, None) => {}
+            other => panic!("{}: fire, required, margin {other:?}", s.name),
+        }
+        let summary = std::fs::read_to_string(bench_run().join(&s.name).join("summary.txt"))
+            .expect("summary.txt");
+        assert!(summary.contains("(127 mm − 30 ms)"), "{}", s.name);
+    }
+    assert!(crashes >= 20, "{crashes} crashes in the library");
+}
+
+#[test]
 fn report_times_use_the_offline_benchs_two_time_bases() {
     // Issue 32: the stubs' `t_ms` meant "after contact" where offline-bench's means "after the
     // start". Now both: `t_ms` after the start, `after_contact_ms` after the contact, and the
