@@ -15,7 +15,8 @@ Checked:
   * every frame of a DBC message is on /can/<name> with the same times, and each signal's value
     equals cantools' decode of the same bytes (scaled, no value-table names);
   * with commands.jsonl: every record is on /stubs/commands unchanged, at its rx_mono_ns;
-  * with report.json: one /stubs/actions message per action, one /stubs/verdict; /truth/world
+  * with report.json: one /stubs/actions message per action, one /stubs/verdict carrying the
+    report's required fire time (true_crash.required_ms) and margin_ms; /truth/world
     (required with --full) every ms from the report's start, its contact (distance 0) within
     1 ms of the report's contact time;
   * with diagnostics.postcard: /ecu/diagnostics holds as many records as the metadata says,
@@ -234,9 +235,20 @@ def main():
         for w, (log_t, _, msg, _) in zip(rep["actions"], acts):
             if msg["what"] != w["what"] or abs(log_t - (rep["start_ns"] + w["t_ms"] * 1e6)) > 1:
                 fail(f"/stubs/actions: {msg} at {log_t} vs {w}")
-        if len(topics.get("/stubs/verdict", [])) != 1:
+        verdicts = topics.get("/stubs/verdict", [])
+        if len(verdicts) != 1:
             fail("/stubs/verdict: not exactly one message")
-        print(f"check_mcap: /stubs/actions: {len(acts)} actions at start + t_ms; one verdict")
+        # The required fire time ("127 mm - 30 ms" of the true pulse) and the airbag's margin
+        # against it, as report.json has them.
+        verdict = verdicts[0][2]
+        want_required = (rep.get("true_crash") or {}).get("required_ms")
+        got_required = (verdict.get("true_crash") or {}).get("required_ms")
+        if got_required != want_required or verdict.get("margin_ms") != rep.get("margin_ms"):
+            fail(f"/stubs/verdict: required {got_required} / margin {verdict.get('margin_ms')} "
+                 f"vs report {want_required} / {rep.get('margin_ms')}")
+        ms = lambda v: "none" if v is None else f"{v:+.1f} ms"
+        print(f"check_mcap: /stubs/actions: {len(acts)} actions at start + t_ms; one verdict "
+              f"(required fire {ms(want_required)}, margin {ms(rep.get('margin_ms'))})")
     truth = topics.get("/truth/world", [])
     if a.full and not truth:
         fail("--full: no /truth/world")

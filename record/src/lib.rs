@@ -8,7 +8,7 @@
 //! | `/can/<DBC message>` | `candump.log` + `bus/restraint.dbc` | frame of that id: every signal's physical value |
 //! | `/stubs/commands` | `commands.jsonl` | frame the actuator stubs received, with its E2E / SecOC verdict |
 //! | `/stubs/actions` | `report.json` | action of a module (airbag fire, pretensioner fire / release …) |
-//! | `/stubs/verdict` | `report.json` | run: the occupant outcome and the modes |
+//! | `/stubs/verdict` | `report.json` | run: the occupant outcome, the modes, the required fire time and the airbag's margin |
 //! | `/ecu/diagnostics`, `/ecu/predicted_pulse` | `diagnostics.postcard` (the stubs' log) | cycle; change of the prediction |
 //! | `/sensors/object`, `/sensors/crash_accel`, `/sensors/safing_accel`, `/sensors/satellite_left`, `/sensors/satellite_right` | `feeds.postcard` (`sensor-feeds --log`) | publication |
 //! | `/truth/world` | the scenario file | ms of the scenario |
