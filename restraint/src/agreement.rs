@@ -274,7 +274,7 @@ impl SeverityAgreement {
         // Compared a little ahead of the newest samples, each trace carried on with its newest
         // deceleration ([`LOOKAHEAD_NS`]): the trapezoid has put only half of a newest sample
         // into the velocity yet, and a wild crash sample decides its fire in the very cycle it
-        // arrives (issue 31: a 177 g sample in a pothole fired with half its 0.43 m/s counted,
+        // arrives (a 177 g sample in a pothole fired with half its 0.43 m/s counted,
         // an excess of 0.20 m/s, inside the tolerance; the other half came a cycle too late).
         // The newest instant either sensor measured counts, the other one carried to it too
         // (the 4 kHz crash sensor's batch may end after the 2 kHz safing sensor's).
@@ -452,7 +452,7 @@ mod tests {
 
     #[test]
     fn a_wild_sample_that_ends_its_batch_disagrees_in_that_cycle() {
-        // Issue 31: the wild sample is the newest of its batch, so the trapezoid holds half of
+        // The wild sample is the newest of its batch, so the trapezoid holds half of
         // it (0.19 m/s of 0.37, inside the tolerance) and its fire is decided in this very
         // cycle: the pair is compared one crash-sensor period ahead, each trace carried on
         // with its newest deceleration, so the whole sample counts now.

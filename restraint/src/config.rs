@@ -94,7 +94,7 @@ pub struct CycleConfig {
     pub match_ratio_max: f64,
     /// Robust planning: every table lookup (pre-crash preset and in-crash re-plan) is for an
     /// opponent at least this much heavier than reported, capped at the table's heaviest mass,
-    /// kg (*default* 1200 — four times the sensing's 300 kg σ, issue 14; 0 = the conservative
+    /// kg (*default* 1200 — four times the sensing's 300 kg σ; 0 = the conservative
     /// mass m + k·σ only). Why: an opponent's mass does not show in the ego pulse
     /// until long after the restraint is committed (the pulses of 1300 and 2400 kg opponents at
     /// 96 km/h agree within 0.1 g for 30 ms), so the plan must already hold the heavier one.
@@ -137,7 +137,7 @@ pub struct CycleConfig {
     /// ramp; none carries this much — the matrix's largest misuse Δv is a pothole under both
     /// front wheels at 1.5 × its envelope, 1.2 m/s (at 1.0 such potholes still fired the airbag:
     /// near miss 32, spike in a pothole 17, braking and pothole 10 of 1 000, seed 1). *What it
-    /// costs* (issue 30's order: no inadvertent fire before fire time): the accelerometer-only
+    /// costs* (the safety order: no inadvertent fire before fire time): the accelerometer-only
     /// airbag fires +1.2 ms (p50) / +1.7 ms (worst) after "127 mm − 30 ms" instead of −0.2 /
     /// +0.5 ms; the FMVSS 208 56 km/h belted case, whose barrier refutes the prediction made for
     /// a 3 000 kg object, fires +11.5 ms instead of +10.5 and its occupant bottoms out (+18.5 %

@@ -320,8 +320,9 @@ impl CrashMonitor {
 
     /// Forgets a confirmation whose event ended without any fire (a bump the generic
     /// thresholds confirmed, a crash the safing channel never agreed with): the detectors
-    /// start afresh, so the next event is judged on its own (issue 20: a decision belongs to
-    /// its event). Call only when no event is in progress.
+    /// start afresh, so the next event is judged on its own (a decision belongs to its event:
+    /// a spike's leftover must-fire must not complete on a later bump). Call only when no
+    /// event is in progress.
     pub fn rearm(&mut self) {
         self.generic = CrashDetector::default();
         self.matcher = PulseMatch::new(*self.matcher.params());

@@ -298,9 +298,9 @@ impl PulseMatch {
     pub fn push(&mut self, s: &AccelSample, freeze: &mut dyn FnMut(&mut PredictedPulse) -> bool) {
         if matches!(self.state, MatchState::Confirmed(_)) {
             // The confirmed pulse is no longer fitted, but the event is followed to its end
-            // (issue 31 item 7: a crash phase that fired nothing ends with it — the ECU stayed
-            // in CrashDetected, the reversible pretensioner tensioned, after a pothole matched
-            // an avoided collision's prediction) and its course is still watched: a fire
+            // (a crash phase that fired nothing ends with it; else the ECU would stay in
+            // CrashDetected, the reversible pretensioner tensioned, after a pothole matched an
+            // avoided collision's prediction) and its course is still watched: a fire
             // planned after the confirmation goes out only while the pulse keeps to the
             // matched ramp (such a pothole ramps like the crash for a few ms, then crests; the
             // crash keeps loading).

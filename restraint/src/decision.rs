@@ -418,8 +418,9 @@ impl Decision {
 
     /// A matched crash whose pulse left the matched ramp before its fires went out: the
     /// prediction no longer explains the event, so the fires still pending are decided by the
-    /// accelerometer-only boundaries of the event, as for a crash without a prediction
-    /// (issue 31: a pothole at the predicted contact of an avoided collision).
+    /// accelerometer-only boundaries of the event, as for a crash without a prediction (a
+    /// pothole at the predicted contact of an avoided collision can ramp like the crash for a
+    /// few ms, then falls away).
     fn hand_over_to_the_conventional_path(&mut self) {
         if self.gate == AirbagGate::Decided && self.airbag_fire_at_ns.take().is_some() {
             self.gate = AirbagGate::Fallback;

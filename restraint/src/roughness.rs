@@ -1,7 +1,7 @@
 //! Road roughness from the crash accelerometer: how far the road has recently pushed the car
 //! *forward* — an excursion no crash makes — added to every crash-phase fire's severity floor.
 //!
-//! **Why** (issue 30, rough road). A rough road is zero-mean: the tunnel's velocity swings back
+//! **Why.** A rough road is zero-mean: the tunnel's velocity swings back
 //! as far as it swings forward. Its swings against the car's motion look, for their first tens
 //! of ms, like a slow crash's onset, and on a long rough stretch at the matrix's 3–4.5 g rms
 //! one of them now and then carries the 1.25 m/s floor (σ of the velocity ≈ 0.33 m/s at 3 g,

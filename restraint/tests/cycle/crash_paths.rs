@@ -111,7 +111,7 @@ fn a_pulse_the_prediction_cannot_explain_goes_the_conventional_way() {
     assert_eq!(f.force_level(), 12.0);
     // The reference time, 10 ms after the measured onset (the wake-up sample at C + 2 ms,
     // 1.97 g ≥ 1.5 g) — or, where later, the first sample at which the event's Δv reaches the
-    // floor `fallback_min_dv_mps` (1.25 m/s since issue 31: the accelerometer-only path may be
+    // floor `fallback_min_dv_mps` (1.25 m/s: the accelerometer-only path may be
     // late where no-misuse-fires requires it). The Δv from the input itself: trapezoids from
     // the sample before the wake-up.
     let g = |ms: u64| if ms < 6 { ramp_g(8.0, ms) } else { 15.0 };
@@ -424,7 +424,7 @@ fn a_dead_accelerometer_fires_nothing_without_both_a_predicted_crash_and_a_crash
 
 #[test]
 fn a_matched_pulse_that_fires_nothing_ends_its_crash_phase_with_the_event() {
-    // Issue 31 item 7. Predicted at 20 m/s (72 km/h: below the closing speed from which a
+    // A crash phase ends with its event. Predicted at 20 m/s (72 km/h: below the closing speed from which a
     // matched crash may fire on the prediction alone, so its airbag waits for the measured
     // pulse). The object list stops at C (the opponent evaded); at C a pothole ramps exactly
     // like the predicted crash for 6 ms (≈ 0.44 m/s: the matcher confirms) and then falls
@@ -448,7 +448,7 @@ fn a_matched_pulse_that_fires_nothing_ends_its_crash_phase_with_the_event() {
 
 #[test]
 fn a_matched_pulse_that_leaves_its_ramp_before_the_planned_fire_is_decided_conventionally() {
-    // Issue 31 (near miss, kerb at a predicted contact). Predicted at 28 m/s (101 km/h: above
+    // A near miss, a kerb at a predicted contact. Predicted at 28 m/s (101 km/h: above
     // the closing speed from which a matched crash fires on its plan). The pulse ramps exactly
     // like the predicted crash for 6 ms — the matcher confirms at C + 5 ms, the plan's airbag
     // is due at ≈ C + 15 ms — and then falls to nothing within 2 ms, as a pothole or kerb
@@ -516,7 +516,7 @@ fn predicted_28_mps_with_airbag_floor(floor_mps: f64, end: u64, g: &dyn Fn(u64) 
 
 #[test]
 fn a_matched_airbag_waits_until_its_crash_carries_the_floor() {
-    // Issue 31 (near miss): a pothole at the predicted contact can follow the predicted ramp
+    // A near miss: a pothole at the predicted contact can follow the predicted ramp
     // up to a +3 ms plan; no misuse event carries the floor. Floor raised to 2.5 m/s so that
     // it is reached after the plan (+15.1 ms, as above): the airbag waits for it.
     let g = |ms: u64| ramp_g(28.0, ms);
@@ -590,7 +590,7 @@ fn crash_with_object(
 
 #[test]
 fn a_tracked_low_speed_crash_with_a_kerb_strike_fires_no_airbag_unless_it_is_far_more_severe() {
-    // Issue 31 item 4. A tracked object closing at 4.2 m/s (15 km/h; EBS < 20 km/h even 1 200 kg
+    // The tracked low-speed limit. A tracked object closing at 4.2 m/s (15 km/h; EBS < 20 km/h even 1 200 kg
     // heavier than its 1 500 kg): the airbag needs the event's Δv above closing × 1.3 + 1.2 =
     // 6.66 m/s. A 15 g × 40 ms pulse (5.9 m/s: a low-speed crash with a kerb strike on top,
     // which the conventional boundary alone fires) stays below it.
@@ -624,7 +624,7 @@ const RAMP_MS: u64 = 8;
 
 #[test]
 fn an_opponent_reported_heavy_does_not_move_a_low_speed_crash_across_the_no_fire_line() {
-    // Issue 31 item 2. 14.5 + 14.5 km/h (8.06 m/s closing) against an equal car reported as
+    // A misreported low-speed crash. 14.5 + 14.5 km/h (8.06 m/s closing) against an equal car reported as
     // 4 000 kg: EBS 20.0 km/h on the report (armed), 14.5 km/h in truth. The true pulse ramps
     // like the prediction (the onset slope is the structures' stiffness × closing speed, not
     // the mass) for 8 ms and then levels off at ≈ 8 g for 60 ms (≈ 4.5 m/s). Every layer says

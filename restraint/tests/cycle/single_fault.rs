@@ -1,4 +1,4 @@
-//! Issue 20: no single fault may fire a restraint. The two deployments a reviewer reproduced
+//! No single fault may fire a restraint. The two deployments a reviewer reproduced
 //! with this bench (a spike that latched a must-fire; a prediction plus a short kerb strike),
 //! and the safing channel's single faults, under the simulated 1 kHz clock. The seeded matrix
 //! over thousands of variants is `misuse-matrix` (e2e-tests crate).
@@ -45,9 +45,9 @@ impl NoTrack for Bench {
 fn reproduction_1_a_spike_then_a_bump_fires_nothing() {
     // Normal driving, no object tracked. One accelerometer sample of 15/25/40/60 g (a fault
     // of the crash sensor, or an electrical spike on both), then 0.5 s later a 4.5 g × 40 ms
-    // bump — which alone fires nothing. Before issue 20 the spike latched a must-fire of the
-    // accelerometer-only algorithm for good and the bump's confirmation fired the airbag at
-    // +511 ms.
+    // bump — which alone fires nothing. A decision that outlived its event would let the spike
+    // latch a must-fire of the accelerometer-only algorithm for good, and the bump's
+    // confirmation fire the airbag (at +511 ms).
     for spike_g in [15.0f32, 25.0, 40.0, 60.0] {
         for both_sensors in [false, true] {
             let mut b = Bench::new(Some(test_lut()));
@@ -72,8 +72,8 @@ fn reproduction_1_a_spike_then_a_bump_fires_nothing() {
 fn reproduction_2_a_prediction_plus_a_kerb_strike_at_the_predicted_contact_fires_no_airbag() {
     // An object predicted to hit at C that does not (near miss, evasion, a ghost: the object
     // list reports no track from C on), and at C a ramp-shaped kerb strike: 4 ms up to 7.4 g
-    // at 20 m/s closing (Δv ≈ 0.15 m/s), or 5 ms up to 6.9 g at 14 m/s. Before issue 20 the
-    // prediction-matched path fired the adaptive airbag at C + 12 ms.
+    // at 20 m/s closing (Δv ≈ 0.15 m/s), or 5 ms up to 6.9 g at 14 m/s. The
+    // prediction-matched path must not fire the adaptive airbag on it.
     for (closing, ramp_ms, peak_g) in [(20.0f32, 4u64, 7.4f32), (14.0, 5, 6.9)] {
         let mut b = Bench::new(Some(test_lut()));
         run_scenario(&mut b, C, T0 + 200 * MS, C, closing, C, None, &|_| 0.0);
@@ -187,7 +187,7 @@ fn a_real_crash_with_a_dead_safing_sensor_fires_when_the_vehicle_deceleration_ag
     assert!(b.ecu.vetoed_fires() > 0);
 }
 
-/// Issue 31 item 1: a crash-sensor fault inside a real misuse event that satisfies the safing
+/// A crash-sensor fault inside a real misuse event that satisfies the safing
 /// sensor. `tolerance_dv_mps` = the severity agreement's absolute tolerance (5 m/s: off).
 fn fault_inside_event(case: &str, tolerance_dv_mps: f64) -> Bench {
     let cfg = restraint::CycleConfig {
@@ -254,7 +254,7 @@ fn a_crash_sensor_fault_inside_a_real_misuse_event_fires_nothing() {
     }
 }
 
-/// Issue 31 item 5: ABS braking at 1 g (vehicle frames say so) and a 7 g × 20 ms half-sine
+/// ABS braking at 1 g (vehicle frames say so) and a 7 g × 20 ms half-sine
 /// pothole (0.891 m/s) at 300 ms; `compensate`: `braking_compensation_max_g` 1.2 or 0. Returns
 /// the bench after the run and the accelerometer-only algorithm's event Δv at the pothole's last sample.
 fn pothole_while_braking(compensate: bool) -> (Bench, f64) {
@@ -336,7 +336,7 @@ fn rough_road_run(roughness_k: f64) -> Bench {
 
 #[test]
 fn a_rough_roads_backward_swings_fire_nothing_its_forward_swings_lift_the_floors() {
-    // Issue 30 (rough road): the forward swings lift every floor by 2 × the held forward
+    // A rough road: the forward swings lift every floor by 2 × the held forward
     // excursion beyond 0.05 m/s (here ≈ 1.8 m/s → +3.5 m/s), so no backward swing carries its
     // floor.
     let b = rough_road_run(restraint::CycleConfig::default().roughness_k);
