@@ -166,7 +166,7 @@ fn genuine_pair_fires_and_its_replay_in_the_session_is_rejected() {
     assert_eq!(rx.secoc_rejected().get("replay"), Some(&1));
 }
 
-/// Issue 8's hole: a genuine Armed + Fire pair recorded in one session (candump during a crash
+/// The replay hole: a genuine Armed + Fire pair recorded in one session (candump during a crash
 /// test) and replayed with cansend in a *later* session, after ECU and actuators restarted.
 /// With a freshness counter restarting at 1 it was ahead of the new session's counter and
 /// fired the airbag; with time-stamp freshness it is rejected — `freshness_stale` when the

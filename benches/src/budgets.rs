@@ -152,12 +152,15 @@ mod tests {
             .iter()
             .find(|c| c.id == "diagram/lookup_varied")
             .unwrap();
-        assert!(lut.budget_us <= 0.1, "issue 7: LUT lookup ≤ 0.1 µs");
+        assert!(
+            lut.budget_us <= 0.1,
+            "the LUT lookup's wall-clock budget: ≤ 0.1 µs"
+        );
         let full: Vec<_> = b.criterion.iter().filter(|c| c.bench == "cycle").collect();
         assert!(!full.is_empty(), "the full-cycle bench must be budgeted");
         assert!(
             full.iter().all(|c| c.budget_us <= 10.0),
-            "issue 7: full cycle ≤ 10 µs"
+            "the full cycle's wall-clock budget: ≤ 10 µs"
         );
         assert!(!b.icount.is_empty());
     }

@@ -2,9 +2,9 @@
 //! the `cycle` criterion bench and the `icount_cycle` callgrind binary so both time the same
 //! code on the same inputs:
 //!
-//! * [`WorstCasePreCrash`] — the hand-picked worst case of issue 7: steady PRE-CRASH with a
+//! * [`WorstCasePreCrash`] — the hand-picked worst case: steady PRE-CRASH with a
 //!   NEW object sample every cycle: track filter + LUT interpolation + state machine +
-//!   command encode and E2E seal + diagnostics record (since issue 15 the closed-form
+//!   command encode and E2E seal + diagnostics record (the closed-form
 //!   collision prediction runs in the next cycle without a sample, so a sample every cycle
 //!   never pays it; the searched worst case, `worst_case`, covers every path).
 //! * [`DecisionOnly`] — PRE-CRASH with no new input: state machine, scheduled fires, cyclic

@@ -277,7 +277,7 @@ pub fn bench_queries(n: usize) -> Vec<Query> {
 }
 
 /// The fixed step the ECU integrated its per-cycle prediction at before it switched to the
-/// closed form (issue 15 removed `prediction_step_ms`), s. Only the comparison rows use it.
+/// closed form (no `prediction_step_ms` any more), s. Only the comparison rows use it.
 pub const FORMER_ECU_STEP_S: f64 = 5.0e-4;
 
 /// Collision predictions as the ECU makes them: the default ego (1785 kg, class 4) against

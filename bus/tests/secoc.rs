@@ -446,7 +446,7 @@ fn sender_clock_stepping_back_keeps_freshness_increasing() {
     );
 }
 
-/// Issue 8's replay hole: a genuine Armed + Fire pair recorded in one session (candump during
+/// The replay hole: a genuine Armed + Fire pair recorded in one session (candump during
 /// a crash test) and replayed in a later one (cansend). With a restarting counter it was
 /// ahead of the new session's counter and accepted; with time stamps it is stale.
 #[test]

@@ -1,5 +1,5 @@
 //! How close the table's optima come to the ideal constant-force bound, and what keeps them
-//! from it (issue 24 item 4: the demo's 48 + 48 km/h optimum peaks at 2.0 × a*).
+//! from it (the demo's 48 + 48 km/h optimum peaks at 2.0 × a*).
 //!
 //! **a\*** is the occupant's ideal deceleration in the model (`OccupantOutcome::ideal_decel_mps2`):
 //! the constant deceleration that stops the occupant, relative to the compartment's pulse, in

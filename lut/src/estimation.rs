@@ -8,7 +8,7 @@
 //! * **filtered**: the restraint core itself (`restraint::RestraintCycle` with `SimIo`): its
 //!   track filter's situation — contact instant (and the early one it plans with), closing
 //!   speed at contact, fused and conservative opponent mass, with their σ;
-//! * **raw**: the estimate the ECU made before issue 15 — the closed form of the newest
+//! * **raw**: the estimate without a track filter — the closed form of the newest
 //!   sample alone (`restraint::time_to_contact` from its distance, speed and acceleration at
 //!   its measurement time; the reported mass and σ).
 //!

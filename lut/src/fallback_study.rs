@@ -533,7 +533,7 @@ pub fn calibrate(rows: &[Row], no_fire_line_kph: f64, margin: f64) -> [f64; KNOT
 }
 
 /// How late the accelerometer-only path may fire a must-fire crash after its deadline, ms
-/// (issue 30, decision 1, the safety order): no misuse event or single fault may fire a
+/// (the safety order): no misuse event or single fault may fire a
 /// restraint, then every must-fire crash fires, then fire time. The path that runs without a
 /// usable prediction (a degraded mode) may be late where the first rule requires it — its
 /// severity floors sit above the largest misuse Δv (1.2 m/s, a pothole under both front

@@ -62,7 +62,7 @@ fn it_also_holds_on_crashes_it_was_not_calibrated_on() {
     };
     let rows = run_sweep(&cfg, &sweep).expect("sweep");
     // Off the calibration sweep the path may be late — by at most the bound of the safety
-    // order (issue 30, decision 1; `ACCEL_ONLY_LATENESS_BOUND_MS`): its floors sit above the
+    // order (`ACCEL_ONLY_LATENESS_BOUND_MS`): its floors sit above the
     // largest misuse Δv, and no misuse may fire comes before fire time. The lateness is a
     // reported figure: printed here per case.
     let late: Vec<String> = violations(&rows, cfg.no_fire_ebs_kph, 28.0, t_ref_ms(), 0.0);

@@ -175,7 +175,7 @@ fn shard_ranges_cover_the_grid_exactly_once() {
 
 #[test]
 fn plot_makes_its_folder_and_a_bad_path_is_one_readable_line() {
-    // Issue 22 item 2: `lut plot` into a missing folder printed the backend's debug text
+    // `lut plot` into a missing folder printed the backend's debug text
     // (`ImageError(IoError(Os { code: 2, … }))`).
     let exe = env!("CARGO_BIN_EXE_lut");
     let table = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/default.lut");

@@ -17,7 +17,7 @@ fn check(name: &str, text: &str) -> (bool, String) {
         .output()
         .expect("run sensor-feeds");
     let _ = std::fs::remove_file(&file);
-    // A valid file's verdict is on stdout (issue 22: it was only on stderr); an error on stderr.
+    // A valid file's verdict is on stdout; an error on stderr.
     let printed = if out.status.success() {
         &out.stdout
     } else {

@@ -1,7 +1,7 @@
 //! The safing accelerometer and `[[accel_event]]` changed nothing that was there before: every
 //! library file's object list, crash accelerometer batches and CAN frames are bit for bit what
 //! the player produced before them (fingerprints recorded with the player of commit b849bea,
-//! before the safing sensor existed). Since issue 31 the accelerometers low-pass their input
+//! before the safing sensor existed). The accelerometers low-pass their input
 //! before sampling (`world::lowpass`, on by default): these fingerprints are taken with it off
 //! (`accel_lowpass_hz = 0`), the ideal sampler of the model they were recorded with — so
 //! everything *else* is still bit for bit as it was.

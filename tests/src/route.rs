@@ -242,8 +242,8 @@ fn injected_flags(scenario: &sensor_feeds::Scenario) -> Vec<&'static str> {
 }
 
 /// The fault-flag changes with only the flags raised after their input had been clear once:
-/// the start-up report, before an input's first sample arrived, is not starvation (issue 30:
-/// a run whose object list is dead by design is not "never Normal" because of it).
+/// the start-up report, before an input's first sample arrived, is not starvation (a run
+/// whose object list is dead by design is not "never Normal" because of it).
 fn raised_after_clear(faults: &[(f64, Vec<String>)]) -> Vec<(f64, Vec<String>)> {
     // The start-up report's flags that have stayed set ever since.
     let mut startup: Vec<&String> = faults

@@ -492,7 +492,7 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
         let recording_started = std::time::Instant::now();
         record::write_run(&dir, &dir.join(record::RUN_MCAP), &meta).map(|s| {
             // Its cost, on the clock the run ran on (the guest's own on an emulated route),
-            // against the whole run's (issue 23: ≤ 5 %).
+            // against the whole run's (≤ 5 %).
             let recording_s = recording_started.elapsed().as_secs_f64();
             let run_s = run_started.elapsed().as_secs_f64();
             let cost = format!(

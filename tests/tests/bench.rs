@@ -42,7 +42,7 @@ fn bench_run() -> &'static Path {
         harness::build_bench_bins();
         harness::vcan_route();
         let bins = harness::bin_dir();
-        // Outside the work tree, as a user's `--out $HOME/runs` (issue 22 item 2: on the guest
+        // Outside the work tree, as a user's `--out $HOME/runs` (on the guest
         // routes such a folder was read-only): every test below reads its reports from here.
         let out = std::env::temp_dir().join(format!("e2e-bench-out-{}", std::process::id()));
         assert!(!out.starts_with(root()) && !out.starts_with(&bins));
@@ -217,9 +217,8 @@ fn every_crash_reports_its_required_fire_time_and_the_airbags_margin() {
 
 #[test]
 fn report_times_use_the_offline_benchs_two_time_bases() {
-    // Issue 32: the stubs' `t_ms` meant "after contact" where offline-bench's means "after the
-    // start". Now both: `t_ms` after the start, `after_contact_ms` after the contact, and the
-    // two differ by the contact's own time after the start for every action of every run.
+    // One time base for both tools: `t_ms` after the start, `after_contact_ms` after the
+    // contact, and the two differ by the contact's own time after the start for every action of every run.
     for (s, r) in all() {
         let contact_after_start_ms =
             (r.contact_ns != 0).then_some((r.contact_ns as f64 - r.start_ns as f64) * 1e-6);

@@ -5,8 +5,7 @@
 //! systems), data sheet Rev. 0, "Signal range and filtering", p. 39: "a third-order, low-pass
 //! Bessel filter" whose −3 dB corner is selectable at 100, 200, **400** (the default code
 //! `FC = 00`) or 800 Hz. The bench's default is that: 3 poles, Bessel, −3 dB at 400 Hz
-//! (`[sensor] accel_lowpass_hz`, 0 = an ideal sampler without filter, the model before
-//! issue 31). What it does: a 4 kHz structural ringing that an unfiltered 4 kHz sampler sees
+//! (`[sensor] accel_lowpass_hz`, 0 = an ideal sampler without filter). What it does: a 4 kHz structural ringing that an unfiltered 4 kHz sampler sees
 //! at its crests as a one-signed deceleration (aliased to 0 Hz) is attenuated ≈ 60 dB before
 //! sampling; a crash pulse (< 100 Hz content) passes, delayed by the filter's group delay
 //! (1/ω₀ = [`group_delay_s`], 0.70 ms at 400 Hz).

@@ -34,7 +34,7 @@ enum Cycles {
     /// Every cycle.
     All,
     /// Cycles without a crash event (no accelerometer event in progress, not CRASH or
-    /// POST-CRASH): the driving and pre-crash path of issue 15's budget.
+    /// POST-CRASH): the driving and pre-crash path of the cycle budget.
     NoCrash,
     /// Cycles of a crash event (the accelerometer's event in progress, CRASH, POST-CRASH):
     /// every sample through the crash detectors.

@@ -185,7 +185,7 @@ mod tests {
     }
 
     /// The bus's names (bus/restraint.dbc, `VAL_ 272 EcuMode`) for every diagnostics mode,
-    /// the phase in brackets (issue 22: the monitor said `degraded` where the bus says
+    /// the phase in brackets (else the monitor says `degraded` where the bus says
     /// `ReferenceFallback`).
     #[test]
     fn modes_are_named_as_on_the_bus() {

@@ -289,7 +289,7 @@ fn short_run(cwd: &std::path::Path, tag: &str, args: &[&str]) -> (bool, String) 
 
 #[test]
 fn started_from_another_folder_the_ecu_finds_its_table_and_keys() {
-    // Issue 22 item 1: from any folder but the repository's root it ran DEGRADED and sent its
+    // From any folder but the repository's root it ran DEGRADED and sent its
     // commands without authenticators, exit 0. The defaults now resolve against the
     // repository, found by walking up from the executable.
     let (ok, err) = short_run(&tmpdir("elsewhere"), "elsewhere", &[]);
@@ -379,7 +379,7 @@ fn an_output_path_is_checked_before_the_run_and_config_paths_follow_their_file()
 
 #[test]
 fn config_errors_are_one_line_naming_the_field_and_the_os_error_once() {
-    // Issue 22 item 4: `mlockall = "yes"` gave line and column but not the field; a missing
+    // `mlockall = "yes"` gave line and column but not the field; a missing
     // file repeated its OS error.
     let dir = tmpdir("errstyle");
     let path = dir.join("typed.toml");

@@ -207,7 +207,7 @@ impl TraceFigure<'_> {
                     .map(|(t, v)| Circle::new((t, v), 3, RED.filled())),
             )
             .map_err(|e| anyhow!("{e}"))?
-            .label("newest sample alone (before issue 15)")
+            .label("newest sample alone (no track filter)")
             .legend(|(x, y)| Circle::new((x + 7, y), 3, RED.filled()));
         chart
             .draw_series(LineSeries::new(

@@ -1,4 +1,4 @@
-//! The misuse / single-fault / must-fire matrix (issues 20, 30, 31): seeded variants of
+//! The misuse / single-fault / must-fire matrix: seeded variants of
 //! misuse events as physics makes them, single sensor faults (alone and inside real events)
 //! and crashes across the no-fire and must-fire lines, each a scenario built in code
 //! (`e2e_tests::misuse`: the families, their envelopes and their sources) and run through the

@@ -235,7 +235,7 @@ pub fn cases() -> Vec<Case> {
     v
 }
 
-/// Issue 14's cases: the crash with a misreported opponent or closing speed and with a dead or
+/// The scenario variants: the crash with a misreported opponent or closing speed and with a dead or
 /// stuck accelerometer (the airbag fires, never worse than the reference restraint; the
 /// accelerometer fault is on the bus before the crash), and the 15 + 15 km/h bump and a slow
 /// barrier with every kind of degraded input (nothing fires).
@@ -356,7 +356,7 @@ fn crash_phase_cases() -> Vec<Case> {
             Variant::AsIs,
             "16 km/h rigid barrier, object list silent from 0.5 s",
         ),
-        // Issue 30 item 5: misuse and safing cases on the real bench, judged like every case.
+        // Misuse and safing cases on the real bench, judged like every case.
         v(
             "misuse-pothole",
             "misuse-pothole",

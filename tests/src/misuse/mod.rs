@@ -1,4 +1,4 @@
-//! The misuse / single-fault / must-fire catalogue of `misuse-matrix` (issues 20, 30, 31):
+//! The misuse / single-fault / must-fire catalogue of `misuse-matrix`:
 //! seeded families of scenarios, each built in code from the documented scenario schema and
 //! judged by what its family requires.
 //!
@@ -16,15 +16,15 @@
 //! |---|---|---|---|---|---|
 //! | pothole (30–110 km/h) | 0.8 m/s, both front wheels (1.2) | 5 g (7.5) | 10 g at 10–300 Hz (15) | 10–30 ms, rear axle again a wheelbase / v later | D: wheel-centre force ≈ 4.5 × static corner load (23 kN typical, 45 kN worst) over 10–30 ms |
 //! | kerb-strike (climbed, 10–50 km/h) | 0.8 m/s (1.2) | 7 g (10.5) | 10 g at 20–300 Hz (15) | 10–30 ms | D: the edge force leans back by θ, tan θ ≈ 1.0–1.5 for a 100–150 mm kerb |
-//! | door-slam (standing) | 0.01 m/s (0.015) | — | 40 g at 125–250 Hz, lobes of 2–4 ms (60) | 20–100 ms | D: 30 kg door at ≤ 3 m/s; the ringing amplitude is issue 31's (15–40 g), above the table's 0.5–3 g |
+//! | door-slam (standing) | 0.01 m/s (0.015) | — | 40 g at 125–250 Hz, lobes of 2–4 ms (60) | 20–100 ms | D: 30 kg door at ≤ 3 m/s; the ringing amplitude 15–40 g, above the table's 0.5–3 g |
 //! | hood-slam (standing) | 0.06 m/s (0.09) | — | 3 g at 20–300 Hz (4.5) | 20–100 ms | D: hood / boot mass × closing speed |
 //! | hammer-blow (standing) | 0.01 m/s (0.015) | — | 1 000 g at 1–10 kHz (1 500) | 0.2–2 ms | D: 1 kg head at ≤ 10 m/s; S: ISO 16750-3 shock is at the door, not the tunnel |
-//! | rough-road (driving) | ≈ 0 (zero-mean band-limited) | crest factor 3 (13.5 g at 4.5 g rms) | 3 g rms (4.5), 5–40 Hz, from rest | 0.3–5 s | issue 30 fixes ≥ 3 g rms for up to 5 s (≈ 10 × the table's 0.3 g); S: random-vibration drive signals are clipped at 3σ (IEC 60068-2-64 asks for a crest factor ≥ 2.5); D: a 4σ lobe at 4.5 g rms is 300 kN through the wheels |
+//! | rough-road (driving) | ≈ 0 (zero-mean band-limited) | crest factor 3 (13.5 g at 4.5 g rms) | 3 g rms (4.5), 5–40 Hz, from rest | 0.3–5 s | the envelope fixes ≥ 3 g rms for up to 5 s (≈ 10 × the table's 0.3 g); S: random-vibration drive signals are clipped at 3σ (IEC 60068-2-64 asks for a crest factor ≥ 2.5); D: a 4σ lobe at 4.5 g rms is 300 kN through the wheels |
 //! | speed-bump (30–80 km/h) | 0.3 m/s per axle (0.45), net ≈ 0 | 3 g (4.5) | 3 g at 10–100 Hz (4.5) | 20–60 ms per axle, two bursts a wheelbase / v apart | D |
 //! | jump-landing (30–110 km/h) | 0.6 m/s (0.9) | 5 g (7.5) | 5 g at 10–100 Hz (7.5) | 20–80 ms | D: x as the sensor sees a vertical landing |
 //! | animal-strike (roe deer, 40–110 km/h) | 0.4 m/s (0.6) | one-signed | 5 g at 20–200 Hz (7.5) | 20–60 ms | D: 25 kg at 100 km/h, v·m_a/(m_a + m_car)·(1+e) |
 //!
-//! The one-signed half-sine sweep of issue 20 (the whole area a velocity change of the car:
+//! The one-signed half-sine sweep (the whole area a velocity change of the car:
 //! a 15 g × 20 ms "pothole" is Δv 1.87 m/s, a 260 kN longitudinal peak) stays as the
 //! **beyond-physics** report: printed, where each floor sits, not a gate.
 //!

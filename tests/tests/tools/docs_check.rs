@@ -1,4 +1,4 @@
-//! The docs check catches what issue 22 item 6 found by hand: a README command whose flag does
+//! The docs check catches what a review found by hand: a README command whose flag does
 //! not exist (`lut plot --field a_max` after the field became `a_max_g`), numbers a command no
 //! longer prints, a command that fails, a command block nobody checks, and a command in the
 //! prose with a flag its tool does not take.

@@ -82,7 +82,7 @@ fn closed_pipe(bin: &str, args: &[&str]) -> (std::process::ExitStatus, String) {
 
 #[test]
 fn a_closed_pipe_ends_the_tools_quietly() {
-    // Issue 22 item 3: `offline-bench | head -1` and `lut inspect … | head -1` panicked
+    // `offline-bench | head -1` and `lut inspect … | head -1` panicked
     // (exit 101, "failed printing to stdout: Broken pipe").
     let root = e2e_tests::repo_root();
     let lut = root.join("data/default.lut");
@@ -123,7 +123,7 @@ const TOOLS: [&str; 13] = [
 
 #[test]
 fn every_tool_answers_version_with_its_own_name() {
-    // Issue 22 item 5: `budget` and `worst_cycle` lacked `--version`.
+    // `budget` and `worst_cycle` lacked `--version`.
     let release = e2e_tests::repo_root().join("target/release");
     for tool in TOOLS {
         let bin = release.join(tool);
@@ -168,7 +168,7 @@ fn long_flags(bin: &std::path::Path) -> Vec<(String, String)> {
 
 #[test]
 fn one_flag_vocabulary_across_tools() {
-    // Issue 22 item 5: `ecu --can-interface` vs `--can`, `loop-vs-cyclictest --fifo` /
+    // `ecu --can-interface` vs `--can`, `loop-vs-cyclictest --fifo` /
     // `--no-mlock` / `--out-dir` vs `--sched-fifo` / `--no-mlockall` / `--out`, `bus-inject
     // mirror --id` (a number, not a DBC name). The old spellings stay as hidden aliases.
     const SYNONYMS: [(&str, &str); 8] = [
@@ -224,7 +224,7 @@ fn run_fresh_copy(cmd: &mut Command) -> std::process::Output {
 
 #[test]
 fn tools_find_the_repository_they_run_in_not_the_one_they_were_built_in() {
-    // Issue 22 item 1: `--repo` defaulted to the folder the crate was built in. A tool copied
+    // `--repo` defaulted to the folder the crate was built in. A tool copied
     // out of the checkout and run outside it now says so (one line, the fix) instead of
     // silently reading the build folder's files; inside a checkout it finds it by walking up.
     let release = e2e_tests::repo_root().join("target/release");
@@ -264,7 +264,7 @@ fn tools_find_the_repository_they_run_in_not_the_one_they_were_built_in() {
 
 #[test]
 fn output_paths_are_checked_before_the_work() {
-    // Issue 22 item 1: an output path that cannot be written failed only at the run's end
+    // an output path that cannot be written failed only at the run's end
     // (after a whole library, a matrix, a table build). Now: at once, naming the flag, with
     // nothing run (stdout empty).
     let release = e2e_tests::repo_root().join("target/release");

@@ -67,7 +67,7 @@ fn the_matrix_on_a_slurm_job_array_prints_the_local_table() {
             "task {k}\n{logs}"
         );
     }
-    // The same command again resumes (issue 30's leftover): one task's file lost, one cut
+    // The same command again resumes: one task's file lost, one cut
     // short → only those two are submitted, and the table is the same.
     std::fs::remove_file(work.join("shard-1.json")).unwrap();
     std::fs::write(work.join("shard-2.json"), "[{\"family\": 0").unwrap();

@@ -4,7 +4,7 @@
 //! real processes, checked here on every change:
 //!
 //! * every library scenario meets its `[expect]` block and is no worse than the reference
-//!   restraint (the judge's verdict), but for the costs the safety order of issue 30 accepts,
+//!   restraint (the judge's verdict), but for the costs the safety order accepts,
 //!   each named with its bound and reason (`e2e_tests::offline::ACCEPTED_COSTS`);
 //! * an adaptive airbag fires within 1 ms of its plan whenever the plan is later than the
 //!   confirmation (plan = fire), a misreported crash's within the table's
@@ -204,7 +204,7 @@ fn with_v2x(mut s: Scenario, station_kg: Option<f64>) -> Scenario {
     s
 }
 
-/// Issue 24 with a second mass source: the object list misreported by up to ±1 200 kg while
+/// With a second mass source: the object list misreported by up to ±1 200 kg while
 /// the V2X station reports the truth, and the other way round (a forged or misconfigured
 /// station, the object list true) — one source wrong at a time, a single fault — is never
 /// worse than the reference and never bottoms out where it does not, though the plan's margin
@@ -238,7 +238,7 @@ fn with_v2x_a_misreported_closing_speed_up_to_5_mps_is_never_worse_than_the_refe
     speed_grid(true);
 }
 
-/// Issue 24's bar: on the library's nominal belted car-to-car cases, the benefit with the
+/// The bar: on the library's nominal belted car-to-car cases, the benefit with the
 /// V2X station (the 300 kg margin over the heavier source) is within 4 points of planning with
 /// no margin at all (`mass_misreport_kg = 0`, no V2X) on average — and the 1 200 kg rule alone
 /// is not (it stays the plan without V2X). Every figure is a closed-loop run of the core.
@@ -311,7 +311,7 @@ fn speed_grid(v2x: bool) {
     j.assert_no_problems();
 }
 
-/// The fault campaign's scenario variants (issue 14: misreported crashes, dead and stuck
+/// The fault campaign's scenario variants (misreported crashes, dead and stuck
 /// accelerometers, bumps with degraded inputs), and its LUT fault without a LUT, offline: the
 /// core meets the expectations the campaign will judge on the real processes.
 #[test]
@@ -360,7 +360,7 @@ fn the_campaigns_scenario_variants_meet_their_expectations_offline() {
 
 #[test]
 fn offline_bench_json_actions_carry_ms_after_the_scenario_start() {
-    // Issue 30 item 7: every action has `t_ms` (ms after the scenario start) beside `t_ns`
+    // Every action has `t_ms` (ms after the scenario start) beside `t_ns`
     // (the simulated clock, scenario time + 1 s). Checked against the run's own contact-relative
     // times, which come another way (`OfflineRun::action`: ms after the true contact).
     let name = "taurus-48-48-abs";
@@ -390,7 +390,7 @@ fn offline_bench_json_actions_carry_ms_after_the_scenario_start() {
     }
 }
 
-/// Issue 31 item 3: the library's 4 kHz ringing in phase with the samples fires nothing through
+/// The library's 4 kHz ringing in phase with the samples fires nothing through
 /// the sensors' anti-alias filter — and fires the airbag with an ideal sampler, so the file
 /// tests the filter, not a pulse too small to matter.
 #[test]
@@ -415,7 +415,7 @@ fn in_phase_4_khz_ringing_fires_only_without_the_anti_alias_filter() {
 
 #[test]
 fn offline_bench_plots_what_a_pothole_did_to_the_sensors_and_the_decision() {
-    // Issue 32 item 7: `--plot DIR` draws each run. The trace it draws is checked against the
+    // `--plot DIR` draws each run. The trace it draws is checked against the
     // scenario's closed form — a 10 g × 8 ms half-sine at 1.5 s, Δv = 2·a·T/π = 0.50 m/s — and
     // the picture is written at its size.
     let name = "misuse-pothole";
@@ -511,7 +511,7 @@ fn edited(name: &str, tag: &str, from: &str, to: &str) -> PathBuf {
 
 #[test]
 fn a_wrong_expectation_fails_offline_bench_and_a_bad_file_does_not_stop_the_others() {
-    // Issue 32 items 1 and 6: a user's regression file can fail; every file is reported.
+    // A user's regression file can fail; every file is reported.
     let wrong = edited(
         "misuse-pothole",
         "wrong",
@@ -588,7 +588,7 @@ fn documented_json_keys(nested: &[&str]) -> (Vec<String>, Vec<(String, Vec<Strin
 
 #[test]
 fn offline_bench_json_is_what_tests_readme_documents_on_one_time_base() {
-    // Issue 32 item 3: one time base (ms after the scenario start, ms after the contact beside
+    // One time base (ms after the scenario start, ms after the contact beside
     // it), typed fields, the schema next to the tools — checked both ways.
     let nested = ["crash_mode", "modes", "faults", "actions"];
     let (top, inner) = documented_json_keys(&nested);
@@ -658,7 +658,7 @@ fn offline_bench_json_is_what_tests_readme_documents_on_one_time_base() {
 
 #[test]
 fn the_table_shows_every_restraint_action_and_says_when_there_is_no_contact() {
-    // Issue 32 item 2: a run without contact that fires shows it (the rough road's
+    // A run without contact that fires shows it (the rough road's
     // pretensioner was hidden behind "no fire … no contact"): the action lines carry each
     // restraint, its kind, source and time, and say "no contact" instead of a contact time.
     let fired = edited(

@@ -895,7 +895,7 @@ mass_kg = 75
 
     #[test]
     fn a_mass_bias_beside_a_reported_mass_is_an_error_that_names_the_winner() {
-        // Issue 32 item 4: `mass_estimate_kg` is the reported mass as given; a bias beside it
+        // `mass_estimate_kg` is the reported mass as given; a bias beside it
         // was silently ignored.
         let text = format!("{OK}\n[sensor]\nmass_estimate_kg = 3000\nmass_bias_kg = 500\n");
         let e = Scenario::parse("x.toml", &text).unwrap_err();

@@ -181,7 +181,7 @@ impl Scenario {
         if let Some(m) = s.mass_estimate_kg {
             range("sensor.mass_estimate_kg", m, 100.0, 100000.0, "kg")?;
         }
-        // Issue 32: a key that would be silently ignored is an error that says which wins.
+        // A key that would be silently ignored is an error that says which wins.
         if s.mass_estimate_kg.is_some() && s.mass_bias_kg != 0.0 {
             return Err((
                 "sensor.mass_bias_kg".into(),

@@ -73,7 +73,7 @@ impl Layers {
         Ok(cfg)
     }
 
-    /// Relative file paths resolved as the user meant them (issue 22: the ECU started from
+    /// Relative file paths resolved as the user meant them (the ECU started from
     /// another folder ran without its table and keys): a path from the `--config` file is
     /// relative to that file's folder (or the nearest folder above it that holds it); a default (`data/default.lut`, …) to the repository the
     /// ECU belongs to — the first folder holding it, walking up from the current directory,

@@ -50,7 +50,7 @@ pub struct CycleSection {
     /// binary (same file at build time), with a warning.
     pub reference: PathBuf,
     /// SecOC key file (`--secoc-keys`, format in `bus::secoc::SecOcKeys`). Missing/corrupt →
-    /// the ECU does not start (fail closed, issue 22: its fire commands would go out without
+    /// the ECU does not start (fail closed: its fire commands would go out without
     /// authenticators), unless `--no-secoc` asks for exactly that; then `EcuStatus` reports
     /// `FaultConfig` and the start-up line says why.
     pub secoc_keys: PathBuf,
@@ -326,7 +326,7 @@ mod tests {
 
     #[test]
     fn removed_prediction_step_is_rejected_and_track_keys_are_read() {
-        // The prediction is solved in closed form since issue 15: the old step key is an
+        // The prediction is solved in closed form: the old step key is an
         // error that names it, not silently ignored.
         let e = EcuConfig::from_toml_str("[cycle]\nprediction_step_ms = 0.5\n", &p())
             .unwrap_err()

@@ -24,7 +24,7 @@ pub(super) fn accel_fault_bound_ms(v: Variant) -> f64 {
     limit + bus::EcuStatus::MESSAGE_CYCLE_TIME_MS as f64
 }
 
-/// Issue 14's checks of a scenario variant: a misreported crash is no worse than the reference
+/// The checks of a scenario variant: a misreported crash is no worse than the reference
 /// restraint (judged on the commanded levels at the planned times where the route's timing is
 /// emulated, as the bench's library test does); a dead or stuck accelerometer is on the bus
 /// before the contact.
