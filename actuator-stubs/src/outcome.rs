@@ -162,7 +162,7 @@ pub fn evaluate(
         a_max_g: physics::mps2_to_g(crash.vehicle.a_max_mps2),
         a_mean_g: physics::mps2_to_g(crash.vehicle.a_mean_mps2),
         crush_mm: crash.vehicle.crush_m * 1e3,
-        required_ms: physics::deadline::required_fire_s(&truth.pulse.ego_pulse()).map(|s| s * 1e3),
+        required_ms: truth.required_fire_ms(),
     };
     let pulse = truth.pulse.ego_pulse();
     let occ = OccupantInput {

@@ -292,9 +292,11 @@ pub struct CycleConfig {
     /// `misreported-low-speed` family fired 35 airbags of 445 (seed 7), at 0.75 21; the must-fire
     /// families' fire times are the same at 1.0 — the floor is what held them.
     pub satellite_boundary_scale: f64,
-    /// While usable satellites see the front end crush less than `satellite_relief_from_mps`,
-    /// the accelerometer-only airbag boundary is lifted by this, m/s, and by less the more
-    /// they relieve (`satellites`, "Low crush"; *default* 1.2: a kerb strike or pothole inside a 12–16 km/h crash, the matrix's envelope × 1.5). 0 = off.
+    /// While usable satellites have not seen the front end crush as much as
+    /// `satellite_relief_from_mps`, the accelerometer-only airbag boundary is lifted by this,
+    /// m/s; from then on, while the relief holds, not at all (`satellites`, "Low crush";
+    /// *default* 1.2: a kerb strike or pothole inside a 12–16 km/h crash, the matrix's
+    /// envelope × 1.5). 0 = off.
     pub satellite_low_crush_lift_mps: f64,
 
     /// Crash accelerometer: no batch for this long → `ACCEL_STALE`, ms (*default* 50: batches

@@ -365,9 +365,7 @@ pub fn run_traced(
             .map_err(|e| anyhow!("{}: judge: {e}", scenario.name))?,
         None => None,
     };
-    let required_ms = contact_s
-        .and_then(|_| physics::deadline::required_fire_s(&truth.pulse.ego_pulse()))
-        .map(|s| s * 1e3);
+    let required_ms = truth.required_fire_ms();
     let rel = |t: u64| OfflineRun::rel_ms(contact_s, t);
     Ok(OfflineRun {
         name: scenario.name.clone(),

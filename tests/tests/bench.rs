@@ -198,8 +198,9 @@ fn every_crash_reports_its_required_fire_time_and_the_airbags_margin() {
             continue;
         }
         crashes += 1;
-        let truth = world::truth::Truth::new(&s).expect("truth");
-        let want = physics::deadline::required_fire_s(&truth.pulse.ego_pulse()).map(|t| t * 1e3);
+        let want = world::truth::Truth::new(&s)
+            .expect("truth")
+            .required_fire_ms();
         let got = r.true_crash.as_ref().expect("true crash").required_ms;
         assert_eq!(got, want, "{}", s.name);
         let fire = r.action("airbag_fire").and_then(|a| a.after_contact_ms);
@@ -218,7 +219,8 @@ fn every_crash_reports_its_required_fire_time_and_the_airbags_margin() {
 #[test]
 fn report_times_use_the_offline_benchs_two_time_bases() {
     // One time base for both tools: `t_ms` after the start, `after_contact_ms` after the
-    // contact, and the two differ by the contact's own time after the start for every action of every run.
+    // contact, and the two differ by the contact's own time after the start for every action
+    // of every run.
     for (s, r) in all() {
         let contact_after_start_ms =
             (r.contact_ns != 0).then_some((r.contact_ns as f64 - r.start_ns as f64) * 1e-6);

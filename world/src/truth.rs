@@ -183,6 +183,14 @@ impl Truth {
         }
     }
 
+    /// The airbag's required fire time, "127 mm − 30 ms" of the true ego pulse, ms after
+    /// contact (`physics::deadline`; `None` without contact, or when the pulse never moves a
+    /// free occupant 127 mm): what every judge of fire time measures against.
+    pub fn required_fire_ms(&self) -> Option<f64> {
+        self.contact_s?;
+        physics::deadline::required_fire_s(&self.pulse.ego_pulse()).map(|s| s * 1e3)
+    }
+
     /// Ego compartment acceleration at `k`-th pulse position (linear interpolation of the
     /// 0.1 ms pulse; 0 after the pulse).
     fn pulse_at(&self, channel: &[f64], t_since_contact_s: f64) -> f64 {

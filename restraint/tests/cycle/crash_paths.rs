@@ -424,9 +424,9 @@ fn a_dead_accelerometer_fires_nothing_without_both_a_predicted_crash_and_a_crash
 
 #[test]
 fn a_matched_pulse_that_fires_nothing_ends_its_crash_phase_with_the_event() {
-    // A crash phase ends with its event. Predicted at 20 m/s (72 km/h: below the closing speed from which a
-    // matched crash may fire on the prediction alone, so its airbag waits for the measured
-    // pulse). The object list stops at C (the opponent evaded); at C a pothole ramps exactly
+    // A crash phase ends with its event. Predicted at 20 m/s (72 km/h: below the closing
+    // speed from which a matched crash may fire on the prediction alone, so its airbag waits
+    // for the measured pulse). The object list stops at C (the opponent evaded); at C a pothole ramps exactly
     // like the predicted crash for 6 ms (≈ 0.44 m/s: the matcher confirms) and then falls
     // away — 0.7 m/s in all, below every floor. Nothing fires, and once the event is over the
     // ECU leaves CrashDetected and releases the reversible pre-crash pretensioner.
@@ -540,10 +540,7 @@ fn a_matched_pulse_that_follows_its_ramp_past_the_plan_below_the_floor_fires_no_
     // floor, so the belt the pre-crash plan tensioned is latched as the crash's pretensioner
     // fire and the crash phase ends in post-crash (a pretensioner not yet fired would have
     // fired there too).
-    let g = |ms: u64| if ms < 17 { ramp_g(28.0, ms) } else { 0.0 };
-    let b = predicted_28_mps_with_airbag_floor(3.0, C + 200 * MS, &g);
-    assert!(b.first_mode(EcuMode::Crash).is_some(), "matched");
-    assert!(no_airbag_fired(&b), "{:?}", first_fire(&b));
+    let b = matched_ramp_stopped_at_without_airbag(17);
     assert_eq!(b.ecu.phase(), Phase::PostCrash);
 }
 
@@ -552,11 +549,19 @@ fn a_matched_pulse_below_both_floors_fires_nothing_and_ends_with_its_event() {
     // As above, stopped at +10 ms: ≈ 0.8 m/s, under the pretensioner's 1.5 m/s floor as a near
     // miss's pothole is. Nothing of the crash phase fires; the belt the pre-crash plan
     // tensioned is not latched and the crash phase ends with the event.
-    let g = |ms: u64| if ms < 10 { ramp_g(28.0, ms) } else { 0.0 };
+    let b = matched_ramp_stopped_at_without_airbag(10);
+    assert!(!matches!(b.ecu.phase(), Phase::Crash | Phase::PostCrash));
+}
+
+/// The crash predicted at 28 m/s with the airbag's floor raised to 3 m/s, its pulse following
+/// the predicted ramp until `stop_ms` after C and then stopping, run to C + 200 ms: checks it
+/// was matched and fired no airbag.
+fn matched_ramp_stopped_at_without_airbag(stop_ms: u64) -> Bench {
+    let g = |ms: u64| if ms < stop_ms { ramp_g(28.0, ms) } else { 0.0 };
     let b = predicted_28_mps_with_airbag_floor(3.0, C + 200 * MS, &g);
     assert!(b.first_mode(EcuMode::Crash).is_some(), "matched");
     assert!(no_airbag_fired(&b), "{:?}", first_fire(&b));
-    assert!(!matches!(b.ecu.phase(), Phase::Crash | Phase::PostCrash));
+    b
 }
 
 /// An approach of an `opp_kg` object closing at `closing_mps` for contact C (object list every
@@ -590,8 +595,8 @@ fn crash_with_object(
 
 #[test]
 fn a_tracked_low_speed_crash_with_a_kerb_strike_fires_no_airbag_unless_it_is_far_more_severe() {
-    // The tracked low-speed limit. A tracked object closing at 4.2 m/s (15 km/h; EBS < 20 km/h even 1 200 kg
-    // heavier than its 1 500 kg): the airbag needs the event's Δv above closing × 1.3 + 1.2 =
+    // The tracked low-speed limit. A tracked object closing at 4.2 m/s (15 km/h; EBS < 20 km/h
+    // even 1 200 kg heavier than its 1 500 kg): the airbag needs the event's Δv above closing × 1.3 + 1.2 =
     // 6.66 m/s. A 15 g × 40 ms pulse (5.9 m/s: a low-speed crash with a kerb strike on top,
     // which the conventional boundary alone fires) stays below it.
     let cfg = ideal_sensor_config;
@@ -624,8 +629,8 @@ const RAMP_MS: u64 = 8;
 
 #[test]
 fn an_opponent_reported_heavy_does_not_move_a_low_speed_crash_across_the_no_fire_line() {
-    // A misreported low-speed crash. 14.5 + 14.5 km/h (8.06 m/s closing) against an equal car reported as
-    // 4 000 kg: EBS 20.0 km/h on the report (armed), 14.5 km/h in truth. The true pulse ramps
+    // A misreported low-speed crash. 14.5 + 14.5 km/h (8.06 m/s closing) against an equal car
+    // reported as 4 000 kg: EBS 20.0 km/h on the report (armed), 14.5 km/h in truth. The true pulse ramps
     // like the prediction (the onset slope is the structures' stiffness × closing speed, not
     // the mass) for 8 ms and then levels off at ≈ 8 g for 60 ms (≈ 4.5 m/s). Every layer says
     // no: below ≈ 83 km/h closing a matched plan does not fire on the prediction alone, the

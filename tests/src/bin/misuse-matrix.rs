@@ -321,11 +321,6 @@ struct Outcome {
     clean_margin_ms: Option<f64>,
 }
 
-/// "127 mm − 30 ms" of the true pulse, ms after contact (`physics::deadline`).
-fn required_ms(truth: &world::Truth) -> Option<f64> {
-    physics::deadline::required_fire_s(&truth.pulse.ego_pulse()).map(|s| s * 1e3)
-}
-
 /// A crash phase entered less than this before the run's end is unfinished, not stuck, ms: the
 /// accelerometer-only decision window (60 ms) and the event's own end after it (a rough road
 /// or offset that lasts to within a few ms of the end would otherwise count).
@@ -357,14 +352,10 @@ fn run_one(cfg: &OfflineConfig, text: &str) -> Result<Outcome> {
         .iter()
         .filter(|a| a.what == "pretensioner_release")
         .count();
-    let required = match r.contact_s {
-        Some(_) => required_ms(&world::Truth::new(&scenario).map_err(|e| anyhow::anyhow!("{e}"))?),
-        None => None,
-    };
     Ok(Outcome {
         airbag_ms,
         pretensioner_kept: fired > released,
-        required_ms: required,
+        required_ms: r.required_ms,
         stuck_in_crash: r.modes.last().is_some_and(|m| {
             // Modes count from the contact, or from the start without one.
             let end_ms = (scenario.duration_s - r.contact_s.unwrap_or(0.0)) * 1e3;
