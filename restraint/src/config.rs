@@ -648,14 +648,6 @@ impl CycleConfig {
         }
     }
 
-    /// The pyrotechnic pretensioner's floor on the conventional path.
-    pub fn pretensioner_floor(&self) -> FireFloor {
-        FireFloor {
-            min_dv_mps: self.pretensioner_min_dv_mps,
-            ..self.fallback_floor()
-        }
-    }
-
     /// The satellite fusion's settings (`satellite_*`) in its units.
     pub fn satellite_params(&self) -> crate::satellites::SatelliteParams {
         crate::satellites::SatelliteParams {

@@ -76,9 +76,9 @@ pub struct CrashMonitor {
     onset_params: ConfirmParams,
     generic: CrashDetector,
     matcher: PulseMatch,
+    /// The accelerometer-only algorithm: the airbag's and the pyrotechnic pretensioner's
+    /// boundaries on the conventional path.
     fallback: FallbackAlgorithm,
-    /// The pyrotechnic pretensioner's own boundary on the conventional path.
-    pretensioner: FallbackAlgorithm,
     window_ns: u64,
     backup_decel_mps2: f64,
     /// The accelerometers' anti-alias group delay, ns: a measured onset is this late.
@@ -96,8 +96,8 @@ impl CrashMonitor {
             onset_params,
             generic: CrashDetector::default(),
             matcher: PulseMatch::new(cfg.match_params()),
-            fallback: FallbackAlgorithm::new(cfg.fallback_dv_mps, cfg.fallback_floor()),
-            pretensioner: FallbackAlgorithm::new(cfg.pretensioner_dv_mps, cfg.pretensioner_floor()),
+            fallback: FallbackAlgorithm::new(cfg.fallback_dv_mps, cfg.fallback_floor())
+                .with_pretensioner(cfg.pretensioner_dv_mps, cfg.pretensioner_min_dv_mps),
             window_ns: ms_to_ns(cfg.match_window_ms),
             backup_decel_mps2: cfg.backup_confirm_g * G_MPS2,
             accel_delay_ns: ms_to_ns(cfg.accel_delay_ms),
@@ -119,17 +119,13 @@ impl CrashMonitor {
         relief: impl FnOnce() -> Relief,
     ) {
         let wake = self.onset_params.wake_mps2;
-        if !(self.matcher.awake()
-            || self.generic.awake()
-            || self.fallback.awake()
-            || self.pretensioner.awake())
+        if !(self.matcher.awake() || self.generic.awake() || self.fallback.awake())
             && batch.all_below(wake)
         {
             if let Some(last) = batch.last_decel_mps2() {
                 self.matcher.note_quiet(last);
                 self.generic.note_quiet(last);
                 self.fallback.note_quiet(last);
-                self.pretensioner.note_quiet(last);
             }
             return;
         }
@@ -138,8 +134,7 @@ impl CrashMonitor {
         // The satellites' low-crush lift is the airbag's: a crash below its no-fire line may
         // still need the belt.
         self.fallback.lift_boundary(relief.boundary_lift_mps);
-        let airbag = self.fallback.thresholds_now(lift, relief);
-        let pretensioner = self.pretensioner.thresholds_now(lift, relief);
+        let thresholds = self.fallback.thresholds_now(lift, relief);
         // A rough road's lobes are no crash evidence for the generic confirmation either (nor
         // for the CrashDetected it puts on the bus, which body ECUs act on): its Δv threshold
         // carries the roughness lift too. On a smooth road the lift is 0; on a rough one every
@@ -149,7 +144,7 @@ impl CrashMonitor {
             ..self.onset_params
         };
         for s in batch.iter() {
-            self.on_sample(&s, ctx, &generic, airbag, pretensioner);
+            self.on_sample(&s, ctx, &generic, thresholds);
         }
     }
 
@@ -167,8 +162,7 @@ impl CrashMonitor {
         s: &AccelSample,
         ctx: &FreezeContext<'_, '_>,
         generic: &ConfirmParams,
-        airbag: Thresholds,
-        pretensioner: Thresholds,
+        thresholds: Thresholds,
     ) {
         self.matcher.push(s, &mut |slot| {
             let Some(sit) = ctx.situation.filter(|_| ctx.armed) else {
@@ -186,8 +180,7 @@ impl CrashMonitor {
             )
         });
         self.generic.push(generic, s);
-        self.fallback.push(&self.onset_params, s, airbag);
-        self.pretensioner.push(&self.onset_params, s, pretensioner);
+        self.fallback.push(&self.onset_params, s, thresholds);
         if self.confirmation.is_some() {
             return;
         }
@@ -304,7 +297,7 @@ impl CrashMonitor {
 
     /// The pretensioner's accelerometer-only decision on the current event.
     pub fn pretensioner(&self) -> FallbackDecision {
-        self.pretensioner.decision()
+        self.fallback.pretensioner_decision()
     }
 
     /// The accelerometer event in progress is still loading (`FallbackAlgorithm::loading`).

@@ -150,27 +150,60 @@ pub struct FireFloor {
     pub loading_fraction: f64,
 }
 
-/// What a sample's decision is judged against now besides the boundary's shape: the severity
-/// floor with the road's lift and the satellites' relief, and the boundary's scale — fixed for a
-/// batch ([`FallbackAlgorithm::thresholds_now`]), so a sample pays one compare for each.
+/// What a sample's decisions are judged against now besides the boundaries' shapes: each
+/// restraint's severity floor with the road's lift and the satellites' relief, and the
+/// boundaries' scale — fixed for a batch ([`FallbackAlgorithm::thresholds_now`]), so a sample
+/// pays one compare for each.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Thresholds {
-    /// Δv since the onset at least this, m/s.
+    /// The airbag's: Δv since the onset at least this, m/s.
     pub min_dv_mps: f64,
-    /// The boundary's values times this.
+    /// The pyrotechnic pretensioner's: Δv since the onset at least this, m/s.
+    pub pretensioner_min_dv_mps: f64,
+    /// The boundaries' values times this.
     pub boundary_scale: f64,
 }
 
-/// State of the accelerometer-only algorithm (one event at a time; the decision belongs to
-/// the event and is forgotten when the next one begins).
+/// One restraint's boundary and its decision on the current event.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Head {
+    thresholds: [f64; KNOTS],
+    /// The severity floor's Δv, m/s (before the road's lift and the satellites' relief).
+    min_dv_mps: f64,
+    decision: FallbackDecision,
+}
+
+impl Head {
+    fn new(thresholds: [f64; KNOTS], min_dv_mps: f64) -> Self {
+        Self {
+            thresholds,
+            min_dv_mps,
+            decision: FallbackDecision::Pending,
+        }
+    }
+
+    fn fired(&self) -> bool {
+        matches!(self.decision, FallbackDecision::Fire { .. })
+    }
+
+    /// Whether `dv` at `tau_ms` reaches the boundary (scaled, lifted) and the floor.
+    fn reached(&self, tau_ms: f64, dv: f64, scale: f64, lift_mps: f64, floor_mps: f64) -> bool {
+        dv >= scale * threshold_mps(&self.thresholds, tau_ms) + lift_mps && dv >= floor_mps
+    }
+}
+
+/// State of the accelerometer-only algorithm: one pass over each sample (onset, Δv, loading,
+/// persistence, re-onset) that both restraints' boundaries read — the airbag's and the
+/// pyrotechnic pretensioner's differ only in their boundary and severity floor. One event at a
+/// time; each decision belongs to the event and is forgotten when the next one begins.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FallbackAlgorithm {
-    thresholds: [f64; KNOTS],
+    airbag: Head,
+    pretensioner: Head,
     floor: FireFloor,
     onset: Onset,
     loading: Loading,
     run: u32,
-    decision: FallbackDecision,
     /// Start of the judged segment of the event (its onset, or the latest re-onset), ns.
     segment_onset_ns: u64,
     /// The event's Δv before the segment's first interval, m/s: the segment's Δv is the
@@ -178,26 +211,34 @@ pub struct FallbackAlgorithm {
     segment_base_dv_mps: f64,
     /// Since when the deceleration has been under the wake threshold inside the event, ns.
     dip_since_ns: Option<u64>,
-    /// What the boundary is lifted by for the samples to come, m/s
+    /// What the airbag's boundary is lifted by for the samples to come, m/s
     /// ([`Self::lift_boundary`]).
     boundary_lift_mps: f64,
 }
 
 impl FallbackAlgorithm {
-    /// The algorithm with a validated boundary and floor.
+    /// The algorithm with a validated airbag boundary and floor; the pretensioner's is the
+    /// same until [`Self::with_pretensioner`] sets its own.
     pub fn new(thresholds: [f64; KNOTS], floor: FireFloor) -> Self {
         Self {
-            thresholds,
+            airbag: Head::new(thresholds, floor.min_dv_mps),
+            pretensioner: Head::new(thresholds, floor.min_dv_mps),
             floor,
             onset: Onset::default(),
             loading: Loading::default(),
             run: 0,
-            decision: FallbackDecision::Pending,
             segment_onset_ns: 0,
             segment_base_dv_mps: 0.0,
             dip_since_ns: None,
             boundary_lift_mps: 0.0,
         }
+    }
+
+    /// The pyrotechnic pretensioner's validated boundary and severity floor (Δv, m/s; the
+    /// floor's persistence and loading rule are the airbag's).
+    pub fn with_pretensioner(mut self, thresholds: [f64; KNOTS], min_dv_mps: f64) -> Self {
+        self.pretensioner = Head::new(thresholds, min_dv_mps);
+        self
     }
 
     /// Lifts the boundary by `lift_mps` for the samples to come (the satellites' low-crush
@@ -208,21 +249,26 @@ impl FallbackAlgorithm {
 
     /// Starts the judged segment at sample `s` (the event's wake-up, or a re-onset; `base`:
     /// the event's Δv before `s`'s interval), its Δv from the interval that ends at `s` on, as
-    /// [`Onset`]'s.
+    /// [`Onset`]'s. A restraint that has fired in the event keeps its decision.
     fn start_segment(&mut self, s: &AccelSample, base_dv_mps: f64) {
         self.segment_onset_ns = s.t_ns;
         self.segment_base_dv_mps = base_dv_mps;
         self.dip_since_ns = None;
         self.loading.start(s.decel_mps2);
-        self.decision = FallbackDecision::Pending;
+        for h in [&mut self.airbag, &mut self.pretensioner] {
+            if !h.fired() {
+                h.decision = FallbackDecision::Pending;
+            }
+        }
     }
 
-    /// The thresholds of the samples to come: the floor with `floor_lift_mps` (what the road's
-    /// roughness adds to it now, [`crate::roughness`]) and `relief` (what the crush-zone
-    /// satellites take off the floor, the lift and the boundary now, [`crate::satellites`]).
+    /// The thresholds of the samples to come: each floor with `floor_lift_mps` (what the
+    /// road's roughness adds to it now, [`crate::roughness`]) and `relief` (what the crush-zone
+    /// satellites take off the floors, the lift and the boundaries now, [`crate::satellites`]).
     pub fn thresholds_now(&self, floor_lift_mps: f64, relief: Relief) -> Thresholds {
         Thresholds {
-            min_dv_mps: relief.floor_mps(self.floor.min_dv_mps, floor_lift_mps),
+            min_dv_mps: relief.floor_mps(self.airbag.min_dv_mps, floor_lift_mps),
+            pretensioner_min_dv_mps: relief.floor_mps(self.pretensioner.min_dv_mps, floor_lift_mps),
             boundary_scale: relief.boundary_mps(1.0),
         }
     }
@@ -235,14 +281,19 @@ impl FallbackAlgorithm {
             OnsetStep::Quiet => return,
             OnsetStep::Reset => {
                 // An event that ended under the boundary was a no-fire; a fired event is over.
-                if self.decision == FallbackDecision::Pending {
-                    self.decision = FallbackDecision::NoFire(s.t_ns);
+                for h in [&mut self.airbag, &mut self.pretensioner] {
+                    if h.decision == FallbackDecision::Pending {
+                        h.decision = FallbackDecision::NoFire(s.t_ns);
+                    }
                 }
                 self.run = 0;
                 self.dip_since_ns = None;
                 return;
             }
             OnsetStep::Woke => {
+                // A new event: no decision of an earlier one carries over.
+                self.airbag.decision = FallbackDecision::Pending;
+                self.pretensioner.decision = FallbackDecision::Pending;
                 self.run = 0;
                 self.start_segment(s, 0.0);
             }
@@ -252,7 +303,7 @@ impl FallbackAlgorithm {
                     && self
                         .dip_since_ns
                         .is_some_and(|d| s.t_ns.saturating_sub(d) >= RE_ONSET_GAP_NS)
-                    && !matches!(self.decision, FallbackDecision::Fire { .. });
+                    && !(self.airbag.fired() && self.pretensioner.fired());
                 if re_onset {
                     self.start_segment(s, before_dv);
                 } else {
@@ -270,7 +321,8 @@ impl FallbackAlgorithm {
         } else {
             0
         };
-        if self.decision != FallbackDecision::Pending {
+        let pending = |h: &Head| h.decision == FallbackDecision::Pending;
+        if !(pending(&self.airbag) || pending(&self.pretensioner)) {
             return;
         }
         let Some(onset) = self.onset.onset_ns() else {
@@ -279,23 +331,46 @@ impl FallbackAlgorithm {
         let tau_ms = s.t_ns.saturating_sub(self.segment_onset_ns) as f64 * 1e-6;
         let dv = self.onset.delta_v_mps() - self.segment_base_dv_mps;
         if tau_ms > WINDOW_MS {
-            self.decision = FallbackDecision::NoFire(s.t_ns);
-        } else if dv
-            >= t.boundary_scale * threshold_mps(&self.thresholds, tau_ms) + self.boundary_lift_mps
-            && dv >= t.min_dv_mps
-            && self.run >= self.floor.samples
-            && self.loading()
-        {
-            self.decision = FallbackDecision::Fire {
-                at_ns: s.t_ns,
-                onset_ns: onset,
-            };
+            for h in [&mut self.airbag, &mut self.pretensioner] {
+                if h.decision == FallbackDecision::Pending {
+                    h.decision = FallbackDecision::NoFire(s.t_ns);
+                }
+            }
+            return;
+        }
+        // Persistence and loading are both restraints' (asked once, and only of a sample
+        // whose Δv reaches a boundary).
+        let fire = FallbackDecision::Fire {
+            at_ns: s.t_ns,
+            onset_ns: onset,
+        };
+        let scale = t.boundary_scale;
+        let airbag = pending(&self.airbag)
+            && self
+                .airbag
+                .reached(tau_ms, dv, scale, self.boundary_lift_mps, t.min_dv_mps);
+        let pretensioner = pending(&self.pretensioner)
+            && self
+                .pretensioner
+                .reached(tau_ms, dv, scale, 0.0, t.pretensioner_min_dv_mps);
+        if (airbag || pretensioner) && self.run >= self.floor.samples && self.loading() {
+            if airbag {
+                self.airbag.decision = fire;
+            }
+            if pretensioner {
+                self.pretensioner.decision = fire;
+            }
         }
     }
 
-    /// The current decision.
+    /// The airbag's decision.
     pub fn decision(&self) -> FallbackDecision {
-        self.decision
+        self.airbag.decision
+    }
+
+    /// The pyrotechnic pretensioner's decision.
+    pub fn pretensioner_decision(&self) -> FallbackDecision {
+        self.pretensioner.decision
     }
 
     /// Onset of the event in progress.
@@ -424,6 +499,28 @@ mod tests {
         // closed at the first sample after the 60 ms window.
         let mut f = FallbackAlgorithm::new(lin, NO_FLOOR);
         run(&mut f, 2.0, 80);
+        assert_eq!(
+            f.decision(),
+            FallbackDecision::NoFire(1_000_000_000 + 61_000_000)
+        );
+    }
+
+    #[test]
+    fn the_pretensioner_reads_the_same_pass_against_its_own_boundary() {
+        // The oracle above on the pretensioner's boundary (linear 0.1 + 0.1·τ/4 m/s), the
+        // airbag's out of reach: the pretensioner decides at τ = 4 ms, the airbag closes its
+        // window under the boundary at the first sample after 60 ms.
+        let lin: [f64; KNOTS] = core::array::from_fn(|i| 0.1 + 0.1 * i as f64);
+        let mut f =
+            FallbackAlgorithm::new([f64::INFINITY; KNOTS], NO_FLOOR).with_pretensioner(lin, 0.0);
+        run(&mut f, 5.0, 80);
+        assert_eq!(
+            f.pretensioner_decision(),
+            FallbackDecision::Fire {
+                at_ns: 1_000_000_000 + 4_000_000,
+                onset_ns: 1_000_000_000
+            }
+        );
         assert_eq!(
             f.decision(),
             FallbackDecision::NoFire(1_000_000_000 + 61_000_000)
