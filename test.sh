@@ -62,7 +62,7 @@ target/release/worst_cycle search --generations 3 --population 16 --cycles no-cr
 target/release/worst_cycle search --generations 3 --population 16 --cycles no-crash \
   --secoc on --start benches/worst-case/seed-secoc.json --budget 11900
 target/release/worst_cycle search --generations 3 --population 16 --cycles crash \
-  --secoc on --start benches/worst-case/seed-crash-phase.json --budget 20100
+  --secoc on --start benches/worst-case/seed-crash-phase.json --budget 19700
 
 step "robustness report (fault campaign of the tests above + fuzz smoke)"
 target/release/fault-campaign report --campaign target/robustness/campaign.json \

@@ -126,18 +126,46 @@ pub const LOADING_SMOOTHING_S: f64 = 0.25e-3;
 /// 2f / (1 + √(1 − k²)): the pulse still holds k of its peak at most until sin θ = k past its
 /// crest, where it has carried (1 + √(1 − k²))/2 of its Δv. For the default k = 0.85 that is
 /// 1.31 f (less the smoothing's lag; tests in `fallback`, and `misuse-matrix`).
+///
+/// What it smooths is the median of the last three samples: one wild sample (a spike of an
+/// otherwise healthy sensor, 10–200 g) is no crest — held as the crest, it kept a crash that
+/// followed it from "loading" until the crash had carried the exemption's Δv, 20 ms late.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Loading {
     smooth_mps2: f64,
     peak_mps2: f64,
+    /// The two samples before the newest, oldest first.
+    prev_mps2: [f64; 2],
+}
+
+/// The median of three (finite inputs; compares, no NaN handling: [`Loading::push`] takes
+/// finite samples only).
+fn median3(a: f64, b: f64, c: f64) -> f64 {
+    let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
+    if c <= lo {
+        lo
+    } else if c >= hi {
+        hi
+    } else {
+        c
+    }
 }
 
 impl Loading {
-    /// Starts a new event at its first (wake-up) sample.
+    /// Starts a new event at its first (wake-up) sample: from rest (the samples before it
+    /// were quiet), the wake-up sample the newest of the median's three.
     pub fn start(&mut self, decel_mps2: f64) {
         *self = Self {
-            smooth_mps2: decel_mps2,
-            peak_mps2: decel_mps2,
+            smooth_mps2: 0.0,
+            peak_mps2: 0.0,
+            prev_mps2: [
+                0.0,
+                if decel_mps2.is_finite() {
+                    decel_mps2
+                } else {
+                    0.0
+                },
+            ],
         };
     }
 
@@ -146,9 +174,16 @@ impl Loading {
     pub fn push(&mut self, decel_mps2: f64, dt_s: f64) {
         let a = dt_s / (LOADING_SMOOTHING_S + dt_s);
         if a.is_finite() && a > 0.0 && decel_mps2.is_finite() {
-            self.smooth_mps2 += a * (decel_mps2 - self.smooth_mps2);
+            let [p0, p1] = self.prev_mps2;
+            self.prev_mps2 = [p1, decel_mps2];
+            self.smooth_mps2 += a * (median3(p0, p1, decel_mps2) - self.smooth_mps2);
             self.peak_mps2 = self.peak_mps2.max(self.smooth_mps2);
         }
+    }
+
+    /// The highest smoothed deceleration since the start, m/s².
+    pub fn peak_mps2(&self) -> f64 {
+        self.peak_mps2
     }
 
     /// The smoothed deceleration is at least `fraction` of its peak since the onset (a
