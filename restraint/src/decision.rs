@@ -433,15 +433,18 @@ impl Decision {
 
     /// Backup for a disagreeing pair: the crash sensor and the safing sensor disagree on the
     /// confirmed event, so neither the crash sensor's decisions nor the safing agreement can
-    /// be trusted — one of them is wrong, and two sensors cannot say which. Before anything
-    /// of the crash phase fired, the backup path's own evidence (a crash predicted above the
-    /// no-fire line, the vehicle deceleration on CAN ≥ `backup_confirm_g` within the match
-    /// window of its contact: two sources independent of both accelerometers) decides the
-    /// event as it does for a faulty crash sensor: the reference restraint, the vehicle
-    /// deceleration standing in for the safing agreement. Without a predicted crash nothing
-    /// fires, as with a dead crash sensor.
+    /// be trusted — one of them is wrong, and two sensors cannot say which. Until the airbag
+    /// has fired, the backup path's own evidence (a crash predicted above the no-fire line,
+    /// the vehicle deceleration on CAN ≥ `backup_confirm_g` within the match window of its
+    /// contact: two sources independent of both accelerometers) decides the event as it does
+    /// for a faulty crash sensor: the reference restraint, the vehicle deceleration standing
+    /// in for the safing agreement. A pyrotechnic pretensioner the crash phase has already
+    /// fired stays fired and is not fired again; the airbag is the backup's to add (a crash
+    /// sensor reading 6 g low under a standing offset lifts its own event's floors out of
+    /// reach, and its crash phase would end with the belt alone). Without a predicted crash
+    /// nothing fires, as with a dead crash sensor.
     fn hand_over_to_the_backup(&mut self, now: u64, evidence: BackupEvidence) {
-        if self.backup_stands_in || self.crash_fired || self.airbag_fired {
+        if self.backup_stands_in || self.airbag_fired {
             return;
         }
         self.backup_stands_in = true;
@@ -452,7 +455,11 @@ impl Decision {
         self.gate = AirbagGate::Decided;
         self.pt_gate = AirbagGate::Decided;
         let reference = self.reference;
+        let belt_fired = self.crash_fired;
         self.schedule(&reference, contact, now, false);
+        if belt_fired {
+            self.pretensioner_at_ns = None;
+        }
     }
 
     /// Schedules a decided plan's crash-phase fires: the pyrotechnic pretensioner and the
