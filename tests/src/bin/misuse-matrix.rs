@@ -319,6 +319,13 @@ struct Outcome {
     /// ms; `None` without a twin or when the twin fired no airbag.
     #[serde(default)]
     clean_margin_ms: Option<f64>,
+    /// A family judged by outcome: whether the reference restraint's airbag is what keeps the
+    /// occupant from bottoming out in the true pulse (`None`: not asked).
+    #[serde(default)]
+    airbag_needed: Option<bool>,
+    /// The occupant bottomed out under what the ECU fired (`None`: no contact).
+    #[serde(default)]
+    bottomed_out: Option<bool>,
 }
 
 /// A crash phase entered less than this before the run's end is unfinished, not stuck, ms: the
@@ -326,13 +333,45 @@ struct Outcome {
 /// or offset that lasts to within a few ms of the end would otherwise count).
 const UNFINISHED_MS: f64 = 150.0;
 
-fn run_variant(cfg: &OfflineConfig, text: &str) -> Result<Outcome> {
+fn run_variant(cfg: &OfflineConfig, text: &str, req: Requirement) -> Result<Outcome> {
     let mut outcome = run_one(cfg, text)?;
     if let Some(clean) = misuse::clean_twin(text) {
         let twin = run_one(cfg, clean)?;
         outcome.clean_margin_ms = twin.airbag_ms.zip(twin.required_ms).map(|(t, r)| t - r);
     }
+    if req == Requirement::ByOutcome {
+        outcome.airbag_needed = Some(airbag_needed(cfg, text)?);
+    }
     Ok(outcome)
+}
+
+/// Whether the reference restraint's airbag is what keeps the occupant from bottoming out in
+/// the variant's true pulse: its belt alone (the airbag never fired) bottoms out, the whole
+/// reference restraint (the airbag at its time) does not. The occupant model and the
+/// reference are the actuator stubs' (`actuator_stubs::outcome`), not the ECU's.
+fn airbag_needed(cfg: &OfflineConfig, text: &str) -> Result<bool> {
+    use actuator_stubs::outcome::{judge, NEVER_S};
+    let scenario =
+        world::Scenario::parse("matrix", text).map_err(|e| anyhow::anyhow!("{e}\n{text}"))?;
+    let truth = world::Truth::new(&scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
+    if truth.collision.is_none() {
+        return Ok(false);
+    }
+    let pulse = truth.pulse.ego_pulse();
+    let occ = physics::OccupantInput {
+        mass_kg: scenario.occupant.mass_kg,
+        chest_to_wheel_m: scenario.occupant.chest_to_wheel_mm * 1e-3,
+        belted: scenario.occupant.belted,
+    };
+    let full = cfg.reference.settings();
+    let belt = physics::RestraintSettings {
+        airbag_force_n: 0.0,
+        airbag_time_s: NEVER_S,
+        ..full
+    };
+    let with_airbag = judge(&pulse, &occ, &full).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let belt_only = judge(&pulse, &occ, &belt).map_err(|e| anyhow::anyhow!("{e}"))?;
+    Ok(belt_only.0.bottomed_out && !with_airbag.0.bottomed_out)
 }
 
 fn run_one(cfg: &OfflineConfig, text: &str) -> Result<Outcome> {
@@ -363,6 +402,11 @@ fn run_one(cfg: &OfflineConfig, text: &str) -> Result<Outcome> {
         }),
         severity_excess_mps: r.severity_excess_mps,
         clean_margin_ms: None,
+        airbag_needed: None,
+        bottomed_out: r
+            .evaluated
+            .as_ref()
+            .map(|e| e.outcome.adaptive.bottomed_out),
     })
 }
 
@@ -382,7 +426,7 @@ fn list() {
             f.envelope
         );
     }
-    println!("requirements: no fire = no airbag and no pyrotechnic pretensioner (a reversible pre-crash one must be released), and a crash phase that fired nothing ends; no airbag = the belt may act; must fire = the airbag fires, its time against \"127 mm − 30 ms\" reported; report only = printed, not judged");
+    println!("requirements: no fire = no airbag and no pyrotechnic pretensioner (a reversible pre-crash one must be released), and a crash phase that fired nothing ends; no airbag = the belt may act; must fire = the airbag fires, its time against \"127 mm − 30 ms\" reported; by outcome = where the reference restraint's airbag is what keeps the occupant from bottoming out, what the ECU fired must keep it from bottoming out too; report only = printed, not judged");
 }
 
 /// Errors as one line (`misuse-matrix: error: …`), never a Debug dump with a backtrace.
@@ -457,7 +501,7 @@ fn run_matrix() -> Result<()> {
                 .par_iter()
                 .map(|&(f, i)| {
                     let text = families[f].variant(i, cli.seed);
-                    let o = run_variant(&cfg, &text);
+                    let o = run_variant(&cfg, &text, families[f].requirement);
                     if done.fetch_add(1, Ordering::Relaxed).is_multiple_of(256) {
                         bar.set_position(done.load(Ordering::Relaxed));
                     }
@@ -508,6 +552,8 @@ fn run_matrix() -> Result<()> {
         let in_time = cli.gate && !open && misuse::IN_TIME.contains(&name);
         let rows: Vec<_> = results.iter().filter(|r| r.0 == f).collect();
         let (mut bad_bag, mut bad_pt, mut missed, mut errors, mut stuck) = (0, 0, 0, 0, 0);
+        // Judged by outcome: variants whose airbag is needed, and airbags fired in the others.
+        let (mut needed, mut fired_unneeded) = (0, 0);
         let mut margins = Vec::new();
         // Fire − required less the clean twin's, where the family has twins.
         let (mut late, mut vs_clean) = (0, f64::NEG_INFINITY);
@@ -596,10 +642,39 @@ fn run_matrix() -> Result<()> {
                         fail("must-fire crash: no airbag");
                     }
                 },
+                Requirement::ByOutcome => {
+                    if o.airbag_needed != Some(true) {
+                        fired_unneeded += usize::from(o.airbag_ms.is_some());
+                        continue;
+                    }
+                    needed += 1;
+                    if let (Some(t), Some(req)) = (o.airbag_ms, o.required_ms) {
+                        margins.push(t - req);
+                        after += usize::from(t > req);
+                    }
+                    if o.bottomed_out == Some(true) {
+                        missed += 1;
+                        fail(&match o.airbag_ms {
+                            None => "the reference airbag keeps this occupant from bottoming out; no airbag, bottomed out".to_owned(),
+                            Some(t) => format!("the reference airbag keeps this occupant from bottoming out; airbag at {t:+.1} ms, bottomed out"),
+                        });
+                    }
+                }
             }
         }
         margins.sort_by(f64::total_cmp);
-        let timing = if margins.is_empty() {
+        let timing = if req == Requirement::ByOutcome {
+            let m = if margins.is_empty() {
+                "—".to_owned()
+            } else {
+                format!(
+                    "{:+.1} / {:+.1}",
+                    margins[margins.len() / 2],
+                    margins[margins.len() - 1]
+                )
+            };
+            format!("{m} (airbag needed in {needed}; fired in {fired_unneeded} of the others)")
+        } else if margins.is_empty() {
             "—".to_owned()
         } else {
             format!(
@@ -658,6 +733,8 @@ fn run_matrix() -> Result<()> {
             "worst_minus_clean_twin_ms": vs_clean.is_finite().then_some(vs_clean),
             "fire_minus_required_ms_p50": margins.get(margins.len() / 2),
             "fire_minus_required_ms_worst": margins.last(),
+            "airbag_needed": (req == Requirement::ByOutcome).then_some(needed),
+            "airbag_fired_where_not_needed": (req == Requirement::ByOutcome).then_some(fired_unneeded),
         }));
     }
     if healthy_excess.is_finite() {

@@ -23,6 +23,27 @@ pub(super) fn must_fire_crash(r: &mut ChaCha8Rng, name: &str, i: u64) -> String 
     barrier(name, i, v, tc, dead, "")
 }
 
+/// A crash between the no-fire and the must-fire lines: a 20–30 km/h barrier or equal cars
+/// at 20 + 20 to 30 + 30 km/h, objects live or dead, the occupant belted or not.
+pub(super) fn grey_zone(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
+    let (v, tc) = (r.gen_range(20.0..30.0), r.gen_range(0.35..0.5));
+    let dead = if r.gen_bool(0.5) {
+        "dropouts = [{ start_s = 0.2, end_s = 100.0, target = \"object\" }]\n"
+    } else {
+        ""
+    };
+    let text = if r.gen_bool(0.5) {
+        barrier(name, i, v, tc, dead, "")
+    } else {
+        equal_class(head_on(name, i, v, 1785.0, tc, None, tc + 0.25, dead, ""))
+    };
+    if r.gen_bool(0.5) {
+        text
+    } else {
+        text.replace("belted = true", "belted = false")
+    }
+}
+
 pub(super) fn must_fire_car(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let (v, tc) = (r.gen_range(35.0..56.0), r.gen_range(0.35..0.5));
     let v2x = v2x_station(r, true);
