@@ -42,7 +42,7 @@ log=$(mktemp); trap 'rm -f "$log"' EXIT
 cargo test --workspace --release --features bus/socket 2>&1 | tee "$log"
 totals=$(awk '/^test result:/ { p += $4; f += $6 } END { printf "%d passed, %d failed", p, f }' "$log")
 
-step "misuse matrix gate: 16 000 seeded misuse / single-fault / must-fire variants through the core (≈ 15 s)"
+step "misuse matrix gate: 16 000 seeded misuse / single-fault / must-fire variants through the core (≈ 30 s on 2 cores)"
 # Every family that holds must stay at 0 fires where none may, 0 misses, 0 stuck crash phases;
 # the families still open (e2e_tests::misuse::OPEN) and the beyond-physics sweep are printed.
 target/release/misuse-matrix --variants 16000 --seed 7 --gate --quiet
