@@ -213,6 +213,17 @@ impl Head {
         matches!(self.decision, FallbackDecision::Fire { .. })
     }
 
+    fn pending(&self) -> bool {
+        self.decision == FallbackDecision::Pending
+    }
+
+    /// A pending decision closes as no-fire at `t_ns` (its event ended, or its window passed).
+    fn close(&mut self, t_ns: u64) {
+        if self.pending() {
+            self.decision = FallbackDecision::NoFire(t_ns);
+        }
+    }
+
     /// Whether `dv` at `tau_ms` reaches the boundary (scaled, lifted) and the floor.
     fn reached(&self, tau_ms: f64, dv: f64, scale: f64, lift_mps: f64, floor_mps: f64) -> bool {
         dv >= scale * threshold_mps(&self.thresholds, tau_ms) + lift_mps && dv >= floor_mps
@@ -323,11 +334,8 @@ impl FallbackAlgorithm {
             OnsetStep::Quiet => return,
             OnsetStep::Reset => {
                 // An event that ended under the boundary was a no-fire; a fired event is over.
-                for h in [&mut self.airbag, &mut self.pretensioner] {
-                    if h.decision == FallbackDecision::Pending {
-                        h.decision = FallbackDecision::NoFire(s.t_ns);
-                    }
-                }
+                self.airbag.close(s.t_ns);
+                self.pretensioner.close(s.t_ns);
                 self.run = 0;
                 self.dip_since_ns = None;
                 return;
@@ -365,8 +373,7 @@ impl FallbackAlgorithm {
         } else {
             0
         };
-        let pending = |h: &Head| h.decision == FallbackDecision::Pending;
-        if !(pending(&self.airbag) || pending(&self.pretensioner)) {
+        if !(self.airbag.pending() || self.pretensioner.pending()) {
             return;
         }
         let Some(onset) = self.onset.onset_ns() else {
@@ -375,11 +382,8 @@ impl FallbackAlgorithm {
         let tau_ms = s.t_ns.saturating_sub(self.segment_onset_ns) as f64 * 1e-6;
         let dv = self.onset.delta_v_mps() - self.segment_base_dv_mps;
         if tau_ms > WINDOW_MS {
-            for h in [&mut self.airbag, &mut self.pretensioner] {
-                if h.decision == FallbackDecision::Pending {
-                    h.decision = FallbackDecision::NoFire(s.t_ns);
-                }
-            }
+            self.airbag.close(s.t_ns);
+            self.pretensioner.close(s.t_ns);
             return;
         }
         // Persistence and loading are both restraints' (asked once, and only of a sample
@@ -389,11 +393,11 @@ impl FallbackAlgorithm {
             onset_ns: onset,
         };
         let scale = t.boundary_scale;
-        let airbag = pending(&self.airbag)
+        let airbag = self.airbag.pending()
             && self
                 .airbag
                 .reached(tau_ms, dv, scale, self.boundary_lift_mps, t.min_dv_mps);
-        let pretensioner = pending(&self.pretensioner)
+        let pretensioner = self.pretensioner.pending()
             && self
                 .pretensioner
                 .reached(tau_ms, dv, scale, 0.0, t.pretensioner_min_dv_mps);
@@ -410,8 +414,9 @@ impl FallbackAlgorithm {
     /// Follows the segment's valleys (module docs, "Re-onset"): the lowest sample of the latest
     /// dip under [`VALLEY_FRACTION`] of the crest is kept, and once the deceleration (as
     /// [`Loading`] smooths it) rises past the crest before that dip, the segment restarts at
-    /// the valley. A valley needs a crest of more than twice the wake threshold: under it, the dip under
-    /// the wake threshold is the re-onset's rule (a quiet stretch's noise is no valley).
+    /// the valley. A valley needs a crest of more than 1 / [`VALLEY_FRACTION`] times the wake
+    /// threshold: under it, the dip under the wake threshold is the re-onset's rule (a quiet
+    /// stretch's noise is no valley).
     fn follow_valley(
         &mut self,
         p: &ConfirmParams,
@@ -422,20 +427,21 @@ impl FallbackAlgorithm {
         let crest = self.loading.peak_mps2();
         let level = VALLEY_FRACTION * crest;
         if level > p.wake_mps2 && s.decel_mps2 < level {
-            let deeper = self
-                .valley
-                .is_some_and(|v| self.in_valley && s.decel_mps2 < v.decel_mps2);
-            if !self.in_valley || deeper {
-                let crest_before = match self.valley {
-                    Some(v) if self.in_valley => v.crest_before_mps2,
-                    _ => crest,
-                };
-                self.valley = Some(Valley {
-                    t_ns: s.t_ns,
-                    dv_mps: before_dv,
-                    decel_mps2: s.decel_mps2,
-                    crest_before_mps2: crest_before,
-                });
+            match &mut self.valley {
+                // Deeper into the open valley: its lowest sample moves, its crest stays.
+                Some(v) if self.in_valley => {
+                    if s.decel_mps2 < v.decel_mps2 {
+                        (v.t_ns, v.dv_mps, v.decel_mps2) = (s.t_ns, before_dv, s.decel_mps2);
+                    }
+                }
+                _ => {
+                    self.valley = Some(Valley {
+                        t_ns: s.t_ns,
+                        dv_mps: before_dv,
+                        decel_mps2: s.decel_mps2,
+                        crest_before_mps2: crest,
+                    })
+                }
             }
             self.in_valley = true;
             return;
@@ -508,6 +514,11 @@ mod tests {
         }
     }
 
+    /// The oracle boundary: linear, 0.1 + 0.1·τ/4 m/s.
+    fn linear() -> [f64; KNOTS] {
+        core::array::from_fn(|i| 0.1 + 0.1 * i as f64)
+    }
+
     /// No floor beyond the boundary: one sample of persistence at 0 g, no Δv floor.
     const NO_FLOOR: FireFloor = FireFloor {
         min_dv_mps: 0.0,
@@ -569,7 +580,7 @@ mod tests {
     fn a_constant_pulse_fires_where_its_velocity_line_meets_the_boundary() {
         // Oracle: Δv after n samples of a = n·a·1 ms (the wake sample counts), τ = (n − 1) ms;
         // fire at the first n with n·a·1e-3 ≥ T(n − 1). Boundary 0.1 + 0.1·τ/4 m/s (linear).
-        let lin: [f64; KNOTS] = core::array::from_fn(|i| 0.1 + 0.1 * i as f64);
+        let lin = linear();
         // Δv after n samples of a from rest (trapezoidal): (n − ½)·a·1 ms, at τ = n − 1 ms.
         let mut f = FallbackAlgorithm::new(lin, NO_FLOOR);
         run(&mut f, 5.0, 80); // a = 49.03 m/s²: (n − ½)·0.04903 ≥ 0.075 + 0.025 n → n ≥ 4.14
@@ -595,7 +606,7 @@ mod tests {
         // The oracle above on the pretensioner's boundary (linear 0.1 + 0.1·τ/4 m/s), the
         // airbag's out of reach: the pretensioner decides at τ = 4 ms, the airbag closes its
         // window under the boundary at the first sample after 60 ms.
-        let lin: [f64; KNOTS] = core::array::from_fn(|i| 0.1 + 0.1 * i as f64);
+        let lin = linear();
         let mut f =
             FallbackAlgorithm::new([f64::INFINITY; KNOTS], NO_FLOOR).with_pretensioner(lin, 0.0);
         run(&mut f, 5.0, 80);
@@ -616,7 +627,7 @@ mod tests {
     fn a_boundary_lift_moves_the_fire_to_where_the_velocity_line_meets_the_lifted_boundary() {
         // The same oracle with the boundary lifted by 0.3 m/s: 5 g fires at the first n with
         // (n − ½)·0.04903 ≥ 0.375 + 0.025 n → n ≥ 16.1, the sample at τ = 16 ms.
-        let lin: [f64; KNOTS] = core::array::from_fn(|i| 0.1 + 0.1 * i as f64);
+        let lin = linear();
         let mut f = FallbackAlgorithm::new(lin, NO_FLOOR);
         f.lift_boundary(0.3);
         run(&mut f, 5.0, 80);

@@ -162,7 +162,7 @@ pub(super) fn low_speed_kerb_untracked(r: &mut ChaCha8Rng, name: &str, i: u64) -
         3
     };
     let keys = match r.gen_range(0..faults) {
-        0 => "dropouts = [{ start_s = 0.2, end_s = 100.0, target = \"object\" }]\n".to_owned(),
+        0 => OBJECTS_DEAD.to_owned(),
         1 => format!("confidence = {}\n", r.gen_range(0.05..0.5)),
         _ => format!("mass_bias_kg = {}\n", r.gen_range(0.0..1200.0)),
     };

@@ -5,21 +5,13 @@ use super::*;
 
 pub(super) fn no_fire_crash(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let (v, tc) = (r.gen_range(8.0..16.0), r.gen_range(0.35..0.5));
-    let dead = if r.gen_bool(0.5) {
-        "dropouts = [{ start_s = 0.2, end_s = 100.0, target = \"object\" }]\n"
-    } else {
-        ""
-    };
+    let dead = if r.gen_bool(0.5) { OBJECTS_DEAD } else { "" };
     barrier(name, i, v, tc, dead, "")
 }
 
 pub(super) fn must_fire_crash(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let (v, tc) = (r.gen_range(35.0..56.0), r.gen_range(0.35..0.5));
-    let dead = if r.gen_bool(0.5) {
-        "dropouts = [{ start_s = 0.2, end_s = 100.0, target = \"object\" }]\n"
-    } else {
-        ""
-    };
+    let dead = if r.gen_bool(0.5) { OBJECTS_DEAD } else { "" };
     barrier(name, i, v, tc, dead, "")
 }
 
@@ -27,11 +19,7 @@ pub(super) fn must_fire_crash(r: &mut ChaCha8Rng, name: &str, i: u64) -> String 
 /// at 20 + 20 to 30 + 30 km/h, objects live or dead, the occupant belted or not.
 pub(super) fn grey_zone(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let (v, tc) = (r.gen_range(20.0..30.0), r.gen_range(0.35..0.5));
-    let dead = if r.gen_bool(0.5) {
-        "dropouts = [{ start_s = 0.2, end_s = 100.0, target = \"object\" }]\n"
-    } else {
-        ""
-    };
+    let dead = if r.gen_bool(0.5) { OBJECTS_DEAD } else { "" };
     let text = if r.gen_bool(0.5) {
         barrier(name, i, v, tc, dead, "")
     } else {

@@ -3,6 +3,10 @@
 
 use super::*;
 
+/// The `[sensor]` key of a crash with the object list dead from 0.2 s on (no prediction).
+pub(super) const OBJECTS_DEAD: &str =
+    "dropouts = [{ start_s = 0.2, end_s = 100.0, target = \"object\" }]\n";
+
 pub(super) const OCCUPANT: &str =
     "[occupant]\nmass_kg = 75\nchest_to_wheel_mm = 300\nbelted = true\n";
 
