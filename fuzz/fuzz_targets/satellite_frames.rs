@@ -72,11 +72,11 @@ fuzz_target!(|data: &[u8]| {
         }
         if r[0] & 2 != 0 {
             one_sided.on_frames(SatelliteSide::Right, &at_rest, now);
-            for (relief, judged) in [(fused.relief(now), "fused"), (one_sided.relief(now), "one")] {
+            for (relief, judged) in [(fused.relief(now, true), "fused"), (one_sided.relief(now, true), "one")] {
                 assert!((0.0..=1.0).contains(&relief.fraction), "{judged}: {relief:?}");
                 assert!(relief.floor_mps(1.25, 0.3) <= Relief::NONE.floor_mps(1.25, 0.3) + 1e-12);
             }
-            let one = one_sided.relief(now);
+            let one = one_sided.relief(now, true);
             assert!(
                 (one.fraction == 0.0 && one.boundary_lift_mps == params.low_crush_lift_mps)
                     || one_sided.faulty(SatelliteSide::Right, now),

@@ -248,12 +248,21 @@ impl Crash {
     }
 }
 
-/// Runs the ECU's detectors over `samples` (contact at `contact_ns`).
-pub fn measure(cfg: &CycleConfig, samples: &[AccelSample], contact_ns: u64) -> Measured {
+/// Runs the ECU's detectors over `samples` (contact at `contact_ns`), for a belted occupant or
+/// (`belted` false) one the ECU does not know to be belted: the airbag boundary is then
+/// `unbelted_dv_mps`.
+pub fn measure(
+    cfg: &CycleConfig,
+    samples: &[AccelSample],
+    contact_ns: u64,
+    belted: bool,
+) -> Measured {
     let p = cfg.confirm_params();
     let mut onset = Onset::default();
     let mut generic = CrashDetector::default();
-    let mut algo = FallbackAlgorithm::new(cfg.fallback_dv_mps, cfg.fallback_floor());
+    let mut algo = FallbackAlgorithm::new(cfg.fallback_dv_mps, cfg.fallback_floor())
+        .with_unbelted(cfg.unbelted_dv_mps);
+    algo.set_belted(belted);
     let mut roughness = cfg.roughness();
     let mut curve = Vec::new();
     let mut first_event = true;
@@ -394,6 +403,9 @@ pub struct Sweep {
     pub families: Vec<Family>,
     /// Sensor variants every case is run with.
     pub sensors: Vec<SensorSpec>,
+    /// The occupant is belted (the airbag boundary as configured); `false`: not known to be
+    /// (the boundary scaled to the unbelted no-fire line).
+    pub belted: bool,
 }
 
 /// Braking that goes on through the crash in the robustness variant, m/s² (1 g).
@@ -419,6 +431,7 @@ impl Sweep {
             step_kph: 1.0,
             families: families(),
             sensors,
+            belted: true,
         }
     }
 
@@ -501,7 +514,7 @@ pub fn run_sweep(cfg: &CycleConfig, sweep: &Sweep) -> Result<Vec<Row>> {
                 .iter()
                 .map(|sensor| {
                     let (samples, contact_ns) = crash.samples(sensor);
-                    measure(cfg, &samples, contact_ns)
+                    measure(cfg, &samples, contact_ns, sweep.belted)
                 })
                 .collect();
             Ok(Row {

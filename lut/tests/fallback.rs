@@ -7,7 +7,7 @@ use lut::fallback_study::{
     calibrate, must_fire_line, run_sweep, violations, Family, SensorSpec, Sweep,
     ACCEL_ONLY_LATENESS_BOUND_MS,
 };
-use restraint::fallback::DEFAULT_DV_MPS;
+use restraint::fallback::{DEFAULT_DV_MPS, DEFAULT_UNBELTED_DV_MPS};
 use restraint::CycleConfig;
 
 fn t_ref_ms() -> f64 {
@@ -32,6 +32,51 @@ fn the_shipped_boundary_is_the_calibration_of_the_sweep_and_meets_its_requiremen
     assert_eq!(must, 28.0);
     let bad = violations(&rows, cfg.no_fire_ebs_kph, must, t_ref_ms(), 0.0);
     assert!(bad.is_empty(), "{bad:#?}");
+}
+
+/// The boundary for an occupant not known to be belted: what the sweep's crashes below the
+/// unbelted no-fire line derive, and on the sweep no crash below that line fires while every
+/// crash from the belted no-fire line on does (an unbelted occupant is held by the airbag
+/// alone), in every sensor variant.
+#[test]
+fn the_unbelted_boundary_is_the_calibration_of_the_sweep_and_meets_its_lines() {
+    let cfg = CycleConfig::default();
+    let sweep = Sweep {
+        belted: false,
+        ..Sweep::calibration()
+    };
+    let rows = run_sweep(&cfg, &sweep).expect("sweep");
+    assert_eq!(
+        calibrate(&rows, cfg.unbelted_no_fire_ebs_kph, 0.10),
+        DEFAULT_UNBELTED_DV_MPS,
+        "the default must be what `lut study fallback --derive --unbelted` derives"
+    );
+    let fired = |r: &lut::fallback_study::Row| {
+        (0..r.measured.len()).all(|i| r.airbag_ms(i, t_ref_ms()).is_some())
+    };
+    for r in &rows {
+        let e = r.req.ebs_kph;
+        if r.spec.no_fire(e, cfg.unbelted_no_fire_ebs_kph) {
+            assert!(
+                !r.fires(t_ref_ms()),
+                "{} at EBS {e}: fired",
+                r.spec.family.label()
+            );
+        }
+        if e >= cfg.no_fire_ebs_kph {
+            assert!(fired(r), "{} at EBS {e}: not fired", r.spec.family.label());
+        }
+    }
+    // Against the belted boundary the unbelted one fires earlier, never later.
+    let belted = run_sweep(&cfg, &Sweep::calibration()).expect("sweep");
+    for (u, b) in rows.iter().zip(&belted) {
+        for i in 0..u.measured.len() {
+            if let Some(tb) = b.airbag_ms(i, t_ref_ms()) {
+                let tu = u.airbag_ms(i, t_ref_ms()).expect("fired for the belted");
+                assert!(tu <= tb, "{}: {tu} ms after {tb} ms", u.spec.family.label());
+            }
+        }
+    }
 }
 
 #[test]
@@ -59,6 +104,7 @@ fn it_also_holds_on_crashes_it_was_not_calibrated_on() {
                 ..SensorSpec::bench(14)
             },
         ],
+        belted: true,
     };
     let rows = run_sweep(&cfg, &sweep).expect("sweep");
     // Off the calibration sweep the path may be late — by at most the bound of the safety

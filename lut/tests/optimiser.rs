@@ -400,7 +400,9 @@ fn relieved_floor_ms(
         let batch = &samples[first..next];
         let dv: f64 = batch.iter().map(|s| s.decel_mps2 * s.dt_s).sum();
         sats.on_tunnel_dv(dv);
-        let floor = sats.relief(now).floor_mps(cfg.fallback_min_dv_mps, 0.0);
+        let floor = sats
+            .relief(now, true)
+            .floor_mps(cfg.fallback_min_dv_mps, 0.0);
         for s in batch {
             onset.push(&p, s);
             if onset.delta_v_mps() >= floor {

@@ -51,6 +51,17 @@ pub struct CycleConfig {
     /// velocity, v_close · m_opp / (m_ego + m_opp): v/2 for equal cars, v for a rigid barrier.
     /// The conservative opponent mass is used (fails towards firing).
     pub no_fire_ebs_kph: f64,
+    /// The airbag's no-fire line for an occupant not known to be belted, km/h (*default* 14,
+    /// ≈ 9 mph): the belt buckle switch reads unbuckled, or its frame is missing or stale. An
+    /// unbelted occupant is held by the airbag alone and strikes the wheel in a 20 km/h crash
+    /// that the belt alone rides down, so production ECUs fire for them from a lower
+    /// severity (dual thresholds; GM's single-stage deploy band 9–14 mph, the field's 50 %
+    /// deployment at a Δv of 8–12 mph). The tracked path's low-speed rule and re-plan use it;
+    /// the accelerometer-only path judges the airbag against `unbelted_dv_mps`, calibrated on
+    /// it. The severity floors — what holds every misuse event — are the same for both. A buckle
+    /// switch that reads unbuckled when the occupant is belted (one fault) can therefore fire
+    /// the airbag in a 14–20 km/h crash, never on misuse.
+    pub unbelted_no_fire_ebs_kph: f64,
 
     /// Crash confirmation: the accelerometer is "awake" from this deceleration, g
     /// (*default* 1.5); the first awake sample is the measured contact instant.
@@ -128,6 +139,10 @@ pub struct CycleConfig {
     /// `lut study fallback --derive`, restraint/README.md, "Crash phase"). Reaching it fires
     /// the reference airbag; not reaching it within 60 ms is a no-fire.
     pub fallback_dv_mps: [f64; crate::fallback::KNOTS],
+    /// The same boundary for an occupant not known to be belted, m/s at 0, 4, … 60 ms
+    /// (*default* calibrated by `lut study fallback --derive --unbelted` on the sweep's crashes
+    /// below `unbelted_no_fire_ebs_kph`); at no knot above `fallback_dv_mps`.
+    pub unbelted_dv_mps: [f64; crate::fallback::KNOTS],
     /// The airbag's severity floor, m/s (*default* 1.25 ≈ 4.5 km/h): a conventional must-fire
     /// needs at least this velocity change since the onset and the generic confirmation's
     /// persistence (`confirm_decel_g` for `confirm_samples`) at the deciding sample, and a
@@ -298,6 +313,12 @@ pub struct CycleConfig {
     /// *default* 1.2: a kerb strike or pothole inside a 12–16 km/h crash, the matrix's
     /// envelope × 1.5). 0 = off.
     pub satellite_low_crush_lift_mps: f64,
+    /// For an occupant not known to be belted the low-crush lift ends once usable satellites
+    /// see the front end crush this much, m/s (*default* 0.5: above a 14 km/h barrier's 0.45 —
+    /// the unbelted no-fire line — and every misuse event's ≤ 0.41; a 20 km/h barrier's ≈ 0.6).
+    /// At `satellite_relief_from_mps` the lift would hold an unbelted occupant's 20–22 km/h
+    /// crash to the boundary plus 1.2 m/s, tens of ms late.
+    pub satellite_unbelted_crush_mps: f64,
 
     /// Crash accelerometer: no batch for this long → `ACCEL_STALE`, ms (*default* 50: batches
     /// come every ms, so 50 missed ones are a dead sensor; with one 20 ms `EcuStatus` period the
@@ -345,6 +366,7 @@ impl Default for CycleConfig {
             avoided_margin_ms: 60.0,
             min_confidence: 0.5,
             no_fire_ebs_kph: 20.0,
+            unbelted_no_fire_ebs_kph: 14.0,
             confirm_wake_g: 1.5,
             confirm_decel_g: 4.0,
             confirm_samples: 3,
@@ -362,6 +384,7 @@ impl Default for CycleConfig {
             v2x_gate_speed_mps: 3.0,
             backup_confirm_g: 4.0,
             fallback_dv_mps: crate::fallback::DEFAULT_DV_MPS,
+            unbelted_dv_mps: crate::fallback::DEFAULT_UNBELTED_DV_MPS,
             fallback_min_dv_mps: 1.25,
             pretensioner_dv_mps: crate::fallback::DEFAULT_PRETENSIONER_DV_MPS,
             pretensioner_min_dv_mps: 1.5,
@@ -392,6 +415,7 @@ impl Default for CycleConfig {
             satellite_floor_mps: 0.5,
             satellite_boundary_scale: 1.0,
             satellite_low_crush_lift_mps: 1.2,
+            satellite_unbelted_crush_mps: 0.5,
             accel_timeout_ms: 50.0,
             accel_stuck_ms: 20.0,
             accel_full_scale_g: 200.0,
@@ -426,6 +450,12 @@ impl CycleConfig {
         range("avoided_margin_ms", self.avoided_margin_ms, 0.0, 1000.0)?;
         range("min_confidence", self.min_confidence, 0.0, 1.0)?;
         range("no_fire_ebs_kph", self.no_fire_ebs_kph, 0.0, 100.0)?;
+        range(
+            "unbelted_no_fire_ebs_kph",
+            self.unbelted_no_fire_ebs_kph,
+            0.0,
+            self.no_fire_ebs_kph,
+        )?;
         range("confirm_wake_g", self.confirm_wake_g, 0.1, 50.0)?;
         range(
             "confirm_decel_g",
@@ -468,6 +498,10 @@ impl CycleConfig {
         range("v2x_gate_speed_mps", self.v2x_gate_speed_mps, 0.0, 30.0)?;
         range("backup_confirm_g", self.backup_confirm_g, 1.5, 15.0)?;
         crate::fallback::validate_thresholds("fallback_dv_mps", &self.fallback_dv_mps)?;
+        crate::fallback::validate_thresholds("unbelted_dv_mps", &self.unbelted_dv_mps)?;
+        for (&u, &b) in self.unbelted_dv_mps.iter().zip(&self.fallback_dv_mps) {
+            range("unbelted_dv_mps", u, 0.0, b)?;
+        }
         range("fallback_min_dv_mps", self.fallback_min_dv_mps, 0.0, 20.0)?;
         crate::fallback::validate_thresholds("pretensioner_dv_mps", &self.pretensioner_dv_mps)?;
         range(
@@ -537,6 +571,12 @@ impl CycleConfig {
             0.0,
             5.0,
         )?;
+        range(
+            "satellite_unbelted_crush_mps",
+            self.satellite_unbelted_crush_mps,
+            0.0,
+            self.satellite_relief_from_mps,
+        )?;
         range("safing_wake_g", self.safing_wake_g, 0.1, 50.0)?;
         range("safing_dv_mps", self.safing_dv_mps, 0.01, 5.0)?;
         range("safing_hold_ms", self.safing_hold_ms, 0.0, 1_000.0)?;
@@ -588,6 +628,16 @@ impl CycleConfig {
         range("e2e_hold_ms", self.e2e_hold_ms, 0.0, 60_000.0)?;
         range("e2e_max_lost", f64::from(self.e2e_max_lost), 0.0, 14.0)?;
         self.track.validate()
+    }
+
+    /// The airbag's no-fire line for the occupant, km/h: `no_fire_ebs_kph` for a belted one,
+    /// `unbelted_no_fire_ebs_kph` for any other (unbuckled, or the buckle not known).
+    pub fn no_fire_line_kph(&self, belted: bool) -> f64 {
+        if belted {
+            self.no_fire_ebs_kph
+        } else {
+            self.unbelted_no_fire_ebs_kph
+        }
     }
 
     /// The closing speed [m/s] from which a matched crash fires on its plan without waiting
@@ -661,6 +711,7 @@ impl CycleConfig {
             floor_mps: self.satellite_floor_mps,
             boundary_scale: self.satellite_boundary_scale,
             low_crush_lift_mps: self.satellite_low_crush_lift_mps,
+            unbelted_crush_mps: self.satellite_unbelted_crush_mps,
         }
     }
 

@@ -97,6 +97,7 @@ impl CrashMonitor {
             generic: CrashDetector::default(),
             matcher: PulseMatch::new(cfg.match_params()),
             fallback: FallbackAlgorithm::new(cfg.fallback_dv_mps, cfg.fallback_floor())
+                .with_unbelted(cfg.unbelted_dv_mps)
                 .with_pretensioner(cfg.pretensioner_dv_mps, cfg.pretensioner_min_dv_mps),
             window_ns: ms_to_ns(cfg.match_window_ms),
             backup_decel_mps2: cfg.backup_confirm_g * G_MPS2,
@@ -111,11 +112,14 @@ impl CrashMonitor {
     /// only updates their integrators' previous value with its last sample: the common case,
     /// every cycle of a drive, and what each detector would do sample by sample. `relief`:
     /// what the crush-zone satellites take off the thresholds now ([`crate::satellites`]),
-    /// asked only for a batch that is judged (a quiet one needs none).
+    /// asked only for a batch that is judged (a quiet one needs none); `belted`: the occupant
+    /// is known to be belted (else the airbag's boundary is the unbelted one,
+    /// `CycleConfig::unbelted_no_fire_ebs_kph`).
     pub(crate) fn on_batch(
         &mut self,
         batch: &PlausibleBatch,
         ctx: &FreezeContext<'_, '_>,
+        belted: bool,
         relief: impl FnOnce() -> Relief,
     ) {
         let wake = self.onset_params.wake_mps2;
@@ -134,6 +138,7 @@ impl CrashMonitor {
         // The satellites' low-crush lift is the airbag's: a crash below its no-fire line may
         // still need the belt.
         self.fallback.lift_boundary(relief.boundary_lift_mps);
+        self.fallback.set_belted(belted);
         let thresholds = self.fallback.thresholds_now(lift, relief);
         // A rough road's lobes are no crash evidence for the generic confirmation either (nor
         // for the CrashDetected it puts on the bus, which body ECUs act on): its Δv threshold
@@ -285,6 +290,12 @@ impl CrashMonitor {
         self.fallback.segment_onset_ns()
     }
 
+    /// The airbag's accelerometer-only boundary for the occupant of the latest judged batch
+    /// (m/s at the knots, before the satellites' relief and lift).
+    pub fn airbag_boundary(&self) -> &[f64; crate::fallback::KNOTS] {
+        self.fallback.airbag_boundary()
+    }
+
     /// What the road's roughness adds to every fire's severity floor now, m/s.
     pub fn floor_lift_mps(&self) -> f64 {
         self.roughness.floor_lift_mps()
@@ -349,17 +360,18 @@ pub struct BackupEvidence {
 
 /// The table's plan for an adaptive crash re-estimated at closing speed `closing_mps` (the
 /// lookup raises the mass to the robust planning mass, `Estimator::lookup`). `None` when the
-/// re-estimated severity is below the no-fire line: the crash then goes the conventional way.
+/// re-estimated severity is below the occupant's no-fire line `no_fire_ebs_kph`: the crash then goes the conventional way.
 pub(crate) fn plan_for(
     cfg: &CycleConfig,
     estimator: &Estimator<'_>,
     sit: &Situation,
     closing_mps: f64,
     inputs: &InputMonitor,
+    no_fire_ebs_kph: f64,
     counters: &mut CycleCounters,
 ) -> Option<RestraintPlan> {
     let ebs = equivalent_barrier_speed_kph(closing_mps, cfg.ego_mass_kg, sit.opponent_mass_kg);
-    if !(ebs >= cfg.no_fire_ebs_kph) {
+    if !(ebs >= no_fire_ebs_kph) {
         return None;
     }
     let planned = Situation {

@@ -238,6 +238,7 @@ impl Activity for RestraintCycle<'_> {
             };
         }
         let braking = self.braking_decel_mps2;
+        let belted = inputs.occupant_belted(now);
         // The satellites first: their crush Δv up to now relieves this cycle's samples.
         let satellites = &mut self.satellites;
         satellites.begin_cycle(now);
@@ -258,8 +259,8 @@ impl Activity for RestraintCycle<'_> {
             satellites.on_tunnel_dv(dv_mps);
             plausible.remove_decel(braking);
             *relief = Relief::NONE;
-            crash.on_batch(&plausible, &freeze, || {
-                *relief = satellites.relief(now);
+            crash.on_batch(&plausible, &freeze, belted, || {
+                *relief = satellites.relief(now, belted);
                 *relief
             });
         });
@@ -323,7 +324,7 @@ impl Activity for RestraintCycle<'_> {
             && (self.inputs.new_object
                 || (self.inputs.occupant_changed && self.estimate.situation.is_some()));
         if estimated {
-            if let Some(plan) = self.estimate.update(now, &self.inputs, c) {
+            if let Some(plan) = self.estimate.update(now, &self.inputs, belted, c) {
                 self.decision.plan = plan;
             }
         }
@@ -383,14 +384,16 @@ impl Activity for RestraintCycle<'_> {
         let event_loading = || crash.event_loading();
         let heaviest_fires_airbag =
             || situation.is_some_and(|s| est.heaviest_opponent_fires_airbag(&s, inputs));
+        let no_fire_ebs_kph = cfg.no_fire_line_kph(belted);
         let mut replan = |closing_mps: f64| {
             let sit = situation?;
-            plan_for(cfg, est, &sit, closing_mps, inputs, c)
+            plan_for(cfg, est, &sit, closing_mps, inputs, no_fire_ebs_kph, c)
         };
         let mut x = DecisionInputs {
             half_period_ns: info.period_ns / 2,
             degraded,
             situation,
+            no_fire_ebs_kph,
             new_object: self.inputs.new_object,
             object_present: self.inputs.object_present,
             confirmation: self.crash.confirmation(),

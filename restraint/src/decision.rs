@@ -82,6 +82,8 @@ pub(crate) struct DecisionInputs<'d> {
     pub degraded: bool,
     /// Newest situation estimate (`None`: no object, no contact, or stale).
     pub situation: Option<Situation>,
+    /// The airbag's no-fire line for the occupant, km/h (`CycleConfig::no_fire_line_kph`).
+    pub no_fire_ebs_kph: f64,
     /// A new object sample arrived this cycle.
     pub new_object: bool,
     /// The newest object sample tracks an object.
@@ -163,10 +165,9 @@ pub struct Decision {
     low_speed_misuse_dv_mps: f64,
     low_speed_dv_factor: f64,
     /// For the low-speed limit: the ego mass, the opponent-mass misreport one fault may carry
-    /// (`mass_misreport_kg`) and the no-fire line.
+    /// (`mass_misreport_kg`; the no-fire line is the situation's, for its occupant).
     ego_mass_kg: f64,
     mass_misreport_kg: f64,
-    no_fire_ebs_kph: f64,
     gate: AirbagGate,
     /// The pyrotechnic pretensioner's gate in the crash phase.
     pt_gate: AirbagGate,
@@ -232,7 +233,6 @@ impl Decision {
             low_speed_dv_factor: cfg.low_speed_dv_factor,
             ego_mass_kg: cfg.ego_mass_kg,
             mass_misreport_kg: cfg.mass_misreport_kg,
-            no_fire_ebs_kph: cfg.no_fire_ebs_kph,
             gate: AirbagGate::Decided,
             pt_gate: AirbagGate::Decided,
             safing_wait_ns: ms_to_ns(cfg.safing_wait_ms),
@@ -355,6 +355,7 @@ impl Decision {
         // severe crash look low-speed); the bound takes the closing speed, not the EBS: the
         // opponent's mass only lowers the ego's Δv (EBS ≤ closing speed), and the reported
         // mass is what a barrier reported as a 3 000 kg object gets wrong.
+        let no_fire_ebs_kph = x.no_fire_ebs_kph;
         if let Some(s) = x.situation.filter(|s| {
             let robust_ebs_kph = crate::estimate::equivalent_barrier_speed_kph(
                 s.closing_speed_mps,
@@ -362,7 +363,7 @@ impl Decision {
                 s.opponent_mass_estimate_kg + self.mass_misreport_kg,
             );
             s.low_speed
-                && robust_ebs_kph < self.no_fire_ebs_kph
+                && robust_ebs_kph < no_fire_ebs_kph
                 && s.contact_estimate_ns.abs_diff(c.contact_ns) <= self.avoided_margin_ns
         }) {
             self.low_speed_dv_limit_mps =

@@ -80,6 +80,13 @@ pub const DEFAULT_DV_MPS: [f64; KNOTS] = [
     0.10, 0.25, 0.70, 1.25, 1.90, 2.55, 3.30, 4.10, 4.90, 5.55, 6.50, 7.05, 7.35, 7.35, 7.35, 7.35,
 ];
 
+/// Default boundary for an occupant not known to be belted, m/s at 0, 4, … 60 ms: the same
+/// envelope (+10 %) over the calibration sweep's crashes below the unbelted no-fire line (14
+/// km/h), from `lut study fallback --derive --unbelted` (`lut/tests/fallback.rs` checks it).
+pub const DEFAULT_UNBELTED_DV_MPS: [f64; KNOTS] = [
+    0.10, 0.20, 0.55, 1.00, 1.55, 2.15, 2.75, 3.45, 3.90, 4.55, 5.10, 5.25, 5.25, 5.25, 5.25, 5.25,
+];
+
 /// Default boundary of the pyrotechnic pretensioner on the conventional path: 0.6 × the
 /// airbag's [`DEFAULT_DV_MPS`] (restraint/README.md, "No-fire lines").
 pub const DEFAULT_PRETENSIONER_DV_MPS: [f64; KNOTS] = [
@@ -236,7 +243,12 @@ impl Head {
 /// time; each decision belongs to the event and is forgotten when the next one begins.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FallbackAlgorithm {
+    /// The airbag's head; its boundary is the occupant's of [`Self::airbag_boundaries`].
     airbag: Head,
+    /// The airbag's boundaries for a belted occupant and for one not known to be belted.
+    airbag_boundaries: [[f64; KNOTS]; 2],
+    /// The airbag judges for a belted occupant ([`Self::set_belted`]).
+    belted: bool,
     pretensioner: Head,
     floor: FireFloor,
     onset: Onset,
@@ -265,6 +277,8 @@ impl FallbackAlgorithm {
     pub fn new(thresholds: [f64; KNOTS], floor: FireFloor) -> Self {
         Self {
             airbag: Head::new(thresholds, floor.min_dv_mps),
+            airbag_boundaries: [thresholds; 2],
+            belted: true,
             pretensioner: Head::new(thresholds, floor.min_dv_mps),
             floor,
             onset: Onset::default(),
@@ -284,6 +298,33 @@ impl FallbackAlgorithm {
     pub fn with_pretensioner(mut self, thresholds: [f64; KNOTS], min_dv_mps: f64) -> Self {
         self.pretensioner = Head::new(thresholds, min_dv_mps);
         self
+    }
+
+    /// The airbag's validated boundary for an occupant not known to be belted (the belted
+    /// one until this sets it; the floors are the same for both).
+    pub fn with_unbelted(mut self, thresholds: [f64; KNOTS]) -> Self {
+        self.airbag_boundaries[1] = thresholds;
+        if !self.belted {
+            self.airbag.thresholds = thresholds;
+        }
+        self
+    }
+
+    /// The occupant of the samples to come is known to be belted (`belted`), or not: the
+    /// airbag's boundary is then the unbelted one. Its floor does not depend on the occupant:
+    /// the floors hold the misuse events, whoever sits in the car. Set once a batch; a sample
+    /// pays nothing for it.
+    #[inline]
+    pub fn set_belted(&mut self, belted: bool) {
+        if belted != self.belted {
+            self.belted = belted;
+            self.airbag.thresholds = self.airbag_boundaries[usize::from(!belted)];
+        }
+    }
+
+    /// The airbag's boundary now (the occupant's, [`Self::set_belted`]).
+    pub fn airbag_boundary(&self) -> &[f64; KNOTS] {
+        &self.airbag.thresholds
     }
 
     /// Lifts the boundary by `lift_mps` for the samples to come (the satellites' low-crush
@@ -538,6 +579,12 @@ mod tests {
 
     /// Runs a constant deceleration `g` from t = 0 for `ms` at 1 kHz.
     fn run(f: &mut FallbackAlgorithm, g: f64, ms: u64) {
+        run_for(f, g, ms, true);
+    }
+
+    /// [`run`] for an occupant `belted` or not known to be.
+    fn run_for(f: &mut FallbackAlgorithm, g: f64, ms: u64, belted: bool) {
+        f.set_belted(belted);
         for k in 0..ms {
             f.push(
                 &params(),
@@ -599,6 +646,43 @@ mod tests {
             f.decision(),
             FallbackDecision::NoFire(1_000_000_000 + 61_000_000)
         );
+    }
+
+    #[test]
+    fn an_occupant_not_known_to_be_belted_is_judged_against_the_unbelted_boundary() {
+        // The oracle above: 2 g never meets the linear boundary (slope 0.0196 < 0.025 m/s per
+        // ms); against half of it (0.05 + 0.0125 n) it fires at the first n with
+        // (n − ½)·0.0196 ≥ 0.0375 + 0.0125 n → n ≥ 6.7, the sample at τ = 6 ms. The
+        // pretensioner keeps its own boundary whoever sits in the car.
+        let lin = linear();
+        let half = lin.map(|v| v / 2.0);
+        let fresh = || {
+            FallbackAlgorithm::new(lin, NO_FLOOR)
+                .with_unbelted(half)
+                .with_pretensioner(lin, 0.0)
+        };
+        let mut belted = fresh();
+        run_for(&mut belted, 2.0, 80, true);
+        assert_eq!(
+            belted.decision(),
+            FallbackDecision::NoFire(1_000_000_000 + 61_000_000)
+        );
+        let mut unbelted = fresh();
+        run_for(&mut unbelted, 2.0, 80, false);
+        assert_eq!(
+            unbelted.decision(),
+            FallbackDecision::Fire {
+                at_ns: 1_000_000_000 + 6_000_000,
+                onset_ns: 1_000_000_000
+            }
+        );
+        assert_eq!(
+            unbelted.pretensioner_decision(),
+            FallbackDecision::NoFire(1_000_000_000 + 61_000_000)
+        );
+        assert_eq!(unbelted.airbag_boundary(), &half);
+        unbelted.set_belted(true);
+        assert_eq!(unbelted.airbag_boundary(), &lin);
     }
 
     #[test]

@@ -227,6 +227,13 @@ impl InputMonitor {
         Self::stale(self.occupant_rx_ns, now, self.occupant_timeout_ns)
     }
 
+    /// The occupant is known to be belted: a fresh occupant frame with the buckle closed. A
+    /// missing or stale frame counts as unbelted, as a failed buckle switch does in production
+    /// ECUs: the occupant who may be unbelted is never left without the airbag's lower line.
+    pub(crate) fn occupant_belted(&self, now: u64) -> bool {
+        self.occupant.buckled && !self.occupant_stale(now)
+    }
+
     /// The station V2X reports, if its frame is fresh (`v2x_timeout_ms`). Optional equipment:
     /// no frame is no fault, only no second mass source.
     pub(crate) fn v2x_station(&self, now: u64) -> Option<&V2xStation> {

@@ -40,7 +40,11 @@
 //! it moves its fire to the window's end (30 + 30 km/h against 2 475 kg, relieved 0.75: +35
 //! ms with 0.3 m/s of lift left). With no usable satellite there is no lift (a satellite
 //! fault can only take the lift away, and a missing one leaves the central-only logic
-//! unchanged).
+//! unchanged). For an occupant not known to be belted, whose no-fire line is lower
+//! (`unbelted_no_fire_ebs_kph`, 14 km/h), the lift ends earlier — once the front end crushes
+//! as much as `satellite_unbelted_crush_mps` (0.5 m/s: above a 14 km/h barrier's 0.45 and
+//! every misuse event's ≤ 0.41), held as the relief is: a crash above that line is no
+//! low-speed crash with a kerb strike in it for this occupant.
 //!
 //! Every Fire still needs the tunnel's own event to cross the lowered boundary and floor, the
 //! persistence and loading rules, and the safing channel's agreement: **the satellites alone
@@ -136,6 +140,8 @@ pub struct SatelliteParams {
     pub boundary_scale: f64,
     /// The airbag boundary's lift while the front end does not crush, m/s.
     pub low_crush_lift_mps: f64,
+    /// Severity from which the lift ends for an occupant not known to be belted, m/s.
+    pub unbelted_crush_mps: f64,
 }
 
 /// Index mask of the ring of bins.
@@ -394,8 +400,9 @@ impl Satellites {
         still
     }
 
-    /// Updates the relief with the severity at `now` and returns it.
-    pub fn relief(&mut self, now: u64) -> Relief {
+    /// Updates the relief with the severity at `now` and returns it (`belted`: the occupant
+    /// is known to be belted; else the low-crush lift ends at `unbelted_crush_mps`).
+    pub fn relief(&mut self, now: u64, belted: bool) -> Relief {
         let p = self.params;
         if !p.enabled {
             return Relief::NONE;
@@ -408,7 +415,14 @@ impl Satellites {
         let severity = self
             .window(now)
             .and_then(|(usable, sums)| severity_of(self.check_plausible(now, usable, sums), sums));
-        if let Some(s) = severity.filter(|s| *s >= p.relief_from_mps) {
+        // The lift ends (and a relief's hold begins) at the occupant's line; the relief's
+        // fraction counts from `relief_from_mps` (0 below it).
+        let line = if belted {
+            p.relief_from_mps
+        } else {
+            p.unbelted_crush_mps
+        };
+        if let Some(s) = severity.filter(|s| *s >= line) {
             self.peak_mps = self.peak_mps.max(s);
             self.hold_until_ns = Some(now.saturating_add(ms_to_ns(RELIEF_HOLD_MS)));
         }
@@ -424,7 +438,9 @@ impl Satellites {
             };
         }
         let span = p.relief_full_mps - p.relief_from_mps;
-        let fraction = if span > 0.0 {
+        let fraction = if self.peak_mps < p.relief_from_mps {
+            0.0 // held by the unbelted line only: no lift, no relief
+        } else if span > 0.0 {
             ((self.peak_mps - p.relief_from_mps) / span).clamp(0.0, 1.0)
         } else {
             1.0
@@ -470,6 +486,7 @@ mod tests {
             floor_mps: 0.5,
             boundary_scale: 0.5,
             low_crush_lift_mps: 0.0,
+            unbelted_crush_mps: 0.5,
         }
     }
 
@@ -487,6 +504,19 @@ mod tests {
     /// Runs `ms` cycles of 1 ms with the left/right satellites at `l`, `r` g and the tunnel at
     /// `tunnel` g; returns the last relief.
     fn run(s: &mut Satellites, from_ms: u64, ms: u64, l: f64, r: f64, tunnel: f64) -> Relief {
+        run_for(s, from_ms, ms, l, r, tunnel, true)
+    }
+
+    /// [`run`] for an occupant `belted` or not known to be.
+    fn run_for(
+        s: &mut Satellites,
+        from_ms: u64,
+        ms: u64,
+        l: f64,
+        r: f64,
+        tunnel: f64,
+        belted: bool,
+    ) -> Relief {
         let mut relief = Relief::NONE;
         for k in from_ms..from_ms + ms {
             let now = k * MS;
@@ -494,7 +524,7 @@ mod tests {
             s.on_frames(SatelliteSide::Left, &frames(l), now);
             s.on_frames(SatelliteSide::Right, &frames(r), now);
             s.on_tunnel_dv(tunnel * G * 1e-3);
-            relief = s.relief(now);
+            relief = s.relief(now, belted);
         }
         relief
     }
@@ -571,7 +601,7 @@ mod tests {
             s.begin_cycle(k * MS);
             s.on_frames(SatelliteSide::Left, &frames(0.0), k * MS);
             s.on_tunnel_dv(15.0 * G * 1e-3);
-            assert_eq!(s.relief(k * MS), Relief::NONE);
+            assert_eq!(s.relief(k * MS, true), Relief::NONE);
         }
     }
 
@@ -593,6 +623,43 @@ mod tests {
     /// The low-crush lift: whole while usable satellites see no crush ahead (a body motion),
     /// none from the moment the severity reaches the relief's lower line while the relief
     /// holds, whole again after it; none with no usable satellite or none at all.
+    /// For an occupant not known to be belted the lift ends at the unbelted line (0.5 m/s),
+    /// held as a relief is, and grants no relief below the relief's own line (1 m/s).
+    /// Closed form: 15 g above the tunnel for 4 ms is a crush Δv of 0.59 m/s.
+    #[test]
+    fn the_lift_ends_earlier_for_an_occupant_not_known_to_be_belted() {
+        let lifted = SatelliteParams {
+            low_crush_lift_mps: 1.2,
+            unbelted_crush_mps: 0.5,
+            ..params()
+        };
+        let mut belted = Satellites::new(lifted);
+        let r = run_for(&mut belted, 1, 10, 20.0, 20.0, 5.0, true);
+        assert_eq!((r.fraction, r.boundary_lift_mps), (0.0, 1.2));
+        let mut unbelted = Satellites::new(lifted);
+        let r = run_for(&mut unbelted, 1, 10, 20.0, 20.0, 5.0, false);
+        assert_eq!(
+            r,
+            Relief {
+                fraction: 0.0,
+                floor_mps: 0.5,
+                boundary_scale: 0.5,
+                boundary_lift_mps: 0.0
+            }
+        );
+        assert_eq!(r.floor_mps(1.25, 0.3), 1.55, "no relief of the floors");
+        assert_eq!(unbelted.relieved_batches, 0);
+        // Held 60 ms after the severity last reached the line, the whole lift after it.
+        assert_eq!(
+            run_for(&mut unbelted, 11, 60, 0.0, 0.0, 0.0, false).boundary_lift_mps,
+            0.0
+        );
+        assert_eq!(
+            run_for(&mut unbelted, 71, 10, 0.0, 0.0, 0.0, false).boundary_lift_mps,
+            1.2
+        );
+    }
+
     #[test]
     fn the_lift_holds_while_the_front_end_does_not_crush() {
         let lifted = SatelliteParams {
@@ -613,7 +680,7 @@ mod tests {
         for k in 96..110u64 {
             s.begin_cycle(k * MS);
             s.on_tunnel_dv(0.0);
-            let r = s.relief(k * MS);
+            let r = s.relief(k * MS, true);
             if k > 101 {
                 assert_eq!(r, Relief::NONE, "{k}");
             }
@@ -656,7 +723,7 @@ mod tests {
             s.begin_cycle(k * MS);
             s.on_frames(SatelliteSide::Left, &frames(20.0), k * MS);
             s.on_tunnel_dv(20.0 * G * 1e-3);
-            assert_eq!(s.relief(k * MS), Relief::NONE);
+            assert_eq!(s.relief(k * MS, true), Relief::NONE);
         }
         assert!(s.faulty(SatelliteSide::Right, 9 * MS));
         assert!(!s.faulty(SatelliteSide::Left, 9 * MS));
@@ -664,7 +731,7 @@ mod tests {
         for k in 10..15u64 {
             s.begin_cycle(k * MS);
             s.on_frames(SatelliteSide::Left, &frames(150.0), k * MS);
-            r = s.relief(k * MS);
+            r = s.relief(k * MS, true);
         }
         assert_eq!(r.fraction, 1.0);
         // One corrupt frame takes the right satellite out for the hold: the left one's crush

@@ -245,7 +245,7 @@ impl TraceCycle {
             t_ms: now_ns.saturating_sub(START_NS) as f64 * 1e-6,
             mode,
             event_dv_mps: crash.event_dv_mps(),
-            airbag_boundary_mps: boundary(&cfg.fallback_dv_mps),
+            airbag_boundary_mps: boundary(crash.airbag_boundary()),
             pretensioner_boundary_mps: boundary(&cfg.pretensioner_dv_mps),
             airbag_floor_mps: cfg.fallback_min_dv_mps + lift,
             pretensioner_floor_mps: cfg.pretensioner_min_dv_mps + lift,

@@ -25,6 +25,10 @@ pub struct FallbackArgs {
     /// Plot fire times over EBS (SVG if .svg, else PNG).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
+    /// Evaluate (or with `--derive` calibrate) the boundary for an occupant not known to be
+    /// belted, `unbelted_dv_mps`, against its no-fire line `unbelted_no_fire_ebs_kph`.
+    #[arg(long)]
+    pub unbelted: bool,
     /// Write every case as JSON.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
@@ -42,13 +46,16 @@ fn ms(t: Option<f64>) -> String {
 
 pub fn run(args: &FallbackArgs) -> Result<()> {
     let started = std::time::Instant::now();
-    let sweep = Sweep::calibration();
+    let sweep = Sweep {
+        belted: !args.unbelted,
+        ..Sweep::calibration()
+    };
     let mut cfg = CycleConfig::default();
     let t_ref_ms = physics::reference::ReferenceRestraint::builtin()
         .map_err(|e| anyhow::anyhow!("{e}"))?
         .restraint
         .airbag_time_ms;
-    if args.derive {
+    if args.derive && sweep.belted {
         let rows = run_sweep(&cfg, &sweep)?;
         cfg.fallback_dv_mps = calibrate(&rows, cfg.no_fire_ebs_kph, args.margin);
         println!(
@@ -56,18 +63,42 @@ pub fn run(args: &FallbackArgs) -> Result<()> {
             args.margin * 100.0,
             knots(&cfg.fallback_dv_mps)
         );
+    } else if args.derive {
+        let rows = run_sweep(&cfg, &sweep)?;
+        cfg.unbelted_dv_mps = calibrate(&rows, cfg.unbelted_no_fire_ebs_kph, args.margin);
+        println!(
+            "derived from the Δv curves of the no-fire cases below {:.0} km/h (margin {:.0} %):\nunbelted_dv_mps = {}",
+            cfg.unbelted_no_fire_ebs_kph,
+            args.margin * 100.0,
+            knots(&cfg.unbelted_dv_mps)
+        );
     }
     let rows = run_sweep(&cfg, &sweep)?;
-    let must = must_fire_line(&rows).unwrap_or(f64::INFINITY);
-    let no_fire = cfg.no_fire_ebs_kph;
+    let no_fire = cfg.no_fire_line_kph(sweep.belted);
     println!(
         "boundary Δv(τ) [m/s] at τ = 0, 4, … {:.0} ms: {}",
         restraint::fallback::WINDOW_MS,
-        knots(&cfg.fallback_dv_mps)
+        knots(if sweep.belted {
+            &cfg.fallback_dv_mps
+        } else {
+            &cfg.unbelted_dv_mps
+        })
     );
-    println!(
-        "no-fire line: EBS < {no_fire:.0} km/h (and an onset below it); must-fire line: EBS ≥ {must:.1} km/h (the belt alone lets the 75 kg occupant at 300 mm bottom out)"
-    );
+    let must = if sweep.belted {
+        let must = must_fire_line(&rows).unwrap_or(f64::INFINITY);
+        println!(
+            "no-fire line: EBS < {no_fire:.0} km/h (and an onset below it); must-fire line: EBS ≥ {must:.1} km/h (the belt alone lets the 75 kg occupant at 300 mm bottom out)"
+        );
+        must
+    } else {
+        // Held by the airbag alone, an unbelted occupant strikes the wheel in every crash
+        // above the belted no-fire line.
+        let must = cfg.no_fire_ebs_kph;
+        println!(
+            "occupant not known to be belted (`unbelted_dv_mps`): no-fire line: EBS < {no_fire:.0} km/h (and an onset below it); must-fire line: EBS ≥ {must:.1} km/h (the belted no-fire line: the airbag alone holds this occupant)"
+        );
+        must
+    };
     println!(
         "{} cases × {} sensor variants (4 kHz seeds 1–3, 4 kHz with 1 g braking through the crash, 1 kHz) in {:.1} s",
         rows.len(),

@@ -223,7 +223,7 @@ pub struct Situation {
     pub v2x_mass_kg: Option<f64>,
     /// Ego equivalent barrier speed, km/h.
     pub ebs_kph: f64,
-    /// Below the no-fire threshold.
+    /// Below the occupant's no-fire line (`CycleConfig::no_fire_line_kph`).
     pub low_speed: bool,
 }
 
@@ -248,6 +248,7 @@ pub struct Estimator<'a> {
     v2x_gate_distance_m: f64,
     v2x_gate_speed_mps: f64,
     no_fire_ebs_kph: f64,
+    unbelted_no_fire_ebs_kph: f64,
     exit_horizon_ns: u64,
     springs: [Option<CombinedSpring>; 6],
     track: TrackFilter,
@@ -294,6 +295,7 @@ impl<'a> Estimator<'a> {
             v2x_gate_distance_m: cfg.v2x_gate_distance_m,
             v2x_gate_speed_mps: cfg.v2x_gate_speed_mps,
             no_fire_ebs_kph: cfg.no_fire_ebs_kph,
+            unbelted_no_fire_ebs_kph: cfg.unbelted_no_fire_ebs_kph,
             exit_horizon_ns: horizon_ns.saturating_add(ms_to_ns(cfg.preset_exit_hysteresis_ms)),
             springs,
             track: TrackFilter::new(&cfg.track, cfg.object_timeout_ms),
@@ -357,12 +359,15 @@ impl<'a> Estimator<'a> {
     /// The situation from the track: a new object sample goes into the track filter first (a
     /// refused sample changes nothing). Looks the LUT up and asks for a prediction
     /// ([`Self::background`]) when contact is within the exit horizon. Returns the plan when
-    /// one was looked up. Called only when a new sample (or a changed occupant) arrived.
+    /// one was looked up. Called only when a new sample (or a changed occupant) arrived;
+    /// `belted`: the occupant is known to be belted (`InputMonitor::occupant_belted`), which
+    /// sets the situation's no-fire line.
     #[inline(always)]
     pub(crate) fn update(
         &mut self,
         now: u64,
         inputs: &InputMonitor,
+        belted: bool,
         counters: &mut CycleCounters,
     ) -> Option<RestraintPlan> {
         if inputs.new_object {
@@ -399,7 +404,7 @@ impl<'a> Estimator<'a> {
         let station = inputs
             .v2x_station(now)
             .filter(|st| self.is_tracked_object(&e, st));
-        let sit = self.situation_of(&e, station);
+        let sit = self.situation_of(&e, station, belted);
         self.situation = Some(sit);
         // Predict only what can become relevant before the next sample: contact within the
         // exit horizon (bounds the work to objects that matter).
@@ -424,8 +429,18 @@ impl<'a> Estimator<'a> {
     }
 
     /// The situation of a track estimate (`station`: the V2X station that is the tracked
-    /// object, if any).
-    fn situation_of(&self, e: &TrackEstimate, station: Option<&V2xStation>) -> Situation {
+    /// object, if any; `belted`: the occupant is known to be belted).
+    fn situation_of(
+        &self,
+        e: &TrackEstimate,
+        station: Option<&V2xStation>,
+        belted: bool,
+    ) -> Situation {
+        let no_fire_ebs_kph = if belted {
+            self.no_fire_ebs_kph
+        } else {
+            self.unbelted_no_fire_ebs_kph
+        };
         let to_ns = |t_s: f64| (t_s * 1.0e9) as u64; // saturating, NaN → 0
         let contact_estimate_ns = e.at_ns.saturating_add(to_ns(e.contact.ttc_s));
         let early_ns = to_ns(self.contact_time_k * e.ttc_sigma_s);
@@ -443,7 +458,7 @@ impl<'a> Estimator<'a> {
             opponent_mass_sigma_kg: e.mass_sigma_kg,
             v2x_mass_kg: station.map(|st| st.mass_kg),
             ebs_kph,
-            low_speed: !(ebs_kph >= self.no_fire_ebs_kph),
+            low_speed: !(ebs_kph >= no_fire_ebs_kph),
         }
     }
 

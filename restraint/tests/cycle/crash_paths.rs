@@ -5,7 +5,9 @@
 //! k·v·t / m_ego, constant pulses), as in `cycle/scenarios.rs`.
 
 use crate::cycle_support::*;
-use bus::codec::{AirbagStageCmdCmdSource, AirbagStageCmdFire, EcuStatusEcuMode};
+use bus::codec::{
+    AirbagStageCmdCmdSource, AirbagStageCmdFire, EcuStatusEcuMode, OccupantClassificationBeltBuckle,
+};
 use restraint::crash::ConfirmKind;
 use restraint::crash_match::{MatchState, Mismatch};
 use restraint::{Degraded, EcuMode, Phase};
@@ -646,4 +648,45 @@ fn an_opponent_reported_heavy_does_not_move_a_low_speed_crash_across_the_no_fire
     let b = crash_with_object(ideal_sensor_config(), true, 8.06, 4000.0, &pulse);
     assert!(b.first_mode(EcuMode::Crash).is_some(), "confirmed");
     assert!(no_airbag_fired(&b), "{:?}", first_fire(&b));
+}
+
+// --- The occupant's buckle ------------------------------------------------------------------
+
+/// A constant 12 g crash without a prediction, judged with a belted airbag boundary out of
+/// reach (50 m/s at every knot) and the default unbelted one, for the buckle `buckle` (`None`:
+/// no occupant frame at all): whether the airbag fires.
+fn conventional_airbag_for(buckle: Option<OccupantClassificationBeltBuckle>) -> bool {
+    let cfg = restraint::CycleConfig {
+        fallback_dv_mps: [50.0; restraint::fallback::KNOTS],
+        ..ideal_sensor_config()
+    };
+    let mut b = Bench::with_config(cfg, Some(test_lut()));
+    match buckle {
+        Some(s) => b.buckle = s,
+        None => b.send_occupant = false,
+    }
+    run_scenario(
+        &mut b,
+        C + 100 * MS,
+        u64::MAX,
+        0,
+        0.0,
+        u64::MAX,
+        Some(C),
+        &|_| 12.0,
+    );
+    !no_airbag_fired(&b)
+}
+
+#[test]
+fn an_occupant_not_known_to_be_belted_is_judged_against_the_unbelted_boundary() {
+    // The belted boundary is out of reach; the unbelted one (the default) is crossed by 12 g
+    // within its window. A switch fault, a missing state or a missing frame count as unbelted
+    // (a failed buckle switch must not leave an unbelted occupant without the airbag).
+    use OccupantClassificationBeltBuckle as Buckle;
+    assert!(!conventional_airbag_for(Some(Buckle::Buckled)));
+    assert!(conventional_airbag_for(Some(Buckle::Unbuckled)));
+    assert!(conventional_airbag_for(Some(Buckle::SwitchFault)));
+    assert!(conventional_airbag_for(Some(Buckle::NotAvailable)));
+    assert!(conventional_airbag_for(None));
 }

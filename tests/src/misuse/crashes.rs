@@ -3,10 +3,16 @@
 use super::text::*;
 use super::*;
 
+/// A barrier below the no-fire line, objects live or dead; a quarter of them with the
+/// occupant unbelted, below the unbelted line.
 pub(super) fn no_fire_crash(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     let (v, tc) = (r.gen_range(8.0..16.0), r.gen_range(0.35..0.5));
     let dead = if r.gen_bool(0.5) { OBJECTS_DEAD } else { "" };
-    barrier(name, i, v, tc, dead, "")
+    if r.gen_bool(0.25) {
+        unbelted(&barrier(name, i, v * UNBELTED_LINE_RATIO, tc, dead, ""))
+    } else {
+        barrier(name, i, v, tc, dead, "")
+    }
 }
 
 pub(super) fn must_fire_crash(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
@@ -28,7 +34,7 @@ pub(super) fn grey_zone(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
     if r.gen_bool(0.5) {
         text
     } else {
-        text.replace("belted = true", "belted = false")
+        unbelted(&text)
     }
 }
 

@@ -228,19 +228,24 @@ pub(super) fn misreported_low_speed(r: &mut ChaCha8Rng, name: &str, i: u64) -> S
 }
 
 pub(super) fn low_speed_crash_and_kerb(r: &mut ChaCha8Rng, name: &str, i: u64) -> String {
+    // A quarter with the occupant unbelted, crash and kerb together as far below the unbelted
+    // line: the kerb's Δv does not shrink with the line, so the crash's speed moves down by
+    // the lines' difference.
+    let belted = r.gen_bool(0.75);
+    let dv_kph = if belted { 0.0 } else { UNBELTED_LINE_SHIFT_KPH };
     let tc = r.gen_range(0.35..0.5);
     let at = tc + r.gen_range(0.0..0.01);
     let kerb = {
         let dv = r.gen_range(0.5..0.8) * MARGIN;
         pothole_with_rebound(r, at, dv)
     };
-    if r.gen_bool(0.5) {
-        barrier(name, i, r.gen_range(12.0..16.0), tc, "", &kerb)
+    let text = if r.gen_bool(0.5) {
+        barrier(name, i, r.gen_range(12.0..16.0) - dv_kph, tc, "", &kerb)
     } else {
         head_on(
             name,
             i,
-            r.gen_range(12.0..15.0),
+            r.gen_range(12.0..15.0) - dv_kph,
             1785.0,
             tc,
             None,
@@ -248,6 +253,11 @@ pub(super) fn low_speed_crash_and_kerb(r: &mut ChaCha8Rng, name: &str, i: u64) -
             "",
             &kerb,
         )
+    };
+    if belted {
+        text
+    } else {
+        unbelted(&text)
     }
 }
 

@@ -37,7 +37,7 @@
 //! | satellite-fault-in-pothole | one crush-zone satellite saturated or stuck, a 60–200 g spike or a 20–200 g offset on it, within ±20 ms of a 0.6–0.8 m/s pothole with rebound (× 1.5) | no fire |
 //! | misreported-low-speed | a crash below the no-fire line with one object fault: 14.5 + 14.5 km/h equal cars reported 4 000 kg; 16 + 16 km/h reported 2 800 kg; 1 000–1 300 kg opponents reported 3 000–4 000 kg at an EBS of 13–16 km/h; a 15.5 km/h barrier with the speed reported 5 m/s high | no airbag |
 //! | aliased-ringing | zero-mean ringing near 4 kHz in phase with the samples (±30–49 g × 1.5, 3–4 ms), at 3.95–4.05 kHz (±30–45 g × 1.5, 20–30 ms), or at a multiple of either sampling rate (2, 4, 8, 12, 16 kHz) | no fire |
-//! | low-speed-crash-and-kerb | a 12–16 km/h barrier or 12 + 12 to 15 + 15 km/h cars, tracked, with a kerb strike of 0.5–0.8 m/s (× 1.5) 0–10 ms after contact | no airbag |
+//! | low-speed-crash-and-kerb | a 12–16 km/h barrier or 12 + 12 to 15 + 15 km/h cars (unbelted: − 6 km/h), tracked, with a kerb strike of 0.5–0.8 m/s (× 1.5) 0–10 ms after contact | no airbag |
 //! | braking-and-pothole | ABS braking at 0.6–1 g with a 0.72–0.76 m/s pothole with rebound (× 1.5: up to 1.14), or with a 0.5–1.3 g crash-sensor offset | no fire |
 //! | near-miss | closing 40–110 km/h (and 30 + 30), the opponent evading 1–50 ms before the predicted contact, a 0.4–0.8 m/s pothole (× 1.5) within ±20 ms of it; also: the ECU must not stay in CrashDetected | no fire, back to Normal |
 //!
@@ -58,6 +58,15 @@
 //! | family | what | requirement |
 //! |---|---|---|
 //! | grey-zone | a 20–30 km/h barrier or equal cars at 20 + 20 to 30 + 30 km/h, objects live or dead, the occupant belted or not | by outcome: the airbag must fire where the reference restraint's airbag is what keeps the occupant from bottoming out (its belt alone bottoms out in the true pulse, with its airbag at the reference time the occupant does not); elsewhere printed |
+//!
+//! ## The occupant
+//! Every variant seats a 75 kg occupant at 300 mm, belted, except: a quarter of every no-fire
+//! family's variants (misuse and single faults) seat them unbelted — the ECU then judges the
+//! airbag against its lower unbelted boundary, whose floors hold the same misuse events; a
+//! quarter of `no-fire-crash` is unbelted at its speeds × 0.7 (the unbelted no-fire line, 14
+//! km/h, over the belted one, 20), and a quarter of `low-speed-crash-and-kerb` and `-untracked`
+//! at its speeds − 6 km/h (the kerb's Δv does not shrink with the line: crash and kerb
+//! together stay as far below it); half of `grey-zone` is unbelted.
 //!
 //! Required fire time of a must-fire crash: the classic "127 mm − 30 ms" criterion — the
 //! instant a free-flying (unbelted) occupant has moved 127 mm relative to the compartment in
@@ -281,7 +290,7 @@ pub const FAMILIES: &[Family] = &[
     },
     Family {
         name: "no-fire-crash",
-        envelope: "barrier 8–16 km/h, objects live or dead",
+        envelope: "barrier 8–16 km/h (a quarter unbelted at 5.6–11.2 km/h), objects live or dead",
         requirement: Requirement::NoAirbag,
         make: no_fire_crash,
     },
@@ -293,7 +302,7 @@ pub const FAMILIES: &[Family] = &[
     },
     Family {
         name: "low-speed-crash-and-kerb",
-        envelope: "barrier 12–16 km/h or 12 + 12 to 15 + 15 km/h cars, tracked, a 0.75–1.2 m/s kerb strike 0–10 ms after contact",
+        envelope: "barrier 12–16 km/h or 12 + 12 to 15 + 15 km/h cars (a quarter unbelted, − 6 km/h), tracked, a 0.75–1.2 m/s kerb strike 0–10 ms after contact",
         requirement: Requirement::NoAirbag,
         make: low_speed_crash_and_kerb,
     },
@@ -392,9 +401,17 @@ pub fn names() -> Vec<&'static str> {
 
 impl Family {
     /// The scenario text of variant `i` under `seed` (reproducible: the same text every time).
+    /// A quarter of a no-fire family's variants carry an occupant the ECU does not know to be
+    /// belted, whose airbag boundary is lower (`unbelted_dv_mps`): the misuse events and
+    /// faults must not fire it either.
     pub fn variant(&self, i: u64, seed: u64) -> String {
         let mut r = ChaCha8Rng::seed_from_u64(seed ^ i.wrapping_mul(0x9E37_79B9_7F4A_7C15));
-        (self.make)(&mut r, &format!("{}-{i}", self.name), i)
+        let text = (self.make)(&mut r, &format!("{}-{i}", self.name), i);
+        if self.requirement == Requirement::NoFire && r.gen_bool(0.25) {
+            text::unbelted(&text)
+        } else {
+            text
+        }
     }
 }
 

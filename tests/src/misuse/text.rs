@@ -10,6 +10,19 @@ pub(super) const OBJECTS_DEAD: &str =
 pub(super) const OCCUPANT: &str =
     "[occupant]\nmass_kg = 75\nchest_to_wheel_mm = 300\nbelted = true\n";
 
+/// `text` with its occupant unbelted.
+pub(super) fn unbelted(text: &str) -> String {
+    text.replace("belted = true", "belted = false")
+}
+
+/// The unbelted no-fire line over the belted one (the ECU's defaults, 14 / 20 km/h): a
+/// crash's speed below the belted line scaled by this stays as far below the unbelted one.
+pub(super) const UNBELTED_LINE_RATIO: f64 = 14.0 / 20.0;
+/// The belted no-fire line less the unbelted one, km/h: a crash with a misuse event in it
+/// (whose Δv does not scale with the line) moved down by this stays as far below the unbelted
+/// line as it was below the belted one.
+pub(super) const UNBELTED_LINE_SHIFT_KPH: f64 = 20.0 - 14.0;
+
 /// The ego section at `kph` (optionally braking from `brake_s` at `brake_g`, ABS).
 pub(super) fn ego(kph: f64, brake: Option<(f64, f64)>) -> String {
     let mut s = format!("[ego]\nmass_kg = 1785\nclass = 4\nspeed_kph = {kph}\n");
