@@ -21,14 +21,17 @@
 //! within it belongs to the earlier event. It is not judged from that event's onset: the
 //! boundary would be read at the earlier event's τ (higher) and the loading rule against its
 //! crest. When the deceleration rises through the wake threshold again after at least
-//! [`RE_ONSET_GAP_MS`] below it and the event has not decided must-fire, the judged segment
-//! starts anew there (Δv, τ, loading, persistence), and a closed no-fire is pending again.
+//! [`RE_ONSET_GAP_MS`] below it (twice that within [`RE_ONSET_EARLY_MS`] of the segment's
+//! start) and the event has not decided must-fire, the judged segment starts anew there (Δv,
+//! τ, loading, persistence), and a closed no-fire is pending again.
 //! A crash rising out of a misuse event's lobe seldom falls to the wake threshold in between
 //! (a kerb strike's ringing or a rough road's lobe running into the contact); it falls into a
 //! *valley*, under [`VALLEY_FRACTION`] of the segment's crest, and then rises past that crest —
 //! the pulse departs from the earlier event's severity. The segment then restarts at the
-//! valley's lowest sample (Δv and τ from there). A lobe that stays under the earlier crest
-//! (a kerb strike's ringing on top of a low-speed crash) keeps the segment it is in.
+//! valley's lowest sample (Δv and τ from there), if that sample reads under [`VALLEY_MAX_G`]:
+//! a higher trough is ringing on top of a crash already loading. A lobe that stays under the
+//! earlier crest (a kerb strike's ringing on top of a low-speed crash) keeps the segment it is
+//! in.
 //! The decision still belongs to the event ([`FallbackDecision::Fire`]'s `onset_ns`); what it
 //! adds is bounded by what it judges — one lobe of the signal, from rest or from a valley,
 //! against the same boundary and floors as a first event.
@@ -62,6 +65,23 @@ pub const RE_ONSET_GAP_MS: f64 = 1.0;
 /// (seed 7).
 pub const VALLEY_FRACTION: f64 = 0.4;
 const RE_ONSET_GAP_NS: u64 = (RE_ONSET_GAP_MS * 1e6) as u64;
+/// Within this long of the judged segment's start, ms, a re-onset needs twice
+/// [`RE_ONSET_GAP_MS`] under the wake threshold: a kerb strike's ringing 0–10 ms into a
+/// low-speed crash cancels the crash's first ramp for about a millisecond, and a segment
+/// restarted there reads the crash's plateau plus the next ringing lobe against the boundary's
+/// first knots (a 15 km/h barrier with a 1.1 m/s kerb fired; `low-speed-crash-and-kerb-untracked`,
+/// seed 11). A crash after an earlier event rises later than this, or from a longer dip.
+pub const RE_ONSET_EARLY_MS: f64 = 10.0;
+const RE_ONSET_EARLY_NS: u64 = (RE_ONSET_EARLY_MS * 1e6) as u64;
+/// A valley restarts the segment only where its lowest sample reads under this, g (twice the
+/// default wake threshold): a valley higher than that is a ringing trough on top of a crash
+/// already loading — its plateau under the dip — not the rest a crash rises out of. Calibrated
+/// on both sides (100 035 variants each of seeds 3 and 11): without it
+/// `low-speed-crash-and-kerb-untracked` fired 2 airbags (13.9 and 9.8 km/h barriers whose
+/// kerb's trough sat at 6.5 and 4.5 g); with it `must-fire-after-event` misses 5 of 2 565 on
+/// seed 3 instead of 4.
+pub const VALLEY_MAX_G: f64 = 3.0;
+const VALLEY_MAX_MPS2: f64 = VALLEY_MAX_G * crate::settings::G_MPS2;
 
 /// From this Δv of the judged segment on, the loading rule no longer applies, m/s. The rule
 /// separates a crested misuse pulse (≤ 1.2 m/s: the matrix's envelope × 1.5) from a crash near
@@ -394,7 +414,7 @@ impl FallbackAlgorithm {
                 let re_onset = above
                     && self
                         .dip_since_ns
-                        .is_some_and(|d| s.t_ns.saturating_sub(d) >= RE_ONSET_GAP_NS)
+                        .is_some_and(|d| s.t_ns.saturating_sub(d) >= self.re_onset_gap_ns(s.t_ns))
                     && not_fired;
                 if re_onset {
                     self.start_segment(s, before_dv);
@@ -452,6 +472,16 @@ impl FallbackAlgorithm {
         }
     }
 
+    /// The dip under the wake threshold a re-onset at `t_ns` needs, ns: twice
+    /// [`RE_ONSET_GAP_MS`] within [`RE_ONSET_EARLY_MS`] of the segment's start.
+    fn re_onset_gap_ns(&self, t_ns: u64) -> u64 {
+        if t_ns.saturating_sub(self.segment_onset_ns) >= RE_ONSET_EARLY_NS {
+            RE_ONSET_GAP_NS
+        } else {
+            2 * RE_ONSET_GAP_NS
+        }
+    }
+
     /// Follows the segment's valleys (module docs, "Re-onset"): the lowest sample of the latest
     /// dip under [`VALLEY_FRACTION`] of the crest is kept, and once the deceleration (as
     /// [`Loading`] smooths it) rises past the crest before that dip, the segment restarts at
@@ -489,7 +519,7 @@ impl FallbackAlgorithm {
         }
         self.in_valley = false;
         if let Some(v) = self.valley {
-            if not_fired && crest > v.crest_before_mps2 {
+            if not_fired && crest > v.crest_before_mps2 && v.decel_mps2 <= VALLEY_MAX_MPS2 {
                 self.start_segment_at(v.t_ns, s, v.dv_mps);
             }
         }
@@ -972,6 +1002,42 @@ mod tests {
             _ => 10.0,
         });
         assert_eq!(f.segment_onset_ns(), Some(1_000_000_000));
+    }
+
+    #[test]
+    fn early_in_a_segment_a_re_onset_needs_a_longer_dip_and_a_valley_a_low_trough() {
+        // A 3.5 g lobe (too low a crest for a valley: 0.4 × 3.5 g is under the wake), one
+        // sample at 1 g (a 1 ms dip under the 1.5 g wake), then 20 g. 5 ms into the segment
+        // (inside RE_ONSET_EARLY_MS) the dip must last 2 ms: no re-onset; 12 ms into it, 1 ms
+        // is enough.
+        for (lobe_ms, restarts) in [(5, false), (12, true)] {
+            let mut f = FallbackAlgorithm::new([f64::INFINITY; KNOTS], floor());
+            run_fn(&mut f, lobe_ms + 5, |k| match k {
+                k if k < lobe_ms => 3.5,
+                k if k == lobe_ms => 1.0,
+                _ => 20.0,
+            });
+            let rise = 1_000_000_000 + (lobe_ms + 1) * 1_000_000;
+            let expected = if restarts { rise } else { 1_000_000_000 };
+            assert_eq!(f.segment_onset_ns(), Some(expected), "lobe {lobe_ms} ms");
+        }
+        // A 15 g lobe for 12 ms, a trough at 4 g (under 0.4 × 15 g, over VALLEY_MAX_G) and a
+        // rise to 25 g: ringing on a crash already loading, the segment stays; the same with
+        // the trough at 2 g restarts at it.
+        for (trough_g, restarts) in [(4.0, false), (2.0, true)] {
+            let mut f = FallbackAlgorithm::new([f64::INFINITY; KNOTS], floor());
+            run_fn(&mut f, 20, |k| match k {
+                0..=11 => 15.0,
+                12..=13 => trough_g,
+                _ => 25.0,
+            });
+            let expected = if restarts {
+                1_000_000_000 + 12_000_000
+            } else {
+                1_000_000_000
+            };
+            assert_eq!(f.segment_onset_ns(), Some(expected), "trough {trough_g} g");
+        }
     }
 
     #[test]
