@@ -596,6 +596,14 @@ pub fn run_json(
 /// ("Severity floors", "a belt-only plan").
 pub const ACCEPTED_COSTS: &[(&str, f64, &str)] = &[
     (
+        "kerb-ringing-in-low-speed-crash",
+        8.0,
+        "a 13.9 km/h barrier with a kerb strike in it and the object list dead: no airbag on \
+         either side; the pyrotechnic pretensioner is the conventional path's, decided when the \
+         event's Δv crosses its own boundary and 1.5 m/s floor (+24.5 ms), the reference's a \
+         fixed +10 ms: +5.9 %",
+    ),
+    (
         "truck-reported-as-car",
         170.0,
         "a standing 9 t truck struck at 50 km/h closing (EBS 42.5 km/h) loads the ego through \
