@@ -218,16 +218,7 @@ fn without_a_prediction_a_bump_fires_nothing_and_a_severe_crash_fires_the_refere
     );
     assert!(no_airbag_fired(&b));
     let mut b = Bench::new(Some(test_lut()));
-    run_scenario(
-        &mut b,
-        C + 100 * MS,
-        u64::MAX,
-        0,
-        0.0,
-        u64::MAX,
-        Some(C),
-        &|_| 20.0,
-    );
+    run_unpredicted_crash(&mut b, C, 20.0);
     let (t, f) = first_fire(&b).expect("reference airbag");
     assert_eq!(f.cmd_source(), AirbagStageCmdCmdSource::Reference);
     // The reference fires when the accelerometer-only algorithm decides: 20 g carries the
@@ -245,16 +236,7 @@ fn the_conventional_airbags_must_fire_fires_the_pretensioner_at_the_same_instant
     let cfg = restraint::CycleConfig::default();
     assert!(cfg.pretensioner_min_dv_mps > cfg.fallback_min_dv_mps);
     let mut b = Bench::new(Some(test_lut()));
-    run_scenario(
-        &mut b,
-        C + 100 * MS,
-        u64::MAX,
-        0,
-        0.0,
-        u64::MAX,
-        Some(C),
-        &|_| 12.0,
-    );
+    run_unpredicted_crash(&mut b, C, 12.0);
     let (bag, _) = first_fire(&b).expect("reference airbag");
     let (pretensioner, _) = b.first_pretensioner_fire().expect("pretensioner");
     let own_floor_ns = C + (cfg.pretensioner_min_dv_mps / (12.0 * f64::from(G)) * 1e9) as u64;
@@ -665,16 +647,7 @@ fn conventional_airbag_for(buckle: Option<OccupantClassificationBeltBuckle>) -> 
         Some(s) => b.buckle = s,
         None => b.send_occupant = false,
     }
-    run_scenario(
-        &mut b,
-        C + 100 * MS,
-        u64::MAX,
-        0,
-        0.0,
-        u64::MAX,
-        Some(C),
-        &|_| 12.0,
-    );
+    run_unpredicted_crash(&mut b, C, 12.0);
     !no_airbag_fired(&b)
 }
 

@@ -440,6 +440,21 @@ pub fn run_scenario(
     }
 }
 
+/// [`run_scenario`] for a crash no object predicts: no object track, a constant `decel_g`
+/// from `crash` on, 100 ms of it.
+pub fn run_unpredicted_crash(b: &mut Bench, crash: u64, decel_g: f32) {
+    run_scenario(
+        b,
+        crash + 100 * MS,
+        u64::MAX,
+        0,
+        0.0,
+        u64::MAX,
+        Some(crash),
+        &|_| decel_g,
+    );
+}
+
 /// When a constant `decel_g` from `crash` on has carried the airbag's severity floor
 /// (`fallback_min_dv_mps`), as the ECU integrates 1 kHz samples that each count their whole
 /// 1 ms: the first sample k with (k + 1) · a · 1 ms ≥ floor. The reference restraint fires in
