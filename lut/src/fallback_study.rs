@@ -403,8 +403,8 @@ pub struct Sweep {
     pub families: Vec<Family>,
     /// Sensor variants every case is run with.
     pub sensors: Vec<SensorSpec>,
-    /// The occupant is belted (the airbag boundary as configured); `false`: not known to be
-    /// (the boundary scaled to the unbelted no-fire line).
+    /// The occupant is belted (the airbag boundary `fallback_dv_mps`); `false`: not known to
+    /// be (`unbelted_dv_mps`).
     pub belted: bool,
 }
 

@@ -113,8 +113,7 @@ impl CrashMonitor {
     /// every cycle of a drive, and what each detector would do sample by sample. `relief`:
     /// what the crush-zone satellites take off the thresholds now ([`crate::satellites`]),
     /// asked only for a batch that is judged (a quiet one needs none); `belted`: the occupant
-    /// is known to be belted (else the airbag's boundary is the unbelted one,
-    /// `CycleConfig::unbelted_no_fire_ebs_kph`).
+    /// is known to be belted (else the airbag's boundary is `CycleConfig::unbelted_dv_mps`).
     pub(crate) fn on_batch(
         &mut self,
         batch: &PlausibleBatch,
@@ -360,7 +359,8 @@ pub struct BackupEvidence {
 
 /// The table's plan for an adaptive crash re-estimated at closing speed `closing_mps` (the
 /// lookup raises the mass to the robust planning mass, `Estimator::lookup`). `None` when the
-/// re-estimated severity is below the occupant's no-fire line `no_fire_ebs_kph`: the crash then goes the conventional way.
+/// re-estimated severity is below the occupant's no-fire line `no_fire_ebs_kph`: the crash
+/// then goes the conventional way.
 pub(crate) fn plan_for(
     cfg: &CycleConfig,
     estimator: &Estimator<'_>,

@@ -239,6 +239,7 @@ impl Activity for RestraintCycle<'_> {
         }
         let braking = self.braking_decel_mps2;
         let belted = inputs.occupant_belted(now);
+        let no_fire_ebs_kph = self.cfg.no_fire_line_kph(belted);
         // The satellites first: their crush Δv up to now relieves this cycle's samples.
         let satellites = &mut self.satellites;
         satellites.begin_cycle(now);
@@ -324,7 +325,7 @@ impl Activity for RestraintCycle<'_> {
             && (self.inputs.new_object
                 || (self.inputs.occupant_changed && self.estimate.situation.is_some()));
         if estimated {
-            if let Some(plan) = self.estimate.update(now, &self.inputs, belted, c) {
+            if let Some(plan) = self.estimate.update(now, &self.inputs, no_fire_ebs_kph, c) {
                 self.decision.plan = plan;
             }
         }
@@ -384,7 +385,6 @@ impl Activity for RestraintCycle<'_> {
         let event_loading = || crash.event_loading();
         let heaviest_fires_airbag =
             || situation.is_some_and(|s| est.heaviest_opponent_fires_airbag(&s, inputs));
-        let no_fire_ebs_kph = cfg.no_fire_line_kph(belted);
         let mut replan = |closing_mps: f64| {
             let sit = situation?;
             plan_for(cfg, est, &sit, closing_mps, inputs, no_fire_ebs_kph, c)

@@ -40,6 +40,16 @@ fn knots(t: &[f64]) -> String {
     format!("[{}]", v.join(", "))
 }
 
+/// The airbag boundary the sweep judges: `fallback_dv_mps` for a belted occupant,
+/// `unbelted_dv_mps` for one not known to be belted.
+fn boundary_mut(cfg: &mut CycleConfig, belted: bool) -> &mut [f64; restraint::fallback::KNOTS] {
+    if belted {
+        &mut cfg.fallback_dv_mps
+    } else {
+        &mut cfg.unbelted_dv_mps
+    }
+}
+
 fn ms(t: Option<f64>) -> String {
     t.map_or("—".into(), |t| format!("{t:.1} ms"))
 }
@@ -55,34 +65,27 @@ pub fn run(args: &FallbackArgs) -> Result<()> {
         .map_err(|e| anyhow::anyhow!("{e}"))?
         .restraint
         .airbag_time_ms;
-    if args.derive && sweep.belted {
+    let no_fire = cfg.no_fire_line_kph(sweep.belted);
+    let key = if sweep.belted {
+        "fallback_dv_mps"
+    } else {
+        "unbelted_dv_mps"
+    };
+    if args.derive {
         let rows = run_sweep(&cfg, &sweep)?;
-        cfg.fallback_dv_mps = calibrate(&rows, cfg.no_fire_ebs_kph, args.margin);
+        let derived = calibrate(&rows, no_fire, args.margin);
+        *boundary_mut(&mut cfg, sweep.belted) = derived;
         println!(
-            "derived from the no-fire cases' Δv curves (margin {:.0} %):\nfallback_dv_mps = {}",
+            "derived from the Δv curves of the no-fire cases below {no_fire:.0} km/h (margin {:.0} %):\n{key} = {}",
             args.margin * 100.0,
-            knots(&cfg.fallback_dv_mps)
-        );
-    } else if args.derive {
-        let rows = run_sweep(&cfg, &sweep)?;
-        cfg.unbelted_dv_mps = calibrate(&rows, cfg.unbelted_no_fire_ebs_kph, args.margin);
-        println!(
-            "derived from the Δv curves of the no-fire cases below {:.0} km/h (margin {:.0} %):\nunbelted_dv_mps = {}",
-            cfg.unbelted_no_fire_ebs_kph,
-            args.margin * 100.0,
-            knots(&cfg.unbelted_dv_mps)
+            knots(&derived)
         );
     }
     let rows = run_sweep(&cfg, &sweep)?;
-    let no_fire = cfg.no_fire_line_kph(sweep.belted);
     println!(
         "boundary Δv(τ) [m/s] at τ = 0, 4, … {:.0} ms: {}",
         restraint::fallback::WINDOW_MS,
-        knots(if sweep.belted {
-            &cfg.fallback_dv_mps
-        } else {
-            &cfg.unbelted_dv_mps
-        })
+        knots(boundary_mut(&mut cfg, sweep.belted))
     );
     let must = if sweep.belted {
         let must = must_fire_line(&rows).unwrap_or(f64::INFINITY);

@@ -247,8 +247,6 @@ pub struct Estimator<'a> {
     v2x_mass_margin_kg: f64,
     v2x_gate_distance_m: f64,
     v2x_gate_speed_mps: f64,
-    no_fire_ebs_kph: f64,
-    unbelted_no_fire_ebs_kph: f64,
     exit_horizon_ns: u64,
     springs: [Option<CombinedSpring>; 6],
     track: TrackFilter,
@@ -294,8 +292,6 @@ impl<'a> Estimator<'a> {
             v2x_mass_margin_kg: cfg.v2x_mass_margin_kg,
             v2x_gate_distance_m: cfg.v2x_gate_distance_m,
             v2x_gate_speed_mps: cfg.v2x_gate_speed_mps,
-            no_fire_ebs_kph: cfg.no_fire_ebs_kph,
-            unbelted_no_fire_ebs_kph: cfg.unbelted_no_fire_ebs_kph,
             exit_horizon_ns: horizon_ns.saturating_add(ms_to_ns(cfg.preset_exit_hysteresis_ms)),
             springs,
             track: TrackFilter::new(&cfg.track, cfg.object_timeout_ms),
@@ -360,14 +356,13 @@ impl<'a> Estimator<'a> {
     /// refused sample changes nothing). Looks the LUT up and asks for a prediction
     /// ([`Self::background`]) when contact is within the exit horizon. Returns the plan when
     /// one was looked up. Called only when a new sample (or a changed occupant) arrived;
-    /// `belted`: the occupant is known to be belted (`InputMonitor::occupant_belted`), which
-    /// sets the situation's no-fire line.
+    /// `no_fire_ebs_kph`: the occupant's no-fire line (`CycleConfig::no_fire_line_kph`).
     #[inline(always)]
     pub(crate) fn update(
         &mut self,
         now: u64,
         inputs: &InputMonitor,
-        belted: bool,
+        no_fire_ebs_kph: f64,
         counters: &mut CycleCounters,
     ) -> Option<RestraintPlan> {
         if inputs.new_object {
@@ -404,7 +399,7 @@ impl<'a> Estimator<'a> {
         let station = inputs
             .v2x_station(now)
             .filter(|st| self.is_tracked_object(&e, st));
-        let sit = self.situation_of(&e, station, belted);
+        let sit = self.situation_of(&e, station, no_fire_ebs_kph);
         self.situation = Some(sit);
         // Predict only what can become relevant before the next sample: contact within the
         // exit horizon (bounds the work to objects that matter).
@@ -429,18 +424,13 @@ impl<'a> Estimator<'a> {
     }
 
     /// The situation of a track estimate (`station`: the V2X station that is the tracked
-    /// object, if any; `belted`: the occupant is known to be belted).
+    /// object, if any; `no_fire_ebs_kph`: the occupant's no-fire line).
     fn situation_of(
         &self,
         e: &TrackEstimate,
         station: Option<&V2xStation>,
-        belted: bool,
+        no_fire_ebs_kph: f64,
     ) -> Situation {
-        let no_fire_ebs_kph = if belted {
-            self.no_fire_ebs_kph
-        } else {
-            self.unbelted_no_fire_ebs_kph
-        };
         let to_ns = |t_s: f64| (t_s * 1.0e9) as u64; // saturating, NaN → 0
         let contact_estimate_ns = e.at_ns.saturating_add(to_ns(e.contact.ttc_s));
         let early_ns = to_ns(self.contact_time_k * e.ttc_sigma_s);
