@@ -317,7 +317,9 @@ pub struct CycleConfig {
     /// see the front end crush this much, m/s (*default* 0.5: above a 14 km/h barrier's 0.45 —
     /// the unbelted no-fire line — and every misuse event's ≤ 0.41; a 20 km/h barrier's ≈ 0.6).
     /// At `satellite_relief_from_mps` the lift would hold an unbelted occupant's 20–22 km/h
-    /// crash to the boundary plus 1.2 m/s, tens of ms late.
+    /// crash to the boundary plus 1.2 m/s, tens of ms late. The unbelted relief counts from
+    /// this line to `satellite_relief_full_mps` × this / `satellite_relief_from_mps` (the
+    /// belted span scaled to the occupant's line).
     pub satellite_unbelted_crush_mps: f64,
 
     /// Crash accelerometer: no batch for this long → `ACCEL_STALE`, ms (*default* 50: batches
@@ -574,7 +576,7 @@ impl CycleConfig {
         range(
             "satellite_unbelted_crush_mps",
             self.satellite_unbelted_crush_mps,
-            0.0,
+            0.1,
             self.satellite_relief_from_mps,
         )?;
         range("safing_wake_g", self.safing_wake_g, 0.1, 50.0)?;

@@ -44,7 +44,12 @@
 //! (`unbelted_no_fire_ebs_kph`, 14 km/h), the lift ends earlier — once the front end crushes
 //! as much as `satellite_unbelted_crush_mps` (0.5 m/s: above a 14 km/h barrier's 0.45 and
 //! every misuse event's ≤ 0.41), held as the relief is: a crash above that line is no
-//! low-speed crash with a kerb strike in it for this occupant.
+//! low-speed crash with a kerb strike in it for this occupant. Its relief counts from the same
+//! line over the belted span scaled to it (0.5 to 1.0 m/s by default): the crush grows with
+//! the crash speed, and a 24 km/h barrier (1.3 m/s) is as far above this occupant's 14 km/h
+//! line as a 34 km/h one above the belted 20 km/h. Without it the unbelted occupant's
+//! 23–25 km/h crashes waited for the 1.25 m/s floor until +13–15 ms and bottomed out, where
+//! the reference airbag at +10 ms holds them.
 //!
 //! Every Fire still needs the tunnel's own event to cross the lowered boundary and floor, the
 //! persistence and loading rules, and the safing channel's agreement: **the satellites alone
@@ -415,12 +420,13 @@ impl Satellites {
         let severity = self
             .window(now)
             .and_then(|(usable, sums)| severity_of(self.check_plausible(now, usable, sums), sums));
-        // The lift ends (and a relief's hold begins) at the occupant's line; the relief's
-        // fraction counts from `relief_from_mps` (0 below it).
-        let line = if belted {
-            p.relief_from_mps
+        // The lift ends, the relief's hold begins and its fraction counts from the occupant's
+        // line; an unbelted occupant's relief spans the belted one scaled to that line.
+        let (line, full) = if belted {
+            (p.relief_from_mps, p.relief_full_mps)
         } else {
-            p.unbelted_crush_mps
+            let scale = p.unbelted_crush_mps / p.relief_from_mps;
+            (p.unbelted_crush_mps, p.relief_full_mps * scale)
         };
         if let Some(s) = severity.filter(|s| *s >= line) {
             self.peak_mps = self.peak_mps.max(s);
@@ -437,11 +443,11 @@ impl Satellites {
                 ..Relief::NONE
             };
         }
-        let span = p.relief_full_mps - p.relief_from_mps;
-        let fraction = if self.peak_mps < p.relief_from_mps {
-            0.0 // held by the unbelted line only: no lift, no relief
+        let span = full - line;
+        let fraction = if self.peak_mps < line {
+            0.0 // a peak held under the other line while the belt state changed
         } else if span > 0.0 {
-            ((self.peak_mps - p.relief_from_mps) / span).clamp(0.0, 1.0)
+            ((self.peak_mps - line) / span).clamp(0.0, 1.0)
         } else {
             1.0
         };
@@ -624,8 +630,9 @@ mod tests {
     /// none from the moment the severity reaches the relief's lower line while the relief
     /// holds, whole again after it; none with no usable satellite or none at all.
     /// For an occupant not known to be belted the lift ends at the unbelted line (0.5 m/s),
-    /// held as a relief is, and grants no relief below the relief's own line (1 m/s).
-    /// Closed form: 15 g above the tunnel for 4 ms is a crush Δv of 0.59 m/s.
+    /// held as a relief is, and the relief spans the belted one scaled to that line: 0.5 to
+    /// 1.0 m/s. Closed form: 15 g above the tunnel for 4 ms is a crush Δv of 0.59 m/s,
+    /// fraction (0.59 − 0.5)/0.5 unbelted and nothing belted.
     #[test]
     fn the_lift_ends_earlier_for_an_occupant_not_known_to_be_belted() {
         let lifted = SatelliteParams {
@@ -633,22 +640,33 @@ mod tests {
             unbelted_crush_mps: 0.5,
             ..params()
         };
+        let crush_mps = 15.0 * G * 0.004;
         let mut belted = Satellites::new(lifted);
         let r = run_for(&mut belted, 1, 10, 20.0, 20.0, 5.0, true);
         assert_eq!((r.fraction, r.boundary_lift_mps), (0.0, 1.2));
         let mut unbelted = Satellites::new(lifted);
         let r = run_for(&mut unbelted, 1, 10, 20.0, 20.0, 5.0, false);
-        assert_eq!(
-            r,
-            Relief {
-                fraction: 0.0,
-                floor_mps: 0.5,
-                boundary_scale: 0.5,
-                boundary_lift_mps: 0.0
-            }
+        let expected = (crush_mps - 0.5) / 0.5;
+        assert!((r.fraction - expected).abs() < 0.03, "{r:?} vs {expected}");
+        assert_eq!(r.boundary_lift_mps, 0.0);
+        assert!(
+            (r.floor_mps(1.25, 0.3) - (1.25 - r.fraction * 0.75 + (1.0 - r.fraction) * 0.3)).abs()
+                < 1e-12
         );
-        assert_eq!(r.floor_mps(1.25, 0.3), 1.55, "no relief of the floors");
-        assert_eq!(unbelted.relieved_batches, 0);
+        // Relieved from the 4th cycle (the window's crush passes 0.5 m/s at 4 × 0.147).
+        assert_eq!(unbelted.relieved_batches, 7);
+        // 1.57 m/s (40 g above the tunnel): the whole relief unbelted, 0.57 of it belted.
+        let mut unbelted = Satellites::new(lifted);
+        assert_eq!(
+            run_for(&mut unbelted, 1, 10, 45.0, 45.0, 5.0, false).fraction,
+            1.0
+        );
+        let mut belted = Satellites::new(lifted);
+        let r = run_for(&mut belted, 1, 10, 45.0, 45.0, 5.0, true);
+        assert!(
+            (r.fraction - (40.0 * G * 0.004 - 1.0)).abs() < 0.03,
+            "{r:?}"
+        );
         // Held 60 ms after the severity last reached the line, the whole lift after it.
         assert_eq!(
             run_for(&mut unbelted, 11, 60, 0.0, 0.0, 0.0, false).boundary_lift_mps,
