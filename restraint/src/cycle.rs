@@ -265,6 +265,11 @@ impl Activity for RestraintCycle<'_> {
                 *relief
             });
         });
+        // A crash phase that has fired nothing follows the next accelerometer event when its
+        // own has ended (`CrashMonitor::follow_later_event`).
+        if self.decision.phase() == Phase::Crash && self.decision.nothing_fired_in_crash() {
+            self.crash.follow_later_event(now);
+        }
         // The independent safing channel: its own monitor, its own function.
         let safing = &mut self.safing;
         let mut safing_batch = crate::accel::PlausibleBatch::new();

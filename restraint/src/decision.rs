@@ -633,8 +633,26 @@ impl Decision {
         None
     }
 
+    /// In the crash phase with nothing fired in it (no airbag, no pyrotechnic pretensioner,
+    /// no latched belt) and no backup standing in: its decisions may still move to a later
+    /// event ([`crate::crash::CrashMonitor::follow_later_event`]).
+    #[inline(never)]
+    pub(crate) fn nothing_fired_in_crash(&self) -> bool {
+        self.phase == Phase::Crash
+            && !(self.airbag_fired || self.crash_fired || self.belt_latched)
+            && !self.backup_stands_in
+            && self.crash_kind != Some(ConfirmKind::Backup)
+    }
+
     /// One step of the state machine at `now`, then the scheduled fires that are due.
     pub(crate) fn step(&mut self, now: u64, x: &mut DecisionInputs<'_>) {
+        // The confirmation moved to a later event (nothing fired for the earlier one): the
+        // crash phase is entered anew for it, from the phase before the crash.
+        if x.confirmation
+            .is_some_and(|c| c.onset_ns != self.event_onset_ns && self.nothing_fired_in_crash())
+        {
+            self.phase = self.before_crash;
+        }
         if let (Some(c), Phase::Monitoring | Phase::PreCrash | Phase::Degraded) =
             (x.confirmation, self.phase)
         {

@@ -444,6 +444,67 @@ fn a_matched_pulse_that_leaves_its_ramp_before_the_planned_fire_is_decided_conve
     assert!(!matches!(b.ecu.phase(), Phase::Crash | Phase::PostCrash));
 }
 
+#[test]
+fn a_crash_phase_whose_event_ended_unfired_follows_the_next_event() {
+    // A road lobe at the predicted contact ramps like the predicted crash (20 m/s, below the
+    // closing speed from which a matched crash fires on its plan alone) for 6 ms and falls in
+    // 2 ms (≈ 0.58 m/s, under every floor): it confirms the crash phase and fires nothing.
+    // Its event ends after the 10 ms quiet gap, with the sample at C + 18 ms; the crash itself
+    // begins with the next one, 20 g constant, and the ECU reads both in one cycle (a batch
+    // of several samples): no cycle sees the accelerometer quiet between the two events. The
+    // crash's must-fire belongs to its own event, not the lobe's, and the crash phase follows
+    // it: the reference airbag fires when the crash carries its floor, as for the same crash
+    // with no lobe before it (`floor_reached_at`).
+    let crash = C + 19 * MS;
+    let pulse = |ms: u64| match ms {
+        0..6 => ramp_g(20.0, ms),
+        6..8 => ramp_g(20.0, 6) * (8 - ms) as f32 / 2.0,
+        8..19 => 0.0,
+        _ => 20.0,
+    };
+    let mut b = Bench::new(Some(test_lut()));
+    run_scenario(
+        &mut b,
+        crash - MS,
+        T0 + 200 * MS,
+        C,
+        20.0,
+        C,
+        Some(C),
+        &pulse,
+    );
+    let confirmed = b.first_mode(EcuMode::Crash).expect("the lobe confirmed");
+    assert!(
+        confirmed < crash,
+        "confirmed at {confirmed}, before the crash"
+    );
+    assert_eq!(b.ecu.phase(), Phase::Crash);
+    // The quiet gap's last sample goes out with the next cycle's batch.
+    let last_quiet = accel_batch(b.now, 0.0);
+    b.io.push_accel(last_quiet);
+    b.io.push_safing(last_quiet);
+    b.now += MS;
+    b.cycle += 1;
+    run_scenario(
+        &mut b,
+        crash + 100 * MS,
+        u64::MAX,
+        0,
+        0.0,
+        0,
+        Some(C),
+        &pulse,
+    );
+    let (t, _) = first_fire(&b).expect("the crash fires the airbag");
+    let floor = floor_reached_at(crash, 20.0);
+    assert!(
+        (floor..=floor + 2 * MS).contains(&t),
+        "airbag at C + {} ms, floor at C + {} ms",
+        (t - C) / MS,
+        (floor - C) / MS
+    );
+}
+
 /// A crash predicted at `closing_mps` for C (object list from 200 ms, until C) and a pulse at C
 /// that ramps exactly like the predicted crash for 6 ms, then falls linearly to nothing over
 /// `fall_ms` (a pothole or kerb strike that began like the crash and crested); 300 ms run on.
