@@ -26,7 +26,7 @@ use crate::fallback::{FallbackAlgorithm, FallbackDecision, Thresholds};
 use crate::inputs::InputMonitor;
 use crate::plan::RestraintPlan;
 use crate::roughness::Roughness;
-use crate::satellites::Relief;
+use crate::satellites::{CrushOnset, Relief};
 use crate::settings::{ms_to_ns, G_MPS2};
 
 /// Which path confirmed the crash.
@@ -149,6 +149,26 @@ impl CrashMonitor {
         };
         for s in batch.iter() {
             self.on_sample(&s, ctx, &generic, thresholds);
+        }
+    }
+
+    /// The front end began to fold ([`CrushOnset`]) after the accelerometer-only algorithm's
+    /// judged segment began — a road's lobe or a kerb strike running into the contact: the
+    /// segment restarts at the fold (`fallback`, "Crush onset"), with the tunnel's Δv since
+    /// less the `braking_mps2` the samples had removed; after `batch`, the latest batch.
+    pub(crate) fn restart_at_crush(
+        &mut self,
+        o: CrushOnset,
+        braking_mps2: f64,
+        batch: &PlausibleBatch,
+    ) {
+        if let Some(last) = batch.iter().last() {
+            let braking_dv_mps = braking_mps2 * last.t_ns.saturating_sub(o.at_ns) as f64 * 1e-9;
+            self.fallback.restart_at_crush(
+                o.at_ns,
+                o.tunnel_dv_mps - braking_dv_mps,
+                last.decel_mps2,
+            );
         }
     }
 

@@ -246,7 +246,9 @@ impl Activity for RestraintCycle<'_> {
         io.drain_satellites(&mut |side, b| satellites.on_frames(side, b, now));
         let crash = &mut self.crash;
         let agreement = &mut self.agreement;
+        // The relief of the cycle's latest judged batch (none when every batch was quiet).
         let relief = &mut self.relief;
+        *relief = Relief::NONE;
         let mut plausible = crate::accel::PlausibleBatch::new();
         let (mut crash_mean, mut safing_mean) = (CycleMean::default(), CycleMean::default());
         io.drain_accel(&mut |a| {
@@ -259,12 +261,17 @@ impl Activity for RestraintCycle<'_> {
             crash.on_raw_batch(dv_mps, span_s);
             satellites.on_tunnel_dv(dv_mps);
             plausible.remove_decel(braking);
-            *relief = Relief::NONE;
             crash.on_batch(&plausible, &freeze, belted, || {
                 *relief = satellites.relief(now, belted);
                 *relief
             });
         });
+        // The front end began to fold in this cycle: a judged segment that a road's lobe or a
+        // kerb strike began earlier restarts at the fold (after the cycle's batches, the
+        // latest of which `plausible` holds).
+        if let Some(o) = self.satellites.crush_onset_at(now) {
+            self.crash.restart_at_crush(o, braking, &plausible);
+        }
         // A crash phase that has fired nothing follows the next accelerometer event when its
         // own has ended (`CrashMonitor::follow_later_event`).
         if self.decision.phase() == Phase::Crash && self.decision.nothing_fired_in_crash() {

@@ -36,6 +36,21 @@
 //! adds is bounded by what it judges — one lobe of the signal, from rest or from a valley,
 //! against the same boundary and floors as a first event.
 //!
+//! **Crush onset.** A rough road's lobe can run into the contact with neither a dip nor a
+//! valley, and a severe crash's Δv rises as steeply as the boundary: read from the lobe's
+//! onset, a 55 km/h barrier crossed the boundary only where it levels off, 40 ms late, and a
+//! 42 km/h one not within the window. The crush-zone satellites date the contact on their own:
+//! the front end folds (each satellite slows faster than the tunnel) from the contact on and
+//! never before it, which no body motion does. When their severity first reaches the
+//! occupant's line they give the end of the last cycle before the fold
+//! ([`crate::satellites::CrushOnset`]); a segment that began [`CRUSH_RESTART_MIN_MS`] or more
+//! before it restarts there, with the tunnel's Δv since (braking compensated as the samples
+//! are) — the crash judged from its own contact, as without the lobe. In the library's crashes
+//! (barriers of 22–56 km/h, cars of 31 + 31 and 48 + 48 km/h) the onset lies 0.5–0.9 ms after
+//! the contact and 0.5–1.0 ms before the tunnel's own wake-up, where the same crash alone
+//! starts its segment: the restarted segment reads a crash no more favourably than the crash
+//! alone.
+//!
 //! It sees what a conventional sensor sees: the opponent's mass does not show in the first
 //! tens of ms (see `crash_match`), so for car-to-car crashes it discriminates by closing
 //! speed and structure; a light opponent's crash ends early and stays under the boundary.
@@ -82,6 +97,12 @@ const RE_ONSET_EARLY_NS: u64 = (RE_ONSET_EARLY_MS * 1e6) as u64;
 /// seed 3 instead of 4.
 pub const VALLEY_MAX_G: f64 = 3.0;
 const VALLEY_MAX_MPS2: f64 = VALLEY_MAX_G * crate::settings::G_MPS2;
+
+/// The crush onset restarts a segment only this much after its start, ms: a segment that began
+/// within it is the crash's own (its wake-up lags the contact by up to ≈ 1 ms, the satellites'
+/// bins date the fold to the cycle).
+pub const CRUSH_RESTART_MIN_MS: f64 = 2.0;
+const CRUSH_RESTART_MIN_NS: u64 = (CRUSH_RESTART_MIN_MS * 1e6) as u64;
 
 /// From this Δv of the judged segment on, the loading rule no longer applies, m/s. The rule
 /// separates a crested misuse pulse (≤ 1.2 m/s: the matrix's envelope × 1.5) from a crash near
@@ -363,12 +384,18 @@ impl FallbackAlgorithm {
     /// [`Self::start_segment`] with the segment's τ and Δv counted from `onset_ns` (a valley
     /// before `s`).
     fn start_segment_at(&mut self, onset_ns: u64, s: &AccelSample, base_dv_mps: f64) {
+        self.start_segment_from(onset_ns, s.decel_mps2, base_dv_mps);
+    }
+
+    /// The judged segment from `onset_ns` with the event's Δv `base_dv_mps` there, the
+    /// loading rule from `decel_mps2`; a decision not fired is pending again.
+    fn start_segment_from(&mut self, onset_ns: u64, decel_mps2: f64, base_dv_mps: f64) {
         self.segment_onset_ns = onset_ns;
         self.segment_base_dv_mps = base_dv_mps;
         self.dip_since_ns = None;
         self.valley = None;
         self.in_valley = false;
-        self.loading.start(s.decel_mps2);
+        self.loading.start(decel_mps2);
         for h in [&mut self.airbag, &mut self.pretensioner] {
             if !h.fired() {
                 h.decision = FallbackDecision::Pending;
@@ -525,6 +552,23 @@ impl FallbackAlgorithm {
         }
     }
 
+    /// Restarts the judged segment where the crush-zone satellites date the front end's first
+    /// fold (module docs, "Crush onset"): at `at_ns`, with `since_dv_mps` of the event's Δv
+    /// after it (the tunnel's, braking compensated as the samples are), the loading rule from
+    /// the latest sample's `decel_mps2`. Only inside an event whose segment began at least
+    /// [`CRUSH_RESTART_MIN_MS`] earlier and not both restraints fired; returns whether it did.
+    pub fn restart_at_crush(&mut self, at_ns: u64, since_dv_mps: f64, decel_mps2: f64) -> bool {
+        let later = at_ns.saturating_sub(self.segment_onset_ns) >= CRUSH_RESTART_MIN_NS;
+        if !(self.onset.awake() && later && since_dv_mps.is_finite())
+            || (self.airbag.fired() && self.pretensioner.fired())
+        {
+            return false;
+        }
+        let base = self.onset.delta_v_mps() - since_dv_mps;
+        self.start_segment_from(at_ns, decel_mps2, base);
+        true
+    }
+
     /// The airbag's decision.
     pub fn decision(&self) -> FallbackDecision {
         self.airbag.decision
@@ -626,6 +670,66 @@ mod tests {
                 f.thresholds_now(0.0, Relief::NONE),
             );
         }
+    }
+
+    /// A 2 g road lobe for 20 ms (under the linear boundary all along), then a 5 g crash. Read
+    /// from the lobe's onset the crash meets the boundary τ + 20 ms ahead; restarted at the
+    /// crush onset the satellites give three samples into the crash (the end of the lobe's last
+    /// sample, with the tunnel's Δv since), it fires within a sample of the same crash without
+    /// the lobe.
+    #[test]
+    fn a_crush_onset_restarts_the_segment_as_if_the_lobe_had_not_been() {
+        const MS: u64 = 1_000_000;
+        let t0 = 1_000_000_000;
+        let sample = |k: u64, g: f64| AccelSample {
+            t_ns: t0 + k * MS,
+            dt_s: 1e-3,
+            decel_mps2: g * G_MPS2,
+        };
+        let fire_at = |f: &FallbackAlgorithm| match f.decision() {
+            FallbackDecision::Fire { at_ns, .. } => (at_ns - t0) / MS,
+            d => panic!("{d:?}"),
+        };
+        let th = Thresholds {
+            min_dv_mps: 0.0,
+            pretensioner_min_dv_mps: 0.0,
+            boundary_scale: 1.0,
+        };
+        let mut clean = FallbackAlgorithm::new(linear(), NO_FLOOR);
+        for k in 20..80 {
+            clean.push(&params(), &sample(k, 5.0), th);
+        }
+        let g = |k: u64| if k < 20 { 2.0 } else { 5.0 };
+        let (mut lobe, mut restarted) = (
+            FallbackAlgorithm::new(linear(), NO_FLOOR),
+            FallbackAlgorithm::new(linear(), NO_FLOOR),
+        );
+        for k in 0..80 {
+            lobe.push(&params(), &sample(k, g(k)), th);
+            restarted.push(&params(), &sample(k, g(k)), th);
+            if k == 22 {
+                let since_dv_mps = 3.0 * 5.0 * G_MPS2 * 1e-3;
+                assert!(restarted.restart_at_crush(t0 + 19 * MS, since_dv_mps, 5.0 * G_MPS2));
+                assert_eq!(restarted.segment_onset_ns(), Some(t0 + 19 * MS));
+            }
+        }
+        let clean_at = fire_at(&clean);
+        assert!(
+            fire_at(&restarted).abs_diff(clean_at) <= 1,
+            "{} vs {clean_at}",
+            fire_at(&restarted)
+        );
+        assert!(
+            fire_at(&lobe) > clean_at + 2,
+            "{} vs {clean_at}",
+            fire_at(&lobe)
+        );
+        // Not within 2 ms of the segment's start, not outside an event.
+        let mut f = FallbackAlgorithm::new(linear(), NO_FLOOR);
+        f.push(&params(), &sample(0, 5.0), th);
+        assert!(!f.restart_at_crush(t0 + MS, 0.0, 5.0 * G_MPS2));
+        let mut quiet = FallbackAlgorithm::new(linear(), NO_FLOOR);
+        assert!(!quiet.restart_at_crush(t0 + 19 * MS, 0.0, 0.0));
     }
 
     #[test]

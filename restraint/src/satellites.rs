@@ -51,6 +51,13 @@
 //! 23–25 km/h crashes waited for the 1.25 m/s floor until +13–15 ms and bottomed out, where
 //! the reference airbag at +10 ms holds them.
 //!
+//! **Crush onset.** The cycle bins also date the fold: walking back from the batch in which
+//! the severity first reaches the occupant's line, over the cycles in which every usable
+//! satellite slowed by [`CRUSH_BIN_MPS`] more than the tunnel, the end of the first cycle that
+//! did not is the [`CrushOnset`] (given once a relief, with the tunnel's Δv since): the
+//! accelerometer-only algorithm restarts its judged segment there when a road lobe or kerb
+//! strike began it earlier (`fallback`, "Crush onset").
+//!
 //! Every Fire still needs the tunnel's own event to cross the lowered boundary and floor, the
 //! persistence and loading rules, and the safing channel's agreement: **the satellites alone
 //! never fire.** With both satellites out of the fusion the tunnel's central-only logic
@@ -76,6 +83,12 @@ pub const FAULT_HOLD_MS: f64 = 500.0;
 /// shows ≈ 2 ms into a 15 g crash.
 pub const IMPLAUSIBLE_LAG_MPS: f64 = 0.3;
 
+/// A cycle bin in which the smaller usable satellite's velocity change exceeds the tunnel's by
+/// this much is one in which the front end folds, m/s: 2 g over the body's for a 1 ms cycle,
+/// 4 × what a satellite's noise and quantisation do in a bin (≤ 0.005 m/s), and a crash's
+/// first millisecond of crush (a 20 km/h barrier: ≈ 0.05 m/s).
+pub const CRUSH_BIN_MPS: f64 = 0.02;
+
 /// Cycle bins kept: the window is at most this many cycles (a power of two).
 const BINS: usize = 16;
 
@@ -93,6 +106,19 @@ pub struct Relief {
     /// crush as much as the relief's lower line, 0 from then on (while the relief holds) and
     /// with no usable satellite (module docs, "Low crush").
     pub boundary_lift_mps: f64,
+}
+
+/// When the front end began to fold, as the satellites' cycle bins date it, and the tunnel's
+/// velocity change since.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CrushOnset {
+    /// The end of the last cycle bin that did not fold (walking back from the newest), ns:
+    /// no later than the contact — a contact late in that bin carried less crush than
+    /// [`CRUSH_BIN_MPS`] in it.
+    pub at_ns: u64,
+    /// The tunnel accelerometer's velocity change after `at_ns` up to this cycle's batch
+    /// (included), as read (before any braking compensation), m/s.
+    pub tunnel_dv_mps: f64,
 }
 
 impl Relief {
@@ -202,6 +228,36 @@ impl Bins {
         }
     }
 
+    /// Where the front end began to fold ([`CrushOnset`]): walking back from the newest bin
+    /// over those in which every `usable` satellite's velocity change exceeds the tunnel's by
+    /// [`CRUSH_BIN_MPS`], the first that does not. `None` when the newest bin does not fold or
+    /// the ring has no bin before the fold.
+    fn crush_onset(&self, usable: [bool; 2]) -> Option<CrushOnset> {
+        let mut tunnel_dv_mps = 0.0;
+        for k in 0..BINS {
+            let i = self.head.wrapping_sub(k) & BIN_MASK;
+            let (Some(dv), Some(&at)) = (self.dv_mps.get(i), self.at_ns.get(i)) else {
+                break;
+            };
+            if at == 0 {
+                break;
+            }
+            let [left, right, tunnel] = *dv;
+            let folds = usable
+                .iter()
+                .zip([left - tunnel, right - tunnel])
+                .all(|(ok, crush)| !*ok || crush >= CRUSH_BIN_MPS);
+            if !folds {
+                return (k > 0).then_some(CrushOnset {
+                    at_ns: at,
+                    tunnel_dv_mps,
+                });
+            }
+            tunnel_dv_mps += tunnel;
+        }
+        None
+    }
+
     /// Sums of the bins opened within `window_ns` before `now` (the current one included).
     /// The ring opens bins in time order, so the walk goes back from the newest and stops at
     /// the first one outside the window: a window of w cycles costs w bins, not the ring.
@@ -270,6 +326,10 @@ pub struct Satellites {
     peak_mps: f64,
     /// The relief holds until, ns.
     hold_until_ns: Option<u64>,
+    /// When the current relief began (the cycle, ns; 0: none yet), and the satellites usable
+    /// then.
+    relief_began_ns: u64,
+    relief_began_usable: [bool; 2],
     /// What was not usable.
     pub faults: SatelliteFaults,
     /// Accelerometer batches judged with a relief (fraction > 0).
@@ -301,6 +361,8 @@ impl Satellites {
             now_ns: 0,
             peak_mps: 0.0,
             hold_until_ns: None,
+            relief_began_ns: 0,
+            relief_began_usable: [false; 2],
             faults: SatelliteFaults::default(),
             relieved_batches: 0,
         }
@@ -417,9 +479,10 @@ impl Satellites {
             self.peak_mps = 0.0;
         }
         // One pass over the window: the plausibility check, then the severity of what is left.
-        let severity = self
+        let judged = self
             .window(now)
-            .and_then(|(usable, sums)| severity_of(self.check_plausible(now, usable, sums), sums));
+            .map(|(usable, sums)| (self.check_plausible(now, usable, sums), sums));
+        let severity = judged.and_then(|(usable, sums)| severity_of(usable, sums));
         // The lift ends, the relief's hold begins and its fraction counts from the occupant's
         // line; an unbelted occupant's relief spans the belted one scaled to that line.
         let (line, full) = if belted {
@@ -429,6 +492,12 @@ impl Satellites {
             (p.unbelted_crush_mps, p.relief_full_mps * scale)
         };
         if let Some(s) = severity.filter(|s| *s >= line) {
+            if self.hold_until_ns.is_none() {
+                // The relief begins: the fold is dated from the usable satellites now
+                // (`Self::crush_onset_at`).
+                self.relief_began_ns = now;
+                self.relief_began_usable = judged.map_or([false; 2], |(usable, _)| usable);
+            }
             self.peak_mps = self.peak_mps.max(s);
             self.hold_until_ns = Some(now.saturating_add(ms_to_ns(RELIEF_HOLD_MS)));
         }
@@ -460,6 +529,23 @@ impl Satellites {
             boundary_scale: p.boundary_scale,
             boundary_lift_mps: 0.0,
         }
+    }
+
+    /// Where the front end began to fold ([`CrushOnset`], module docs "Crush onset"), when the
+    /// relief began in this cycle (`now`): `None` in every other cycle, so the walk over the
+    /// bins is made once a relief.
+    #[inline]
+    pub fn crush_onset_at(&self, now: u64) -> Option<CrushOnset> {
+        if self.relief_began_ns != now {
+            return None;
+        }
+        self.crush_onset_walk()
+    }
+
+    /// [`Self::crush_onset_at`]'s walk, out of the cycle's common path.
+    #[inline(never)]
+    fn crush_onset_walk(&self) -> Option<CrushOnset> {
+        self.bins.crush_onset(self.relief_began_usable)
     }
 
     /// Whether `side` is missing or faulty at `now` (for the status; `false` when the car has
@@ -676,6 +762,40 @@ mod tests {
             run_for(&mut unbelted, 71, 10, 0.0, 0.0, 0.0, false).boundary_lift_mps,
             1.2
         );
+    }
+
+    /// The crush onset is given once, in the cycle whose severity first reaches the line: the
+    /// end of the last cycle whose bin did not fold, with the tunnel's Δv since. Closed form:
+    /// 10 cycles of a 5 g body motion (satellites and tunnel alike), then both satellites at
+    /// 45 g over a 15 g tunnel: a crush of 30 g·1 ms = 0.29 m/s a cycle, 1.0 m/s (the belted
+    /// line) in the 4th folding cycle (1.18 m/s over the 4 ms window); the onset is cycle 10,
+    /// the tunnel's 4 cycles × 15 g·1 ms after it.
+    #[test]
+    fn the_crush_onset_is_the_last_cycle_before_the_front_end_folds() {
+        let mut s = Satellites::new(params());
+        run(&mut s, 1, 10, 5.0, 5.0, 5.0);
+        assert_eq!(s.crush_onset_at(10 * MS), None);
+        let (mut given, mut first) = (0, None);
+        for k in 11..=20u64 {
+            run(&mut s, k, 1, 45.0, 45.0, 15.0);
+            if let Some(o) = s.crush_onset_at(k * MS) {
+                given += 1;
+                first = first.or(Some((k, o)));
+            }
+        }
+        assert_eq!(given, 1);
+        let (k, o) = first.unwrap();
+        assert_eq!(k, 14);
+        assert_eq!(o.at_ns, 10 * MS);
+        // The tunnel's bins hold the 15 g as the frames' codes carry it (0.5 g steps).
+        assert!(
+            (o.tunnel_dv_mps - 4.0 * 15.0 * G * 1e-3).abs() < 0.01,
+            "{o:?}"
+        );
+        // A fold from the first bin on has no bin before it: no onset.
+        let mut s = Satellites::new(params());
+        run(&mut s, 1, 6, 45.0, 45.0, 15.0);
+        assert!((1..=6).all(|k| s.crush_onset_at(k * MS).is_none()));
     }
 
     #[test]
