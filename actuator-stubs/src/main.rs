@@ -100,13 +100,7 @@ const RX_IDS: [u32; 5] = [
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
-    match run(&cli) {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("actuator-stubs: error: {e:#}");
-            std::process::ExitCode::FAILURE
-        }
-    }
+    host::exit_code("actuator-stubs", run(&cli))
 }
 
 /// Offset CLOCK_REALTIME − CLOCK_MONOTONIC [ns], to map kernel (realtime) receive stamps.
@@ -115,7 +109,7 @@ fn realtime_minus_monotonic_ns() -> i128 {
 }
 
 fn run(cli: &Cli) -> Result<()> {
-    let scenario = Scenario::load(&cli.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let scenario = Scenario::load(&cli.scenario)?;
     let reference = match &cli.reference {
         Some(p) => physics::reference::ReferenceRestraint::load(p),
         None => physics::reference::ReferenceRestraint::builtin(),

@@ -12,13 +12,7 @@ fn main() -> std::process::ExitCode {
         Some(Command::Monitor(args)) => monitor::run(args),
         None => run(&cli),
     };
-    match result {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("ecu: error: {e:#}");
-            std::process::ExitCode::FAILURE
-        }
-    }
+    host::exit_code("ecu", result)
 }
 
 /// The LUT, or `None` with a clear message: a table that is there but corrupt leaves the ECU
@@ -112,8 +106,7 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
         cfg.cycle.decision.clone(),
         lut.as_ref().map(ecu::lut_input),
         &reference.restraint,
-    )
-    .map_err(|e| anyhow::anyhow!("{e}"))?;
+    )?;
     if let Some(m) = notes.lut_rejected {
         eprintln!("ecu: warning: {m}");
     }

@@ -7,9 +7,11 @@
 //! * [`stop`] — the SIGTERM/SIGINT stop flag (and SIGPIPE's default for the command-line
 //!   tools);
 //! * [`files`] — where a tool finds the repository's files from any folder, output paths
-//!   checked before the work, and [`NoFlush`] for logs that flush on their own schedule.
+//!   checked before the work, and [`NoFlush`] for logs that flush on their own schedule;
+//! * [`exit`] — how every command-line tool ends: exit codes 0 / 1 / 2 and a one-line error.
 
 pub mod clock;
+pub mod exit;
 pub mod files;
 pub mod stop;
 
@@ -17,5 +19,6 @@ pub use clock::{
     monotonic_ns, realtime_ns, sleep_through_signals_until_ns, sleep_until_ns, sync_time_us, Clock,
     MonotonicClock, SimClock, SleepOutcome,
 };
+pub use exit::{exit_code, CheckFailed};
 pub use files::{check_output_dir, check_output_file, find_repo, find_upwards, NoFlush};
 pub use stop::{default_sigpipe, install_stop_signals};

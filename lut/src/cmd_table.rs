@@ -85,7 +85,7 @@ pub fn run_build(a: &BuildArgs) -> Result<()> {
             );
             let progress = Progress::new(range.len(), "optimising", "cells", a.quiet);
             let (shard, stats) = table::build_shard(&grid, k, n, threads, &progress)?;
-            diagram::write_atomically(&out, &shard.to_bytes()?).map_err(|e| anyhow!("{e}"))?;
+            diagram::write_atomically(&out, &shard.to_bytes()?)?;
             report(&stats);
             eprintln!("shard written to {}", out.display());
         }
@@ -99,7 +99,7 @@ pub fn run_build(a: &BuildArgs) -> Result<()> {
                 a.grid.display()
             );
             let (d, stats) = table::build_table(&grid, threads, a.quiet)?;
-            d.save(&out).map_err(|e| anyhow!("{e}"))?;
+            d.save(&out)?;
             report(&stats);
             let bottoming = d.cells().iter().filter(|c| c.is_bottoming_out()).count();
             eprintln!("table written to {} (LUT id 0x{:04x}, CRC-32C 0x{:08x}, {bottoming} bottoming-out cells)", out.display(), d.lut_id(), d.checksum());
@@ -141,7 +141,7 @@ pub fn run_merge(a: &MergeArgs) -> Result<()> {
         })
         .collect::<Result<Vec<_>>>()?;
     let d = table::merge_shards(&shards, None)?;
-    d.save(&a.out).map_err(|e| anyhow!("{e}"))?;
+    d.save(&a.out)?;
     eprintln!(
         "merged {} shards into {} (LUT id 0x{:04x})",
         shards.len(),
@@ -176,7 +176,7 @@ pub struct VerifyArgs {
 }
 
 pub fn run_verify(a: &VerifyArgs) -> Result<()> {
-    let d = Diagram::load_any(&a.file).map_err(|e| anyhow!("{e}"))?;
+    let d = Diagram::load_any(&a.file)?;
     let rows = table::verify(&d, a.cells, a.seed)?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&rows)?);
@@ -212,10 +212,14 @@ pub fn run_verify(a: &VerifyArgs) -> Result<()> {
     );
     let margin_failed = verify_margin(&d, a)?;
     if bad > 0 {
-        bail!("{bad} of {} verified cells do not match", rows.len());
+        return Err(host::CheckFailed(format!(
+            "{bad} of {} verified cells do not match",
+            rows.len()
+        ))
+        .into());
     }
     if let Some(why) = margin_failed {
-        bail!("{why}");
+        return Err(host::CheckFailed(why).into());
     }
     Ok(())
 }
@@ -310,7 +314,7 @@ fn field_stats(cells: &[Cell]) -> Vec<(&'static str, f64, f64, f64)> {
 }
 
 pub fn run_inspect(a: &InspectArgs) -> Result<()> {
-    let d = Diagram::load_any(&a.file).map_err(|e| anyhow!("{e}"))?;
+    let d = Diagram::load_any(&a.file)?;
     let h = d.header();
     let cells = d.cells();
     let bottoming = cells.iter().filter(|c| c.is_bottoming_out()).count();
@@ -389,8 +393,8 @@ pub struct ExportArgs {
 }
 
 pub fn run_export(a: &ExportArgs) -> Result<()> {
-    let d = Diagram::load_any(&a.file).map_err(|e| anyhow!("{e}"))?;
-    d.save_json(&a.out).map_err(|e| anyhow!("{e}"))?;
+    let d = Diagram::load_any(&a.file)?;
+    d.save_json(&a.out)?;
     eprintln!("{} written", a.out.display());
     Ok(())
 }
@@ -431,7 +435,7 @@ fn axis_by_name(n: &str) -> Result<AxisId> {
 }
 
 pub fn run_plot(a: &PlotArgs) -> Result<()> {
-    let d = Diagram::load_any(&a.file).map_err(|e| anyhow!("{e}"))?;
+    let d = Diagram::load_any(&a.file)?;
     let fi = Cell::FIELD_NAMES
         .iter()
         .position(|f| *f == a.field)

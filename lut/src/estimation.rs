@@ -519,7 +519,7 @@ pub fn load_scenarios(dir: &Path, table: &Diagram) -> Result<Vec<StudyScenario>>
     files.sort();
     let mut out = Vec::new();
     for f in files {
-        let s = Scenario::load(&f).map_err(|e| anyhow!("{e}"))?;
+        let s = Scenario::load(&f)?;
         let truth = Truth::new(&s).map_err(|e| anyhow!("{}: {e}", f.display()))?;
         let misreported = s.sensor.speed_bias_mps != 0.0 || s.sensor.mass_estimate_kg.is_some();
         if truth.contact_s.is_none() || misreported {

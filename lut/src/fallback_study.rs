@@ -501,7 +501,7 @@ impl Row {
 pub fn run_sweep(cfg: &CycleConfig, sweep: &Sweep) -> Result<Vec<Row>> {
     use rayon::prelude::*;
     let reference = physics::reference::ReferenceRestraint::builtin()
-        .map_err(|e| anyhow::anyhow!("{e}"))?
+        .map_err(anyhow::Error::msg)?
         .settings();
     sweep
         .cases()

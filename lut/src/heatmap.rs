@@ -3,7 +3,7 @@
 //! red (high), with the value written in it. SVG if the name ends in `.svg`, else PNG.
 
 use crate::plot::{render, Figure};
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -64,7 +64,7 @@ fn draw_on<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, panels: &[HeatPane
 where
     DB::ErrorType: 'static,
 {
-    root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+    root.fill(&WHITE)?;
     let areas = root.split_evenly((1, panels.len().max(1)));
     for (area, p) in areas.iter().zip(panels) {
         let xe = edges(&p.x);
@@ -89,15 +89,13 @@ where
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(60)
-            .build_cartesian_2d(xe[0]..xe[xe.len() - 1], ye[0]..ye[ye.len() - 1])
-            .map_err(|e| anyhow!("{e}"))?;
+            .build_cartesian_2d(xe[0]..xe[xe.len() - 1], ye[0]..ye[ye.len() - 1])?;
         chart
             .configure_mesh()
             .disable_mesh()
             .x_desc(p.x_label.as_str())
             .y_desc(p.y_label.as_str())
-            .draw()
-            .map_err(|e| anyhow!("{e}"))?;
+            .draw()?;
         for (iy, row) in p.z.iter().enumerate() {
             for (ix, &v) in row.iter().enumerate() {
                 let (x0, x1, y0, y1) = (xe[ix], xe[ix + 1], ye[iy], ye[iy + 1]);
@@ -106,9 +104,7 @@ where
                 } else {
                     RGBColor(200, 200, 200).filled()
                 };
-                chart
-                    .draw_series(std::iter::once(Rectangle::new([(x0, y0), (x1, y1)], fill)))
-                    .map_err(|e| anyhow!("{e}"))?;
+                chart.draw_series(std::iter::once(Rectangle::new([(x0, y0), (x1, y1)], fill)))?;
                 let marked = p
                     .marked
                     .as_ref()
@@ -117,12 +113,10 @@ where
                     .copied()
                     .unwrap_or(false);
                 if marked {
-                    chart
-                        .draw_series(std::iter::once(Rectangle::new(
-                            [(x0, y0), (x1, y1)],
-                            BLACK.stroke_width(3),
-                        )))
-                        .map_err(|e| anyhow!("{e}"))?;
+                    chart.draw_series(std::iter::once(Rectangle::new(
+                        [(x0, y0), (x1, y1)],
+                        BLACK.stroke_width(3),
+                    )))?;
                 }
                 if p.x.len() <= 16 && p.y.len() <= 16 {
                     let label = if v.is_finite() {
@@ -130,18 +124,16 @@ where
                     } else {
                         "–".into()
                     };
-                    chart
-                        .draw_series(std::iter::once(Text::new(
-                            label,
-                            (0.5 * (x0 + x1), 0.5 * (y0 + y1)),
-                            ("sans-serif", 13).into_font().color(&BLACK).pos(
-                                plotters::style::text_anchor::Pos::new(
-                                    plotters::style::text_anchor::HPos::Center,
-                                    plotters::style::text_anchor::VPos::Center,
-                                ),
+                    chart.draw_series(std::iter::once(Text::new(
+                        label,
+                        (0.5 * (x0 + x1), 0.5 * (y0 + y1)),
+                        ("sans-serif", 13).into_font().color(&BLACK).pos(
+                            plotters::style::text_anchor::Pos::new(
+                                plotters::style::text_anchor::HPos::Center,
+                                plotters::style::text_anchor::VPos::Center,
                             ),
-                        )))
-                        .map_err(|e| anyhow!("{e}"))?;
+                        ),
+                    )))?;
                 }
             }
         }

@@ -62,16 +62,10 @@ fn main() -> std::process::ExitCode {
     host::default_sigpipe();
     let matches = Cli::command().get_matches();
     let checked = check_outputs(&matches);
-    match checked
+    let result = checked
         .and_then(|()| Ok(Cli::from_arg_matches(&matches)?))
-        .and_then(run)
-    {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("lut: error: {e:#}");
-            std::process::ExitCode::FAILURE
-        }
-    }
+        .and_then(run);
+    host::exit_code("lut", result)
 }
 
 /// Every output path of every subcommand (`--out`, `--plot`, `--json`) is checked before the

@@ -90,7 +90,7 @@ fn draw_on<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, panels: &[Panel<'_
 where
     DB::ErrorType: 'static,
 {
-    root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e}"))?;
+    root.fill(&WHITE)?;
     let areas = root.split_evenly((panels.len().max(1), 1));
     for (area, panel) in areas.iter().zip(panels) {
         let (x0, x1) = bounds(panel.series.iter().flat_map(|s| s.x.iter().copied()));
@@ -100,22 +100,19 @@ where
             .margin(10)
             .x_label_area_size(35)
             .y_label_area_size(55)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
+            .build_cartesian_2d(x0..x1, y0..y1)?;
         chart
             .configure_mesh()
             .x_desc(panel.x_label)
             .y_desc(panel.y_label)
-            .draw()
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
+            .draw()?;
         for (i, s) in panel.series.iter().enumerate() {
             let color = Palette99::pick(i).to_rgba();
             chart
                 .draw_series(LineSeries::new(
                     s.x.iter().zip(s.y).map(|(&x, &y)| (x, y)),
                     color.stroke_width(2),
-                ))
-                .map_err(|e| anyhow::anyhow!("{e}"))?
+                ))?
                 .label(s.label.clone())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color));
         }
@@ -123,8 +120,7 @@ where
             .configure_series_labels()
             .background_style(WHITE.mix(0.8))
             .border_style(BLACK)
-            .draw()
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
+            .draw()?;
     }
     Ok(())
 }

@@ -298,7 +298,7 @@ impl Sampler {
     /// Load the table (checking it is the one the study was set up with) and predict the true
     /// pulse once.
     pub fn new(job: &RobustnessJob) -> Result<Self> {
-        let table = Diagram::load(&job.table).map_err(|e| anyhow!("{e}"))?;
+        let table = Diagram::load(&job.table)?;
         if table.checksum() != job.table_crc32c {
             bail!(
                 "{}: CRC-32C 0x{:08x}, but the study was set up with 0x{:08x} (table changed)",
@@ -569,7 +569,7 @@ pub fn read_shard(origin: &str, bytes: &[u8]) -> Result<ShardFile<Samples>> {
 pub fn write_result(r: &StudyResult, out: &Path) -> Result<()> {
     let mut text = serde_json::to_string_pretty(r)?;
     text.push('\n');
-    diagram::write_atomically(out, text.as_bytes()).map_err(|e| anyhow!("{e}"))
+    Ok(diagram::write_atomically(out, text.as_bytes())?)
 }
 
 /// Read a result JSON.

@@ -62,9 +62,13 @@ enum Command {
     },
 }
 
-fn main() -> Result<()> {
+fn main() -> std::process::ExitCode {
     host::stop::default_sigpipe();
-    match Cli::parse().command {
+    host::exit_code("record", run(Cli::parse()))
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
         Command::Mcap {
             dir,
             out,

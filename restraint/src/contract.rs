@@ -113,6 +113,8 @@ impl core::fmt::Display for StartupError {
     }
 }
 
+impl core::error::Error for StartupError {}
+
 /// The I/O of one cycle. Every method is non-blocking and allocation-free in a real
 /// implementation; inputs are drained oldest first.
 pub trait CycleIo {

@@ -26,6 +26,8 @@ impl core::fmt::Display for ConfigError {
     }
 }
 
+impl core::error::Error for ConfigError {}
+
 /// `value` of setting `key` within `lo..=hi` (NaN and infinities are outside every range).
 pub(crate) fn check_range(
     key: &'static str,

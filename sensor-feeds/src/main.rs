@@ -62,13 +62,7 @@ const TRUTH_PERIOD_TICKS: u64 = 10;
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
-    match run(&cli) {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("sensor-feeds: error: {e:#}");
-            std::process::ExitCode::FAILURE
-        }
-    }
+    host::exit_code("sensor-feeds", run(&cli))
 }
 
 fn describe(truth: &Truth) -> String {
@@ -124,7 +118,7 @@ fn describe_event(i: usize, e: &AccelEvent) -> String {
 }
 
 fn run(cli: &Cli) -> Result<()> {
-    let scenario = Scenario::load(&cli.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let scenario = Scenario::load(&cli.scenario)?;
     if !(cli.speedup.is_finite() && cli.speedup >= 0.1 && cli.speedup <= 100.0) {
         anyhow::bail!("--speedup must be within 0.1..=100");
     }

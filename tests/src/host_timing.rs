@@ -149,7 +149,7 @@ pub fn run_host_timing(cfg: &HostTimingConfig) -> Result<HostTiming> {
             .spawn()
             .context("starting the ECU")?;
         std::thread::sleep(Duration::from_millis(300));
-        let scenario = world::Scenario::load(&run.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let scenario = world::Scenario::load(&run.scenario)?;
         let mut feeds = crate::feeds_command(&run, None, None)
             .stdout(Stdio::piped())
             .spawn()

@@ -262,7 +262,7 @@ pub fn run_scenario(cfg: &RunConfig) -> Result<RunResult> {
 /// Runs one scenario through the real processes, disturbed by `dist`.
 pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunResult> {
     let run_started = std::time::Instant::now();
-    let scenario = world::Scenario::load(&cfg.scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let scenario = world::Scenario::load(&cfg.scenario)?;
     let dir = cfg.out.join(&scenario.name);
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     for stale in [

@@ -62,9 +62,7 @@ where
     else {
         anyhow::bail!("cycle period must be > 0 ns");
     };
-    activity
-        .startup(clock.now_ns(), io)
-        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    activity.startup(clock.now_ns(), io)?;
 
     let mut slot = 0u64;
     let mut deadline_ns = grid.deadline_ns(0);

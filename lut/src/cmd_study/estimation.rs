@@ -66,7 +66,7 @@ pub fn run(a: &EstimationArgs) -> Result<()> {
     progress.finish();
     let mut text = serde_json::to_string_pretty(&r)?;
     text.push('\n');
-    diagram::write_atomically(&a.out, text.as_bytes()).map_err(|e| anyhow!("{e}"))?;
+    diagram::write_atomically(&a.out, text.as_bytes())?;
     print!("{}", table_text(&r));
     eprintln!("result written to {}", a.out.display());
     if let Some(p) = &a.plot {
@@ -168,14 +168,12 @@ impl TraceFigure<'_> {
             .margin(10)
             .x_label_area_size(35)
             .y_label_area_size(60)
-            .build_cartesian_2d(-1000.0..0.0, (truth - half_range)..(truth + half_range))
-            .map_err(|e| anyhow!("{e}"))?;
+            .build_cartesian_2d(-1000.0..0.0, (truth - half_range)..(truth + half_range))?;
         chart
             .configure_mesh()
             .x_desc("time before the true contact [ms]")
             .y_desc(y_label)
-            .draw()
-            .map_err(|e| anyhow!("{e}"))?;
+            .draw()?;
         let band: Vec<(f64, f64, f64)> = pts
             .iter()
             .filter_map(|p| {
@@ -187,16 +185,14 @@ impl TraceFigure<'_> {
         let mut poly: Vec<(f64, f64)> = band.iter().map(|(t, v, s)| (*t, v + s)).collect();
         poly.extend(band.iter().rev().map(|(t, v, s)| (*t, v - s)));
         chart
-            .draw_series(std::iter::once(Polygon::new(poly, BLUE.mix(0.2).filled())))
-            .map_err(|e| anyhow!("{e}"))?
+            .draw_series(std::iter::once(Polygon::new(poly, BLUE.mix(0.2).filled())))?
             .label("filtered ± σ")
             .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 15, y + 5)], BLUE.mix(0.2).filled()));
         chart
             .draw_series(LineSeries::new(
                 band.iter().map(|(t, v, _)| (*t, *v)),
                 &BLUE,
-            ))
-            .map_err(|e| anyhow!("{e}"))?
+            ))?
             .label("filtered (restraint core)")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], BLUE));
         chart
@@ -205,16 +201,14 @@ impl TraceFigure<'_> {
                     .filter(|p| p.sample)
                     .filter_map(|p| p.raw.map(|h| (x(p.t_s), value(&h))))
                     .map(|(t, v)| Circle::new((t, v), 3, RED.filled())),
-            )
-            .map_err(|e| anyhow!("{e}"))?
+            )?
             .label("newest sample alone (no track filter)")
             .legend(|(x, y)| Circle::new((x + 7, y), 3, RED.filled()));
         chart
             .draw_series(LineSeries::new(
                 [(-1000.0, truth), (0.0, truth)],
                 BLACK.stroke_width(2),
-            ))
-            .map_err(|e| anyhow!("{e}"))?
+            ))?
             .label("truth")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], BLACK.stroke_width(2)));
         chart
@@ -222,8 +216,7 @@ impl TraceFigure<'_> {
             .border_style(BLACK)
             .background_style(WHITE.mix(0.8))
             .position(SeriesLabelPosition::UpperLeft)
-            .draw()
-            .map_err(|e| anyhow!("{e}"))?;
+            .draw()?;
         Ok(())
     }
 }
@@ -233,10 +226,9 @@ impl plot::Figure for TraceFigure<'_> {
     where
         DB::ErrorType: 'static,
     {
-        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        root.fill(&WHITE)?;
         let (top, rest) = root.split_vertically(40);
-        top.titled(&self.title, ("sans-serif", 22))
-            .map_err(|e| anyhow!("{e}"))?;
+        top.titled(&self.title, ("sans-serif", 22))?;
         let areas = rest.split_evenly((3, 1));
         let tc = self.run.contact_s;
         let r = self.run;

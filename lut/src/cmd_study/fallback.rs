@@ -62,7 +62,7 @@ pub fn run(args: &FallbackArgs) -> Result<()> {
     };
     let mut cfg = CycleConfig::default();
     let t_ref_ms = physics::reference::ReferenceRestraint::builtin()
-        .map_err(|e| anyhow::anyhow!("{e}"))?
+        .map_err(anyhow::Error::msg)?
         .restraint
         .airbag_time_ms;
     let no_fire = cfg.no_fire_line_kph(sweep.belted);

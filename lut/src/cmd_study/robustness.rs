@@ -80,7 +80,7 @@ impl RobustnessArgs {
             return Err(anyhow!("--samples must be ≥ 1"));
         }
         let table = std::path::absolute(&self.table)?;
-        let d = Diagram::load(&table).map_err(|e| anyhow!("{e}"))?;
+        let d = Diagram::load(&table)?;
         let job = RobustnessJob {
             table,
             table_crc32c: d.checksum(),

@@ -68,7 +68,7 @@ impl TableJob {
             .map_err(|e| anyhow!("merged table: {e}"))?
             .map(|line| format!("; {line}"))
             .unwrap_or_default();
-        diagram::write_atomically(out, &bytes).map_err(|e| anyhow!("{e}"))?;
+        diagram::write_atomically(out, &bytes)?;
         Ok(format!(
             "table {name}: {} cells, LUT id 0x{:04x}, CRC-32C 0x{:08x}; {} cells re-optimised, all within tolerance{margin}",
             back.cells().len(),

@@ -126,7 +126,7 @@ fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T> {
 fn write_json<T: Serialize>(path: &Path, v: &T) -> Result<()> {
     let mut text = serde_json::to_string_pretty(v)?;
     text.push('\n');
-    diagram::write_atomically(path, text.as_bytes()).map_err(|e| anyhow!("{e}"))
+    Ok(diagram::write_atomically(path, text.as_bytes())?)
 }
 
 fn absolute(p: &Path) -> Result<PathBuf> {
@@ -238,7 +238,7 @@ impl Work {
             .compute_shard(k as usize, n, threads, &progress)?;
         progress.finish();
         let path = self.shard_path(k);
-        diagram::write_atomically(&path, &bytes).map_err(|e| anyhow!("{e}"))?;
+        diagram::write_atomically(&path, &bytes)?;
         self.check_shard(k)?;
         eprintln!("shard written to {}", path.display());
         Ok(())

@@ -139,13 +139,8 @@ fn parse_message(s: &str) -> Result<u32, String> {
 }
 
 fn main() -> std::process::ExitCode {
-    match run(Cli::parse()) {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("bus-inject: error: {e:#}");
-            std::process::ExitCode::FAILURE
-        }
-    }
+    host::default_sigpipe();
+    host::exit_code("bus-inject", run(Cli::parse()))
 }
 
 use bus::candump::cansend_arg;

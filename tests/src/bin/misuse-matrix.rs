@@ -353,7 +353,7 @@ fn airbag_needed(cfg: &OfflineConfig, text: &str) -> Result<bool> {
     use actuator_stubs::outcome::{judge, NEVER_S};
     let scenario =
         world::Scenario::parse("matrix", text).map_err(|e| anyhow::anyhow!("{e}\n{text}"))?;
-    let truth = world::Truth::new(&scenario).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let truth = world::Truth::new(&scenario).map_err(anyhow::Error::msg)?;
     if truth.collision.is_none() {
         return Ok(false);
     }
@@ -369,8 +369,8 @@ fn airbag_needed(cfg: &OfflineConfig, text: &str) -> Result<bool> {
         airbag_time_s: NEVER_S,
         ..full
     };
-    let with_airbag = judge(&pulse, &occ, &full).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let belt_only = judge(&pulse, &occ, &belt).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let with_airbag = judge(&pulse, &occ, &full).map_err(anyhow::Error::msg)?;
+    let belt_only = judge(&pulse, &occ, &belt).map_err(anyhow::Error::msg)?;
     Ok(belt_only.0.bottomed_out && !with_airbag.0.bottomed_out)
 }
 

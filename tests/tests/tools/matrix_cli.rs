@@ -122,6 +122,49 @@ const TOOLS: [&str; 13] = [
 ];
 
 #[test]
+fn every_tool_exits_2_with_one_line_on_an_error() {
+    // The processes and `lut` exited 1 for every error, so a `lut verify` mismatch (1, a
+    // check that failed) looked like a missing file; `record` printed anyhow's multi-line
+    // `Error: … Caused by:` form.
+    let release = e2e_tests::repo_root().join("target/release");
+    let out_dir = std::env::temp_dir().join(format!("exit-codes-{}", std::process::id()));
+    let out_dir = out_dir.to_str().expect("path");
+    let missing: [(&str, Vec<&str>); 6] = [
+        ("lut", vec!["verify", "/nonexistent.lut"]),
+        ("record", vec!["mcap", "/nonexistent-run"]),
+        ("sensor-feeds", vec!["--scenario", "/nonexistent.toml"]),
+        (
+            "actuator-stubs",
+            vec!["--scenario", "/nonexistent.toml", "--out", out_dir],
+        ),
+        ("ecu", vec!["--config", "/nonexistent.toml"]),
+        ("offline-bench", vec!["--scenario", "/nonexistent.toml"]),
+    ];
+    for (tool, args) in missing {
+        let out = Command::new(release.join(tool))
+            .args(&args)
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{tool} {args:?}: {err}");
+        // One line (`offline-bench` runs a batch: a line a file, then its verdict).
+        let last = err.trim_end().lines().last().unwrap_or_default();
+        assert!(
+            last.starts_with(&format!("{tool}: error: "))
+                && (tool == "offline-bench" || err.trim_end().lines().count() == 1),
+            "{tool} {args:?}: {err}"
+        );
+    }
+    for tool in TOOLS {
+        let out = Command::new(release.join(tool))
+            .arg("--no-such-flag")
+            .output()
+            .expect("runs");
+        assert_eq!(out.status.code(), Some(2), "{tool}");
+    }
+}
+
+#[test]
 fn every_tool_answers_version_with_its_own_name() {
     // `budget` and `worst_cycle` lacked `--version`.
     let release = e2e_tests::repo_root().join("target/release");

@@ -527,7 +527,8 @@ fn a_wrong_expectation_fails_offline_bench_and_a_bad_file_does_not_stop_the_othe
     let good = root().join("scenarios/taurus-48-48-abs.toml");
     let (code, stdout, stderr, json) =
         offline_bench(&[wrong.clone(), broken.clone(), good.clone()], &[]);
-    assert_eq!(code, 1, "{stderr}");
+    // A file that did not run is an error (2), which outranks a missed expectation (1).
+    assert_eq!(code, 2, "{stderr}");
     assert!(
         stderr.contains("misuse-pothole: [expect] airbag_fires = true, measured false"),
         "{stderr}"
@@ -549,6 +550,8 @@ fn a_wrong_expectation_fails_offline_bench_and_a_bad_file_does_not_stop_the_othe
         .is_some_and(|e| e.contains("peak_g")));
     assert_eq!(runs[2]["expect"]["met"], true);
     // --no-expect runs the same files without judging them: only the bad file fails.
+    let (code, ..) = offline_bench(std::slice::from_ref(&wrong), &[]);
+    assert_eq!(code, 1, "a missed expectation alone is a failed check");
     let (code, _, _, json) = offline_bench(std::slice::from_ref(&wrong), &["--no-expect"]);
     assert_eq!(code, 0);
     assert!(json[0]["expect"].is_null());
