@@ -12,13 +12,15 @@
 //! * [`gate`] — reading criterion's `estimates.json` and comparing with the budgets.
 //! * [`icount`] — instructions per iteration from two callgrind runs.
 //! * [`latency`] — cyclictest histogram and ECU report parsing for the loop harness.
-//! * [`worst_case`] — the search space of one cycle's inputs and state, searched for the
-//!   case with the most instructions (`worst_cycle`), the gate's worst-case row.
+//! * [`worst_case`] — the search space of one cycle's inputs and state, a case run and
+//!   measured (the gate's worst-case rows);
+//! * [`search`] — the search's operators over cases (`worst_cycle search`).
 
 pub mod budgets;
 pub mod ecu_cycle;
 pub mod gate;
 pub mod icount;
 pub mod latency;
+pub mod search;
 pub mod workload;
 pub mod worst_case;

@@ -9,6 +9,7 @@ use lut::distributed::{Job, TableJob};
 use lut::margin;
 use lut::progress::Progress;
 use lut::table::{self, Grid, GridFile};
+use lut::verify;
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
@@ -177,7 +178,7 @@ pub struct VerifyArgs {
 
 pub fn run_verify(a: &VerifyArgs) -> Result<()> {
     let d = Diagram::load_any(&a.file)?;
-    let rows = table::verify(&d, a.cells, a.seed)?;
+    let rows = verify::verify(&d, a.cells, a.seed)?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&rows)?);
     } else {
@@ -205,10 +206,10 @@ pub fn run_verify(a: &VerifyArgs) -> Result<()> {
         a.file.display(),
         rows.len() - bad,
         rows.len(),
-        table::RESIM_TOL_ABS_G,
-        table::RESIM_TOL_REL * 100.0,
-        table::REOPT_TOL_ABS_G,
-        table::REOPT_TOL_REL * 100.0
+        verify::RESIM_TOL_ABS_G,
+        verify::RESIM_TOL_REL * 100.0,
+        verify::REOPT_TOL_ABS_G,
+        verify::REOPT_TOL_REL * 100.0
     );
     let margin_failed = verify_margin(&d, a)?;
     if bad > 0 {
@@ -241,7 +242,7 @@ fn verify_margin(d: &Diagram, a: &VerifyArgs) -> Result<Option<String>> {
         bail!("--margin-kg must be ≥ 0 and --margin-step-kg > 0 (finite)");
     }
     let reference = margin::reference_settings()?;
-    let rows = table::check_margin(d, &reference, span_kg, a.margin_step_kg)?;
+    let rows = verify::check_margin(d, &reference, span_kg, a.margin_step_kg)?;
     let s = margin::MarginSummary::of(&rows);
     let source = match (a.margin_kg, stated) {
         (Some(_), _) => "given",

@@ -27,8 +27,8 @@
 //! differ only by the variation); results are collected in index order, so threads change
 //! nothing.
 
+use crate::hash::{fnv1a, splitmix64};
 use crate::robustness::{self, Estimate, Outcome, Sampler, Spread};
-use crate::table::{fnv1a, splitmix64};
 use anyhow::{anyhow, Context, Result};
 use diagram::Diagram;
 use rand::{Rng, SeedableRng};

@@ -8,7 +8,9 @@
 //!   the crush-zone satellites' relief of its severity floor.
 //! * [`optimise`] — particle swarm + Nelder–Mead over the four restraint variables, penalty
 //!   method for the no-bottoming-out constraint.
-//! * [`table`] — grid files, cell optimisation, build / shard / merge / verify.
+//! * [`table`] — grid files, cell optimisation, build / shard / merge.
+//! * [`verify`] — checking a built table: cells re-optimised, the planning margin.
+//! * [`hash`] — seeds and fingerprints the same on every machine (SplitMix64, FNV-1a).
 //! * [`shard`] — shard files a distributed run can trust (identity, range, checksum).
 //! * [`progress`] — progress bar / lines / progress file of long computations.
 //! * [`slurm`] — the Slurm client tools (sbatch, squeue, scontrol, scancel).
@@ -29,6 +31,7 @@ pub mod distributed;
 pub mod estimation;
 pub mod fallback_study;
 pub mod fire_floor;
+pub mod hash;
 pub mod limiter_switch;
 pub mod margin;
 pub mod optimise;
@@ -40,3 +43,4 @@ pub mod scenario;
 pub mod shard;
 pub mod slurm;
 pub mod table;
+pub mod verify;

@@ -274,7 +274,7 @@ impl LighterSet {
     }
 }
 
-/// What the check of a table (`table::check_margin`) found, for a report.
+/// What the check of a table (`verify::check_margin`) found, for a report.
 #[derive(Clone, Debug, Serialize)]
 pub struct MarginSummary {
     /// Cells checked.

@@ -24,10 +24,11 @@
 //! depend on which thread, shard or machine computes it, and the statistics are computed from
 //! the samples in index order: a local run and a Slurm array give the same result bit for bit.
 
+use crate::hash::splitmix64;
 use crate::progress::Progress;
 use crate::scenario::{Ego, Opponent, Pulse};
 use crate::shard::{self, Payload, ShardFile, ShardHeader};
-use crate::table::{occupant_at, splitmix64};
+use crate::table::occupant_at;
 use anyhow::{anyhow, bail, Context, Result};
 use diagram::{Diagram, Query};
 use physics::{mps2_to_g, simulate_occupant, MassClass, RestraintHardware, RestraintSettings};

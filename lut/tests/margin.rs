@@ -6,6 +6,7 @@
 use diagram::{Cell, Diagram};
 use lut::margin::{self, truths, MarginSummary, EXTRA_SPAN_KG};
 use lut::table::{self, Grid};
+use lut::verify;
 use physics::reference::ReferenceRestraint;
 use physics::RestraintSettings;
 use std::path::PathBuf;
@@ -72,7 +73,7 @@ fn the_reference_restraint_planned_anywhere_is_never_worse_than_itself() {
     // Oracle: with no airbag floor the setting executes exactly as the reference at every
     // truth, so every change is 0 and every cell holds.
     let d = ci_table(Some(&reference()), "0", &[]);
-    let rows = table::check_margin(&d, &reference(), 2400.0, 200.0).unwrap();
+    let rows = verify::check_margin(&d, &reference(), 2400.0, 200.0).unwrap();
     assert_eq!(rows.len(), 24);
     for r in &rows {
         assert!(r.ok, "{r:?}");
@@ -99,7 +100,7 @@ fn a_restraint_too_weak_for_a_crash_fails_where_the_reference_holds_the_occupant
     };
     let d = ci_table(Some(&weak), "0", &[]);
     let hw = physics::RestraintHardware::default();
-    let rows = table::check_margin(&d, &reference(), 2400.0, 200.0).unwrap();
+    let rows = verify::check_margin(&d, &reference(), 2400.0, 200.0).unwrap();
     let mut seen_bottoming = 0;
     for r in &rows {
         let p = Grid::from_table(&d).unwrap().axes.point(r.index).unwrap();
@@ -240,8 +241,8 @@ fn a_grid_with_a_robust_span_builds_cells_that_hold_it_or_hold_it_better() {
     let (r, _) = table::build_table(&robust, Some(2), true).unwrap();
     assert_eq!(margin::stated_span_kg(&p).unwrap(), None);
     assert_eq!(margin::stated_span_kg(&r).unwrap(), Some(2400.0));
-    let rows_p = table::check_margin(&p, &reference(), 2400.0, margin::DEFAULT_STEP_KG).unwrap();
-    let rows_r = table::check_margin(&r, &reference(), 2400.0, margin::DEFAULT_STEP_KG).unwrap();
+    let rows_p = verify::check_margin(&p, &reference(), 2400.0, margin::DEFAULT_STEP_KG).unwrap();
+    let rows_r = verify::check_margin(&r, &reference(), 2400.0, margin::DEFAULT_STEP_KG).unwrap();
     let fails = |x: &margin::MarginRow| x.bottoms_out_alone + x.strikes_deeper;
     let mut changed = 0;
     for ((a, b), (ca, cb)) in rows_p
@@ -285,18 +286,18 @@ fn the_collect_job_s_check_refuses_a_table_that_breaks_its_stated_span() {
         airbag_time_s: 0.010,
     };
     let breaks = ci_table(Some(&weak), "0", &[(EXTRA_SPAN_KG, "2400")]);
-    let e = table::enforce_stated_margin(&breaks)
+    let e = verify::enforce_stated_margin(&breaks)
         .unwrap_err()
         .to_string();
     assert!(e.contains("breaks the planning margin of 2400 kg"), "{e}");
     let holds = ci_table(Some(&reference()), "0", &[(EXTRA_SPAN_KG, "2400")]);
     assert_eq!(
-        table::enforce_stated_margin(&holds).unwrap().as_deref(),
+        verify::enforce_stated_margin(&holds).unwrap().as_deref(),
         Some("planning margin of 2400 kg holds in all 24 cells")
     );
     // A table stating nothing is not checked (the weak one included).
     assert_eq!(
-        table::enforce_stated_margin(&ci_table(Some(&weak), "0", &[])).unwrap(),
+        verify::enforce_stated_margin(&ci_table(Some(&weak), "0", &[])).unwrap(),
         None
     );
 }

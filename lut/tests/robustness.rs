@@ -5,7 +5,7 @@
 use diagram::{Diagram, Query};
 use lut::progress::Progress;
 use lut::robustness::{self, EstimateErrors, RobustnessJob, Situation};
-use lut::table;
+use lut::verify;
 use std::path::PathBuf;
 
 fn table_path() -> PathBuf {
@@ -118,7 +118,7 @@ fn a_perfect_estimate_reproduces_the_table_and_has_no_spread() {
     let stored = f64::from(l.values.a_max_g) + f64::from(l.values.a_mean_g);
     let ours = r.exact_estimate.a_max_g + r.exact_estimate.a_mean_g;
     assert!(
-        (ours - stored).abs() <= table::RESIM_TOL_ABS_G.max(table::RESIM_TOL_REL * stored),
+        (ours - stored).abs() <= verify::RESIM_TOL_ABS_G.max(verify::RESIM_TOL_REL * stored),
         "study {ours:.3} g vs table {stored:.3} g"
     );
     assert_eq!(r.exact_estimate.bottoming_out, l.bottoming_out);

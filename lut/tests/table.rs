@@ -4,6 +4,7 @@
 use diagram::Diagram;
 use lut::progress::Progress;
 use lut::table::{self, Grid};
+use lut::verify;
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -152,7 +153,7 @@ fn verify_detects_a_table_that_does_not_match_the_physics() {
         c.a_mean_g *= 0.8;
     }
     let tampered = Diagram::new(data).unwrap();
-    let rows = table::verify(&tampered, 4, 9).unwrap();
+    let rows = verify::verify(&tampered, 4, 9).unwrap();
     assert!(rows.iter().all(|r| !r.ok), "{rows:?}");
 }
 

@@ -12,6 +12,7 @@
 use anyhow::Context;
 use clap::{Parser, Subcommand, ValueEnum};
 use cycle_benches::icount;
+use cycle_benches::search;
 use cycle_benches::worst_case::{self, CycleCase, MEASURED_FN};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -156,7 +157,7 @@ fn search(
         .map(|(_, c)| force_secoc(c.clone(), secoc))
         .collect();
     while cases.len() < population {
-        cases.push(force_secoc(worst_case::random_case(&mut rng), secoc));
+        cases.push(force_secoc(search::random_case(&mut rng), secoc));
     }
     let mut best: Option<(u64, CycleCase, String)> = None;
     let mut start_counts: Vec<(String, u64)> = Vec::new();
@@ -204,10 +205,10 @@ fn search(
         cases = parents.clone();
         while cases.len() < population {
             let child = if rng.gen_bool(0.1) {
-                worst_case::random_case(&mut rng)
+                search::random_case(&mut rng)
             } else {
                 let p = &parents[rng.gen_range(0..parents.len())];
-                worst_case::mutate(p, 0.3, &mut rng)
+                search::mutate(p, 0.3, &mut rng)
             };
             cases.push(force_secoc(child, secoc));
         }

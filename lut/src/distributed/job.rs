@@ -4,6 +4,7 @@ use crate::progress::Progress;
 use crate::robustness::RobustnessJob;
 use crate::shard::ShardHeader;
 use crate::table::{self, Grid, GridFile};
+use crate::verify;
 use anyhow::{anyhow, bail, Result};
 use diagram::Diagram;
 use serde::{Deserialize, Serialize};
@@ -52,7 +53,7 @@ impl TableJob {
         if table::table_identity(back.header(), back.axes())? != identity {
             bail!("merged table's header and axes are not those of the grid");
         }
-        let rows = table::verify(&back, self.verify_cells, self.verify_seed)?;
+        let rows = verify::verify(&back, self.verify_cells, self.verify_seed)?;
         let bad: Vec<String> = rows
             .iter()
             .filter(|r| !r.ok)
@@ -64,7 +65,7 @@ impl TableJob {
                 bad.join("; ")
             );
         }
-        let margin = table::enforce_stated_margin(&back)
+        let margin = verify::enforce_stated_margin(&back)
             .map_err(|e| anyhow!("merged table: {e}"))?
             .map(|line| format!("; {line}"))
             .unwrap_or_default();
