@@ -26,7 +26,7 @@ pub fn lut_input(d: &diagram::Diagram) -> restraint::Lut<'_> {
         ego_mass_kg: d.header().ego.mass_kg,
         ego_class: d.header().ego.class,
         // An unreadable span: NaN, which the core rejects.
-        verified_lighter_kg: d
+        lighter_opponent_kg: d
             .header()
             .lighter_opponent_span_kg()
             .map_or(Some(f32::NAN), |s| s.map(|kg| kg as f32)),

@@ -9,7 +9,7 @@
 //! plan (one source light by up to the misreport bound) and at least the plan minus twice the
 //! bound (a source heavy by it), or the plan minus 1 200 + 300 kg with a station. Both sets lie
 //! inside [M − 2 400 kg, M]. A table may state the span it holds for in its header
-//! ([`EXTRA_SPAN_KG`]); `lut verify` checks every cell and enforces a stated span.
+//! ([`diagram::EXTRA_LIGHTER_OPPONENT_KG`]); `lut verify` checks every cell and enforces a stated span.
 //!
 //! The airbag is judged as the ECU fires it: at the cell's planned time, or later where the
 //! lighter truth's pulse carries the airbag's severity floor only later (plan = fire,
@@ -27,10 +27,6 @@ use physics::{
 };
 use serde::Serialize;
 
-/// Header key (`build.extra`) of the span the table is verified for: a setting planned for
-/// opponent mass M holds for every true opponent from M − this [kg] to M (the diagram crate's,
-/// which the ECU reads too).
-pub const EXTRA_SPAN_KG: &str = diagram::EXTRA_LIGHTER_OPPONENT_KG;
 /// The span the shipped rule needs: the truth up to twice the misreport bound (1 200 kg)
 /// lighter than the plan.
 pub const DEFAULT_SPAN_KG: f64 = 2400.0;
@@ -114,12 +110,12 @@ pub fn truths(planned_kg: f64, span_kg: f64, step_kg: f64, floor_kg: f64) -> Vec
     out
 }
 
-/// The lighter opponents a check runs over: from the plan down to the plan − `lighter_kg` by
+/// The lighter opponents a check runs over: from the plan down to the plan − `lighter_opponent_kg` by
 /// `step_kg`, never below `floor_kg` (the mass axis' lightest).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Span {
     /// How far below the plan [kg].
-    pub lighter_kg: f64,
+    pub lighter_opponent_kg: f64,
     /// Step between the checked masses [kg].
     pub step_kg: f64,
     /// The lightest checked mass [kg].
@@ -152,7 +148,7 @@ impl LighterSet {
         let v = f64::from(q.closing_speed_kph);
         let masses_kg = truths(
             f64::from(q.opponent_mass_kg),
-            span.lighter_kg,
+            span.lighter_opponent_kg,
             span.step_kg,
             span.floor_kg,
         );

@@ -114,7 +114,7 @@ pub struct Grid {
     /// Axes.
     pub axes: Axes,
     /// The planning margin's span the cells hold [kg] (`[robust]`), if any.
-    pub robust_lighter_kg: Option<f64>,
+    pub robust_lighter_opponent_kg: Option<f64>,
 }
 
 const EXTRA_PARTICLES: &str = "optimiser.particles";
@@ -164,7 +164,7 @@ impl Grid {
         if seat.first().is_some_and(|&d| f64::from(d) <= lo) {
             bail!("{origin}: seat_distance_mm must exceed the {lo} mm module thickness");
         }
-        let robust_lighter_kg = match f.robust {
+        let robust_lighter_opponent_kg = match f.robust {
             None => None,
             Some(r) if r.lighter_opponent_kg.is_finite() && r.lighter_opponent_kg > 0.0 => {
                 Some(r.lighter_opponent_kg)
@@ -189,7 +189,7 @@ impl Grid {
             description: f.ego.description,
             optimiser,
             axes,
-            robust_lighter_kg,
+            robust_lighter_opponent_kg,
         })
     }
 
@@ -247,8 +247,8 @@ impl Grid {
             "occupant".into(),
             "belted; seat friction and hardware: physics::defaults".into(),
         );
-        if let Some(kg) = self.robust_lighter_kg {
-            extra.insert(margin::EXTRA_SPAN_KG.into(), format!("{kg}"));
+        if let Some(kg) = self.robust_lighter_opponent_kg {
+            extra.insert(diagram::EXTRA_LIGHTER_OPPONENT_KG.into(), format!("{kg}"));
         }
         extra.insert(
             "objective".into(),
@@ -322,7 +322,7 @@ impl Grid {
             description: h.ego.description.clone(),
             optimiser,
             axes: d.axes().clone(),
-            robust_lighter_kg: margin::stated_span_kg(d)?,
+            robust_lighter_opponent_kg: margin::stated_span_kg(d)?,
         })
     }
 
@@ -346,7 +346,7 @@ impl Grid {
             .map(|&m| f64::from(m))
             .ok_or_else(|| anyhow!("no mass axis"))?;
         let span = margin::Span {
-            lighter_kg: span_kg,
+            lighter_opponent_kg: span_kg,
             step_kg,
             floor_kg,
         };
@@ -450,7 +450,7 @@ pub fn optimise_point(grid: &Grid, p: &GridPoint, cfg: &OptimiserConfig) -> Resu
         cfg,
     )
     .with_context(|| format!("cell {} {:?}", p.index, p.coords))?;
-    let optimum = match grid.robust_lighter_kg {
+    let optimum = match grid.robust_lighter_opponent_kg {
         Some(span_kg) => hold_margin(grid, p, cfg, optimum, span_kg)
             .with_context(|| format!("cell {} {:?}: planning margin", p.index, p.coords))?,
         None => optimum,

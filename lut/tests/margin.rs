@@ -3,8 +3,9 @@
 //! reference's own setting changes nothing; a restraint too weak for any crash bottoms out
 //! where the reference does not), the span a header states, and the binary enforcing it.
 
+use diagram::EXTRA_LIGHTER_OPPONENT_KG;
 use diagram::{Cell, Diagram};
-use lut::margin::{self, truths, MarginSummary, EXTRA_SPAN_KG};
+use lut::margin::{self, truths, MarginSummary};
 use lut::table::{self, Grid};
 use lut::verify;
 use physics::reference::ReferenceRestraint;
@@ -138,12 +139,12 @@ fn a_restraint_too_weak_for_a_crash_fails_where_the_reference_holds_the_occupant
 fn the_span_a_header_states_is_read_and_a_bad_one_refused() {
     let none = ci_table(None, "0", &[]);
     assert_eq!(margin::stated_span_kg(&none).unwrap(), None);
-    let stated = ci_table(None, "0", &[(EXTRA_SPAN_KG, "2400")]);
+    let stated = ci_table(None, "0", &[(EXTRA_LIGHTER_OPPONENT_KG, "2400")]);
     assert_eq!(margin::stated_span_kg(&stated).unwrap(), Some(2400.0));
     for bad in ["-1", "NaN", "heavy"] {
-        let d = ci_table(None, "0", &[(EXTRA_SPAN_KG, bad)]);
+        let d = ci_table(None, "0", &[(EXTRA_LIGHTER_OPPONENT_KG, bad)]);
         let e = margin::stated_span_kg(&d).unwrap_err().to_string();
-        assert!(e.contains(EXTRA_SPAN_KG), "{e}");
+        assert!(e.contains(EXTRA_LIGHTER_OPPONENT_KG), "{e}");
     }
 }
 
@@ -182,7 +183,7 @@ fn lut_verify_enforces_a_stated_or_given_span_and_reports_an_unstated_one() {
     );
     // Stated in the header: enforced.
     let (ok, err) = run(
-        &ci_table(Some(&weak), "0", &[(EXTRA_SPAN_KG, "2400")]),
+        &ci_table(Some(&weak), "0", &[(EXTRA_LIGHTER_OPPONENT_KG, "2400")]),
         "stated.lut",
         &[],
     );
@@ -201,7 +202,11 @@ fn lut_verify_enforces_a_stated_or_given_span_and_reports_an_unstated_one() {
         "{err}"
     );
     let (ok, err) = run(
-        &ci_table(Some(&reference()), "0", &[(EXTRA_SPAN_KG, "2400")]),
+        &ci_table(
+            Some(&reference()),
+            "0",
+            &[(EXTRA_LIGHTER_OPPONENT_KG, "2400")],
+        ),
         "holds.lut",
         &[],
     );
@@ -236,7 +241,7 @@ fn a_grid_with_a_robust_span_builds_cells_that_hold_it_or_hold_it_better() {
         &format!("{text}\n[robust]\nlighter_opponent_kg = 2400.0\n"),
     )
     .unwrap();
-    assert_eq!(robust.robust_lighter_kg, Some(2400.0));
+    assert_eq!(robust.robust_lighter_opponent_kg, Some(2400.0));
     let (p, _) = table::build_table(&plain, Some(2), true).unwrap();
     let (r, _) = table::build_table(&robust, Some(2), true).unwrap();
     assert_eq!(margin::stated_span_kg(&p).unwrap(), None);
@@ -285,12 +290,16 @@ fn the_collect_job_s_check_refuses_a_table_that_breaks_its_stated_span() {
         pretensioner_time_s: 0.020,
         airbag_time_s: 0.010,
     };
-    let breaks = ci_table(Some(&weak), "0", &[(EXTRA_SPAN_KG, "2400")]);
+    let breaks = ci_table(Some(&weak), "0", &[(EXTRA_LIGHTER_OPPONENT_KG, "2400")]);
     let e = verify::enforce_stated_margin(&breaks)
         .unwrap_err()
         .to_string();
     assert!(e.contains("breaks the planning margin of 2400 kg"), "{e}");
-    let holds = ci_table(Some(&reference()), "0", &[(EXTRA_SPAN_KG, "2400")]);
+    let holds = ci_table(
+        Some(&reference()),
+        "0",
+        &[(EXTRA_LIGHTER_OPPONENT_KG, "2400")],
+    );
     assert_eq!(
         verify::enforce_stated_margin(&holds).unwrap().as_deref(),
         Some("planning margin of 2400 kg holds in all 24 cells")

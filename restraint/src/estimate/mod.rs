@@ -104,7 +104,7 @@ pub struct Lut<'a> {
     /// `robust.lighter_opponent_kg`): a plan up to this much heavier than the true opponent
     /// does not bottom the occupant out where the reference does not. `None`: the table states
     /// none (no claim, accepted); NaN: it states one the shell could not read (rejected).
-    pub verified_lighter_kg: Option<f32>,
+    pub lighter_opponent_kg: Option<f32>,
 }
 
 /// Why a LUT was rejected at start-up (the ECU then runs DEGRADED on the reference restraint).
@@ -124,7 +124,7 @@ pub enum LutMismatch {
     /// Verified for plans less heavy than the truth than the configured margins make them.
     Margin {
         /// The span the table states, kg (NaN: unreadable).
-        verified_lighter_kg: f32,
+        lighter_opponent_kg: f32,
         /// The span the configuration needs, kg: 2 × `mass_misreport_kg`, or
         /// `mass_misreport_kg` + `v2x_mass_margin_kg` if more.
         needed_kg: f64,
@@ -146,11 +146,11 @@ impl core::fmt::Display for LutMismatch {
                  restraint)"
             ),
             Self::Margin {
-                verified_lighter_kg,
+                lighter_opponent_kg,
                 needed_kg,
             } => write!(
                 f,
-                "LUT is verified for plans up to {verified_lighter_kg} kg heavier than the \
+                "LUT is verified for plans up to {lighter_opponent_kg} kg heavier than the \
                  opponent (robust.lighter_opponent_kg), the ECU's planning margins need \
                  {needed_kg} kg (2 × mass_misreport_kg, or mass_misreport_kg + \
                  v2x_mass_margin_kg): LUT rejected, DEGRADED (reference restraint)"
@@ -181,14 +181,14 @@ pub fn check_lut<'a>(
         };
         return (None, Some(m));
     }
-    if let Some(span_kg) = l.verified_lighter_kg {
+    if let Some(span_kg) = l.lighter_opponent_kg {
         let needed_kg =
             (2.0 * cfg.mass_misreport_kg).max(cfg.mass_misreport_kg + cfg.v2x_mass_margin_kg);
         // NaN-safe: an unreadable span (NaN) covers nothing. 0.5 kg: the span is stored as
         // text and read as f32.
         if !(needed_kg <= f64::from(span_kg) + 0.5) {
             let m = LutMismatch::Margin {
-                verified_lighter_kg: span_kg,
+                lighter_opponent_kg: span_kg,
                 needed_kg,
             };
             return (None, Some(m));

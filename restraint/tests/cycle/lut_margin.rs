@@ -50,13 +50,13 @@ fn a_table_verified_for_less_than_the_margins_need_is_rejected_and_says_why() {
     ] {
         let m = notes(cfg, &stating(span)).expect("rejected");
         let LutMismatch::Margin {
-            verified_lighter_kg,
+            lighter_opponent_kg,
             needed_kg,
         } = m
         else {
             panic!("{m:?}")
         };
-        assert_eq!(f64::from(verified_lighter_kg), span.parse::<f64>().unwrap());
+        assert_eq!(f64::from(lighter_opponent_kg), span.parse::<f64>().unwrap());
         assert_eq!(needed_kg, needed);
         let text = m.to_string();
         assert!(
@@ -67,11 +67,11 @@ fn a_table_verified_for_less_than_the_margins_need_is_rejected_and_says_why() {
     // A span the shell could not read covers nothing.
     let d = stating("2400");
     let mut l = lut_of(&d);
-    l.verified_lighter_kg = Some(f32::NAN);
+    l.lighter_opponent_kg = Some(f32::NAN);
     let (_, n) = RestraintCycle::new(ideal_sensor_config(), Some(l), &REFERENCE).unwrap();
     assert!(matches!(n.lut_rejected, Some(LutMismatch::Margin { .. })));
     let bad = stating("heavy");
-    assert!(lut_of(&bad).verified_lighter_kg.is_some_and(f32::is_nan));
+    assert!(lut_of(&bad).lighter_opponent_kg.is_some_and(f32::is_nan));
 }
 
 #[test]
