@@ -44,21 +44,28 @@ pub fn random_case(rng: &mut ChaCha8Rng) -> CycleCase {
 }
 
 fn object_kind(rng: &mut ChaCha8Rng) -> ObjectKind {
-    use ObjectKind::*;
-    [
-        OnTrack,
-        Outlier,
-        OutOfOrder,
-        NonFinite,
-        NewObject,
-        NoObject,
-        LowConfidence,
-    ][rng.gen_range(0..7)]
+    ObjectKind::ALL[rng.gen_range(0..ObjectKind::ALL.len())]
 }
 
 fn can_kind(rng: &mut ChaCha8Rng) -> CanKind {
-    use CanKind::*;
-    [Ego, Occupant, OccupantChanged, Corrupt, Foreign, V2x][rng.gen_range(0..6)]
+    CanKind::ALL[rng.gen_range(0..CanKind::ALL.len())]
+}
+
+/// One edit of a measured cycle's input list (at most `max` long): an element added, removed
+/// or replaced by `new`.
+fn edit<T>(list: &mut Vec<T>, max: usize, rng: &mut ChaCha8Rng, new: fn(&mut ChaCha8Rng) -> T) {
+    match rng.gen_range(0..3) {
+        0 if list.len() < max => list.push(new(rng)),
+        1 if !list.is_empty() => {
+            let i = rng.gen_range(0..list.len());
+            list.remove(i);
+        }
+        _ if !list.is_empty() => {
+            let i = rng.gen_range(0..list.len());
+            list[i] = new(rng);
+        }
+        _ => list.push(new(rng)),
+    }
 }
 
 /// A mutation of `c`: each field changes with probability `p` (numbers by a normal step of a
@@ -107,32 +114,10 @@ pub fn mutate(c: &CycleCase, p: f64, rng: &mut ChaCha8Rng) -> CycleCase {
         }
     }
     if rng.gen_bool(p) {
-        match rng.gen_range(0..3) {
-            0 if m.objects.len() < 2 => m.objects.push(object_kind(rng)),
-            1 if !m.objects.is_empty() => {
-                let i = rng.gen_range(0..m.objects.len());
-                m.objects.remove(i);
-            }
-            _ if !m.objects.is_empty() => {
-                let i = rng.gen_range(0..m.objects.len());
-                m.objects[i] = object_kind(rng);
-            }
-            _ => m.objects.push(object_kind(rng)),
-        }
+        edit(&mut m.objects, 2, rng, object_kind);
     }
     if rng.gen_bool(p) {
-        match rng.gen_range(0..3) {
-            0 if m.can.len() < 4 => m.can.push(can_kind(rng)),
-            1 if !m.can.is_empty() => {
-                let i = rng.gen_range(0..m.can.len());
-                m.can.remove(i);
-            }
-            _ if !m.can.is_empty() => {
-                let i = rng.gen_range(0..m.can.len());
-                m.can[i] = can_kind(rng);
-            }
-            _ => m.can.push(can_kind(rng)),
-        }
+        edit(&mut m.can, 4, rng, can_kind);
     }
     if rng.gen_bool(p) {
         m.accel_batches = rng.gen_range(0..=2);

@@ -82,6 +82,19 @@ pub enum ObjectKind {
     LowConfidence,
 }
 
+impl ObjectKind {
+    /// Every kind, in declaration order.
+    pub const ALL: [Self; 7] = [
+        Self::OnTrack,
+        Self::Outlier,
+        Self::OutOfOrder,
+        Self::NonFinite,
+        Self::NewObject,
+        Self::NoObject,
+        Self::LowConfidence,
+    ];
+}
+
 /// What one measured-cycle CAN frame is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -98,6 +111,18 @@ pub enum CanKind {
     Foreign,
     /// The next V2xOpponentMass of a station that is the tracked object.
     V2x,
+}
+
+impl CanKind {
+    /// Every kind, in declaration order.
+    pub const ALL: [Self; 6] = [
+        Self::Ego,
+        Self::Occupant,
+        Self::OccupantChanged,
+        Self::Corrupt,
+        Self::Foreign,
+        Self::V2x,
+    ];
 }
 
 /// One point of the search space (see the module docs). Every field is clamped to its
