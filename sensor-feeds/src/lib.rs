@@ -2,10 +2,7 @@
 //! true world, the sensor models, the acceleration events) tick by tick ([`player`]). The
 //! `sensor-feeds` binary publishes it in real time over iceoryx2 and CAN; the offline bench
 //! hands the same records to the ECU core under a simulated clock.
-//!
-//! The world's modules and types are re-exported under their old paths
-//! (`sensor_feeds::scenario`, `sensor_feeds::Truth`, …): they moved to `world`,
-//! unchanged.
+
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -13,8 +10,6 @@
 pub mod player;
 
 pub use player::{PlayCounts, Player, TickOutput};
-pub use world::{events, scenario, sensors, truth};
-pub use world::{Scenario, ScenarioError, SensorModelSim, Truth, WorldState};
 
 /// The bench's clock, from the one clock module of the bench processes (`host`).
 pub use host::monotonic_ns;

@@ -15,11 +15,12 @@ use ipc::{
     SatelliteLeftPublisher, SatelliteRightPublisher, ServiceNames,
 };
 use sensor_feeds::player::TICK_NS;
-use sensor_feeds::{monotonic_ns, sleep_until_ns, Player, Scenario, TickOutput, Truth};
+use sensor_feeds::{monotonic_ns, sleep_until_ns, Player, TickOutput};
 use signals::{FeedItem, FeedLogRecord};
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 use world::scenario::{AccelEvent, AccelEventKind};
+use world::{Scenario, Truth};
 
 /// Scenario player: object, vehicle, occupant and crash-accelerometer feeds.
 #[derive(Parser, Debug)]

@@ -6,12 +6,12 @@
 //! produced; the offline bench (`e2e-tests`' `offline-bench`) hands the same records to the ECU
 //! core under a simulated clock, so both run one model of the sensors.
 
-use crate::scenario::{AccelFaultKind, AccelSensor, DropoutTarget, SensorModel};
-use crate::sensors::SensorModelSim;
-use crate::truth::Truth;
 use bus::{E2eProtector, RawFrame};
 use ipc::{CrashAccelSample, ObjectState, SatelliteFrames, ACCEL_BATCH_CAPACITY};
 use signals::psi5;
+use world::scenario::{AccelFaultKind, AccelSensor, DropoutTarget, SensorModel};
+use world::sensors::SensorModelSim;
+use world::truth::Truth;
 
 /// The feed grid: one tick per ms of scenario time.
 pub const TICK_NS: u64 = 1_000_000;
@@ -393,7 +393,7 @@ fn push_batch(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Scenario;
+    use world::Scenario;
 
     fn player(sensor: &str) -> Player {
         let text = format!(

@@ -6,9 +6,10 @@
 //! (`accel_lowpass_hz = 0`), the ideal sampler of the model they were recorded with — so
 //! everything *else* is still bit for bit as it was.
 
-use sensor_feeds::{Player, Scenario, TickOutput, Truth};
+use sensor_feeds::{Player, TickOutput};
 use std::fmt::Write;
 use std::path::PathBuf;
+use world::{Scenario, Truth};
 
 /// FNV-1a (64 bit) over the `Debug` text of every record of a whole run (`{:?}` prints each
 /// float in its shortest round-tripping form: equal text is equal bits).

@@ -195,8 +195,8 @@ pub const STARVED_INPUT_FLAGS: [&str; 5] = [
 ];
 
 /// The EcuStatus input flags a scenario's declared faults raise.
-fn injected_flags(scenario: &sensor_feeds::Scenario) -> Vec<&'static str> {
-    use sensor_feeds::scenario::DropoutTarget;
+fn injected_flags(scenario: &world::Scenario) -> Vec<&'static str> {
+    use world::scenario::DropoutTarget;
     let s = &scenario.sensor;
     let mut v = Vec::new();
     for d in &s.dropouts {
@@ -230,7 +230,7 @@ fn injected_flags(scenario: &sensor_feeds::Scenario) -> Vec<&'static str> {
     }
     // `[[accel_event]]` faults of one sensor (a spike at its rail, an offset) raise that
     // sensor's flag: the case's own, never an excuse for a run.
-    use sensor_feeds::scenario::EventSensor;
+    use world::scenario::EventSensor;
     for e in &scenario.accel_events {
         match e.sensor {
             EventSensor::Crash => v.push("accel_sensor"),
@@ -267,7 +267,7 @@ fn raised_after_clear(faults: &[(f64, Vec<String>)]) -> Vec<(f64, Vec<String>)> 
 /// run again ([`Allowances::time_limit_attempts`]); with real timers it is a failure like any
 /// other.
 pub fn starved_run(
-    scenario: &sensor_feeds::Scenario,
+    scenario: &world::Scenario,
     r: &actuator_stubs::report::Report,
 ) -> Option<String> {
     let mut why = Vec::new();
@@ -366,8 +366,8 @@ mod tests {
         .expect("report JSON")
     }
 
-    fn scenario(name: &str) -> sensor_feeds::Scenario {
-        sensor_feeds::Scenario::load(crate::repo_root().join(format!("scenarios/{name}.toml")))
+    fn scenario(name: &str) -> world::Scenario {
+        world::Scenario::load(crate::repo_root().join(format!("scenarios/{name}.toml")))
             .expect("scenario")
     }
 

@@ -69,7 +69,7 @@ fn main() -> std::process::ExitCode {
 fn run_until_measured(cfg: &RunConfig) -> Result<(e2e_tests::RunResult, Vec<String>)> {
     let route = e2e_tests::Route::current();
     let attempts = route.allowances().time_limit_attempts;
-    let scenario = sensor_feeds::Scenario::load(&cfg.scenario).ok();
+    let scenario = world::Scenario::load(&cfg.scenario).ok();
     let mut earlier = Vec::new();
     let mut attempt = 1;
     loop {
@@ -153,7 +153,7 @@ fn run() -> Result<bool> {
                 let missed = if cli.no_expect {
                     Vec::new()
                 } else {
-                    match sensor_feeds::Scenario::load(scenario) {
+                    match world::Scenario::load(scenario) {
                         Ok(s) => e2e_tests::expect::check(
                             &s,
                             &e2e_tests::expect::Observed::bench(&r.report, r.ecu_report.as_ref()),

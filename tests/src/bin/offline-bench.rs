@@ -104,7 +104,7 @@ fn run_all() -> Result<bool> {
     // Load every file first: the table's name column fits the longest name.
     let loaded: Vec<_> = files
         .iter()
-        .map(|f| (f, sensor_feeds::Scenario::load(f)))
+        .map(|f| (f, world::Scenario::load(f)))
         .collect();
     let width = loaded
         .iter()
@@ -121,7 +121,7 @@ fn run_all() -> Result<bool> {
         let s = match loaded {
             Ok(mut s) => {
                 if cli.v2x && s.v2x.is_none() {
-                    s.v2x = Some(sensor_feeds::scenario::V2x::default());
+                    s.v2x = Some(world::scenario::V2x::default());
                 }
                 s
             }

@@ -574,8 +574,8 @@ mod tests {
         let d = tmp("frozen");
         let src = crate::repo_root().join("scenarios/taurus-48-48-abs.toml");
         let p = frozen_scenario(&src, &d, 0.4, 0.7).expect("variant");
-        let orig = sensor_feeds::Scenario::load(&src).expect("original");
-        let s = sensor_feeds::Scenario::load(&p).expect("variant parses and validates");
+        let orig = world::Scenario::load(&src).expect("original");
+        let s = world::Scenario::load(&p).expect("variant parses and validates");
         assert_eq!(s.name, orig.name);
         assert_eq!(s.duration_s, orig.duration_s);
         assert!(!s.sensor.frozen(0.39) && s.sensor.frozen(0.4) && !s.sensor.frozen(0.7));
@@ -588,7 +588,7 @@ mod tests {
         let src = crate::repo_root().join("scenarios/taurus-48-48-abs.toml");
         let load = |v| {
             let p = variant_scenario(&src, &d, v).expect("variant");
-            sensor_feeds::Scenario::load(&p).expect("variant parses and validates")
+            world::Scenario::load(&p).expect("variant parses and validates")
         };
         let s = load(Variant::MassMisreport {
             true_kg: 2500.0,
@@ -599,16 +599,16 @@ mod tests {
         assert_eq!(s.opponent_class().map(|c| c.number()), Some(6));
         assert_eq!(s.sensor.mass_estimate_kg, Some(1300.0));
         assert_eq!(s.expect.airbag_fires, Some(true));
-        let contact = sensor_feeds::Truth::new(&s).unwrap().contact_s.unwrap();
+        let contact = world::Truth::new(&s).unwrap().contact_s.unwrap();
         let s = load(Variant::AccelDead {
             before_contact_s: 0.6,
         });
         assert!(s
             .sensor
-            .dropped(sensor_feeds::scenario::DropoutTarget::Accel, contact - 0.59));
+            .dropped(world::scenario::DropoutTarget::Accel, contact - 0.59));
         assert!(!s
             .sensor
-            .dropped(sensor_feeds::scenario::DropoutTarget::Accel, contact - 0.61));
+            .dropped(world::scenario::DropoutTarget::Accel, contact - 0.61));
         assert_eq!(s.expect.accel_fault_before_contact, Some(true));
         assert_eq!(s.expect.reference_fallback, Some(true));
         let s = load(Variant::AccelStuck {
@@ -627,10 +627,10 @@ mod tests {
             },
         )
         .unwrap();
-        let s = sensor_feeds::Scenario::load(&p).unwrap();
+        let s = world::Scenario::load(&p).unwrap();
         assert!(s
             .sensor
-            .dropped(sensor_feeds::scenario::DropoutTarget::Vehicle, 1.0));
+            .dropped(world::scenario::DropoutTarget::Vehicle, 1.0));
         assert_eq!(s.expect.airbag_fires, Some(false));
         assert_eq!(s.expect.reference_fallback, Some(true));
     }
@@ -655,11 +655,11 @@ mod tests {
         let d = tmp("long");
         let src = crate::repo_root().join("scenarios/taurus-48-48-abs.toml");
         let p = lengthened_scenario(&src, &d, 2.0).expect("variant");
-        let a = sensor_feeds::Scenario::load(&src).expect("original");
-        let b = sensor_feeds::Scenario::load(&p).expect("variant");
+        let a = world::Scenario::load(&src).expect("original");
+        let b = world::Scenario::load(&p).expect("variant");
         let (ta, tb) = (
-            sensor_feeds::Truth::new(&a).expect("truth"),
-            sensor_feeds::Truth::new(&b).expect("truth"),
+            world::Truth::new(&a).expect("truth"),
+            world::Truth::new(&b).expect("truth"),
         );
         let (ca, cb) = (
             ta.contact_s.expect("contact"),

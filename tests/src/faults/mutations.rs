@@ -57,8 +57,8 @@ pub(crate) fn frozen_scenario(src: &Path, dir: &Path, from_s: f64, to_s: f64) ->
 /// judge checks); a dead or stuck accelerometer is on the bus before the contact and the
 /// crash gets the reference restraint; every other variant keeps the base's expectations.
 pub fn variant_scenario(src: &Path, dir: &Path, v: Variant) -> Result<PathBuf> {
-    let base = sensor_feeds::Scenario::load(src)?;
-    let contact_s = sensor_feeds::Truth::new(&base)
+    let base = world::Scenario::load(src)?;
+    let contact_s = world::Truth::new(&base)
         .map_err(anyhow::Error::msg)?
         .contact_s;
     let text =

@@ -179,7 +179,7 @@ impl Checks {
 pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> CaseResult {
     let r = &run.report;
     // The scenario file the run played (the campaign's variant where the case made one).
-    let played = sensor_feeds::Scenario::load(&run.scenario).ok();
+    let played = world::Scenario::load(&run.scenario).ok();
     let ecu = run.ecu_report.as_ref();
     let fire = r.action("airbag_fire");
     let mut checks = Checks::new(starved_inputs_at_fire(fire, &r.ecu_faults).or_else(|| {
