@@ -343,18 +343,18 @@ impl CrashMonitor {
 
     /// Moves the latched confirmation to the accelerometer event in progress when that began
     /// after the confirmed one (the confirmed event ended and the next began inside the crash
-    /// phase); returns whether it moved. Call only while the crash phase has fired nothing:
+    /// phase). Call only while the crash phase has fired nothing:
     /// then the next event is confirmed and decided on its own onset, exactly as if the crash
     /// phase had ended with the first one — a rough road's lobe at the predicted contact can
     /// confirm the crash phase, end, and leave the real crash a millisecond later to an event
     /// whose decisions belong to no confirmation. The backup's confirmation (no crash-sensor
     /// event) never moves.
-    pub fn follow_later_event(&mut self, now: u64) -> bool {
+    pub fn follow_later_event(&mut self, now: u64) {
         let (Some(c), Some(onset_ns)) = (self.confirmation, self.fallback.onset_ns()) else {
-            return false;
+            return;
         };
         if c.kind == ConfirmKind::Backup || onset_ns <= c.onset_ns {
-            return false;
+            return;
         }
         self.confirmation = Some(Confirmation {
             at_ns: now,
@@ -364,7 +364,6 @@ impl CrashMonitor {
                 prediction_refuted: false,
             },
         });
-        true
     }
 
     /// Forgets a confirmation whose event ended without any fire (a bump the generic

@@ -273,7 +273,8 @@ impl Activity for RestraintCycle<'_> {
             self.crash.restart_at_crush(o, braking, &plausible);
         }
         // A crash phase that has fired nothing follows the next accelerometer event when its
-        // own has ended (`CrashMonitor::follow_later_event`).
+        // own has ended (`CrashMonitor::follow_later_event`). The phase is asked first, inline:
+        // outside a crash the cycle pays one compare, not the out-of-line call.
         if self.decision.phase() == Phase::Crash && self.decision.nothing_fired_in_crash() {
             self.crash.follow_later_event(now);
         }

@@ -742,13 +742,13 @@ mod tests {
         // Relieved from the 4th cycle (the window's crush passes 0.5 m/s at 4 × 0.147).
         assert_eq!(unbelted.relieved_batches, 7);
         // 1.57 m/s (40 g above the tunnel): the whole relief unbelted, 0.57 of it belted.
-        let mut unbelted = Satellites::new(lifted);
+        let mut severe_unbelted = Satellites::new(lifted);
         assert_eq!(
-            run_for(&mut unbelted, 1, 10, 45.0, 45.0, 5.0, false).fraction,
+            run_for(&mut severe_unbelted, 1, 10, 45.0, 45.0, 5.0, false).fraction,
             1.0
         );
-        let mut belted = Satellites::new(lifted);
-        let r = run_for(&mut belted, 1, 10, 45.0, 45.0, 5.0, true);
+        let mut severe_belted = Satellites::new(lifted);
+        let r = run_for(&mut severe_belted, 1, 10, 45.0, 45.0, 5.0, true);
         assert!(
             (r.fraction - (40.0 * G * 0.004 - 1.0)).abs() < 0.03,
             "{r:?}"
