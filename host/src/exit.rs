@@ -34,6 +34,14 @@ pub fn exit_code(tool: &str, result: anyhow::Result<()>) -> ExitCode {
     }
 }
 
+/// [`exit_code`] for a tool whose run is a check (`Ok(false)`: it ran and failed, exit 1).
+pub fn check_exit_code(tool: &str, result: anyhow::Result<bool>) -> ExitCode {
+    match result {
+        Ok(false) => ExitCode::from(1),
+        r => exit_code(tool, r.map(|_| ())),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -47,5 +55,11 @@ mod tests {
         let io: anyhow::Result<()> =
             Err(std::io::Error::from(std::io::ErrorKind::NotFound)).context("/nonexistent");
         assert_eq!(exit_code("t", io), ExitCode::from(2));
+        assert_eq!(check_exit_code("t", Ok(true)), ExitCode::SUCCESS);
+        assert_eq!(check_exit_code("t", Ok(false)), ExitCode::from(1));
+        assert_eq!(
+            check_exit_code("t", Err(anyhow::anyhow!("x"))),
+            ExitCode::from(2)
+        );
     }
 }

@@ -19,6 +19,6 @@ pub use clock::{
     monotonic_ns, realtime_ns, sleep_through_signals_until_ns, sleep_until_ns, sync_time_us, Clock,
     MonotonicClock, SimClock, SleepOutcome,
 };
-pub use exit::{exit_code, CheckFailed};
+pub use exit::{check_exit_code, exit_code, CheckFailed};
 pub use files::{check_output_dir, check_output_file, find_repo, find_upwards, NoFlush};
 pub use stop::{default_sigpipe, install_stop_signals};

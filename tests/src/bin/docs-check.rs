@@ -36,14 +36,7 @@ struct Cli {
 
 fn main() -> std::process::ExitCode {
     host::default_sigpipe();
-    match run(Cli::parse()) {
-        Ok(true) => std::process::ExitCode::SUCCESS,
-        Ok(false) => std::process::ExitCode::from(1),
-        Err(e) => {
-            eprintln!("docs-check: error: {e:#}");
-            std::process::ExitCode::from(2)
-        }
-    }
+    host::check_exit_code("docs-check", run(Cli::parse()))
 }
 
 fn run(cli: Cli) -> anyhow::Result<bool> {

@@ -91,14 +91,7 @@ enum Cmd {
 
 fn main() -> std::process::ExitCode {
     host::default_sigpipe();
-    match run() {
-        Ok(true) => std::process::ExitCode::SUCCESS,
-        Ok(false) => std::process::ExitCode::from(1),
-        Err(e) => {
-            eprintln!("fault-campaign: error: {e:#}");
-            std::process::ExitCode::from(2)
-        }
-    }
+    host::check_exit_code("fault-campaign", run())
 }
 
 /// The folder of this binary (where the other bench binaries are built).

@@ -50,14 +50,7 @@ struct Cli {
 
 fn main() -> std::process::ExitCode {
     host::default_sigpipe();
-    match run() {
-        Ok(true) => std::process::ExitCode::SUCCESS,
-        Ok(false) => std::process::ExitCode::from(1),
-        Err(e) => {
-            eprintln!("hil-bench: error: {e:#}");
-            std::process::ExitCode::from(2)
-        }
-    }
+    host::check_exit_code("hil-bench", run())
 }
 
 /// One scenario run; where the route's timing is emulated, a run the machine starved

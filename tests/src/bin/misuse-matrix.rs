@@ -432,13 +432,7 @@ fn list() {
 /// Errors as one line (`misuse-matrix: error: …`), never a Debug dump with a backtrace.
 fn main() -> std::process::ExitCode {
     host::default_sigpipe();
-    match run_matrix() {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("misuse-matrix: error: {e:#}");
-            std::process::ExitCode::from(2)
-        }
-    }
+    host::exit_code("misuse-matrix", run_matrix())
 }
 
 fn run_matrix() -> Result<()> {

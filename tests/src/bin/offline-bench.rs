@@ -65,14 +65,7 @@ struct Cli {
 
 fn main() -> std::process::ExitCode {
     host::default_sigpipe();
-    match run_all() {
-        Ok(true) => std::process::ExitCode::SUCCESS,
-        Ok(false) => std::process::ExitCode::from(1),
-        Err(e) => {
-            eprintln!("offline-bench: error: {e:#}");
-            std::process::ExitCode::from(2)
-        }
-    }
+    host::check_exit_code("offline-bench", run_all())
 }
 
 /// Runs every file; `Ok(false)` when a file missed an expectation, an error when one did not
