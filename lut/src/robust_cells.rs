@@ -9,7 +9,7 @@
 //! point of the set the truth may lie in: opponent mass m̂ ± Δm (clamped to the axis' 800 …
 //! 3 000 kg), closing speed v̂ ± Δv, the airbag up to the fire-delay tolerance late.
 //!
-//! **Objective** (the second form): the nominal point's a_max + a_mean, subject to, at
+//! **Objective**: the nominal point's a_max + a_mean, subject to, at
 //! every point of the set, (1) no bottoming-out where the reference restraint does not bottom
 //! out (and the ride-down reserve kept where the reference keeps it), and (2) a_max + a_mean
 //! no worse than the reference restraint's at that point (where both bottom out: no more

@@ -67,7 +67,7 @@ pub const TABLE5: [Table5Row; 7] = [
     },
 ];
 
-/// Calibration tolerances required by the issue (relative): crush ±8 %, peak ±15 %, mean ±10 %.
+/// Calibration tolerances the constructed curves must meet (relative): crush ±8 %, peak ±15 %, mean ±10 %.
 pub const TOLERANCE_CRUSH: f64 = 0.08;
 /// Peak deceleration tolerance (relative).
 pub const TOLERANCE_A_MAX: f64 = 0.15;

@@ -6,8 +6,8 @@
 
 use std::process::Command;
 
-/// Crates that need an operating system or an allocator (the shell's crates). The issue's
-/// list, plus the other std-only crates of this workspace.
+/// Crates that need an operating system or an allocator (the shell's crates). The
+/// specification's list, plus the other std-only crates of this workspace.
 const STD_ONLY: &[&str] = &[
     "iceoryx2",
     "socketcan",

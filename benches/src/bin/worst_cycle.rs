@@ -55,7 +55,7 @@ impl Cycles {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum Secoc {
-    /// Every case without SecOC (the budget conditions).
+    /// Every case without SecOC (the conditions of the 6 000-instruction line).
     Off,
     /// Every case with the SecOC sender set.
     On,

@@ -70,8 +70,7 @@ pub enum Fault {
         /// Replays of the recorded pair.
         pairs: u32,
     },
-    /// The scenario itself is changed (a sensor that misreports, fails or goes silent; issue
-    /// 14): [`variant_scenario`] writes the variant, with the `[expect]` it must meet.
+    /// The scenario itself is changed (a sensor that misreports, fails or goes silent): [`variant_scenario`] writes the variant, with the `[expect]` it must meet.
     Variant(Variant),
 }
 

@@ -4,6 +4,7 @@
 //! build apiece, and these four need nothing of their own.
 
 mod bus_encode;
+mod commits;
 mod docs_check;
 mod matrix_cli;
 mod matrix_slurm;
