@@ -46,6 +46,7 @@ rc=0
 export RECORD_ON_HOST=1
 ./vcan-setup.sh --run -- "$target/release/hil-bench" --scenario "$scenario" --out "$out" --repo "$PWD" "${mf4[@]}" || rc=$?
 "$target/release/record" pending "$out" || rc=$(( rc == 0 ? 1 : rc ))
+"$target/release/actuator-stubs" draw-pending "$out" || rc=$(( rc == 0 ? 1 : rc ))
 
 dir="$out/$name"
 if [ -s "$dir/candump.log" ]; then

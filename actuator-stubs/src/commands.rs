@@ -13,13 +13,6 @@ use bus::codec::{
 use bus::Messages;
 use serde::{Deserialize, Serialize};
 
-/// `data_hex` of a record: the payload's bytes as lower-case hex pairs. The run's recording
-/// pairs these records with candump's frames by id and payload (`record`), so writer and
-/// reader share this one function.
-pub fn data_hex(payload: &[u8]) -> String {
-    payload.iter().map(|b| format!("{b:02x}")).collect()
-}
-
 /// One received frame, decoded (JSONL record of the command log).
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct CommandRecord {

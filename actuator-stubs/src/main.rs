@@ -24,17 +24,20 @@ use world::{Scenario, Truth};
 
 /// Belt retractor + airbag module stubs: validate, log, act on and judge commands.
 #[derive(Parser, Debug)]
-#[command(name = "actuator-stubs", version)]
+#[command(name = "actuator-stubs", version, subcommand_negates_reqs = true)]
 struct Cli {
+    /// Instead of a run: draw the pictures runs left with `--plot-later`.
+    #[command(subcommand)]
+    command: Option<Command>,
     /// Scenario file (the same the sensor feeds play).
-    #[arg(long)]
-    scenario: PathBuf,
+    #[arg(long, required = true)]
+    scenario: Option<PathBuf>,
     /// CAN interface.
     #[arg(long, default_value = "vcan0")]
     can: String,
     /// Output folder (commands.jsonl, report.json, outcome.png).
-    #[arg(long)]
-    out: PathBuf,
+    #[arg(long, required = true)]
+    out: Option<PathBuf>,
     /// Reference restraint file (default: the built-in data/reference-restraint.toml).
     #[arg(long)]
     reference: Option<PathBuf>,
@@ -65,8 +68,8 @@ struct Cli {
     /// campaign compares them with what the ECU sent).
     #[arg(long)]
     until_signal: bool,
-    /// Do not draw outcome.png: leave what it is drawn from in outcome-plot.json
-    /// (`actuator_stubs::plot::draw_later`, run by `record pending` on the host). Drawing costs
+    /// Do not draw outcome.png: leave what it is drawn from in outcome-plot.json for
+    /// `actuator-stubs draw-pending`, run on the host after the run. Drawing costs
     /// 0.6–1.0 s of an emulated guest's time at the end of the run.
     #[arg(long)]
     plot_later: bool,
@@ -98,9 +101,42 @@ const RX_IDS: [u32; 5] = [
     bus::EcuStatus::RAW_ID,
 ];
 
+/// What the stubs do besides a run.
+#[derive(clap::Subcommand, Debug)]
+enum Command {
+    /// Draw `outcome.png` in every run folder under ROOT (three levels) whose run left
+    /// `outcome-plot.json` (`--plot-later`), and append a line to its `summary.txt`; the
+    /// bench's callers run it on the host after a run in an emulated guest.
+    DrawPending {
+        /// The runs' output folder.
+        root: PathBuf,
+    },
+}
+
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
-    host::exit_code("actuator-stubs", run(&cli))
+    let result = match &cli.command {
+        Some(Command::DrawPending { root }) => draw_pending(root),
+        None => run(&cli),
+    };
+    host::exit_code("actuator-stubs", result)
+}
+
+/// `draw-pending`: each drawn picture's line; an error when one could not be drawn (the
+/// others are).
+fn draw_pending(root: &std::path::Path) -> Result<()> {
+    let mut failed = 0;
+    for d in plot::draw_pending(root).map_err(anyhow::Error::msg)? {
+        match d.result {
+            Ok(line) => println!("{line}"),
+            Err(e) => {
+                eprintln!("actuator-stubs: {}: {e}", d.dir.display());
+                failed += 1;
+            }
+        }
+    }
+    anyhow::ensure!(failed == 0, "{failed} picture(s) not drawn");
+    Ok(())
 }
 
 /// Offset CLOCK_REALTIME − CLOCK_MONOTONIC [ns], to map kernel (realtime) receive stamps.
@@ -109,14 +145,18 @@ fn realtime_minus_monotonic_ns() -> i128 {
 }
 
 fn run(cli: &Cli) -> Result<()> {
-    let scenario = Scenario::load(&cli.scenario)?;
+    // clap requires both without a subcommand.
+    let (Some(scenario_path), Some(out)) = (&cli.scenario, &cli.out) else {
+        anyhow::bail!("--scenario and --out are required");
+    };
+    let scenario = Scenario::load(scenario_path)?;
     let reference = match &cli.reference {
         Some(p) => physics::reference::ReferenceRestraint::load(p),
         None => physics::reference::ReferenceRestraint::builtin(),
     }
     .map_err(|e| anyhow::anyhow!("reference restraint: {e}"))?;
     let keys = load_keys(cli)?;
-    std::fs::create_dir_all(&cli.out).with_context(|| format!("creating {}", cli.out.display()))?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let stop = host::install_stop_signals().context("installing signal handler")?;
     let mut sock = BusSocket::open(&cli.can, &RX_IDS).with_context(|| {
         format!(
@@ -139,13 +179,13 @@ fn run(cli: &Cli) -> Result<()> {
     // bus.
     let mut diag_sub = ipc::DiagnosticsSubscriber::new(&node, &names)?;
     let mut diag_modes: Vec<(u64, u8)> = Vec::new();
-    let diag_path = cli.out.join(actuator_stubs::DIAGNOSTICS_LOG);
+    let diag_path = out.join(actuator_stubs::DIAGNOSTICS_LOG);
     let mut diag_log = std::io::BufWriter::new(
         std::fs::File::create(&diag_path)
             .with_context(|| format!("creating {}", diag_path.display()))?,
     );
     let mut diag_log_error: Option<String> = None;
-    let log_path = cli.out.join("commands.jsonl");
+    let log_path = out.join("commands.jsonl");
     let mut log = std::io::BufWriter::new(
         std::fs::File::create(&log_path)
             .with_context(|| format!("creating {}", log_path.display()))?,
@@ -219,7 +259,7 @@ fn run(cli: &Cli) -> Result<()> {
                 rx_mono_ns: rx_ns,
                 id: f.id,
                 message: name,
-                data_hex: actuator_stubs::commands::data_hex(f.payload()),
+                data_hex: bus::candump::data_hex(f.payload()),
                 e2e: v.e2e,
                 secoc: v.secoc,
                 decoded: v.decoded,
@@ -277,7 +317,7 @@ fn run(cli: &Cli) -> Result<()> {
         &receiver,
         stop_reason,
     )?;
-    let path = cli.out.join("report.json");
+    let path = out.join("report.json");
     std::fs::write(&path, serde_json::to_string_pretty(&report)?)
         .with_context(|| format!("writing {}", path.display()))?;
     eprintln!(
@@ -301,6 +341,7 @@ fn build_report(
     receiver: &Receiver,
     stop_reason: &str,
 ) -> Result<Report> {
+    let out = cli.out.as_deref().context("--out is required")?;
     let contact_ns = truth.contact_ns;
     let rel_ms = |t: u64| (contact_ns != 0).then_some((t as f64 - contact_ns as f64) * 1e-6);
     let since_start_s =
@@ -412,7 +453,7 @@ fn build_report(
         .map(|(fire, required)| fire - required);
     report.true_crash = Some(judged.true_crash);
     let pulse = t.pulse.ego_pulse();
-    let png = cli.out.join("outcome.png");
+    let png = out.join("outcome.png");
     let pulse_g: Vec<f64> = pulse
         .accel_mps2
         .iter()
@@ -428,7 +469,7 @@ fn build_report(
             pulse_g,
             pulse_step_ms: pulse.step_s * 1e3,
         };
-        let note = cli.out.join(plot::PLOT_LATER);
+        let note = out.join(plot::PLOT_LATER);
         match serde_json::to_vec(&data)
             .map_err(|e| e.to_string())
             .and_then(|b| std::fs::write(&note, b).map_err(|e| e.to_string()))

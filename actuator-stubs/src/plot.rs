@@ -4,11 +4,13 @@
 use crate::report::Judged;
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::path::Path;
+use std::io::Write;
+use std::path::{Path, PathBuf};
 
 /// File name of a picture left to be drawn after the run (`actuator-stubs --plot-later`):
 /// drawing costs 0.6–1.0 s of an emulated guest's time at the end of every run, on the run's
-/// critical path, and a few ms on the host. `draw_later` draws it there.
+/// critical path, and a few ms on the host. [`draw_pending`] (`actuator-stubs draw-pending
+/// ROOT`) draws them there.
 pub const PLOT_LATER: &str = "outcome-plot.json";
 
 /// Everything [`draw`] needs, as written for [`draw_later`] (the time histories are not in
@@ -83,6 +85,64 @@ pub fn draw_later(dir: &Path) -> Result<bool, String> {
     )?;
     std::fs::remove_file(&note).map_err(|e| format!("{}: {e}", note.display()))?;
     Ok(true)
+}
+
+/// One picture drawn by [`draw_pending`]: its run folder and the summary line, or what failed.
+#[derive(Debug)]
+pub struct Drawn {
+    /// The run folder.
+    pub dir: PathBuf,
+    /// The line appended to its `summary.txt`, or why the picture was not drawn.
+    pub result: Result<String, String>,
+}
+
+/// Draws every picture left in `root` and its sub-folders (three levels, as the run folders
+/// lie: `OUT/<scenario>/`, the campaign's `OUT/<guest>/<case>/<scenario>/`) and appends a line
+/// to each folder's `summary.txt`. A folder that fails keeps its note and says why; the others
+/// are drawn.
+///
+/// # Errors
+/// `root` cannot be read.
+pub fn draw_pending(root: &Path) -> Result<Vec<Drawn>, String> {
+    let mut dirs = Vec::new();
+    collect(root, 0, &mut dirs)?;
+    dirs.sort();
+    Ok(dirs
+        .into_iter()
+        .map(|dir| {
+            let result = draw_later(&dir).and_then(|_| {
+                let line = format!(
+                    "outcome picture: {} (drawn on the host after the run)",
+                    dir.join("outcome.png").display()
+                );
+                let summary = dir.join("summary.txt");
+                std::fs::OpenOptions::new()
+                    .create(true)
+                    .append(true)
+                    .open(&summary)
+                    .and_then(|mut f| writeln!(f, "{line}"))
+                    .map_err(|e| format!("{}: {e}", summary.display()))?;
+                Ok(line)
+            });
+            Drawn { dir, result }
+        })
+        .collect())
+}
+
+fn collect(dir: &Path, depth: usize, out: &mut Vec<PathBuf>) -> Result<(), String> {
+    if dir.join(PLOT_LATER).is_file() {
+        out.push(dir.to_path_buf());
+    }
+    if depth < 3 {
+        let entries = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        for e in entries {
+            let e = e.map_err(|e| format!("{}: {e}", dir.display()))?;
+            if e.file_type().is_ok_and(|t| t.is_dir()) {
+                collect(&e.path(), depth + 1, out)?;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Draws the two-panel PNG; `pulse_g` is the compartment deceleration [g] at `pulse_step_ms`.

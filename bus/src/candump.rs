@@ -75,6 +75,13 @@ pub fn log_line(t_us: u64, device: &str, f: &RawFrame) -> String {
     )
 }
 
+/// A payload's bytes as lower-case hex pairs, as a record beside a candump log names a frame
+/// (the stubs' `commands.jsonl`): the run's recording pairs such records with candump's
+/// frames by id and payload, so writer and reader share this one function.
+pub fn data_hex(payload: &[u8]) -> String {
+    payload.iter().map(|b| format!("{b:02x}")).collect()
+}
+
 /// `ID#HEX` as `cansend` takes it (3 hex digits for a standard id, 8 for an extended one).
 pub fn cansend_arg(f: &RawFrame) -> String {
     let hex: String = f.payload().iter().map(|b| format!("{b:02X}")).collect();

@@ -40,5 +40,11 @@ pub use write::{write_run, RunMeta, WriteSummary};
 /// postcard `signals::FeedLogRecord`s back to back).
 pub const FEEDS_LOG: &str = "feeds.postcard";
 
+/// The actuator stubs' log of the ECU's diagnostics in a run folder (postcard
+/// `signals::EcuDiagnostics` back to back). The stubs write it under their own name for it,
+/// `actuator_stubs::DIAGNOSTICS_LOG`: this crate reads run folders without linking the stubs,
+/// and a test of the bench checks that the two names are one.
+pub const DIAGNOSTICS_LOG: &str = "diagnostics.postcard";
+
 /// File name of a run's recording in its folder.
 pub const RUN_MCAP: &str = "run.mcap";

@@ -1,9 +1,9 @@
-//! Recordings (and the stubs' outcome picture) written after the fact, on the host. On a guest
-//! route the bench runs inside an emulated machine where writing a recording costs ≈ 15× its
-//! host time (the demo's: 0.5 s of a 4.1 s run in the guest, 12 %; 0.04 s on the host), and
-//! drawing the outcome picture 0.6–1.0 s (`actuator-stubs --plot-later`). A caller that runs the bench in a guest
-//! and can act when it ends (`demo.sh`, the test harness) sets `RECORD_ON_HOST=1`: each run
-//! then leaves [`PENDING`] (what the recording needs to know that the folder cannot say) and
+//! Recordings written after the fact, on the host. On a guest route the bench runs inside an
+//! emulated machine where writing a recording costs ≈ 15× its host time (the demo's: 0.5 s of
+//! a 4.1 s run in the guest, 12 %; 0.04 s on the host); the stubs' outcome picture goes the
+//! same way (`actuator-stubs --plot-later`, then `actuator-stubs draw-pending ROOT`). A caller
+//! that runs the bench in a guest and can act when it ends (`demo.sh`, the test harness) sets
+//! `RECORD_ON_HOST=1`: each run then leaves [`PENDING`] (what the recording needs to know that the folder cannot say) and
 //! the caller runs [`write_pending`] (`record pending ROOT`) on the host afterwards. Without
 //! the variable a run records itself, wherever it runs.
 
@@ -139,13 +139,6 @@ fn write_one(dir: &Path) -> Result<Vec<String>> {
     if p.mf4 {
         let m = write_run_mf4(dir, &dir.join(RUN_MF4))?;
         lines.push(crate::mf4::summary_line(&dir.join(RUN_MF4), &m));
-    }
-    // The stubs' outcome picture, left for the host with the recording (`--plot-later`).
-    if actuator_stubs::plot::draw_later(dir).map_err(anyhow::Error::msg)? {
-        lines.push(format!(
-            "outcome picture: {} (drawn on the host after the run)",
-            dir.join("outcome.png").display()
-        ));
     }
     let summary = dir.join("summary.txt");
     let mut f = std::fs::OpenOptions::new()

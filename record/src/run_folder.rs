@@ -1,7 +1,6 @@
 //! What a run folder holds, read once for every recording format: candump's frames, the stubs'
 //! commands, report and diagnostics, and the realtime − monotonic offset between them.
 
-use actuator_stubs::report::Report;
 use anyhow::{Context, Result};
 use bus::candump::CandumpLog;
 use serde::Deserialize;
@@ -10,6 +9,28 @@ use signals::{EcuDiagnostics, FeedLogRecord};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+/// What a recording takes from the actuator stubs' `report.json` to place it on the run's
+/// timeline (`actuator_stubs::report::Report` owns the schema; the report is recorded as it
+/// is, every other field included).
+#[derive(Debug, Deserialize)]
+pub(crate) struct ReportTimes {
+    /// Scenario name.
+    pub scenario: String,
+    /// CLOCK_MONOTONIC scenario start [ns] (0 if the stubs received no bench truth).
+    pub start_ns: u64,
+    /// CLOCK_MONOTONIC true contact [ns] (0 = none).
+    pub contact_ns: u64,
+    /// The modules' actions, in the report's order.
+    pub actions: Vec<ActionTime>,
+}
+
+/// When one of the stubs' actions happened.
+#[derive(Debug, Deserialize)]
+pub(crate) struct ActionTime {
+    /// ms after the scenario's start.
+    pub t_ms: f64,
+}
+
 /// A run folder's files, parsed.
 pub(crate) struct RunFiles {
     pub candump_path: PathBuf,
@@ -17,8 +38,9 @@ pub(crate) struct RunFiles {
     /// `commands.jsonl` (empty without it) and how many of its lines were unreadable.
     pub commands: Vec<Value>,
     pub commands_unreadable: usize,
-    /// `report.json`, typed and as it is (`None` without it).
-    pub report: Option<(Report, Value)>,
+    /// `report.json`: the times a recording places on its timeline, and the report as it is
+    /// (`None` without it).
+    pub report: Option<(ReportTimes, Value)>,
     /// The stubs' diagnostics log: records and trailing bytes of a partial last record.
     pub diagnostics: (Vec<EcuDiagnostics>, usize),
     /// The feeds' log of what they published, and trailing bytes of a partial last record.
@@ -42,19 +64,19 @@ impl RunFiles {
             (Vec::new(), 0)
         };
         let report_path = dir.join("report.json");
-        // Read once as JSON (recorded as it is) and typed from that (its times).
-        let report: Option<(Report, Value)> = if report_path.exists() {
+        // Read once as JSON (recorded as it is) and its times from that.
+        let report: Option<(ReportTimes, Value)> = if report_path.exists() {
             let text = std::fs::read_to_string(&report_path)
                 .with_context(|| report_path.display().to_string())?;
             let json: Value = serde_json::from_str(&text)
                 .with_context(|| format!("{}: invalid", report_path.display()))?;
-            let typed = Report::deserialize(&json)
+            let typed = ReportTimes::deserialize(&json)
                 .with_context(|| format!("{}: invalid", report_path.display()))?;
             Some((typed, json))
         } else {
             None
         };
-        let diagnostics = read_postcard(&dir.join(actuator_stubs::DIAGNOSTICS_LOG))?;
+        let diagnostics = read_postcard(&dir.join(crate::DIAGNOSTICS_LOG))?;
         let feeds = read_postcard(&dir.join(crate::FEEDS_LOG))?;
         let offset = clock_offset_ns(&log, &commands);
         Ok(Self {
@@ -76,10 +98,7 @@ fn clock_offset_ns(log: &CandumpLog, commands: &[Value]) -> Option<i64> {
     let mut by_frame: HashMap<(u32, String), Vec<u64>> = HashMap::new();
     for f in &log.frames {
         by_frame
-            .entry((
-                f.frame.id,
-                actuator_stubs::commands::data_hex(f.frame.payload()),
-            ))
+            .entry((f.frame.id, bus::candump::data_hex(f.frame.payload())))
             .or_default()
             .push(f.t_us * 1_000);
     }

@@ -211,11 +211,23 @@ pub fn run_in_guests(
                 .map(|e| format!("{}: {e}", w.dir.display()))
         })
         .collect();
+    // The stubs' outcome pictures go the same way (`--plot-later`).
+    let drawn = actuator_stubs::plot::draw_pending(out).expect("the runs' output folder");
+    let failed: Vec<String> = failed
+        .into_iter()
+        .chain(drawn.iter().filter_map(|d| {
+            d.result
+                .as_ref()
+                .err()
+                .map(|e| format!("{}: {e}", d.dir.display()))
+        }))
+        .collect();
     // Reported, not asserted: the tests that read the recordings fail on a missing one, and a
     // fault case may damage what its recording is written from.
     eprintln!(
-        "{what}: {} recordings written on the host in {:.1} s{}",
-        written.len() - failed.len(),
+        "{what}: {} recordings and {} pictures written on the host in {:.1} s{}",
+        written.len() - written.iter().filter(|w| w.result.is_err()).count(),
+        drawn.iter().filter(|d| d.result.is_ok()).count(),
         started.elapsed().as_secs_f64(),
         if failed.is_empty() {
             String::new()

@@ -38,7 +38,7 @@ fn command_line(mono: u64, f: &bus::RawFrame, message: &str) -> String {
         rx_mono_ns: mono,
         id: f.id,
         message: message.to_owned(),
-        data_hex: actuator_stubs::commands::data_hex(f.payload()),
+        data_hex: bus::candump::data_hex(f.payload()),
         e2e: "ok".to_owned(),
         secoc: None,
         decoded: None,
@@ -325,6 +325,12 @@ fn known_run(dir: &Path) -> Known {
 /// the same instant. A frame changed after the file was written, or a stamp 2 µs off, fails
 /// the check (it is no check that cannot fail).
 #[test]
+fn the_recording_reads_the_diagnostics_log_under_the_name_the_stubs_write() {
+    // `record` reads run folders without linking the stubs; the name is the contract.
+    assert_eq!(record::DIAGNOSTICS_LOG, actuator_stubs::DIAGNOSTICS_LOG);
+}
+
+#[test]
 fn run_mf4_is_the_bus_logging_asammdf_decodes_with_the_dbc() {
     let dir = std::env::temp_dir().join(format!("record-mf4-{}", std::process::id()));
     known_run(&dir);
@@ -411,7 +417,7 @@ fn pending_recordings_are_written_after_the_run_and_a_bad_note_fails_alone() {
     );
 
     // The stubs' picture left to the host (`--plot-later`): a rising deceleration and
-    // excursion, drawn to outcome.png by the same pass.
+    // excursion, drawn to outcome.png by the stubs' own pass after the recordings.
     let judged = |a: f64| {
         format!(
             r#"{{"load_limiter_kn": 6.0, "airbag_level_kn": 5.0, "pretensioner_ms": -30.0,
@@ -436,14 +442,22 @@ fn pending_recordings_are_written_after_the_run_and_a_bad_note_fails_alone() {
     let lines = by(&good).result.as_ref().unwrap();
     assert!(lines[0].starts_with("recording: ") && lines[0].contains("written on the host"));
     assert!(lines[1].starts_with("recording (MDF 4.1): "));
-    assert!(lines[2].starts_with("outcome picture: "), "{lines:?}");
+    assert_eq!(lines.len(), 2, "{lines:?}");
+    let drawn = actuator_stubs::plot::draw_pending(&root).unwrap();
+    assert_eq!(drawn.len(), 1, "{drawn:?}");
+    assert_eq!(drawn[0].dir, good);
+    let line = drawn[0].result.as_ref().unwrap();
+    assert!(line.starts_with("outcome picture: "), "{line}");
     let png = std::fs::read(good.join("outcome.png")).unwrap();
     assert_eq!(&png[1..4], b"PNG");
     assert!(!good.join(actuator_stubs::plot::PLOT_LATER).exists());
     assert!(!good.join(record::pending::PENDING).exists());
     let summary = std::fs::read_to_string(good.join("summary.txt")).unwrap();
     assert!(
-        summary.starts_with("the run's summary\nrecording: "),
+        summary.starts_with("the run's summary\nrecording: ")
+            && summary
+                .trim_end()
+                .ends_with("(drawn on the host after the run)"),
         "{summary}"
     );
     python_check(&good, false);
