@@ -60,7 +60,30 @@ pub fn mps2_to_g(accel_mps2: f64) -> f64 {
     accel_mps2 / defaults::STANDARD_GRAVITY_MPS2
 }
 
+/// Ego equivalent barrier speed, km/h: the ego's speed change to the common velocity of a
+/// two-mass collision, v_close · m_opp / (m_ego + m_opp) (v/2 for equal masses, v for a rigid
+/// barrier).
+pub fn equivalent_barrier_speed_kph(closing_mps: f64, ego_kg: f64, opp_kg: f64) -> f64 {
+    let share = if opp_kg.is_infinite() {
+        1.0
+    } else {
+        opp_kg / (ego_kg + opp_kg)
+    };
+    closing_mps * share * 3.6
+}
+
 /// Convert km/h to m/s.
 pub fn kph_to_mps(speed_kph: f64) -> f64 {
     speed_kph / 3.6
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ebs_is_half_for_equal_masses_and_full_for_a_barrier() {
+        assert!((equivalent_barrier_speed_kph(30.0, 1500.0, 1500.0) - 54.0).abs() < 1e-9);
+        assert!((equivalent_barrier_speed_kph(15.0, 1500.0, f64::INFINITY) - 54.0).abs() < 1e-9);
+    }
 }

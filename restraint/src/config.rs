@@ -646,17 +646,14 @@ impl CycleConfig {
     /// for the accelerometer-only boundary: above the no-fire line even with the lightest
     /// opponent (`lightest_opponent_kg`) and a closing speed `speed_misreport_mps` lower than
     /// measured — the EBS v·m/(m_ego + m) solved for v
-    /// (`estimate::equivalent_barrier_speed_kph`), plus the misreport. −∞ when the line is at 0
+    /// (`physics::equivalent_barrier_speed_kph`), plus the misreport. −∞ when the line is at 0
     /// (every crash is above it).
     pub fn unguarded_closing_mps(&self) -> f64 {
         if self.no_fire_ebs_kph <= 0.0 {
             return f64::NEG_INFINITY;
         }
-        let per_mps_kph = crate::estimate::equivalent_barrier_speed_kph(
-            1.0,
-            self.ego_mass_kg,
-            self.lightest_opponent_kg,
-        );
+        let per_mps_kph =
+            physics::equivalent_barrier_speed_kph(1.0, self.ego_mass_kg, self.lightest_opponent_kg);
         self.speed_misreport_mps + self.no_fire_ebs_kph / per_mps_kph
     }
 

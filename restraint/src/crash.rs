@@ -21,13 +21,14 @@ use crate::config::CycleConfig;
 use crate::confirm::{ConfirmParams, CrashDetector};
 use crate::counters::CycleCounters;
 use crate::crash_match::{MatchState, PulseMatch, SeverityEstimate};
-use crate::estimate::{equivalent_barrier_speed_kph, Estimator, Situation};
+use crate::estimate::{Estimator, Situation};
 use crate::fallback::{FallbackAlgorithm, FallbackDecision, Thresholds};
 use crate::inputs::InputMonitor;
 use crate::plan::RestraintPlan;
 use crate::roughness::Roughness;
 use crate::satellites::{CrushOnset, Relief};
 use crate::settings::{ms_to_ns, G_MPS2};
+use physics::equivalent_barrier_speed_kph;
 
 /// Which path confirmed the crash.
 #[derive(Debug, Clone, Copy, PartialEq)]

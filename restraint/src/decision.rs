@@ -357,7 +357,7 @@ impl Decision {
         // mass is what a barrier reported as a 3 000 kg object gets wrong.
         let no_fire_ebs_kph = x.no_fire_ebs_kph;
         if let Some(s) = x.situation.filter(|s| {
-            let robust_ebs_kph = crate::estimate::equivalent_barrier_speed_kph(
+            let robust_ebs_kph = physics::equivalent_barrier_speed_kph(
                 s.closing_speed_mps,
                 self.ego_mass_kg,
                 s.opponent_mass_estimate_kg + self.mass_misreport_kg,

@@ -72,9 +72,7 @@ pub use counters::CycleCounters;
 pub use cycle::{RestraintCycle, StartupNotes};
 pub use decision::{Phase, Pretensioner};
 pub use estimate::track::{Refused, TrackEstimate, TrackEvent, TrackFilter};
-pub use estimate::{
-    equivalent_barrier_speed_kph, time_to_contact, Contact, Lut, LutMismatch, Situation,
-};
+pub use estimate::{time_to_contact, Contact, Lut, LutMismatch, Situation};
 pub use inputs::{input_can_ids, Occupant};
 pub use outputs::bus_mode;
 pub use plan::{PlanSource, ReferenceSettings, RestraintPlan};

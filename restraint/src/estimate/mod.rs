@@ -77,17 +77,6 @@ pub fn time_to_contact(d_m: f64, v_mps: f64, a_mps2: f64) -> Option<Contact> {
     })
 }
 
-/// Ego equivalent barrier speed, km/h: the ego's speed change to the common velocity,
-/// v_close · m_opp / (m_ego + m_opp) (v/2 for equal masses, v for a rigid barrier).
-pub fn equivalent_barrier_speed_kph(closing_mps: f64, ego_kg: f64, opp_kg: f64) -> f64 {
-    let share = if opp_kg.is_infinite() {
-        1.0
-    } else {
-        opp_kg / (ego_kg + opp_kg)
-    };
-    closing_mps * share * 3.6
-}
-
 /// The characteristic diagram as the core needs it: the borrowed, validated view plus the
 /// header facts the shell read from the file.
 #[derive(Debug, Clone, Copy)]
@@ -436,7 +425,7 @@ impl<'a> Estimator<'a> {
         let early_ns = to_ns(self.contact_time_k * e.ttc_sigma_s);
         let opp_kg = e.mass_kg + self.conservative_mass_k * e.mass_sigma_kg;
         let v = e.contact.closing_speed_mps;
-        let ebs_kph = equivalent_barrier_speed_kph(v, self.ego_mass_kg, opp_kg);
+        let ebs_kph = physics::equivalent_barrier_speed_kph(v, self.ego_mass_kg, opp_kg);
         Situation {
             contact_ns: contact_estimate_ns.saturating_sub(early_ns),
             contact_estimate_ns,
@@ -624,11 +613,5 @@ mod tests {
         assert!(time_to_contact(10.0, 5.0, -8.0).is_none());
         assert!(time_to_contact(10.0, -1.0, 0.0).is_none());
         assert!(time_to_contact(f64::NAN, 1.0, 0.0).is_none());
-    }
-
-    #[test]
-    fn ebs_is_half_for_equal_masses_and_full_for_a_barrier() {
-        assert!((equivalent_barrier_speed_kph(30.0, 1500.0, 1500.0) - 54.0).abs() < 1e-9);
-        assert!((equivalent_barrier_speed_kph(15.0, 1500.0, f64::INFINITY) - 54.0).abs() < 1e-9);
     }
 }
