@@ -172,6 +172,21 @@ impl<const N: usize> PulseBuffer<N> {
     pub const fn capacity(&self) -> usize {
         N
     }
+    /// Maps a pulse solved along a collision's normal onto the ego's x axis, `axis_cos` being
+    /// the cosine between them (`crash_mode::Engaged::axis_cos`): the ego's acceleration and
+    /// velocity change times it, its crush along x divided by it. 1 leaves the pulse as it is;
+    /// anything outside (0, 1] is ignored.
+    pub fn project_ego_onto_axis(&mut self, axis_cos: f64) {
+        if !(axis_cos > 0.0 && axis_cos < 1.0) {
+            return;
+        }
+        let n = self.len();
+        for k in 0..n {
+            self.ego_accel_mps2[k] *= axis_cos;
+            self.ego_vel_mps[k] *= axis_cos;
+            self.ego_crush_m[k] /= axis_cos;
+        }
+    }
     /// Samples written by the last simulation.
     pub fn len(&self) -> usize {
         self.len.min(N)

@@ -29,9 +29,10 @@
 //!
 //! **What it leaves out** (say so where it matters): the stress wave and the ringing of the
 //! front end at contact (real satellites read short spikes of hundreds of g, which their
-//! low-pass and the algorithm's Δv windows integrate away), the sensor's destruction once the
-//! folds reach it (here it moves with the face), and the side-to-side difference of offset and
-//! angular impacts (both satellites see the same full-width crush).
+//! low-pass and the algorithm's Δv windows integrate away) and the sensor's destruction once the
+//! folds reach it (here it moves with the face). The side-to-side difference of offset and
+//! angular impacts is the caller's: it passes the crush at each rail tip (`world`'s truth,
+//! `satellite_crush_m`).
 
 /// *Default* depth of a satellite behind the fascia [m]: at the rail tips, ahead of it only the
 /// fascia, the foam, the bumper beam and the crash boxes (Bosch, Continental and ZF upfront

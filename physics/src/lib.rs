@@ -8,6 +8,8 @@
 //!   cheap summary, any-instant states, sampled pulses. The integrator stays as its oracle.
 //! * [`occupant`] — one rigid occupant body with belt, airbag + column, seat friction,
 //!   bottoming-out detection, and the ideal constant-force bound a*.
+//! * [`crash_mode`] — full frontal, offset, angular, pole and underride: the part of the ego's
+//!   class curve each engages, and when.
 //! * [`crush_zone`] (feature `std`) — what a crush-zone (upfront) satellite feels ahead of the
 //!   body: the front structure's graded fold from the ego's crush.
 //! * [`j211`] — SAE J211 CFC filter (phaseless, in place, no allocation).
@@ -25,6 +27,7 @@
 #![warn(missing_docs)]
 
 pub mod collision;
+pub mod crash_mode;
 #[cfg(feature = "std")]
 pub mod crush_zone;
 pub mod deadline;

@@ -10,7 +10,7 @@
 
 use crate::events::AccelEvents;
 use crate::lowpass::AntiAlias;
-use crate::scenario::{AccelSensor, BrakeStateName, Scenario};
+use crate::scenario::{AccelSensor, BrakeStateName, FrontSide, Scenario};
 use crate::truth::Truth;
 use bus::codec::V2xOpponentMassStationStatus;
 use bus::codec::{
@@ -173,12 +173,15 @@ impl SensorModelSim {
         let full_scale = full_scale_g * physics::defaults::STANDARD_GRAVITY_MPS2;
         let noise = noise_sd * gauss(rng);
         let (truth, events) = (&self.truth, &self.events);
-        let satellite = sensor.is_satellite();
+        let side = match sensor {
+            AccelSensor::SatelliteLeft => Some(FrontSide::Left),
+            AccelSensor::SatelliteRight => Some(FrontSide::Right),
+            AccelSensor::Crash | AccelSensor::Safing => None,
+        };
         let input = |t: f64| {
-            let a = if satellite {
-                truth.satellite_accel_mps2(t)
-            } else {
-                truth.ego_accel_mps2(t)
+            let a = match side {
+                Some(side) => truth.satellite_accel_mps2(side, t),
+                None => truth.ego_accel_mps2(t),
             };
             // Only when an event is active: otherwise the sum is the one it always was.
             match events.added_mps2(sensor, t) {

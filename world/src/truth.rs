@@ -7,8 +7,37 @@
 //! `initial_distance − s_ego(t) − s_opp(t)` and therefore never increases before contact,
 //! which makes the contact instant a clean bisection root.
 
-use crate::scenario::{Braking, OpponentKind, Scenario};
+use crate::scenario::{Braking, FrontSide, Scenario};
+use physics::crash_mode::{CrashMode, RAIL_INBOARD_FRACTION};
 use physics::{CollisionInput, CollisionSummary, CombinedSpring, DefaultPulseBuffer};
+
+/// The crush of the front at the rail tip on `side`, from the ego's crush along x (its
+/// deepest, at the struck side or the centre): what the satellite there folds with.
+///
+/// * full width: the same at both tips;
+/// * offset: the tips inside the overlap as the struck part; a tip outside it is not reached
+///   (the structure beside the overlap shears, it does not fold back);
+/// * angled wall: a tip `y` in from the struck corner once the wall has advanced `y·tan θ`;
+/// * pole: the tips lie beside the pole, the beam wraps round it and pulls them back only when
+///   the engine is reached (`POLE_GAP_M`): late and weak;
+/// * underride: the tips pass under the bed: never.
+pub fn satellite_crush_m(scenario: &Scenario, side: FrontSide, crush_m: &[f64]) -> Vec<f64> {
+    let struck = scenario.opponent.struck_side.unwrap_or_default() == side;
+    // Lateral position of this side's rail tip from the struck edge, as a share of the width.
+    let y = if struck {
+        RAIL_INBOARD_FRACTION
+    } else {
+        1.0 - RAIL_INBOARD_FRACTION
+    };
+    let shifted = |gap: f64| crush_m.iter().map(|c| (c - gap).max(0.0)).collect();
+    match scenario.crash_mode() {
+        CrashMode::FullFrontal => crush_m.to_vec(),
+        CrashMode::Offset { overlap } if overlap >= y => crush_m.to_vec(),
+        CrashMode::Offset { .. } | CrashMode::Underride => vec![0.0; crush_m.len()],
+        CrashMode::Angular { angle_rad } => shifted(y * scenario.ego.width_m * angle_rad.tan()),
+        CrashMode::Pole => shifted(physics::crash_mode::POLE_GAP_M),
+    }
+}
 
 /// Speed [m/s], travelled distance [m] and acceleration [m/s², negative = braking] of one
 /// braking vehicle at time `t_s`, in closed form.
@@ -86,9 +115,9 @@ pub struct Truth {
     pub collision: Option<CollisionSummary>,
     /// True compartment pulses from first contact (0.1 ms steps).
     pub pulse: Box<DefaultPulseBuffer>,
-    /// A crush-zone satellite's acceleration relative to the body, on the pulse's grid
-    /// ([`physics::crush_zone`]; empty without contact).
-    satellite_rel_mps2: Vec<f64>,
+    /// Each crush-zone satellite's acceleration relative to the body (left, right), on the
+    /// pulse's grid ([`physics::crush_zone`]; empty without contact).
+    satellite_rel_mps2: [Vec<f64>; 2],
 }
 
 impl Truth {
@@ -101,7 +130,7 @@ impl Truth {
             opp_speed_at_contact_mps: 0.0,
             collision: None,
             pulse: Box::new(DefaultPulseBuffer::new()),
-            satellite_rel_mps2: Vec::new(),
+            satellite_rel_mps2: [Vec::new(), Vec::new()],
         };
         // After an evasive manoeuvre the opponent is out of the path: no contact afterwards.
         let end = scenario
@@ -127,23 +156,44 @@ impl Truth {
         truth.contact_s = Some(tc);
         truth.ego_speed_at_contact_mps = ve;
         truth.opp_speed_at_contact_mps = vo;
-        let ego_curve = scenario.ego_class().curve();
-        let opp_curve = scenario.opponent_class().map(|c| c.curve());
-        let spring = CombinedSpring::series(ego_curve, opp_curve).map_err(|e| format!("{e:?}"))?;
-        let input = CollisionInput::with_defaults(
+        let mode = scenario.crash_mode();
+        let engaged = mode
+            .engage(scenario.ego_class().curve(), scenario.ego.width_m)
+            .map_err(|e| format!("crash mode: {e:?}"))?;
+        let face = scenario
+            .opponent_face()
+            .map_err(|e| format!("opponent face: {e:?}"))?;
+        let spring =
+            CombinedSpring::series(&engaged.curve, face.as_ref()).map_err(|e| format!("{e:?}"))?;
+        let mut input = CollisionInput::with_defaults(
             &spring,
             scenario.ego.mass_kg,
             scenario.opponent_mass_kg(),
-            closing,
+            // Along the collision's normal: an angled wall arrests only that share.
+            closing * engaged.axis_cos,
         );
-        let summary = physics::simulate_collision(&input, &mut truth.pulse)
+        if mode != CrashMode::FullFrontal {
+            // The partial modes' soft stages last longer than the full frontal's 150 ms: the
+            // whole buffer, so the pulse ends with the contact.
+            input.duration_s = (truth.pulse.capacity() - 1) as f64 * input.step_s;
+        }
+        let mut summary = physics::simulate_collision(&input, &mut truth.pulse)
             .map_err(|e| format!("true collision physics: {e:?}"))?;
+        truth.pulse.project_ego_onto_axis(engaged.axis_cos);
+        let c = engaged.axis_cos;
+        summary.vehicle.a_max_mps2 *= c;
+        summary.vehicle.a_mean_mps2 *= c;
+        summary.vehicle.delta_v_mps *= c;
+        summary.vehicle.crush_m /= c;
         truth.collision = Some(summary);
-        truth.satellite_rel_mps2 = physics::crush_zone::relative_accel_mps2(
-            truth.pulse.ego_crush_m(),
-            truth.pulse.step_s(),
-            scenario.sensor.satellite_depth_m,
-        );
+        for side in [FrontSide::Left, FrontSide::Right] {
+            let crush = satellite_crush_m(scenario, side, truth.pulse.ego_crush_m());
+            truth.satellite_rel_mps2[side as usize] = physics::crush_zone::relative_accel_mps2(
+                &crush,
+                truth.pulse.step_s(),
+                scenario.sensor.satellite_depth_m,
+            );
+        }
         Ok(truth)
     }
 
@@ -159,11 +209,10 @@ impl Truth {
 
     fn opp_motion(&self, t: f64) -> (f64, f64, f64) {
         let o = &self.scenario.opponent;
-        match o.kind {
-            OpponentKind::Barrier => (0.0, 0.0, 0.0),
-            OpponentKind::Vehicle => {
-                braking_motion(physics::kph_to_mps(o.speed_kph), o.braking.as_ref(), t)
-            }
+        if o.kind.is_fixed() {
+            (0.0, 0.0, 0.0)
+        } else {
+            braking_motion(physics::kph_to_mps(o.speed_kph), o.braking.as_ref(), t)
         }
     }
 
@@ -231,19 +280,22 @@ impl Truth {
     /// without the rest of the state: the accelerometers' filter reads it on substeps).
     pub fn ego_accel_mps2(&self, t_s: f64) -> f64 {
         match self.contact_s {
+            // After the pulse's end nothing pushes the car: a contact that outlasts the buffer
+            // (a slow underride) ends with it.
+            Some(tc) if t_s - tc >= self.pulse.len() as f64 * self.pulse.step_s() => 0.0,
             Some(tc) if t_s >= tc => self.pulse_at(self.pulse.ego_accel_mps2(), t_s - tc),
             _ => self.ego_motion(t_s).2,
         }
     }
 
-    /// What a crush-zone satellite feels at `t_s` [m/s²]: the body's acceleration and, from
-    /// contact, the crush of the structure ahead of it ([`physics::crush_zone`]). Both
-    /// satellites feel the same (a full-width frontal impact).
-    pub fn satellite_accel_mps2(&self, t_s: f64) -> f64 {
+    /// What the crush-zone satellite on `side` feels at `t_s` [m/s²]: the body's acceleration
+    /// and, from contact, the crush of the structure ahead of it ([`physics::crush_zone`]) as
+    /// far as the crash mode reaches its rail tip ([`satellite_crush_m`]).
+    pub fn satellite_accel_mps2(&self, side: FrontSide, t_s: f64) -> f64 {
         let body = self.ego_accel_mps2(t_s);
         match self.contact_s {
             Some(tc) if t_s >= tc && t_s - tc < self.pulse.len() as f64 * self.pulse.step_s() => {
-                body + self.pulse_at(&self.satellite_rel_mps2, t_s - tc)
+                body + self.pulse_at(&self.satellite_rel_mps2[side as usize], t_s - tc)
             }
             _ => body,
         }

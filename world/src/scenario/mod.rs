@@ -111,6 +111,14 @@ pub struct Vehicle {
     pub speed_kph: f64,
     /// Braking manoeuvre (absent: no braking).
     pub braking: Option<Braking>,
+    /// Front width [m] (the ego's: where an offset or angled impact reaches its rails;
+    /// default `physics::crash_mode::DEFAULT_WIDTH_M`, 1.8 m).
+    #[serde(default = "default_width_m")]
+    pub width_m: f64,
+}
+
+fn default_width_m() -> f64 {
+    physics::crash_mode::DEFAULT_WIDTH_M
 }
 
 /// A braking manoeuvre: deceleration ramps linearly from 0 at `start_s` to `decel_mps2` over
@@ -149,14 +157,55 @@ pub enum BrakeStateName {
     Aeb,
 }
 
-/// What the ego collides with.
+/// What the ego collides with (the crash modes: `physics::crash_mode`).
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
+#[serde(rename_all = "snake_case")]
 pub enum OpponentKind {
-    /// Another vehicle (two-mass collision).
+    /// Another vehicle (two-mass collision), over `overlap_percent` of the ego's width.
     Vehicle,
-    /// Rigid, non-deforming, immovable barrier (infinite mass, rigid face).
+    /// Rigid, non-deforming, immovable barrier (infinite mass, rigid face), over
+    /// `overlap_percent` of the ego's width or at `angle_deg` to its front.
     Barrier,
+    /// A UN R94 offset deformable barrier: honeycomb face on a fixed block, struck over
+    /// `overlap_percent` (default 40) of the ego's width.
+    OffsetBarrier,
+    /// A rigid pole on the ego's centre line, between its rails.
+    Pole,
+    /// The rear of a truck's bed (`mass_kg` the truck's): the ego's bumper and rails pass under.
+    Underride,
+}
+
+impl OpponentKind {
+    /// The name used in scenario files.
+    pub fn name(self) -> &'static str {
+        match self {
+            OpponentKind::Vehicle => "vehicle",
+            OpponentKind::Barrier => "barrier",
+            OpponentKind::OffsetBarrier => "offset_barrier",
+            OpponentKind::Pole => "pole",
+            OpponentKind::Underride => "underride",
+        }
+    }
+
+    /// Fixed in place and of unbounded mass (a barrier, a pole): the object classifier's
+    /// report of its mass is all the ECU can have.
+    pub fn is_fixed(self) -> bool {
+        matches!(
+            self,
+            OpponentKind::Barrier | OpponentKind::OffsetBarrier | OpponentKind::Pole
+        )
+    }
+}
+
+/// A side of the ego's front.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum FrontSide {
+    /// The left (driver's, left-hand traffic's) side.
+    #[default]
+    Left,
+    /// The right side.
+    Right,
 }
 
 /// The opponent.
@@ -179,6 +228,13 @@ pub struct Opponent {
     /// Evasive manoeuvre: from this instant [s] the opponent has left the ego's path (swerved
     /// away) — no contact can happen afterwards and the sensor reports no valid object in path.
     pub evade_s: Option<f64>,
+    /// Share of the ego's front width struck [%] (vehicle and barrier: default 100;
+    /// offset_barrier: default 40).
+    pub overlap_percent: Option<f64>,
+    /// Angle between a rigid barrier's face and the ego's front [°] (barrier only; default 0).
+    pub angle_deg: Option<f64>,
+    /// The side an offset or angled impact strikes first (default left).
+    pub struck_side: Option<FrontSide>,
 }
 
 /// Which feed a dropout window silences.
@@ -629,25 +685,66 @@ impl Scenario {
         class_or_mass(self.ego.class, self.ego.mass_kg)
     }
 
-    /// Opponent stiffness class (`None` for a barrier).
+    /// Opponent stiffness class (a vehicle's; `None` for everything else).
     pub fn opponent_class(&self) -> Option<physics::MassClass> {
         match self.opponent.kind {
-            OpponentKind::Barrier => None,
             OpponentKind::Vehicle => Some(class_or_mass(
                 self.opponent.class,
                 self.opponent
                     .mass_kg
                     .unwrap_or(physics::paper::TABLE5_MASS_KG),
             )),
+            _ => None,
         }
     }
 
-    /// True opponent mass [kg] (∞ for a barrier).
+    /// True opponent mass [kg] (∞ for a barrier or a pole).
     pub fn opponent_mass_kg(&self) -> f64 {
-        match self.opponent.kind {
-            OpponentKind::Barrier => f64::INFINITY,
-            OpponentKind::Vehicle => self.opponent.mass_kg.unwrap_or(f64::NAN),
+        if self.opponent.kind.is_fixed() {
+            f64::INFINITY
+        } else {
+            self.opponent.mass_kg.unwrap_or(f64::NAN)
         }
+    }
+
+    /// The struck share of the ego's front width, 0–1.
+    pub fn overlap(&self) -> f64 {
+        let default = match self.opponent.kind {
+            OpponentKind::OffsetBarrier => 40.0,
+            _ => 100.0,
+        };
+        self.opponent.overlap_percent.unwrap_or(default) / 100.0
+    }
+
+    /// How the ego meets its opponent: which of its front's load paths engage, and when.
+    pub fn crash_mode(&self) -> physics::crash_mode::CrashMode {
+        use physics::crash_mode::CrashMode;
+        let o = &self.opponent;
+        match o.kind {
+            OpponentKind::Pole => CrashMode::Pole,
+            OpponentKind::Underride => CrashMode::Underride,
+            _ => match o.angle_deg {
+                Some(a) if a > 0.0 => CrashMode::Angular {
+                    angle_rad: a.to_radians(),
+                },
+                _ if self.overlap() < 1.0 => CrashMode::Offset {
+                    overlap: self.overlap(),
+                },
+                _ => CrashMode::FullFrontal,
+            },
+        }
+    }
+
+    /// The opponent's own face in series with the ego's front: a vehicle's class curve, a
+    /// deformable barrier's honeycomb over the struck width; `None` for a rigid face.
+    pub fn opponent_face(&self) -> Result<Option<physics::Curve>, physics::PhysicsError> {
+        Ok(match self.opponent.kind {
+            OpponentKind::Vehicle => self.opponent_class().map(|c| *c.curve()),
+            OpponentKind::OffsetBarrier => Some(physics::crash_mode::odb_face_curve(
+                self.overlap() * self.ego.width_m,
+            )?),
+            _ => None,
+        })
     }
 }
 

@@ -101,41 +101,77 @@ impl Scenario {
             1000.0,
             "m",
         )?;
-        match o.kind {
-            OpponentKind::Vehicle => {
-                let m = o.mass_kg.ok_or((
-                    "opponent.mass_kg".to_owned(),
-                    "required for kind = \"vehicle\"".to_owned(),
-                ))?;
-                range("opponent.mass_kg", m, 300.0, 10000.0, "kg")?;
-                class("opponent.class", o.class)?;
-                range("opponent.speed_kph", o.speed_kph, 0.0, 200.0, "km/h")?;
-                braking("opponent.braking", &o.braking, self.duration_s)?;
-                if let Some(te) = o.evade_s {
-                    range("opponent.evade_s", te, 0.0, self.duration_s, "s")?;
-                }
+        range("ego.width_m", self.ego.width_m, 1.4, 2.6, "m")?;
+        let kind = o.kind.name();
+        let unused = |key: &str, why: &str| {
+            Err((
+                format!("opponent.{key}"),
+                format!("not used by kind = \"{kind}\" ({why}): remove this key"),
+            ))
+        };
+        if o.kind.is_fixed() {
+            let bad = [
+                ("mass_kg", o.mass_kg.is_some()),
+                ("class", o.class.is_some()),
+                ("speed_kph", o.speed_kph != 0.0),
+                ("braking", o.braking.is_some()),
+                ("evade_s", o.evade_s.is_some()),
+            ];
+            if let Some((k, _)) = bad.iter().find(|(_, b)| *b) {
+                return unused(k, "it is fixed in place, of unbounded mass");
             }
-            OpponentKind::Barrier => {
-                let bad = if o.mass_kg.is_some() {
-                    Some("mass_kg")
-                } else if o.class.is_some() {
-                    Some("class")
-                } else if o.speed_kph != 0.0 {
-                    Some("speed_kph")
-                } else if o.braking.is_some() {
-                    Some("braking")
-                } else if o.evade_s.is_some() {
-                    Some("evade_s")
-                } else {
-                    None
-                };
-                if let Some(k) = bad {
-                    return Err((
-                        format!("opponent.{k}"),
-                        "a rigid barrier is immovable and non-deforming: remove this key".into(),
-                    ));
-                }
+        } else {
+            let (low_kg, high_kg) = match o.kind {
+                OpponentKind::Underride => (3000.0, 40000.0),
+                _ => (300.0, 10000.0),
+            };
+            let m = o.mass_kg.ok_or((
+                "opponent.mass_kg".to_owned(),
+                format!("required for kind = \"{kind}\""),
+            ))?;
+            range("opponent.mass_kg", m, low_kg, high_kg, "kg")?;
+            if o.kind == OpponentKind::Underride && o.class.is_some() {
+                return unused("class", "the ego meets the bed, not the truck's front");
             }
+            class("opponent.class", o.class)?;
+            range("opponent.speed_kph", o.speed_kph, 0.0, 200.0, "km/h")?;
+            braking("opponent.braking", &o.braking, self.duration_s)?;
+            if let Some(te) = o.evade_s {
+                range("opponent.evade_s", te, 0.0, self.duration_s, "s")?;
+            }
+        }
+        if let Some(p) = o.overlap_percent {
+            if matches!(o.kind, OpponentKind::Pole | OpponentKind::Underride) {
+                return unused("overlap_percent", "it strikes the centre of the front");
+            }
+            range("opponent.overlap_percent", p, 10.0, 100.0, "%")?;
+        }
+        if let Some(a) = o.angle_deg {
+            if o.kind != OpponentKind::Barrier {
+                return unused("angle_deg", "an angled impact is a rigid barrier's");
+            }
+            range("opponent.angle_deg", a, 0.0, 45.0, "°")?;
+            if a > 0.0 && o.overlap_percent.is_some_and(|p| p < 100.0) {
+                return Err((
+                    "opponent.angle_deg".into(),
+                    "an angled barrier strikes the whole front, corner first: remove \
+                     overlap_percent or the angle"
+                        .into(),
+                ));
+            }
+        }
+        if o.struck_side.is_some()
+            && matches!(
+                self.crash_mode(),
+                physics::crash_mode::CrashMode::FullFrontal
+                    | physics::crash_mode::CrashMode::Pole
+                    | physics::crash_mode::CrashMode::Underride
+            )
+        {
+            return unused(
+                "struck_side",
+                "only an offset or angled impact strikes one side first",
+            );
         }
         let s = &self.sensor;
         range(
@@ -190,11 +226,13 @@ impl Scenario {
                     .into(),
             ));
         }
-        if o.kind == OpponentKind::Barrier && s.mass_estimate_kg.is_none() {
+        if o.kind.is_fixed() && s.mass_estimate_kg.is_none() {
             return Err((
                 "sensor.mass_estimate_kg".into(),
-                "required for a barrier opponent (what the object classifier reports for it)"
-                    .into(),
+                format!(
+                    "required for kind = \"{}\" (what the object classifier reports for it)",
+                    o.kind.name()
+                ),
             ));
         }
         range("sensor.confidence", s.confidence, 0.0, 1.0, "")?;
