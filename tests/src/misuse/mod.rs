@@ -59,6 +59,16 @@
 //! |---|---|---|
 //! | grey-zone | a 20–30 km/h barrier or equal cars at 20 + 20 to 30 + 30 km/h, objects live or dead, the occupant belted or not | by outcome: the airbag must fire where the reference restraint's airbag is what keeps the occupant from bottoming out (its belt alone bottoms out in the true pulse, with its airbag at the reference time the occupant does not); elsewhere printed |
 //!
+//! ## Crash modes (`modes`, `physics::crash_mode`)
+//! | family | what | requirement |
+//! |---|---|---|
+//! | no-fire-mode | an offset deformable barrier (35–50 %) at 12–24 km/h, a centre pole at 10–20 km/h, objects live or dead | no airbag |
+//! | no-fire-light-offset | an 800–1 300 kg car struck with 35–60 % of the width at an ego EBS of 10–16 km/h: closing at 30–45 km/h, its struck rail crushes like a must-fire offset crash's | no airbag |
+//! | must-fire-offset | an offset deformable barrier (35–50 %) at 40–64 km/h, or equal cars 35 + 35 to 56 + 56 km/h overlapping by 35–60 % | airbag |
+//! | must-fire-angular | a rigid wall at 15–30° at 32–48 km/h (FMVSS 208 oblique), belted or not | airbag |
+//! | must-fire-pole | a centre pole at 32–50 km/h | airbag |
+//! | must-fire-underride | a standing 8–30 t truck's bed at 40–60 km/h | airbag |
+//!
 //! ## The occupant
 //! Every variant seats a 75 kg occupant at 300 mm, belted, except: a quarter of every no-fire
 //! family's variants (misuse and single faults) seat them unbelted — the ECU then judges the
@@ -79,6 +89,7 @@ mod crash_with;
 mod crashes;
 mod events;
 mod faults;
+mod modes;
 mod text;
 
 use crash_with::*;
@@ -86,6 +97,7 @@ pub use crash_with::{clean_twin, ADDED, FAULTY_SENSOR_FAMILIES, LATE_VS_CLEAN_MS
 use crashes::*;
 use events::*;
 use faults::*;
+use modes::*;
 
 /// What a family requires.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -367,6 +379,42 @@ pub const FAMILIES: &[Family] = &[
         make: grey_zone,
     },
     Family {
+        name: "no-fire-mode",
+        envelope: "below the no-fire line in the soft modes: an offset deformable barrier (35–50 %) at 12–24 km/h, a centre pole at 10–20 km/h, objects live or dead",
+        requirement: Requirement::NoAirbag,
+        make: no_fire_mode,
+    },
+    Family {
+        name: "no-fire-light-offset",
+        envelope: "an 800–1 300 kg car struck with 35–60 % of the width at an ego EBS of 10–16 km/h (closing 30–45 km/h: its rail crushes like a must-fire offset's), objects live or dead",
+        requirement: Requirement::NoAirbag,
+        make: no_fire_light_offset,
+    },
+    Family {
+        name: "must-fire-offset",
+        envelope: "an offset deformable barrier (35–50 %) at 40–64 km/h, or equal cars 35 + 35 to 56 + 56 km/h overlapping by 35–60 %, either side struck, objects live or dead",
+        requirement: Requirement::MustFire,
+        make: must_fire_offset,
+    },
+    Family {
+        name: "must-fire-angular",
+        envelope: "a rigid wall at 15–30° at 32–48 km/h (FMVSS 208 oblique), either side first, objects live or dead, the occupant belted or not",
+        requirement: Requirement::MustFire,
+        make: must_fire_angular,
+    },
+    Family {
+        name: "must-fire-pole",
+        envelope: "a centre pole at 32–50 km/h, objects live or dead",
+        requirement: Requirement::MustFire,
+        make: must_fire_pole,
+    },
+    Family {
+        name: "must-fire-underride",
+        envelope: "the bed of a standing 8–30 t truck at 40–60 km/h, tracked with its true mass or untracked",
+        requirement: Requirement::MustFire,
+        make: must_fire_underride,
+    },
+    Family {
         name: "beyond-physics-half-sine",
         envelope: "one-signed half-sine 3–15 g × 5–20 ms on both sensors (its whole area a Δv of the car): where each floor sits, printed, not judged",
         requirement: Requirement::Report,
@@ -382,6 +430,10 @@ pub const OPEN: &[&str] = &[
     "must-fire-after-event",
     "must-fire-sensor-fault",
     "grey-zone",
+    "must-fire-offset",
+    "must-fire-angular",
+    "must-fire-pole",
+    "must-fire-underride",
 ];
 
 /// Must-fire families gated on time: with `--gate`, every airbag must fire at or before its
