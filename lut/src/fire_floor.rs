@@ -181,7 +181,8 @@ pub fn accel_only_fire_s(
                 fraction,
                 floor_mps: relief.floor_mps,
                 boundary_scale: relief.boundary_scale,
-                // A car without satellites below the unguarded closing speed: no lift.
+                // A car without satellites below the unguarded closing speed: no lift; a
+                // full-width crash: no one-sided fold.
                 ..Relief::NONE
             },
         );

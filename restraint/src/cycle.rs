@@ -244,6 +244,19 @@ impl Activity for RestraintCycle<'_> {
         let satellites = &mut self.satellites;
         satellites.begin_cycle(now);
         io.drain_satellites(&mut |side, b| satellites.on_frames(side, b, now));
+        // A one-sided fold lowers the boundary only for a tracked crash that is a must-fire one
+        // even against the lightest opponent the object list's report allows; asked only while
+        // the crash detector judges an event (a fold needs milliseconds of crush anyway).
+        let one_sided_ok = self.crash.awake()
+            && self.estimate.situation.as_ref().is_some_and(|s| {
+                must_fire_if_lightest(
+                    s.closing_speed_mps,
+                    s.opponent_mass_estimate_kg - self.cfg.mass_misreport_kg,
+                    self.cfg.ego_mass_kg,
+                    no_fire_ebs_kph,
+                )
+            });
+        satellites.allow_one_sided(one_sided_ok);
         let crash = &mut self.crash;
         let agreement = &mut self.agreement;
         // The relief of the cycle's latest judged batch (none when every batch was quiet).
@@ -524,6 +537,57 @@ impl Activity for RestraintCycle<'_> {
         }
         for (name, reason) in E2E_COUNTER_NAMES.iter().zip(RejectReason::VARIANTS) {
             out(name, e2e.rejected_for(*reason));
+        }
+    }
+}
+
+/// Whether a tracked crash at `closing_mps` is a must-fire one (ego EBS at the no-fire line or
+/// above) against an opponent of `lightest_kg` — its reported mass less the planning margin:
+/// then one object fault cannot make a no-fire crash pass (`satellites`, "One side folds").
+fn must_fire_if_lightest(
+    closing_mps: f64,
+    lightest_kg: f64,
+    ego_kg: f64,
+    no_fire_ebs_kph: f64,
+) -> bool {
+    // EBS = v · m / (ego + m) · 3.6 ≥ line, without the division (both masses ≥ 0).
+    let m = lightest_kg.max(0.0);
+    closing_mps * m * 3.6 >= no_fire_ebs_kph * (ego_kg + m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::must_fire_if_lightest;
+
+    /// The division-free form is the EBS against the line: a 64 km/h fixed barrier reported
+    /// at 3 000 kg is a must-fire crash even at 1 800 kg (EBS 32.1 km/h), equal cars at
+    /// 35 + 35 km/h are not at 585 kg (17.3 km/h), and a mass under the margin is none.
+    #[test]
+    fn the_lightest_opponent_decides_against_the_line() {
+        let ego = 1785.0;
+        assert!(must_fire_if_lightest(
+            64.0 / 3.6,
+            3000.0 - 1200.0,
+            ego,
+            20.0
+        ));
+        assert!(!must_fire_if_lightest(
+            70.0 / 3.6,
+            1785.0 - 1200.0,
+            ego,
+            20.0
+        ));
+        assert!(!must_fire_if_lightest(100.0, 800.0 - 1200.0, ego, 20.0));
+        assert!(!must_fire_if_lightest(f64::NAN, 3000.0, ego, 20.0));
+        for (v, m) in [(10.0, 900.0), (12.3, 2400.0), (30.0, 300.0), (8.0, 9000.0)] {
+            let ebs = physics::equivalent_barrier_speed_kph(v, ego, m);
+            for line in [ebs - 0.01, ebs + 0.01] {
+                assert_eq!(
+                    must_fire_if_lightest(v, m, ego, line),
+                    ebs >= line,
+                    "{v} {m} {line}"
+                );
+            }
         }
     }
 }

@@ -65,7 +65,7 @@
 //! | no-fire-mode | an offset deformable barrier (35–50 %) at 12–24 km/h, a centre pole at 10–20 km/h, objects live or dead | no airbag |
 //! | no-fire-light-offset | an 800–1 300 kg car struck with 35–60 % of the width at an ego EBS of 10–16 km/h: closing at 30–45 km/h, its struck rail crushes like a must-fire offset crash's | no airbag |
 //! | must-fire-offset | an offset deformable barrier (35–50 %) at 40–64 km/h, or equal cars 35 + 35 to 56 + 56 km/h overlapping by 35–60 % | airbag |
-//! | must-fire-angular | a rigid wall at 15–30° at 32–48 km/h (FMVSS 208 oblique), belted or not | airbag |
+//! | must-fire-angular | a rigid wall at 15–30°: unbelted at 32–48 km/h (FMVSS 208 oblique), belted at 40–56 km/h | airbag |
 //! | must-fire-pole | a centre pole at 32–50 km/h | airbag |
 //! | must-fire-underride | a standing 8–30 t truck's bed at 40–60 km/h | airbag |
 //!
@@ -398,7 +398,7 @@ pub const FAMILIES: &[Family] = &[
     },
     Family {
         name: "must-fire-angular",
-        envelope: "a rigid wall at 15–30° at 32–48 km/h (FMVSS 208 oblique), either side first, objects live or dead, the occupant belted or not",
+        envelope: "a rigid wall at 15–30°, either side first, objects live or dead: unbelted at 32–48 km/h (FMVSS 208 oblique), belted at 40–56 km/h",
         requirement: Requirement::MustFire,
         make: must_fire_angular,
     },
