@@ -104,9 +104,7 @@ pub struct Drawn {
 /// # Errors
 /// `root` cannot be read.
 pub fn draw_pending(root: &Path) -> Result<Vec<Drawn>, String> {
-    let mut dirs = Vec::new();
-    collect(root, 0, &mut dirs)?;
-    dirs.sort();
+    let dirs = host::files::run_folders_holding(root, PLOT_LATER).map_err(|e| e.to_string())?;
     Ok(dirs
         .into_iter()
         .map(|dir| {
@@ -127,22 +125,6 @@ pub fn draw_pending(root: &Path) -> Result<Vec<Drawn>, String> {
             Drawn { dir, result }
         })
         .collect())
-}
-
-fn collect(dir: &Path, depth: usize, out: &mut Vec<PathBuf>) -> Result<(), String> {
-    if dir.join(PLOT_LATER).is_file() {
-        out.push(dir.to_path_buf());
-    }
-    if depth < 3 {
-        let entries = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        for e in entries {
-            let e = e.map_err(|e| format!("{}: {e}", dir.display()))?;
-            if e.file_type().is_ok_and(|t| t.is_dir()) {
-                collect(&e.path(), depth + 1, out)?;
-            }
-        }
-    }
-    Ok(())
 }
 
 /// Draws the two-panel PNG; `pulse_g` is the compartment deceleration [g] at `pulse_step_ms`.

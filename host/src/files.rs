@@ -73,6 +73,34 @@ impl<W: std::io::Write> std::io::Write for NoFlush<W> {
     }
 }
 
+/// The folders under `root` (itself and up to three levels down, as a bench's run folders lie:
+/// `OUT/<scenario>/`, the campaign's `OUT/<guest>/<case>/<scenario>/`) that hold a file
+/// `name`, sorted: the runs that left work for the host (a recording, a picture).
+///
+/// # Errors
+/// A folder cannot be read.
+pub fn run_folders_holding(root: &Path, name: &str) -> std::io::Result<Vec<PathBuf>> {
+    fn walk(dir: &Path, name: &str, depth: usize, out: &mut Vec<PathBuf>) -> std::io::Result<()> {
+        if dir.join(name).is_file() {
+            out.push(dir.to_path_buf());
+        }
+        if depth < 3 {
+            for e in std::fs::read_dir(dir)? {
+                let e = e?;
+                if e.file_type()?.is_dir() {
+                    walk(&e.path(), name, depth + 1, out)?;
+                }
+            }
+        }
+        Ok(())
+    }
+    let mut out = Vec::new();
+    walk(root, name, 0, &mut out)
+        .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", root.display())))?;
+    out.sort();
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

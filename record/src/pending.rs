@@ -96,9 +96,7 @@ pub struct Written {
 /// # Errors
 /// `root` cannot be read.
 pub fn write_pending(root: &Path) -> Result<Vec<Written>> {
-    let mut dirs = Vec::new();
-    collect(root, 0, &mut dirs)?;
-    dirs.sort();
+    let dirs = host::files::run_folders_holding(root, PENDING)?;
     Ok(dirs
         .into_iter()
         .map(|dir| {
@@ -106,21 +104,6 @@ pub fn write_pending(root: &Path) -> Result<Vec<Written>> {
             Written { dir, result }
         })
         .collect())
-}
-
-fn collect(dir: &Path, depth: usize, out: &mut Vec<PathBuf>) -> Result<()> {
-    if dir.join(PENDING).is_file() {
-        out.push(dir.to_path_buf());
-    }
-    if depth < 3 {
-        for e in std::fs::read_dir(dir).with_context(|| dir.display().to_string())? {
-            let e = e?;
-            if e.file_type()?.is_dir() {
-                collect(&e.path(), depth + 1, out)?;
-            }
-        }
-    }
-    Ok(())
 }
 
 fn write_one(dir: &Path) -> Result<Vec<String>> {
