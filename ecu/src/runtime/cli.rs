@@ -97,8 +97,8 @@ pub struct RunArgs {
     #[arg(long)]
     pub no_can: bool,
     /// SocketCAN interface (default vcan0); `--can`, as in every bench tool.
-    #[arg(long = "can", alias = "can-interface", value_name = "IF")]
-    pub can_interface: Option<String>,
+    #[arg(long, alias = "can-interface", value_name = "IF")]
+    pub can: Option<String>,
     /// iceoryx2 service-name prefix.
     #[arg(long, value_name = "PREFIX")]
     pub service_prefix: Option<String>,
@@ -152,7 +152,7 @@ impl RunArgs {
             ("cycle.reference", v(self.reference.as_ref())),
             ("cycle.secoc_keys", v(self.secoc_keys.as_ref())),
             ("can.enabled", v(self.no_can.then_some(false))),
-            ("can.interface", v(self.can_interface.as_ref())),
+            ("can.interface", v(self.can.as_ref())),
             ("ipc.service_prefix", v(self.service_prefix.as_ref())),
             ("ipc.node_name", v(self.node_name.as_ref())),
         ]
