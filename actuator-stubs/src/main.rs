@@ -308,6 +308,7 @@ fn run(cli: &Cli) -> Result<()> {
     }
     let report = build_report(
         cli,
+        out,
         &scenario,
         &reference,
         &truth,
@@ -332,6 +333,7 @@ fn run(cli: &Cli) -> Result<()> {
 #[allow(clippy::too_many_arguments)]
 fn build_report(
     cli: &Cli,
+    out: &std::path::Path,
     scenario: &Scenario,
     reference: &physics::reference::ReferenceRestraint,
     truth: &BenchTruth,
@@ -341,7 +343,6 @@ fn build_report(
     receiver: &Receiver,
     stop_reason: &str,
 ) -> Result<Report> {
-    let out = cli.out.as_deref().context("--out is required")?;
     let contact_ns = truth.contact_ns;
     let rel_ms = |t: u64| (contact_ns != 0).then_some((t as f64 - contact_ns as f64) * 1e-6);
     let since_start_s =

@@ -371,24 +371,29 @@ pub struct Satellites {
 /// tunnel), m/s. A tunnel reading forward (a shunt from behind, or a faulty one) is no crush
 /// ahead: the satellites are measured against a tunnel that at most stands still.
 fn severity_of(usable: [bool; 2], sums: [f64; 3]) -> Option<f64> {
-    let [left, right, tunnel] = sums;
-    let tunnel = tunnel.max(0.0);
     usable
         .iter()
-        .zip([left - tunnel, right - tunnel])
+        .zip(crush_of(sums))
         .filter(|(ok, _)| **ok)
         .map(|(_, s)| s)
         .fold(None, |m: Option<f64>, s| Some(m.map_or(s, |m| m.min(s))))
         .filter(|s| s.is_finite())
 }
 
+/// Each satellite's crush Δv (left, right) from the window's `sums` (left, right, tunnel),
+/// m/s, against a tunnel that at most stands still.
+#[inline]
+fn crush_of(sums: [f64; 3]) -> [f64; 2] {
+    let [left, right, tunnel] = sums;
+    let tunnel = tunnel.max(0.0);
+    [left - tunnel, right - tunnel]
+}
+
 /// One side folds and the other does not (module docs, "One side folds"): both usable, the
 /// larger crush Δv at least `one_sided_crush_mps`, the smaller at most
 /// `one_sided_other_max_mps`.
 fn one_sided_of(usable: [bool; 2], sums: [f64; 3], p: &SatelliteParams) -> bool {
-    let [left, right, tunnel] = sums;
-    let tunnel = tunnel.max(0.0);
-    let (l, r) = (left - tunnel, right - tunnel);
+    let [l, r] = crush_of(sums);
     let (hi, lo) = if l > r { (l, r) } else { (r, l) };
     usable == [true, true] && hi >= p.one_sided_crush_mps && lo <= p.one_sided_other_max_mps
 }
