@@ -50,7 +50,10 @@
 //!    least `confirm_samples` finite samples ≥ `confirm_decel_g` and an upper bound of the
 //!    integrated Δv ≥ `confirm_delta_v_mps` (each positive sample counts at most half its own
 //!    period plus half the longest usable period, the most a trapezoid can give it); backup —
-//!    a frame decoding as `EgoVehicleState` with `EgoLongAccel` ≤ −`backup_confirm_g`;
+//!    a frame decoding as `EgoVehicleState` with `EgoLongAccel` ≤ −`backup_confirm_g`, or
+//!    (the safing sensor measuring the crash for a faulty crash sensor; the harness feeds both
+//!    sensors the same samples) that Δv bound ≥ the lowest airbag floor the satellites' relief
+//!    allows, min(`fallback_min_dv_mps`, `satellite_floor_mps`);
 //! 3. a command with source `Adaptive` is only sent with a LUT and after at least one LUT
 //!    lookup (the adaptive settings come from nowhere else).
 #![no_main]
@@ -221,7 +224,10 @@ impl AccelFed {
         match kind {
             Some(ConfirmKind::Matched(_)) => self.over_wake >= 3,
             Some(ConfirmKind::Generic { .. }) => generic,
-            Some(ConfirmKind::Backup) => self.can_crash_decel,
+            Some(ConfirmKind::Backup) => {
+                let floor_mps = cfg.fallback_min_dv_mps.min(cfg.satellite_floor_mps);
+                self.can_crash_decel || self.delta_v_bound_mps() >= floor_mps * (1.0 - 1.0e-9)
+            }
             None => false,
         }
     }
@@ -385,7 +391,7 @@ impl Harness {
                             self.fed.confirmation_possible(cfg, kind),
                             "airbag fire sent although no input could confirm the crash the way \
                              it was confirmed ({kind:?}): {} samples ≥ {} g, {} ≥ {} g (generic \
-                             needs {}), Δv bound {:.4} m/s (needs {}), CAN crash decel {}",
+                             needs {}), Δv bound {:.4} m/s (generic needs {}), CAN crash decel {}",
                             self.fed.over_wake,
                             cfg.confirm_wake_g,
                             self.fed.over_threshold,

@@ -257,6 +257,13 @@ impl SeverityAgreement {
         self.event == Some((onset_ns, true)) || self.safing_reads_more == Some(onset_ns)
     }
 
+    /// Whether the crash sensor measured more than the safing sensor allows on the event that
+    /// began at `onset_ns`, and the safing sensor never more than the crash sensor allows: the
+    /// safing sensor's reading is then the smaller of the two, whichever of them is wrong.
+    pub fn crash_reads_more(&self, onset_ns: u64) -> bool {
+        self.event == Some((onset_ns, true)) && self.safing_reads_more != Some(onset_ns)
+    }
+
     /// Whether the pair agrees on the event that began at `onset_ns` so far (module docs).
     /// A disagreement holds for the rest of that event.
     pub fn agrees(&mut self, onset_ns: u64) -> bool {

@@ -26,9 +26,15 @@ use crate::fallback::{FallbackAlgorithm, FallbackDecision, Thresholds};
 use crate::inputs::InputMonitor;
 use crate::plan::RestraintPlan;
 use crate::roughness::Roughness;
+use crate::safing::Safing;
 use crate::satellites::{CrushOnset, Relief};
 use crate::settings::{ms_to_ns, G_MPS2};
 use physics::equivalent_barrier_speed_kph;
+
+/// How often the crash sensor's roughness measure is kept for a fault to come, ms
+/// ([`CrashMonitor::end_safing_roughness`]).
+pub const SNAPSHOT_MS: u64 = 32;
+const SNAPSHOT_NS: u64 = SNAPSHOT_MS * 1_000_000;
 
 /// Which path confirmed the crash.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -87,6 +93,19 @@ pub struct CrashMonitor {
     confirmation: Option<Confirmation>,
     /// The road's roughness: lifts every fire's severity floor.
     roughness: Roughness,
+    /// The same measure on the safing sensor while the crash sensor is known faulty (`None`
+    /// while it is healthy): the lift of the backup's floor while the safing sensor stands in
+    /// for it ([`Self::backup_boundaries`]). It starts from the crash sensor's measure as it
+    /// was before the fault could reach it (`roughness_before`) and follows the safing sensor
+    /// from then on; the healthy cycles pay nothing for it but the snapshot.
+    safing_roughness: Option<Roughness>,
+    /// The crash sensor's measure [`SNAPSHOT_MS`] and 2 × [`SNAPSHOT_MS`] ago at most
+    /// (refreshed every [`SNAPSHOT_MS`] while the crash sensor is healthy): the checks find a
+    /// fault within 13 (pair check) to 20 ms (stuck) of its start, so the older one is the road
+    /// as the fault had not touched it — a fault that reads forward would hold the lift up.
+    roughness_before: [Roughness; 2],
+    /// When the next snapshot is due, ns.
+    next_snapshot_ns: u64,
 }
 
 impl CrashMonitor {
@@ -105,6 +124,9 @@ impl CrashMonitor {
             accel_delay_ns: ms_to_ns(cfg.accel_delay_ms),
             confirmation: None,
             roughness: cfg.roughness(),
+            safing_roughness: None,
+            roughness_before: [cfg.roughness(); 2],
+            next_snapshot_ns: 0,
         }
     }
 
@@ -181,6 +203,28 @@ impl CrashMonitor {
         self.roughness.push(dv_mps, span_s);
     }
 
+    /// The safing sensor's batch for its own roughness measure while the crash sensor is known
+    /// faulty (as [`Self::on_raw_batch`]).
+    pub(crate) fn on_raw_safing_batch(&mut self, dv_mps: f64, span_s: f64) {
+        let [before, _] = self.roughness_before;
+        self.safing_roughness
+            .get_or_insert(before)
+            .push(dv_mps, span_s);
+    }
+
+    /// The crash sensor is healthy at `now`: the safing sensor's roughness measure ends, and
+    /// the crash sensor's is kept for the next fault (`roughness_before`).
+    #[inline]
+    pub(crate) fn end_safing_roughness(&mut self, now: u64) {
+        if self.safing_roughness.is_some() {
+            self.safing_roughness = None;
+        }
+        if now >= self.next_snapshot_ns {
+            self.roughness_before = [self.roughness_before[1], self.roughness];
+            self.next_snapshot_ns = now.saturating_add(SNAPSHOT_NS);
+        }
+    }
+
     /// One plausible accelerometer sample for all three detectors.
     fn on_sample(
         &mut self,
@@ -244,6 +288,7 @@ impl CrashMonitor {
         situation: Option<&Situation>,
         inputs: &InputMonitor,
         safing_onset_ns: Option<u64>,
+        measured: Option<BackupSeverity>,
     ) {
         if self.confirmation.is_some() || !accel_faulty {
             return;
@@ -251,7 +296,7 @@ impl CrashMonitor {
         let Some(sit) = situation else {
             return;
         };
-        if let Some(b) = self.backup_evidence(now, sit, inputs, safing_onset_ns) {
+        if let Some(b) = self.backup_evidence(now, sit, inputs, safing_onset_ns, measured) {
             self.confirmation = Some(Confirmation {
                 at_ns: b.rx_ns,
                 contact_ns: b.contact_ns,
@@ -262,30 +307,80 @@ impl CrashMonitor {
     }
 
     /// The backup path's evidence at `now`: a crash predicted above the no-fire line
-    /// (`sit`) and a fresh vehicle frame received within ± the match window of its contact
-    /// whose deceleration reaches `backup_confirm_g`. Two sources independent of the crash
-    /// accelerometer: the object list and the vehicle dynamics. The contact is the healthy
-    /// safing sensor's onset (`safing_onset_ns`, less the structure's delay) when that lies
-    /// within the match window of the predicted one — measured, where the object list's
-    /// prediction is off by its latency and range error (8 ms in a 109 km/h closing car
-    /// crash) — else the predicted contact.
+    /// (`sit`), measured by a source independent of the crash accelerometer — a fresh
+    /// vehicle frame received within ± the match window of its contact whose deceleration
+    /// reaches `backup_confirm_g`, or, while the crash accelerometer is known faulty, the
+    /// healthy safing sensor's event (`measured`, [`Self::backup_boundaries`]) beginning within
+    /// that window and reaching the airbag's accelerometer-only boundary and floor. The object list
+    /// and one of the vehicle dynamics or the safing sensor: two sources that no single fault
+    /// makes agree on a crash. The vehicle frame comes every 10 ms; the safing sensor measures
+    /// the crash as the crash sensor would, so the backup fires when the crash sensor's
+    /// boundary would have. The contact is the safing sensor's onset (`safing_onset_ns`, less
+    /// the structure's delay) when that lies within the match window of the predicted one —
+    /// measured, where the object list's prediction is off by its latency and range error (8 ms
+    /// in a 109 km/h closing car crash) — else the predicted contact.
+    #[inline(never)]
     pub(crate) fn backup_evidence(
         &self,
         now: u64,
         sit: &Situation,
         inputs: &InputMonitor,
         safing_onset_ns: Option<u64>,
+        measured: Option<BackupSeverity>,
     ) -> Option<BackupEvidence> {
-        let (decel, rx_ns) = inputs.vehicle_decel(now)?;
-        let in_window = rx_ns.abs_diff(sit.contact_ns) <= self.window_ns;
-        if sit.low_speed || !in_window || !(decel >= self.backup_decel_mps2) {
+        if sit.low_speed {
             return None;
         }
-        let contact_ns = safing_onset_ns
-            .map(|t| t.saturating_sub(self.accel_delay_ns))
-            .filter(|t| t.abs_diff(sit.contact_ns) <= self.window_ns)
-            .unwrap_or(sit.contact_ns);
-        Some(BackupEvidence { rx_ns, contact_ns })
+        let in_window = |t: u64| t.abs_diff(sit.contact_ns) <= self.window_ns;
+        if let Some((decel, rx_ns)) = inputs.vehicle_decel(now) {
+            if in_window(rx_ns) && decel >= self.backup_decel_mps2 {
+                let contact_ns = safing_onset_ns
+                    .map(|t| t.saturating_sub(self.accel_delay_ns))
+                    .filter(|&t| in_window(t))
+                    .unwrap_or(sit.contact_ns);
+                return Some(BackupEvidence { rx_ns, contact_ns });
+            }
+        }
+        let m = measured.filter(|m| m.airbag)?;
+        let contact_ns = m.contact_ns.filter(|&t| in_window(t))?;
+        Some(BackupEvidence {
+            rx_ns: now,
+            contact_ns,
+        })
+    }
+
+    /// The crash measured by the healthy safing sensor, for the backup path: whether the
+    /// safing event's Δv since its onset, at its newest sample, has reached the
+    /// accelerometer-only airbag's and pyrotechnic pretensioner's boundaries and severity
+    /// floors — with the satellites' `relief` and the road's lift as the crash sensor's samples
+    /// are judged, the lift measured on the safing sensor while the crash sensor is known
+    /// faulty — and the contact that onset dates (as
+    /// [`Self::backup_evidence`] dates it). Persistence and loading are not asked: the backup's
+    /// crash is decided by its own evidence, this times it and, for a crash sensor known
+    /// faulty, stands in for its measurement.
+    #[inline(never)]
+    pub(crate) fn backup_boundaries(&self, safing: &Safing, relief: Relief) -> BackupSeverity {
+        let Some((onset_ns, latest_ns)) = safing.event_span_ns() else {
+            return BackupSeverity::default();
+        };
+        let tau_ms = latest_ns.saturating_sub(onset_ns) as f64 * 1e-6;
+        let t = self.fallback.thresholds_now(
+            self.safing_roughness
+                .unwrap_or(self.roughness)
+                .floor_lift_mps(),
+            relief,
+        );
+        let (airbag, pretensioner) = self.fallback.boundaries_reached(
+            tau_ms,
+            safing.delta_v_mps(),
+            t,
+            relief.boundary_lift_mps,
+        );
+        BackupSeverity {
+            contact_ns: Some(onset_ns.saturating_sub(self.accel_delay_ns)),
+            airbag,
+            pretensioner,
+        }
     }
 
     /// The latched confirmation.
@@ -401,6 +496,18 @@ pub struct BackupEvidence {
     pub rx_ns: u64,
     /// The contact the backup path's fires are timed from, ns.
     pub contact_ns: u64,
+}
+
+/// What the healthy safing sensor measures of the backup path's crash
+/// (`CrashMonitor::backup_boundaries`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct BackupSeverity {
+    /// The contact its event's onset dates, ns (`None`: no safing event in progress).
+    pub contact_ns: Option<u64>,
+    /// Its Δv has reached the airbag's accelerometer-only boundary and floor.
+    pub airbag: bool,
+    /// Its Δv has reached the pyrotechnic pretensioner's accelerometer-only boundary and floor.
+    pub pretensioner: bool,
 }
 
 /// The table's plan for an adaptive crash re-estimated at closing speed `closing_mps` (the

@@ -57,6 +57,9 @@ pub struct RestraintCycle<'lut> {
     /// The deceleration the car's braking explains, m/s², held while an accelerometer event
     /// is in progress (`braking_compensation_max_g`).
     braking_decel_mps2: f64,
+    /// The crash sensor was known faulty at the end of the previous cycle: the safing sensor
+    /// is the satellites' tunnel reference.
+    crash_sensor_faulty: bool,
     outputs: Outputs,
     reasons: Degraded,
     counters: CycleCounters,
@@ -98,6 +101,7 @@ impl<'lut> RestraintCycle<'lut> {
             satellites: Satellites::new(cfg.satellite_params()),
             relief: Relief::NONE,
             braking_decel_mps2: 0.0,
+            crash_sensor_faulty: false,
             outputs: Outputs::new(lut_id),
             reasons: Degraded::empty(),
             counters: CycleCounters::default(),
@@ -257,6 +261,10 @@ impl Activity for RestraintCycle<'_> {
                 )
             });
         satellites.allow_one_sided(one_sided_ok);
+        // The satellites' crush and the road's roughness are measured on the tunnel: the crash
+        // sensor, or the safing sensor while the crash sensor is known faulty (as of the
+        // previous cycle).
+        let tunnel_is_safing = self.crash_sensor_faulty;
         let crash = &mut self.crash;
         let agreement = &mut self.agreement;
         // The relief of the cycle's latest judged batch (none when every batch was quiet).
@@ -272,7 +280,9 @@ impl Activity for RestraintCycle<'_> {
             agreement.crash.on_batch(&plausible);
             let (dv_mps, span_s) = plausible.decel_integral_mps();
             crash.on_raw_batch(dv_mps, span_s);
-            satellites.on_tunnel_dv(dv_mps);
+            if !tunnel_is_safing {
+                satellites.on_tunnel_dv(dv_mps);
+            }
             plausible.remove_decel(braking);
             crash.on_batch(&plausible, &freeze, belted, || {
                 *relief = satellites.relief(now, belted);
@@ -293,10 +303,19 @@ impl Activity for RestraintCycle<'_> {
         }
         // The independent safing channel: its own monitor, its own function.
         let safing = &mut self.safing;
+        let crash = &mut self.crash;
+        let satellites = &mut self.satellites;
         let mut safing_batch = crate::accel::PlausibleBatch::new();
         io.drain_safing(&mut |a| {
             inputs.on_safing(a, now, &mut safing_batch);
             safing_mean.add(&safing_batch);
+            if tunnel_is_safing {
+                let (dv_mps, span_s) = safing_batch.decel_integral_mps();
+                crash.on_raw_safing_batch(dv_mps, span_s);
+                satellites.on_tunnel_dv(dv_mps);
+            } else {
+                crash.end_safing_roughness(now);
+            }
             safing.on_batch(&safing_batch);
             agreement.safing.on_batch(&safing_batch);
         });
@@ -365,16 +384,18 @@ impl Activity for RestraintCycle<'_> {
         let safing_faulty = self
             .reasons
             .intersects(Degraded::SAFING_STALE | Degraded::SAFING_INVALID);
+        self.crash_sensor_faulty = accel_faulty;
         let mut safing = self.safing.agrees(now, safing_faulty, vehicle);
         // With a healthy safing sensor, safing must also agree in severity on the confirmed
         // event (module `agreement`) — also once the crash sensor is found faulty (a stuck
         // sensor's first 20 ms were plausible); the backup path (confirmed by the vehicle
         // deceleration) has no crash-sensor event to compare.
-        let mut pair_disagrees = false;
+        let (mut pair_disagrees, mut crash_reads_more) = (false, false);
         if let Some(c) = self.crash.confirmation() {
             if !safing_faulty && c.kind != crate::crash::ConfirmKind::Backup {
                 safing &= self.agreement.agrees(c.onset_ns);
                 pair_disagrees = self.agreement.pair_disagrees(c.onset_ns);
+                crash_reads_more = self.agreement.crash_reads_more(c.onset_ns);
             }
         }
         // Two accelerometers that disagree on the confirmed event cannot say which of them is
@@ -388,10 +409,21 @@ impl Activity for RestraintCycle<'_> {
                 .confirmation()
                 .is_some_and(|c| c.kind != crate::crash::ConfirmKind::Backup);
         let safing_onset_ns = (!safing_faulty).then(|| self.safing.onset_ns()).flatten();
+        // The safing sensor measures the crash for the backup while the crash sensor is known
+        // faulty, or reads more than the safing sensor allows (whichever of the two is wrong,
+        // the safing sensor's is then the smaller reading) — never for a safing sensor that
+        // reads more —, with the satellites' relief against it as the tunnel.
+        let safing_measures = accel_faulty || crash_flagged || crash_reads_more;
+        let measured = if safing_measures && !safing_faulty && self.safing.onset_ns().is_some() {
+            let relief = self.satellites.relief(now, belted);
+            Some(self.crash.backup_boundaries(&self.safing, relief))
+        } else {
+            None
+        };
         let backup_for_disagreement = if pair_disagrees || crash_flagged {
             self.estimate.situation.as_ref().and_then(|s| {
                 self.crash
-                    .backup_evidence(now, s, &self.inputs, safing_onset_ns)
+                    .backup_evidence(now, s, &self.inputs, safing_onset_ns, measured)
             })
         } else {
             None
@@ -402,6 +434,7 @@ impl Activity for RestraintCycle<'_> {
             self.estimate.situation.as_ref(),
             &self.inputs,
             safing_onset_ns,
+            measured,
         );
         let (cfg, est, inputs) = (&self.cfg, &self.estimate, &self.inputs);
         let situation = est.situation;
@@ -428,6 +461,7 @@ impl Activity for RestraintCycle<'_> {
             segment_onset_ns: self.crash.segment_onset_ns(),
             safing,
             backup_for_disagreement,
+            backup_severity: measured,
             event_in_progress: self.crash.event_in_progress(),
             event_dv_mps: self.crash.event_dv_mps(),
             event_loading: &event_loading,

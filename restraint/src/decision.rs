@@ -27,7 +27,7 @@
 //! phase, the active plan and the pretensioner/airbag commands ([`Decision`]'s accessors).
 
 use crate::config::CycleConfig;
-use crate::crash::{BackupEvidence, ConfirmKind, Confirmation};
+use crate::crash::{BackupEvidence, BackupSeverity, ConfirmKind, Confirmation};
 use crate::estimate::Situation;
 use crate::fallback::{FallbackDecision, WINDOW_MS};
 use crate::plan::{PlanSource, RestraintPlan};
@@ -102,6 +102,9 @@ pub(crate) struct DecisionInputs<'d> {
     /// The two accelerometers disagree on the confirmed event and the backup path's evidence
     /// holds (`CrashMonitor::backup_evidence`).
     pub backup_for_disagreement: Option<BackupEvidence>,
+    /// What the healthy safing sensor measures of the crash while the crash sensor is known
+    /// faulty (`CrashMonitor::backup_boundaries`).
+    pub backup_severity: Option<BackupSeverity>,
     /// An accelerometer event is still in progress.
     pub event_in_progress: bool,
     /// The velocity change of the current accelerometer event since its onset, m/s.
@@ -463,6 +466,29 @@ impl Decision {
         }
     }
 
+    /// The backup path fires the reference restraint at its times after the contact. A crash
+    /// that the healthy safing sensor measures as severe sooner — the Δv of the event whose
+    /// onset dated the contact reaches a restraint's accelerometer-only boundary and floor —
+    /// fires that restraint then, as the crash sensor's would have in the same crash. Only a
+    /// fire the backup has already scheduled moves, and only to an earlier time: the decision
+    /// stays the backup evidence's (a predicted crash and the vehicle deceleration).
+    #[inline(never)]
+    fn bring_backup_forward(&mut self, now: u64, s: BackupSeverity) {
+        if s.contact_ns.is_none() || s.contact_ns != self.contact_ns {
+            return;
+        }
+        if s.airbag {
+            if let Some(t) = self.airbag_fire_at_ns.as_mut() {
+                *t = (*t).min(now);
+            }
+        }
+        if s.pretensioner {
+            if let Some(t) = self.pretensioner_at_ns.as_mut() {
+                *t = (*t).min(now);
+            }
+        }
+    }
+
     /// Schedules a decided plan's crash-phase fires: the pyrotechnic pretensioner and the
     /// airbag (if the plan fires it), each at its time after `contact`, never before
     /// `not_before` (the confirmation or hand-over: the past). A belt the pre-crash plan
@@ -666,6 +692,11 @@ impl Decision {
         }
         if let (Phase::Crash, Some(b)) = (self.phase, x.backup_for_disagreement) {
             self.hand_over_to_the_backup(now, b);
+        }
+        if let (Phase::Crash, Some(ConfirmKind::Backup), Some(s)) =
+            (self.phase, self.crash_kind, x.backup_severity)
+        {
+            self.bring_backup_forward(now, s);
         }
         if self.phase == Phase::Crash {
             self.gate_airbag(now, x.fallback, x.event_dv_mps, x.segment_onset_ns);

@@ -368,6 +368,27 @@ impl FallbackAlgorithm {
         &self.airbag.thresholds
     }
 
+    /// Whether a velocity change `dv_mps` at `tau_ms` after an onset reaches the airbag's
+    /// (the occupant's) and the pyrotechnic pretensioner's boundaries and floors under `t`,
+    /// the airbag's boundary lifted by `boundary_lift_mps`: the judgement of one sample of
+    /// another sensor, without the persistence and loading rules
+    /// ([`crate::crash::CrashMonitor::backup_boundaries`]).
+    pub fn boundaries_reached(
+        &self,
+        tau_ms: f64,
+        dv_mps: f64,
+        t: Thresholds,
+        boundary_lift_mps: f64,
+    ) -> (bool, bool) {
+        let scale = t.boundary_scale;
+        (
+            self.airbag
+                .reached(tau_ms, dv_mps, scale, boundary_lift_mps, t.min_dv_mps),
+            self.pretensioner
+                .reached(tau_ms, dv_mps, scale, 0.0, t.pretensioner_min_dv_mps),
+        )
+    }
+
     /// Lifts the boundary by `lift_mps` for the samples to come (the satellites' low-crush
     /// lift, [`crate::satellites::Relief::boundary_lift_mps`]; set once a batch, 0 by default).
     pub fn lift_boundary(&mut self, lift_mps: f64) {

@@ -55,6 +55,8 @@ pub struct Safing {
     run: u32,
     /// Closed until this time (set when the closing event ended), ns.
     closed_until_ns: Option<u64>,
+    /// The newest sample of the event in progress, ns.
+    latest_ns: u64,
 }
 
 impl Safing {
@@ -66,6 +68,7 @@ impl Safing {
             closed: false,
             run: 0,
             closed_until_ns: None,
+            latest_ns: 0,
         }
     }
 
@@ -89,6 +92,7 @@ impl Safing {
                     }
                 }
                 OnsetStep::Woke | OnsetStep::Awake => {
+                    self.latest_ns = s.t_ns;
                     self.run = if s.decel_mps2 >= self.params.onset.wake_mps2 {
                         self.run.saturating_add(1)
                     } else {
@@ -125,6 +129,11 @@ impl Safing {
     /// Onset of the safing channel's event in progress, ns (`None` when quiet).
     pub fn onset_ns(&self) -> Option<u64> {
         self.onset.onset_ns()
+    }
+
+    /// The safing channel's event in progress: its onset and its newest sample, ns.
+    pub fn event_span_ns(&self) -> Option<(u64, u64)> {
+        self.onset.onset_ns().map(|o| (o, self.latest_ns.max(o)))
     }
 
     /// Δv since the onset of the safing channel's event in progress, m/s (0 when quiet).

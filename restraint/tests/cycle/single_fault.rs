@@ -415,18 +415,66 @@ fn a_disagreeing_pair_in_a_predicted_crash_is_decided_by_the_vehicle_deceleratio
             bus::codec::AirbagStageCmdCmdSource::Reference,
             "{what}"
         );
-        // Not before the reference time (contact + 10 ms), and at the latest one vehicle frame
-        // period after the first frame that shows the crash (at C, every 10 ms) and the cycle.
-        assert!((C + 10 * MS..=C + 21 * MS).contains(&t), "{what}: {t}");
+        if crash_sensor {
+            // The safing sensor reads the smaller of the two, the true 20 g: it measures the
+            // crash as the crash sensor's own boundary and floor would, and the backup fires
+            // then — when 20 g has carried the airbag's floor.
+            assert_eq!(t, floor_reached_at(C, 20.0), "{what}");
+        } else {
+            // The safing sensor's 5 g reaches no boundary: not before the reference time
+            // (contact + 10 ms), and at the latest one vehicle frame period after the first
+            // frame that shows the crash (at C, every 10 ms) and the cycle.
+            assert!((C + 10 * MS..=C + 21 * MS).contains(&t), "{what}: {t}");
+        }
         assert!(pretensioner_fired(&b), "{what}");
-        // The vehicle frame showing only braking (1 g): nothing fires — the faulty sensor's
-        // event alone decides nothing.
-        let b = crash_with_one_sensor_off(crash_sensor, offset, 1.0);
-        assert!(
-            !airbag_fired(&b),
-            "{what}: airbag without the vehicle deceleration"
-        );
     }
+    // The vehicle frame showing only braking (1 g) and a safing sensor that reads 5 g: nothing
+    // fires — the crash sensor's event alone decides nothing.
+    let b = crash_with_one_sensor_off(false, 15.0, 1.0);
+    assert!(!airbag_fired(&b), "airbag without the vehicle deceleration");
+    // With the crash sensor 10 g high and the vehicle frame at 1 g, both accelerometers read at
+    // least the true 20 g: the smaller reading and the predicted crash decide it.
+    let b = crash_with_one_sensor_off(true, 10.0, 1.0);
+    assert_eq!(
+        b.first_airbag_fire().map(|(t, _)| t),
+        Some(floor_reached_at(C, 20.0))
+    );
+}
+
+#[test]
+fn a_safing_sensor_reading_more_never_measures_a_crash_for_the_backup() {
+    // A predicted crash that does not come (a near miss at C) with an 8 g, 10 ms pothole on both
+    // sensors; the safing sensor alone reads 25 g more from C (a fault) and the vehicle frame
+    // shows 1 g. The pair disagrees with the safing sensor reading more: its reading is the
+    // larger of the two and may be the wrong one, so it never stands in for the crash
+    // sensor's measurement — nothing fires.
+    let mut b = Bench::new(Some(test_lut()));
+    idle_until(&mut b, T0 + 100 * MS);
+    b.ego_long_accel_mps2 = -G;
+    while b.now < C + 150 * MS {
+        if (b.now - T0).is_multiple_of(10 * MS) && b.now < C {
+            b.push_approach(C, 20.0, 1500.0, 100.0);
+        }
+        let car_g = if (C..C + 10 * MS).contains(&b.now) {
+            8.0
+        } else {
+            0.0
+        };
+        b.push_accel(-car_g * G);
+        if (C..C + 30 * MS).contains(&b.now) {
+            b.push_safing_sensor_fault(-(car_g + 25.0) * G);
+        }
+        b.step();
+    }
+    // The pothole confirms a crash phase and the pair check sees the disagreement.
+    let crash_phase = [restraint::EcuMode::Crash, restraint::EcuMode::PostCrash]
+        .into_iter()
+        .any(|m| b.first_mode(m).is_some());
+    assert!(crash_phase, "no crash phase");
+    assert!(!airbag_fired(&b), "airbag");
+    // The reversible pre-crash belt of the predicted crash is released: no pyrotechnic fire
+    // latched it.
+    assert_ne!(b.ecu.pretensioner(), Pretensioner::Fired, "pretensioner");
 }
 
 /// The degraded reasons the cycle at `t` published.
@@ -485,8 +533,9 @@ fn a_crash_sensor_offset_before_contact_is_flagged_and_the_backup_fires_in_time(
             "{offset_g} g: flagged at {flagged:?}"
         );
         assert!(!reasons_at(&b, C - 10 * MS).contains(Degraded::SAFING_INVALID));
-        // The backup path, timed from the safing sensor's onset at C: the reference airbag at
-        // C + 10 ms (the vehicle frame at C confirms), whatever the crash sensor reads.
+        // The backup path, confirmed by the vehicle frame at C and timed by the healthy safing
+        // sensor: the reference airbag when its 20 g have carried the accelerometer-only
+        // floor (the clean crash's own time), whatever the crash sensor reads.
         let (t, cmd) = b
             .first_airbag_fire()
             .unwrap_or_else(|| panic!("{offset_g} g: no airbag"));
@@ -494,10 +543,7 @@ fn a_crash_sensor_offset_before_contact_is_flagged_and_the_backup_fires_in_time(
             cmd.cmd_source(),
             bus::codec::AirbagStageCmdCmdSource::Reference
         );
-        assert!(
-            (C + 10 * MS..=C + 11 * MS).contains(&t),
-            "{offset_g} g: {t}"
-        );
+        assert_eq!(t, floor_reached_at(C, 20.0), "{offset_g} g");
         assert!(pretensioner_fired(&b), "{offset_g} g");
     }
 }
