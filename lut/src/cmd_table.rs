@@ -15,7 +15,7 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct BuildArgs {
     /// Grid file (TOML).
-    #[arg(long, default_value = "data/default-grid.toml")]
+    #[arg(long, default_value = "data/default-grid.toml", value_parser = lut::paths::input_file)]
     pub grid: PathBuf,
     /// Output: a `.lut` table, or with --shard a shard file (default shard-K-of-N.bin).
     #[arg(long)]
@@ -58,7 +58,7 @@ pub fn run_build(a: &BuildArgs) -> Result<()> {
         let out = a
             .out
             .clone()
-            .unwrap_or_else(|| PathBuf::from("data/default.lut"));
+            .unwrap_or_else(|| lut::paths::repo_output("data/default.lut"));
         let spec = GridFile::load(&a.grid)?;
         Grid::from_spec(&a.grid.display().to_string(), spec.clone())?;
         let job = Job::Table(TableJob {
@@ -94,7 +94,7 @@ pub fn run_build(a: &BuildArgs) -> Result<()> {
             let out = a
                 .out
                 .clone()
-                .unwrap_or_else(|| PathBuf::from("data/default.lut"));
+                .unwrap_or_else(|| lut::paths::repo_output("data/default.lut"));
             eprintln!(
                 "building {count} cells ({lens:?}) from {}",
                 a.grid.display()
@@ -155,6 +155,7 @@ pub fn run_merge(a: &MergeArgs) -> Result<()> {
 #[derive(Args, Debug)]
 pub struct VerifyArgs {
     /// Table file (.lut or .json).
+    #[arg(value_parser = lut::paths::input_file)]
     pub file: PathBuf,
     /// Number of random cells to re-optimise.
     #[arg(long, default_value_t = 20)]
@@ -291,6 +292,7 @@ fn verify_margin(d: &Diagram, a: &VerifyArgs) -> Result<Option<String>> {
 #[derive(Args, Debug)]
 pub struct InspectArgs {
     /// Table file (.lut or .json).
+    #[arg(value_parser = lut::paths::input_file)]
     pub file: PathBuf,
     /// JSON output.
     #[arg(long)]
@@ -387,6 +389,7 @@ pub fn run_inspect(a: &InspectArgs) -> Result<()> {
 #[derive(Args, Debug)]
 pub struct ExportArgs {
     /// Table file.
+    #[arg(value_parser = lut::paths::input_file)]
     pub file: PathBuf,
     /// JSON output file.
     #[arg(long)]
@@ -403,6 +406,7 @@ pub fn run_export(a: &ExportArgs) -> Result<()> {
 #[derive(Args, Debug)]
 pub struct PlotArgs {
     /// Table file.
+    #[arg(value_parser = lut::paths::input_file)]
     pub file: PathBuf,
     /// Output field to plot (one of the cell fields, e.g. a_max_g, belt_limiter_kn).
     #[arg(long, default_value = "a_max_g")]

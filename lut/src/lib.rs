@@ -35,6 +35,7 @@ pub mod hash;
 pub mod limiter_switch;
 pub mod margin;
 pub mod optimise;
+pub mod paths;
 pub mod progress;
 pub mod reference;
 pub mod robust_cells;

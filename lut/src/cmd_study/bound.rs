@@ -11,7 +11,7 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct BoundArgs {
     /// The table.
-    #[arg(long, default_value = "data/default.lut")]
+    #[arg(long, default_value = "data/default.lut", value_parser = lut::paths::input_file)]
     pub table: PathBuf,
     /// Cells re-optimised under each lever.
     #[arg(long, default_value_t = 24)]

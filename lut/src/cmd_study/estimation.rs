@@ -15,10 +15,10 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct EstimationArgs {
     /// Folder of scenario files (every one with a contact is used).
-    #[arg(long, default_value = "scenarios")]
+    #[arg(long, default_value = "scenarios", value_parser = lut::paths::input_file)]
     pub scenarios: PathBuf,
     /// The table the occupant outcome is looked up in.
-    #[arg(long, default_value = "data/default.lut")]
+    #[arg(long, default_value = "data/default.lut", value_parser = lut::paths::input_file)]
     pub table: PathBuf,
     /// Noise seeds per scenario and variation.
     #[arg(long, default_value_t = 40)]

@@ -18,10 +18,10 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct LimiterSwitchArgs {
     /// Reference restraint file.
-    #[arg(long, default_value = "data/reference-restraint.toml")]
+    #[arg(long, default_value = "data/reference-restraint.toml", value_parser = lut::paths::input_file)]
     pub reference: PathBuf,
     /// The grid whose optimiser settings the plans use.
-    #[arg(long, default_value = "data/default-grid.toml")]
+    #[arg(long, default_value = "data/default-grid.toml", value_parser = lut::paths::input_file)]
     pub grid: PathBuf,
     /// Switch times after contact [ms], comma-separated.
     #[arg(long, value_delimiter = ',', default_values_t = [30.0, 40.0, 50.0])]

@@ -189,7 +189,7 @@ pub fn opponent_mass(a: &OpponentMassArgs) -> Result<()> {
 #[derive(Args, Debug)]
 pub struct ReductionArgs {
     /// Reference restraint file.
-    #[arg(long, default_value = "data/reference-restraint.toml")]
+    #[arg(long, default_value = "data/reference-restraint.toml", value_parser = lut::paths::input_file)]
     pub reference: PathBuf,
     /// Opponent mass [kg] (default: the ego's own mass, the paper's symmetric case).
     #[arg(long, default_value_t = DEFAULT_EGO_MASS_KG)]

@@ -18,10 +18,10 @@ use std::path::{Path, PathBuf};
 #[derive(Args, Debug)]
 pub struct RobustCellsArgs {
     /// Reference restraint file.
-    #[arg(long, default_value = "data/reference-restraint.toml")]
+    #[arg(long, default_value = "data/reference-restraint.toml", value_parser = lut::paths::input_file)]
     pub reference: PathBuf,
     /// The grid whose optimiser settings the cells use.
-    #[arg(long, default_value = "data/default-grid.toml")]
+    #[arg(long, default_value = "data/default-grid.toml", value_parser = lut::paths::input_file)]
     pub grid: PathBuf,
     /// Opponent mass half-width of the set [kg].
     #[arg(long, default_value_t = Uncertainty::MISREPORT.mass_kg)]

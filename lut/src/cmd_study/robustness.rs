@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 #[derive(Args, Debug)]
 pub struct RobustnessArgs {
     /// The table the ECU uses.
-    #[arg(long, default_value = "data/default.lut")]
+    #[arg(long, default_value = "data/default.lut", value_parser = lut::paths::input_file)]
     pub table: PathBuf,
     /// True closing speed [km/h].
     #[arg(long, default_value_t = 91.0)]
