@@ -38,7 +38,8 @@ struct Cli {
     /// Output folder (commands.jsonl, report.json, outcome.png).
     #[arg(long, required = true)]
     out: Option<PathBuf>,
-    /// Reference restraint file (default: the built-in data/reference-restraint.toml).
+    /// Reference restraint file (default: the repository's data/reference-restraint.toml, as
+    /// the ECU reads it; missing or unreadable: the copy built into the binary).
     #[arg(long)]
     reference: Option<PathBuf>,
     /// Give up waiting for the bench truth's `done` after this many seconds.
@@ -150,11 +151,11 @@ fn run(cli: &Cli) -> Result<()> {
         anyhow::bail!("--scenario and --out are required");
     };
     let scenario = Scenario::load(scenario_path)?;
-    let reference = match &cli.reference {
-        Some(p) => physics::reference::ReferenceRestraint::load(p),
-        None => physics::reference::ReferenceRestraint::builtin(),
+    let (reference, reference_from) = outcome::reference_restraint(cli.reference.as_deref())
+        .map_err(|e| anyhow::anyhow!("reference restraint: {e}"))?;
+    if reference_from.starts_with("built into") {
+        eprintln!("actuator-stubs: warning: reference restraint {reference_from}");
     }
-    .map_err(|e| anyhow::anyhow!("reference restraint: {e}"))?;
     let keys = load_keys(cli)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let stop = host::install_stop_signals().context("installing signal handler")?;

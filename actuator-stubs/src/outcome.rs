@@ -223,8 +223,47 @@ pub fn no_worse(adaptive: &Judged, reference: &Judged) -> bool {
         <= (reference.a_max_g + reference.a_mean_g) * (1.0 + NO_WORSE_TOLERANCE)
 }
 
+/// The repository file the ECU reads its reference restraint from by default.
+pub const REFERENCE_FILE: &str = "data/reference-restraint.toml";
+
+/// The reference restraint the judge compares against, and where it came from: `path` when
+/// given (an error if it cannot be read); else the repository's [`REFERENCE_FILE`] as the ECU
+/// finds it — the first folder holding it walking up from the current folder, then from the
+/// executable's —, so that editing that file changes the ECU and the judge together; else,
+/// missing or unreadable as for the ECU, the copy built into the binary (with the reason).
+pub fn reference_restraint(
+    path: Option<&std::path::Path>,
+) -> Result<(physics::reference::ReferenceRestraint, String), String> {
+    use physics::reference::ReferenceRestraint;
+    if let Some(p) = path {
+        return Ok((ReferenceRestraint::load(p)?, p.display().to_string()));
+    }
+    let builtin = |why: String| {
+        ReferenceRestraint::builtin().map(|r| (r, format!("built into the binary ({why})")))
+    };
+    match host::files::find_upwards(std::path::Path::new(REFERENCE_FILE)) {
+        Some(p) => match ReferenceRestraint::load(&p) {
+            Ok(r) => Ok((r, p.display().to_string())),
+            Err(e) => builtin(e),
+        },
+        None => builtin(format!("no {REFERENCE_FILE} above the current folder")),
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_judge_reads_the_repositorys_reference_file_as_the_ecu_does() {
+        // The tests run in actuator-stubs/: the repository's file is one folder up.
+        let (r, from) = super::reference_restraint(None).expect("loads");
+        assert!(from.ends_with(super::REFERENCE_FILE), "{from}");
+        let file = physics::reference::ReferenceRestraint::load(&from).expect("file");
+        assert_eq!(r, file);
+        // A file named on the command line is that file, and an unreadable one an error.
+        let missing = std::path::Path::new("/nonexistent-reference.toml");
+        assert!(super::reference_restraint(Some(missing)).is_err());
+    }
+
     use super::*;
     use crate::commands::{Decoded, Modules};
 
