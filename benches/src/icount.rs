@@ -114,17 +114,74 @@ pub fn collected_totals(
     Ok((totals, String::from_utf8_lossy(&out.stdout).into_owned()))
 }
 
-/// Iteration count from `argv[1]` for the `icount_*` binaries (default 1000).
+/// Iteration count from `argv[1]` for the `icount_*` binaries (default 1000). `--help` and
+/// `--version` answer and exit 0; anything else that is not a whole number is an error: one
+/// line `NAME: error: …` and exit 2, as every tool of the bench (a typo must not measure the
+/// default count).
 pub fn iterations_from_args() -> u64 {
-    std::env::args()
-        .nth(1)
-        .and_then(|a| a.parse().ok())
-        .unwrap_or(1000)
+    let mut args = std::env::args();
+    let name = args
+        .next()
+        .as_deref()
+        .and_then(|a| Path::new(a).file_name()?.to_str().map(str::to_owned))
+        .unwrap_or_else(|| "icount".to_owned());
+    match parse_iterations(args.next().as_deref()) {
+        Ok(n) => n,
+        Err(Answer::Help) => {
+            println!(
+                "Usage: {name} [N]\n       {name} --help | --version\n\nRuns its measured \
+                 path N times (default 1000) and prints a checksum; `budget` runs it under \
+                 callgrind for two N and differences the totals (benches/README.md)."
+            );
+            std::process::exit(0)
+        }
+        Err(Answer::Version) => {
+            println!("{name} {}", env!("CARGO_PKG_VERSION"));
+            std::process::exit(0)
+        }
+        Err(Answer::Bad(a)) => {
+            eprintln!("{name}: error: N must be a whole number of iterations, got '{a}'");
+            std::process::exit(2)
+        }
+    }
+}
+
+/// What an `icount_*` binary's first argument asks for besides a count.
+#[derive(Debug, PartialEq)]
+enum Answer {
+    Help,
+    Version,
+    Bad(String),
+}
+
+fn parse_iterations(arg: Option<&str>) -> Result<u64, Answer> {
+    match arg {
+        None => Ok(1000),
+        Some("-h" | "--help") => Err(Answer::Help),
+        Some("-V" | "--version") => Err(Answer::Version),
+        Some(a) => a.parse().map_err(|_| Answer::Bad(a.to_owned())),
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_iteration_argument_is_a_count_a_question_or_an_error() {
+        assert_eq!(parse_iterations(None), Ok(1000));
+        assert_eq!(parse_iterations(Some("120")), Ok(120));
+        assert_eq!(parse_iterations(Some("--help")), Err(Answer::Help));
+        assert_eq!(parse_iterations(Some("-V")), Err(Answer::Version));
+        assert_eq!(
+            parse_iterations(Some("--no-such-flag")),
+            Err(Answer::Bad("--no-such-flag".into()))
+        );
+        assert_eq!(
+            parse_iterations(Some("1e3")),
+            Err(Answer::Bad("1e3".into()))
+        );
+    }
 
     #[test]
     fn parses_totals_and_summary_lines() {

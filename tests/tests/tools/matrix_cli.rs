@@ -105,7 +105,7 @@ fn a_closed_pipe_ends_the_tools_quietly() {
 }
 
 /// Every command-line tool of the bench (the binaries `./test.sh` builds).
-const TOOLS: [&str; 13] = [
+const TOOLS: [&str; 17] = [
     "ecu",
     "sensor-feeds",
     "actuator-stubs",
@@ -119,6 +119,10 @@ const TOOLS: [&str; 13] = [
     "worst_cycle",
     "loop-vs-cyclictest",
     "docs-check",
+    "icount_cycle",
+    "icount_crash",
+    "icount_lut",
+    "icount_prediction",
 ];
 
 #[test]
