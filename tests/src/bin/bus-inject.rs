@@ -247,7 +247,7 @@ fn encode(id: u32, assignments: &[String], counter: u8) -> Result<RawFrame> {
                 s.max,
                 s.unit
             ),
-            None => anyhow::anyhow!("{e}"),
+            None => anyhow::Error::new(e),
         }
     })?;
     if e2e {
