@@ -215,54 +215,34 @@ fn the_repositorys_files_are_found_from_any_folder_of_it() {
     // folder: from `docs/` every one of them was "No such file". Run from two sub-folders
     // and from outside the repository (found beside the executable; a path found nowhere is
     // kept as typed and the error names it).
-    let exe = env!("CARGO_BIN_EXE_lut");
     let repo = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let dir = std::env::temp_dir().join(format!("lut-plot-cwd-{}", std::process::id()));
-    for cwd in [repo.join("docs"), repo.join("lut/src")] {
-        let out = Command::new(exe)
-            .args(["inspect", "data/default.lut"])
-            .current_dir(&cwd)
+    let png = dir.join("surface.png");
+    let lut_in = |cwd: &std::path::Path, args: &[&std::ffi::OsStr]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_lut"))
+            .args(args)
+            .current_dir(cwd)
             .output()
             .unwrap();
-        assert!(
-            out.status.success(),
-            "{}: {}",
-            cwd.display(),
-            String::from_utf8_lossy(&out.stderr)
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let table = std::ffi::OsStr::new("data/default.lut");
+    let outside = std::env::temp_dir();
+    for cwd in [repo.join("docs"), repo.join("lut/src"), outside.clone()] {
+        let (code, err) = lut_in(&cwd, &["inspect".as_ref(), table]);
+        assert_eq!(code, Some(0), "{}: {err}", cwd.display());
+        let (code, err) = lut_in(
+            &cwd,
+            &["plot".as_ref(), table, "--out".as_ref(), png.as_ref()],
         );
-        let png = dir.join("surface.png");
-        let out = Command::new(exe)
-            .args(["plot", "data/default.lut", "--out"])
-            .arg(&png)
-            .current_dir(&cwd)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        assert_eq!(code, Some(0), "{}: {err}", cwd.display());
         assert!(png.exists());
     }
-    let outside = std::env::temp_dir();
-    let out = Command::new(exe)
-        .args(["inspect", "data/default.lut"])
-        .current_dir(&outside)
-        .output()
-        .unwrap();
-    // The executable lies in the repository's target/: found beside it even from outside.
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let out = Command::new(exe)
-        .args(["inspect", "nowhere/x.lut"])
-        .current_dir(&outside)
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(2));
-    let err = String::from_utf8_lossy(&out.stderr);
+    let (code, err) = lut_in(&outside, &["inspect".as_ref(), "nowhere/x.lut".as_ref()]);
+    assert_eq!(code, Some(2));
     assert!(err.starts_with("lut: error: nowhere/x.lut"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
