@@ -209,7 +209,7 @@ fn wait_ready(ready: std::sync::mpsc::Receiver<()>, child: &mut Child, what: &st
         match ready.recv_timeout(Duration::from_millis(20)) {
             Ok(()) => return Ok(()),
             Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
-                bail!("{what} exited before it was ready: {:?}", child.wait()?)
+                bail!("{what} exited before it was ready: {}", child.wait()?)
             }
             Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
         }
@@ -386,8 +386,18 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
         Some(dir.join("ecu-stderr.txt")),
         Some(ecu::runtime::app::READY_LINE),
     );
+    // An ECU that did not start aborts the run: the scenario played without it would be judged
+    // as an ECU that fired nothing ("airbag not fired, WORSE"), with the cause one file away.
     if let Err(e) = wait_ready(ecu_ready, &mut ecu, "ecu") {
-        problems.push(format!("{e:#}"));
+        let _ = terminate(&mut ecu, "ecu", Duration::from_secs(2));
+        let _ = ecu_stderr.map(std::thread::JoinHandle::join);
+        // Killed, not stopped: a stopped judge would write a report of a run that was not made.
+        let _ = stubs.kill();
+        let _ = stubs.wait();
+        let _ = terminate(&mut candump, "candump", Duration::from_secs(2));
+        let console = std::fs::read_to_string(dir.join("ecu-stderr.txt")).unwrap_or_default();
+        let last = console.lines().last().unwrap_or("nothing on its console");
+        bail!("the ECU did not start ({e:#}); its last line: {last}");
     }
     // The feeds fix scenario t = 0 when they are ready and print it ("epoch_ns N").
     let mut feeds = spawn(

@@ -82,6 +82,42 @@ fn bench_run() -> &'static Path {
     })
 }
 
+#[test]
+fn a_run_whose_ecu_does_not_start_is_aborted_and_exits_2() {
+    // A wrong `--ecu-arg=--config` path made the ECU exit at start, and hil-bench still played
+    // the scenario and reported "airbag not fired, +329.9 % (WORSE)" with exit 1.
+    harness::build_bench_bins();
+    harness::vcan_route();
+    let out = std::env::temp_dir().join(format!("e2e-bench-no-ecu-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let run: Vec<std::ffi::OsString> = vec![
+        harness::bin_dir().join("hil-bench").into(),
+        "--out".into(),
+        out.clone().into(),
+        "--repo".into(),
+        root().into(),
+        "--brief".into(),
+        "--scenario".into(),
+        root().join("scenarios/taurus-48-48-abs.toml").into(),
+        "--ecu-arg=--config".into(),
+        "--ecu-arg=/nonexistent-ecu.toml".into(),
+    ];
+    let o = harness::run_in_guests("hil-bench, the ECU not starting", &out, vec![run]).remove(0);
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr),
+    );
+    assert_eq!(o.status.code(), Some(2), "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains("run aborted: the ECU did not start"),
+        "{stdout}"
+    );
+    assert!(stderr.contains("/nonexistent-ecu.toml"), "{stderr}");
+    // Nothing was judged: no report.
+    assert!(!out.join("taurus-48-48-abs/report.json").exists());
+    let _ = std::fs::remove_dir_all(&out);
+}
+
 /// The ECU's report of scenario `name`'s run (`None`: it wrote none).
 fn ecu_report(name: &str) -> Option<serde_json::Value> {
     let text = std::fs::read_to_string(bench_run().join(name).join("ecu-report.json")).ok()?;

@@ -130,6 +130,7 @@ fn run() -> Result<bool> {
     // The output folder is checked before the runs, not after them.
     host::check_output_dir(&cli.out).with_context(|| format!("--out {}", cli.out.display()))?;
     let mut all_ok = true;
+    let mut errors = 0;
     for (i, scenario) in cli.scenario.iter().enumerate() {
         let cfg = RunConfig {
             scenario: scenario.clone(),
@@ -222,10 +223,20 @@ fn run() -> Result<bool> {
                 all_ok &= r.problems.is_empty() && missed.is_empty() && recorded;
             }
             Err(e) => {
+                // A run that could not be made (the ECU did not start, a process failed) is an
+                // error, not a verdict: said on --brief's line too, and the exit status is 2.
+                if cli.brief {
+                    println!("{}: run aborted: {e:#}", scenario.display());
+                }
                 eprintln!("hil-bench: {}: {e:#}", scenario.display());
-                all_ok = false;
+                errors += 1;
             }
         }
     }
+    anyhow::ensure!(
+        errors == 0,
+        "{errors} of {} runs could not be made (above)",
+        cli.scenario.len()
+    );
     Ok(all_ok)
 }
