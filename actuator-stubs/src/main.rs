@@ -151,10 +151,10 @@ fn run(cli: &Cli) -> Result<()> {
         anyhow::bail!("--scenario and --out are required");
     };
     let scenario = Scenario::load(scenario_path)?;
-    let (reference, reference_from) = outcome::reference_restraint(cli.reference.as_deref())
+    let (reference, from) = outcome::reference_restraint(cli.reference.as_deref())
         .map_err(|e| anyhow::anyhow!("reference restraint: {e}"))?;
-    if reference_from.starts_with("built into") {
-        eprintln!("actuator-stubs: warning: reference restraint {reference_from}");
+    if let outcome::ReferenceSource::BuiltIn(why) = from {
+        eprintln!("actuator-stubs: warning: reference restraint built into the binary ({why})");
     }
     let keys = load_keys(cli)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;

@@ -226,6 +226,15 @@ pub fn no_worse(adaptive: &Judged, reference: &Judged) -> bool {
 /// The repository file the ECU reads its reference restraint from by default.
 pub const REFERENCE_FILE: &str = "data/reference-restraint.toml";
 
+/// Where the judge's reference restraint came from ([`reference_restraint`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum ReferenceSource {
+    /// This file.
+    File(std::path::PathBuf),
+    /// The copy built into the binary, and why no file was used.
+    BuiltIn(String),
+}
+
 /// The reference restraint the judge compares against, and where it came from: `path` when
 /// given (an error if it cannot be read); else the repository's [`REFERENCE_FILE`] as the ECU
 /// finds it — the first folder holding it walking up from the current folder, then from the
@@ -233,17 +242,19 @@ pub const REFERENCE_FILE: &str = "data/reference-restraint.toml";
 /// missing or unreadable as for the ECU, the copy built into the binary (with the reason).
 pub fn reference_restraint(
     path: Option<&std::path::Path>,
-) -> Result<(physics::reference::ReferenceRestraint, String), String> {
+) -> Result<(physics::reference::ReferenceRestraint, ReferenceSource), String> {
     use physics::reference::ReferenceRestraint;
     if let Some(p) = path {
-        return Ok((ReferenceRestraint::load(p)?, p.display().to_string()));
+        return Ok((
+            ReferenceRestraint::load(p)?,
+            ReferenceSource::File(p.to_path_buf()),
+        ));
     }
-    let builtin = |why: String| {
-        ReferenceRestraint::builtin().map(|r| (r, format!("built into the binary ({why})")))
-    };
+    let builtin =
+        |why: String| ReferenceRestraint::builtin().map(|r| (r, ReferenceSource::BuiltIn(why)));
     match host::files::find_upwards(std::path::Path::new(REFERENCE_FILE)) {
         Some(p) => match ReferenceRestraint::load(&p) {
-            Ok(r) => Ok((r, p.display().to_string())),
+            Ok(r) => Ok((r, ReferenceSource::File(p))),
             Err(e) => builtin(e),
         },
         None => builtin(format!("no {REFERENCE_FILE} above the current folder")),
@@ -256,7 +267,10 @@ mod tests {
     fn the_judge_reads_the_repositorys_reference_file_as_the_ecu_does() {
         // The tests run in actuator-stubs/: the repository's file is one folder up.
         let (r, from) = super::reference_restraint(None).expect("loads");
-        assert!(from.ends_with(super::REFERENCE_FILE), "{from}");
+        let super::ReferenceSource::File(from) = from else {
+            panic!("not the repository's file: {from:?}")
+        };
+        assert!(from.ends_with(super::REFERENCE_FILE), "{}", from.display());
         let file = physics::reference::ReferenceRestraint::load(&from).expect("file");
         assert_eq!(r, file);
         // A file named on the command line is that file, and an unreadable one an error.
