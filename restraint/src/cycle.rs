@@ -58,7 +58,7 @@ pub struct RestraintCycle<'lut> {
     /// is in progress (`braking_compensation_max_g`).
     braking_decel_mps2: f64,
     /// The crash sensor was known faulty at the end of the previous cycle: the safing sensor
-    /// is the satellites' tunnel reference.
+    /// is the tunnel for the satellites' crush and the road's roughness.
     crash_sensor_faulty: bool,
     outputs: Outputs,
     reasons: Degraded,

@@ -103,7 +103,7 @@ pub(crate) struct DecisionInputs<'d> {
     /// holds (`CrashMonitor::backup_evidence`).
     pub backup_for_disagreement: Option<BackupEvidence>,
     /// What the healthy safing sensor measures of the crash while the crash sensor is known
-    /// faulty (`CrashMonitor::backup_boundaries`).
+    /// faulty or reads more than the safing sensor allows (`CrashMonitor::backup_boundaries`).
     pub backup_severity: Option<BackupSeverity>,
     /// An accelerometer event is still in progress.
     pub event_in_progress: bool,
@@ -471,7 +471,7 @@ impl Decision {
     /// onset dated the contact reaches a restraint's accelerometer-only boundary and floor —
     /// fires that restraint then, as the crash sensor's would have in the same crash. Only a
     /// fire the backup has already scheduled moves, and only to an earlier time: the decision
-    /// stays the backup evidence's (a predicted crash and the vehicle deceleration).
+    /// stays the backup evidence's (`CrashMonitor::backup_evidence`).
     #[inline(never)]
     fn bring_backup_forward(&mut self, now: u64, s: BackupSeverity) {
         if s.contact_ns.is_none() || s.contact_ns != self.contact_ns {
