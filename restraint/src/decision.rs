@@ -355,15 +355,21 @@ impl Decision {
         // A tracked low-speed object whose predicted contact is the measured one: its own
         // Δv (and a misuse event's on top) never fires the airbag. Low-speed here even with
         // the opponent `mass_misreport_kg` heavier than reported (one misreport cannot make a
-        // severe crash look low-speed); the bound takes the closing speed, not the EBS: the
-        // opponent's mass only lowers the ego's Δv (EBS ≤ closing speed), and the reported
-        // mass is what a barrier reported as a 3 000 kg object gets wrong.
+        // severe crash look low-speed), and a standing object's mass is not credited at all:
+        // the object sensor cannot weigh a wall, a pole or a parked truck (it reports a
+        // default), so its EBS is the closing speed. The bound takes the closing speed, not
+        // the EBS: the opponent's mass only lowers the ego's Δv (EBS ≤ closing speed).
         let no_fire_ebs_kph = x.no_fire_ebs_kph;
         if let Some(s) = x.situation.filter(|s| {
+            let robust_opponent_kg = if s.opponent_standing {
+                f64::INFINITY
+            } else {
+                s.opponent_mass_estimate_kg + self.mass_misreport_kg
+            };
             let robust_ebs_kph = physics::equivalent_barrier_speed_kph(
                 s.closing_speed_mps,
                 self.ego_mass_kg,
-                s.opponent_mass_estimate_kg + self.mass_misreport_kg,
+                robust_opponent_kg,
             );
             s.low_speed
                 && robust_ebs_kph < no_fire_ebs_kph

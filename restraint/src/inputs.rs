@@ -24,6 +24,11 @@ use crate::settings::ms_to_ns;
 use crate::signals::{CrashAccelSample, Degraded, ObjectState};
 /// Closing speed above ego speed + this is implausible (opponent > 250 km/h), m/s.
 const MAX_OPPONENT_SPEED_MPS: f32 = 70.0;
+/// An object whose ground speed towards the ego is at most this stands, m/s: the object
+/// sensor's closing-speed noise (0.2 m/s σ) with room, well below any moving traffic. A
+/// standing object may be a wall, a pole or a parked truck, which the object sensor cannot
+/// weigh (it reports a default mass).
+pub const STANDING_SPEED_MPS: f32 = 2.0;
 
 /// CAN ids the ECU consumes (kernel filter of the SocketCAN port), from the generated codec.
 pub fn input_can_ids() -> [u32; 3] {
@@ -121,6 +126,9 @@ pub struct InputMonitor {
     object_rx_ns: Option<u64>,
     /// A new object sample arrived this cycle.
     pub(crate) new_object: bool,
+    /// The newest accepted object stands: its closing speed is the ego's own within
+    /// [`STANDING_SPEED_MPS`] (`false` without a fresh vehicle frame).
+    pub(crate) object_standing: bool,
     ego_speed_mps: f32,
     /// Newest `EgoLongAccel`, m/s² (negative = decelerating).
     ego_long_accel_mps2: f32,
@@ -172,6 +180,7 @@ impl InputMonitor {
             object_invalid: false,
             object_rx_ns: None,
             new_object: false,
+            object_standing: false,
             ego_speed_mps: 0.0,
             ego_long_accel_mps2: 0.0,
             ego_braking: false,
@@ -350,6 +359,8 @@ impl InputMonitor {
             return;
         }
         if self.object_plausible(o, now) {
+            self.object_standing = !self.vehicle_stale(now)
+                && (o.closing_speed_mps - self.ego_speed_mps).abs() <= STANDING_SPEED_MPS;
             self.object = *o;
             self.object_present = f64::from(o.confidence) >= self.min_confidence;
             self.object_invalid = false;

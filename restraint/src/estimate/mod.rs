@@ -214,6 +214,11 @@ pub struct Situation {
     pub ebs_kph: f64,
     /// Below the occupant's no-fire line (`CycleConfig::no_fire_line_kph`).
     pub low_speed: bool,
+    /// The object stands (its closing speed is the ego's own within
+    /// [`crate::inputs::STANDING_SPEED_MPS`]; `false` when the ego's speed is unknown): a
+    /// wall, a pole, a tree or a parked vehicle, whose mass the object sensor cannot weigh (it
+    /// reports a default).
+    pub opponent_standing: bool,
 }
 
 /// The spring of the opponent class of `opp_kg` (by mass; beyond the heaviest class the
@@ -388,7 +393,7 @@ impl<'a> Estimator<'a> {
         let station = inputs
             .v2x_station(now)
             .filter(|st| self.is_tracked_object(&e, st));
-        let sit = self.situation_of(&e, station, no_fire_ebs_kph);
+        let sit = self.situation_of(&e, station, no_fire_ebs_kph, inputs.object_standing);
         self.situation = Some(sit);
         // Predict only what can become relevant before the next sample: contact within the
         // exit horizon (bounds the work to objects that matter).
@@ -413,12 +418,14 @@ impl<'a> Estimator<'a> {
     }
 
     /// The situation of a track estimate (`station`: the V2X station that is the tracked
-    /// object, if any; `no_fire_ebs_kph`: the occupant's no-fire line).
+    /// object, if any; `no_fire_ebs_kph`: the occupant's no-fire line; `standing`: the object
+    /// stands, [`Situation::opponent_standing`]).
     fn situation_of(
         &self,
         e: &TrackEstimate,
         station: Option<&V2xStation>,
         no_fire_ebs_kph: f64,
+        standing: bool,
     ) -> Situation {
         let to_ns = |t_s: f64| (t_s * 1.0e9) as u64; // saturating, NaN → 0
         let contact_estimate_ns = e.at_ns.saturating_add(to_ns(e.contact.ttc_s));
@@ -438,6 +445,7 @@ impl<'a> Estimator<'a> {
             v2x_mass_kg: station.map(|st| st.mass_kg),
             ebs_kph,
             low_speed: !(ebs_kph >= no_fire_ebs_kph),
+            opponent_standing: standing,
         }
     }
 

@@ -669,6 +669,34 @@ fn a_tracked_low_speed_crash_with_a_kerb_strike_fires_no_airbag_unless_it_is_far
     );
 }
 
+#[test]
+fn a_standing_object_is_not_credited_with_its_reported_mass() {
+    // A tracked object closing at 7.8 m/s (28 km/h) reported at 3 000 kg: 1 200 kg heavier it
+    // puts a moving opponent's crash at an EBS of 19.6 km/h, under the 20 km/h line, and the
+    // low-speed limit (7.8 × 1.3 + 1.2 = 11.3 m/s) holds the airbag back from a 15 g × 40 ms
+    // pulse (5.9 m/s). Standing (its closing speed the ego's own), it may be a wall the
+    // object sensor cannot weigh: its EBS is the closing speed, 28 km/h, and the
+    // conventional boundary decides — and fires.
+    let pulse = |ms: u64| if ms < 40 { 15.0 } else { 0.0 };
+    let run = |ego_speed_mps: f32| {
+        let mut b = Bench::with_config(ideal_sensor_config(), Some(test_lut()));
+        b.ego_speed_mps = ego_speed_mps;
+        while b.now < C + 300 * MS {
+            if (b.now - T0).is_multiple_of(10 * MS) && b.now >= T0 + 200 * MS && b.now < C {
+                b.push_approach(C, 7.8, 3000.0, 100.0);
+            }
+            if b.now >= C {
+                b.push_accel(-pulse((b.now - C) / MS) * G);
+            }
+            b.step();
+        }
+        assert!(b.first_mode(EcuMode::Crash).is_some(), "confirmed");
+        first_fire(&b)
+    };
+    assert!(run(15.0).is_none(), "a moving 3 000 kg opponent: held");
+    assert!(run(7.8).is_some(), "a standing object: the boundary fires");
+}
+
 /// How long the low-speed crash below ramps like the prediction before it levels off, ms.
 const RAMP_MS: u64 = 8;
 

@@ -123,6 +123,8 @@ pub struct Bench {
     pending_accel_mps2: Option<f32>,
     /// The safing accelerometer delivers a sample every step (false: a dead safing sensor).
     pub safing_live: bool,
+    /// The ego speed the vehicle frame reports, m/s.
+    pub ego_speed_mps: f32,
     /// A fault of one sensor for the next step: the crash (`.0`) or the safing (`.1`)
     /// accelerometer reads this instead of the mechanical acceleration, m/s².
     pending_fault_mps2: (Option<f32>, Option<f32>),
@@ -202,6 +204,7 @@ impl Bench {
             abs_braking: false,
             pending_accel_mps2: None,
             safing_live: true,
+            ego_speed_mps: 15.0,
             pending_fault_mps2: (None, None),
         }
     }
@@ -233,7 +236,7 @@ impl Bench {
     pub fn step(&mut self) {
         let ms = (self.now - T0) / MS;
         if self.send_vehicle && ms.is_multiple_of(10) {
-            let f = self.vehicle_frame(15.0);
+            let f = self.vehicle_frame(self.ego_speed_mps);
             self.io.push_can(f);
         }
         if self.send_occupant && ms.is_multiple_of(100) {
