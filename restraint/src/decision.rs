@@ -29,7 +29,7 @@
 use crate::config::CycleConfig;
 use crate::crash::{BackupEvidence, BackupSeverity, ConfirmKind, Confirmation};
 use crate::estimate::Situation;
-use crate::fallback::{FallbackDecision, WINDOW_MS};
+use crate::fallback::{FallbackDecision, LATE_WINDOW_MS};
 use crate::plan::{PlanSource, RestraintPlan};
 use crate::satellites::Relief;
 use crate::settings::ms_to_ns;
@@ -543,12 +543,12 @@ impl Decision {
     }
 
     /// The accelerometer-only decision window of the crash phase's event has passed: one ms
-    /// after [`WINDOW_MS`] from the contact, or from the segment being judged when the event
-    /// re-onset later (`fallback`, "Re-onset").
+    /// after [`LATE_WINDOW_MS`] from the contact, or from the segment being judged when the
+    /// event re-onset later (`fallback`, "Re-onset").
     fn window_over(&self, now: u64, segment_onset_ns: Option<u64>) -> bool {
         let contact = self.contact_ns.unwrap_or(now);
         let from = segment_onset_ns.map_or(contact, |s| s.max(contact));
-        now > at(from, (WINDOW_MS + 1.0) as f32)
+        now > at(from, (LATE_WINDOW_MS + 1.0) as f32)
     }
 
     /// The conventional path: the reference airbag when the accelerometer-only algorithm says

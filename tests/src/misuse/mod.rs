@@ -430,10 +430,7 @@ pub const OPEN: &[&str] = &[
     "must-fire-after-event",
     "must-fire-sensor-fault",
     "grey-zone",
-    "must-fire-offset",
-    "must-fire-angular",
     "must-fire-pole",
-    "must-fire-underride",
 ];
 
 /// Must-fire families gated on time: with `--gate`, every airbag must fire at or before its
