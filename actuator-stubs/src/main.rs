@@ -320,8 +320,11 @@ fn run(cli: &Cli) -> Result<()> {
         stop_reason,
     )?;
     let path = out.join("report.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&report)?)
-        .with_context(|| format!("writing {}", path.display()))?;
+    std::fs::write(
+        &path,
+        host::results::to_json_pretty(Report::SCHEMA_VERSION, &report)?,
+    )
+    .with_context(|| format!("writing {}", path.display()))?;
     eprintln!(
         "actuator-stubs: {} ({}), report {}",
         scenario.name,

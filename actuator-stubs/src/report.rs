@@ -163,6 +163,9 @@ pub struct Report {
 }
 
 impl Report {
+    /// `schema_version` of `report.json` (docs/using.md, "JSON results").
+    pub const SCHEMA_VERSION: u32 = 1;
+
     /// The first action of this kind ("airbag_fire", "pretensioner_fire", …), as
     /// [`crate::commands::Modules::action`] is during the run.
     pub fn action(&self, what: &str) -> Option<&TimedAction> {

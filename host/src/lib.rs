@@ -8,11 +8,13 @@
 //!   tools);
 //! * [`files`] — where a tool finds the repository's files from any folder, output paths
 //!   checked before the work, and [`NoFlush`] for logs that flush on their own schedule;
-//! * [`exit`] — how every command-line tool ends: exit codes 0 / 1 / 2 and a one-line error.
+//! * [`exit`] — how every command-line tool ends: exit codes 0 / 1 / 2 and a one-line error;
+//! * [`results`] — the JSON results the tools write, each with its `schema_version`.
 
 pub mod clock;
 pub mod exit;
 pub mod files;
+pub mod results;
 pub mod stop;
 
 pub use clock::{

@@ -639,6 +639,24 @@ pub fn markdown_files(repo: &Path) -> Result<Vec<PathBuf>> {
     Ok(out)
 }
 
+/// The `schema_version` docs/using.md, "JSON results", documents for `document` (the first
+/// column's text, e.g. "`report.json`"); `None` when the table does not name it.
+pub fn documented_schema_version(repo: &Path, document: &str) -> Option<u32> {
+    let text = std::fs::read_to_string(repo.join("docs/using.md")).ok()?;
+    let table = text
+        .split("## JSON results")
+        .nth(1)?
+        .split("\n## ")
+        .next()?;
+    table.lines().find_map(|line| {
+        let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+        // | document | written by | schema_version | its fields |
+        (cells.len() >= 5 && cells[1].starts_with(document))
+            .then(|| cells[3].parse().ok())
+            .flatten()
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

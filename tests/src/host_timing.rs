@@ -54,6 +54,11 @@ pub struct HostTiming {
     pub cpus: String,
 }
 
+impl HostTiming {
+    /// `schema_version` of `host-timing.json` (docs/using.md, "JSON results").
+    pub const SCHEMA_VERSION: u32 = 1;
+}
+
 /// Where the runs happen.
 #[derive(Clone, Debug)]
 pub struct HostTimingConfig {

@@ -521,8 +521,11 @@ fn confirmed_json(k: &restraint::crash::ConfirmKind) -> serde_json::Value {
     }
 }
 
+/// `schema_version` of each run `offline-bench --json` writes (docs/using.md, "JSON results").
+pub const RUN_SCHEMA_VERSION: u32 = 1;
+
 /// One run as `offline-bench --json` writes it (schema: tests/README.md, "offline-bench
-/// JSON"). Every time is `t_ms`, ms after the scenario start, with `after_contact_ms` beside
+/// JSON"), `schema_version` in each (the file is their array). Every time is `t_ms`, ms after the scenario start, with `after_contact_ms` beside
 /// it (`null` without contact); `actions[].t_ns` is the simulated clock (scenario time + 1 s).
 pub fn run_json(
     r: &OfflineRun,
@@ -555,6 +558,7 @@ pub fn run_json(
         })
         .collect();
     serde_json::json!({
+        "schema_version": RUN_SCHEMA_VERSION,
         "scenario": r.name,
         "file": file.display().to_string(),
         "contact_ms": contact_ms,

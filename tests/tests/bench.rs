@@ -166,6 +166,25 @@ fn every_scenario_meets_its_declared_expectations() {
 }
 
 #[test]
+fn every_run_s_json_results_carry_their_documented_schema_version() {
+    let doc = |d: &str| {
+        e2e_tests::docs::documented_schema_version(&root(), d)
+            .unwrap_or_else(|| panic!("docs/using.md, \"JSON results\", names no {d}"))
+    };
+    let (stubs, ecu) = (doc("`report.json`"), doc("`ecu-report.json`"));
+    for p in library() {
+        let name = p.file_stem().and_then(|s| s.to_str()).expect("name");
+        let path = bench_run().join(name).join("report.json");
+        let text =
+            std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let v: serde_json::Value = serde_json::from_str(&text).expect("report.json");
+        assert_eq!(v["schema_version"], stubs, "{}", path.display());
+        let r = ecu_report(name).unwrap_or_else(|| panic!("{name}: no ecu-report.json"));
+        assert_eq!(r["schema_version"], ecu, "{name}: ecu-report.json");
+    }
+}
+
+#[test]
 fn pre_crash_cases_preset_before_contact_and_fire_at_the_planned_time() {
     let mut checked = 0;
     for (s, r) in all() {

@@ -191,9 +191,12 @@ impl<'a> TimingReport<'a> {
         }
     }
 
-    /// Pretty JSON.
+    /// `schema_version` of the `--report-json` document (docs/using.md, "JSON results").
+    pub const SCHEMA_VERSION: u32 = 1;
+
+    /// Pretty JSON, `schema_version` first.
     pub fn to_json(&self) -> serde_json::Result<String> {
-        serde_json::to_string_pretty(self)
+        host::results::to_json_pretty(Self::SCHEMA_VERSION, self)
     }
 
     /// Human-readable text.

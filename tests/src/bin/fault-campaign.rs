@@ -139,7 +139,10 @@ fn run() -> Result<bool> {
             host::check_output_dir(&out).with_context(|| format!("--out {}", out.display()))?;
             let campaign = run_campaign(&cfg, &cases)?;
             let path = out.join("campaign.json");
-            std::fs::write(&path, serde_json::to_string_pretty(&campaign)?)?;
+            std::fs::write(
+                &path,
+                host::results::to_json_pretty(Campaign::SCHEMA_VERSION, &campaign)?,
+            )?;
             let png = out.join("campaign.png");
             e2e_tests::timeline::draw_timeline(&campaign, &png)?;
             println!(
@@ -167,7 +170,10 @@ fn run() -> Result<bool> {
             host::check_output_dir(&out).with_context(|| format!("--out {}", out.display()))?;
             let h = run_host_timing(&cfg)?;
             let path = out.join("host-timing.json");
-            std::fs::write(&path, serde_json::to_string_pretty(&h)?)?;
+            std::fs::write(
+                &path,
+                host::results::to_json_pretty(HostTiming::SCHEMA_VERSION, &h)?,
+            )?;
             println!("{}", host_timing_text(&h));
             println!("host timing: {}", path.display());
             Ok(true)

@@ -747,6 +747,7 @@ fn run_matrix() -> Result<()> {
         std::fs::write(
             path,
             serde_json::to_string_pretty(&serde_json::json!({
+                "schema_version": misuse::SCHEMA_VERSION,
                 "seed": cli.seed, "families": json_rows, "failures": failures,
             }))?,
         )

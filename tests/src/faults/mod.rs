@@ -172,6 +172,11 @@ pub struct Campaign {
     pub cases: Vec<CaseResult>,
 }
 
+impl Campaign {
+    /// `schema_version` of `campaign.json` (docs/using.md, "JSON results").
+    pub const SCHEMA_VERSION: u32 = 1;
+}
+
 /// Runs every case (or those named in `only`), the baseline always first.
 pub fn run_campaign(cfg: &CampaignConfig, only: &[String]) -> Result<Campaign> {
     let route = crate::Route::current();

@@ -422,6 +422,9 @@ pub const FAMILIES: &[Family] = &[
     },
 ];
 
+/// `schema_version` of `misuse-matrix --json` (docs/using.md, "JSON results").
+pub const SCHEMA_VERSION: u32 = 1;
+
 /// Families that do not hold yet: `misuse-matrix --gate` prints them and does not fail on
 /// them, so the suite gates everything that holds while the rest is open work. A family found
 /// failing goes here, with a README note (restraint/README.md, "Each path after an earlier
