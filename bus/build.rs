@@ -72,6 +72,7 @@ fn unit_suffix(unit: &str) -> &'static str {
     match unit {
         "kN" => "_kn",
         "ms" => "_ms",
+        "us" => "_us",
         "m/s" => "_mps",
         "m/s2" => "_mps2",
         "kg" => "_kg",
