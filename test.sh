@@ -57,11 +57,11 @@ target/release/budget --no-criterion --prebuilt
 
 step "worst-case search: a short run from the committed seeds, no case above the budget"
 # Seconds; the long search that found the seeds is in benches/README.md ("Worst case, searched").
-target/release/worst_cycle search --generations 3 --population 16 --cycles no-crash \
+target/release/worst-cycle search --generations 3 --population 16 --cycles no-crash \
   --start benches/worst-case/seed.json --budget 9350
-target/release/worst_cycle search --generations 3 --population 16 --cycles no-crash \
+target/release/worst-cycle search --generations 3 --population 16 --cycles no-crash \
   --secoc on --start benches/worst-case/seed-secoc.json --budget 11980
-target/release/worst_cycle search --generations 3 --population 16 --cycles crash \
+target/release/worst-cycle search --generations 3 --population 16 --cycles crash \
   --secoc on --start benches/worst-case/seed-crash-phase.json --budget 19850
 
 step "robustness report (fault campaign of the tests above + fuzz smoke)"

@@ -1,5 +1,5 @@
 //! The ECU restraint cycle (`restraint::RestraintCycle::step`) on three paths, set up by
-//! `cycle_benches::ecu_cycle` (shared with the `icount_cycle` instruction-count binary):
+//! `cycle_benches::ecu_cycle` (shared with the `icount-cycle` instruction-count binary):
 //!
 //! * `decision_only` — PRE-CRASH, no new input (inputs refreshed in untimed cycles): state
 //!   machine, scheduled fires, cyclic command/heartbeat encode + E2E, diagnostics record.

@@ -3,7 +3,7 @@
 //! Grid of the size a default table is expected to have (9 closing speeds ×
 //! 12 opponent masses × 7 occupant masses × 6 seat distances = 4536 cells,
 //! ~160 KB), non-uniform closing-speed axis so the binary search is real.
-//! Table and queries live in `cycle_benches::workload` (shared with `icount_lut`).
+//! Table and queries live in `cycle_benches::workload` (shared with `icount-lut`).
 //! Budget: ≤ 100 ns per query (benches/budgets.toml).
 
 use std::hint::black_box;

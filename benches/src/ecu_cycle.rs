@@ -1,5 +1,5 @@
 //! The real ECU cycle (`restraint::RestraintCycle::step`) on its measured paths, shared by
-//! the `cycle` criterion bench and the `icount_cycle` callgrind binary so both time the same
+//! the `cycle` criterion bench and the `icount-cycle` callgrind binary so both time the same
 //! code on the same inputs:
 //!
 //! * [`WorstCasePreCrash`] — the hand-picked worst case: steady PRE-CRASH with a
@@ -353,7 +353,7 @@ pub fn crash_confirmation_setup() -> anyhow::Result<(RestraintCycle<'static>, Si
     Ok((ecu, io, clock))
 }
 
-/// The crash phase of a predicted crash, cycle by cycle (`icount_crash`): a cycle driven into
+/// The crash phase of a predicted crash, cycle by cycle (`icount-crash`): a cycle driven into
 /// PRE-CRASH by an approach that predicts contact at `contact_ns` (25 m/s, 1500 ± 150 kg →
 /// conservative 1650 kg, class 3), then from the contact on the accelerometer delivers the
 /// predicted pulse itself (the closed-form collision of that situation) in 8-sample 8 kHz

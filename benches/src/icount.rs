@@ -114,7 +114,7 @@ pub fn collected_totals(
     Ok((totals, String::from_utf8_lossy(&out.stdout).into_owned()))
 }
 
-/// Iteration count from `argv[1]` for the `icount_*` binaries (default 1000). `--help` and
+/// Iteration count from `argv[1]` for the `icount-*` binaries (default 1000). `--help` and
 /// `--version` answer and exit 0; anything else that is not a whole number is an error: one
 /// line `NAME: error: …` and exit 2, as every tool of the bench (a typo must not measure the
 /// default count).
@@ -146,7 +146,7 @@ pub fn iterations_from_args() -> u64 {
     }
 }
 
-/// What an `icount_*` binary's first argument asks for besides a count.
+/// What an `icount-*` binary's first argument asks for besides a count.
 #[derive(Debug, PartialEq)]
 enum Answer {
     Help,

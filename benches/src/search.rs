@@ -1,4 +1,4 @@
-//! The worst-case search's operators over [`CycleCase`]s (`worst_cycle search`): a random case,
+//! The worst-case search's operators over [`CycleCase`]s (`worst-cycle search`): a random case,
 //! uniform in every range of the space, and a mutation of one. Running and measuring a case is
 //! [`crate::worst_case`]'s.
 

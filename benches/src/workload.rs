@@ -283,7 +283,7 @@ pub const FORMER_ECU_STEP_S: f64 = 5.0e-4;
 /// Collision predictions as the ECU makes them: the default ego (1785 kg, class 4) against
 /// opponents over the default table's opponent-mass and closing-speed axes (opponent class by
 /// mass), cycled so that consecutive calls see different inputs (no single-case favouritism).
-/// Shared by the `collision_*_varied` criterion benches and `icount_prediction`.
+/// Shared by the `collision_*_varied` criterion benches and `icount-prediction`.
 pub struct PredictionWorkload {
     springs: Vec<CombinedSpring>,
     /// (spring index, opponent kg, closing m/s).

@@ -25,7 +25,7 @@
 //! [`prepare`] runs the prefix (not measured); [`measured_step`] is the one cycle whose
 //! instructions count — a non-inlined function, so callgrind can collect exactly it
 //! (`--toggle-collect`), and [`crate::icount::collected_totals`] reads one count per case.
-//! The search (`worst_cycle search`, its operators in [`crate::search`]) is a seeded (μ + λ)
+//! The search (`worst-cycle search`, its operators in [`crate::search`]) is a seeded (μ + λ)
 //! evolution over cases with that count as its objective; the gate measures the committed seed
 //! `benches/worst-case/seed.json`.
 

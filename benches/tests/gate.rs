@@ -30,7 +30,7 @@ fn criterion_row(id: &str, budget_us: f64) -> String {
 }
 
 fn icount_row(budget: f64) -> String {
-    format!("[[icount]]\nstage = \"LUT lookup\"\nbin = \"icount_lut\"\nbudget_instructions = {budget}\niterations = [100, 300]\n")
+    format!("[[icount]]\nstage = \"LUT lookup\"\nbin = \"icount-lut\"\nbudget_instructions = {budget}\niterations = [100, 300]\n")
 }
 
 /// The gate table row for `what` (criterion's own output, printed before the table, also
@@ -97,12 +97,12 @@ fn instruction_count_gate_fails_below_and_passes_above_the_measured_count() {
     let low = budgets_file("icount-low", &icount_row(10.0));
     let (code, text) = gate(&low, &["--no-criterion", "--prebuilt"]);
     assert_eq!(code, 1, "{text}");
-    assert!(verdict_line(&text, "icount_lut").contains("FAIL"), "{text}");
+    assert!(verdict_line(&text, "icount-lut").contains("FAIL"), "{text}");
 
     let high = budgets_file("icount-high", &icount_row(100_000.0));
     let (code, text) = gate(&high, &["--no-criterion", "--prebuilt"]);
     assert_eq!(code, 0, "{text}");
-    assert!(verdict_line(&text, "icount_lut").contains("PASS"), "{text}");
+    assert!(verdict_line(&text, "icount-lut").contains("PASS"), "{text}");
     for p in [low, high] {
         let _ = std::fs::remove_file(p);
     }
@@ -119,20 +119,20 @@ fn collected_count_of_the_searched_worst_case_fails_below_and_passes_above() {
     let seed = concat!(env!("CARGO_MANIFEST_DIR"), "/worst-case/seed.json");
     let row = |budget: f64| {
         format!(
-            "[[icount]]\nstage = \"searched\"\nbin = \"worst_cycle\"\ncollect = \"cycle_benches::worst_case::measured_step\"\nargs = [\"eval\", \"{seed}\"]\nbudget_instructions = {budget}\n"
+            "[[icount]]\nstage = \"searched\"\nbin = \"worst-cycle\"\ncollect = \"cycle_benches::worst_case::measured_step\"\nargs = [\"eval\", \"{seed}\"]\nbudget_instructions = {budget}\n"
         )
     };
     let low = budgets_file("collect-low", &row(10.0));
     let (code, text) = gate(&low, &["--no-criterion", "--prebuilt"]);
     assert_eq!(code, 1, "{text}");
     assert!(
-        verdict_line(&text, "worst_cycle").contains("FAIL"),
+        verdict_line(&text, "worst-cycle").contains("FAIL"),
         "{text}"
     );
     let high = budgets_file("collect-high", &row(1e6));
     let (code, text) = gate(&high, &["--no-criterion", "--prebuilt"]);
     assert_eq!(code, 0, "{text}");
-    let line = verdict_line(&text, "worst_cycle");
+    let line = verdict_line(&text, "worst-cycle");
     assert!(
         line.contains("PASS") && line.contains("max of 1 call"),
         "{text}"
@@ -145,7 +145,7 @@ fn collected_count_of_the_searched_worst_case_fails_below_and_passes_above() {
     let (code, text) = gate(&wrong, &["--no-criterion", "--prebuilt"]);
     assert_eq!(code, 1, "{text}");
     assert!(
-        verdict_line(&text, "worst_cycle").contains("MISSING"),
+        verdict_line(&text, "worst-cycle").contains("MISSING"),
         "{text}"
     );
     for p in [low, high, wrong] {

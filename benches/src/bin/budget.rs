@@ -2,7 +2,7 @@
 //! [--only REGEX] [--budgets FILE] [--no-icount] [--no-criterion] [--prebuilt]`.
 //!
 //! Runs the budgeted criterion benches (`cargo bench`), reads the fresh `estimates.json`,
-//! measures instructions per iteration of the `icount_*` binaries under callgrind, prints one
+//! measures instructions per iteration of the `icount-*` binaries under callgrind, prints one
 //! table and exits 1 if any row is FAIL or MISSING (a budgeted benchmark that did not produce
 //! a fresh result is a failure, never a silent pass), 2 on a usage/set-up error.
 

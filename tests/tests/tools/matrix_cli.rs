@@ -116,13 +116,13 @@ const TOOLS: [&str; 17] = [
     "fault-campaign",
     "bus-inject",
     "budget",
-    "worst_cycle",
+    "worst-cycle",
     "loop-vs-cyclictest",
     "docs-check",
-    "icount_cycle",
-    "icount_crash",
-    "icount_lut",
-    "icount_prediction",
+    "icount-cycle",
+    "icount-crash",
+    "icount-lut",
+    "icount-prediction",
 ];
 
 #[test]
@@ -170,7 +170,7 @@ fn every_tool_exits_2_with_one_line_on_an_error() {
 
 #[test]
 fn every_tool_answers_version_with_its_own_name() {
-    // `budget` and `worst_cycle` lacked `--version`.
+    // `budget` and `worst-cycle` lacked `--version`.
     let release = e2e_tests::repo_root().join("target/release");
     for tool in TOOLS {
         let bin = release.join(tool);
@@ -325,7 +325,7 @@ fn output_paths_are_checked_before_the_work() {
             vec!["build", "--grid", "data/default-grid.toml", "--out", bad],
         ),
         ("lut", vec!["study", "stiffness", "--plot", bad]),
-        ("worst_cycle", vec!["search", "--out", bad]),
+        ("worst-cycle", vec!["search", "--out", bad]),
         ("hil-bench", vec!["--scenario", "x.toml", "--out", bad]),
     ] {
         let out = Command::new(release.join(tool))

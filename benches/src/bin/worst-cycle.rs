@@ -1,9 +1,9 @@
-//! `worst_cycle`: the searched worst case of one ECU cycle (see `cycle_benches::worst_case`).
+//! `worst-cycle`: the searched worst case of one ECU cycle (see `cycle_benches::worst_case`).
 //!
-//! * `worst_cycle eval CASES.json` — prepares each case (a JSON case or list of cases) and
+//! * `worst-cycle eval CASES.json` — prepares each case (a JSON case or list of cases) and
 //!   runs its measured cycle once, printing its path; what the search and the gate run under
 //!   callgrind, which counts only `measured_step`.
-//! * `worst_cycle search [--generations G] [--population P] [--seed S] [--secoc on|off|any]
+//! * `worst-cycle search [--generations G] [--population P] [--seed S] [--secoc on|off|any]
 //!   [--cycles all|no-crash|crash] [--start FILE]… [--budget N] [--out FILE]` — a seeded (μ + λ) evolution of cases,
 //!   one callgrind run per generation; starts from the `--start` cases (the committed seeds)
 //!   and the hand-picked case plus random ones; writes the best case found to `--out`; exits 1
@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 
 #[derive(Parser, Debug)]
 #[command(
-    name = "worst_cycle",
+    name = "worst-cycle",
     version,
     about = "Search for the ECU cycle with the most instructions"
 )]
@@ -191,7 +191,7 @@ fn search(
         }
         let median = scored[scored.len() / 2].0;
         eprintln!(
-            "worst_cycle search: generation {}/{generations}: best {} instr (ever {}), median {median}, {evaluated} cases evaluated",
+            "worst-cycle search: generation {}/{generations}: best {} instr (ever {}), median {median}, {evaluated} cases evaluated",
             g + 1,
             top.0,
             best.as_ref().map_or(0, |b| b.0),
@@ -225,7 +225,7 @@ fn search(
     if let Some(out) = out {
         std::fs::write(out, serde_json::to_string_pretty(&case)? + "\n")
             .with_context(|| format!("cannot write {}", out.display()))?;
-        eprintln!("worst_cycle search: best case written to {}", out.display());
+        eprintln!("worst-cycle search: best case written to {}", out.display());
     }
     if let Some(b) = budget {
         if let Some((n, c)) = over.iter().max_by_key(|(n, _)| *n) {
@@ -274,7 +274,7 @@ fn main() {
         Ok(true) => {}
         Ok(false) => std::process::exit(1),
         Err(e) => {
-            eprintln!("worst_cycle: error: {e:#}");
+            eprintln!("worst-cycle: error: {e:#}");
             std::process::exit(2);
         }
     }

@@ -1,4 +1,4 @@
-//! Instruction-count workload: `icount_prediction N [MODE]` runs N collision predictions over
+//! Instruction-count workload: `icount-prediction N [MODE]` runs N collision predictions over
 //! [`cycle_benches::workload::PredictionWorkload`] (default ego against the default table's
 //! opponent masses and closing speeds). Measured under callgrind at two N; see
 //! `cycle_benches::icount`. MODE:

@@ -1,4 +1,4 @@
-//! Instruction-count workload: `icount_lut N` runs N characteristic-diagram lookups over the
+//! Instruction-count workload: `icount-lut N` runs N characteristic-diagram lookups over the
 //! bench table and query mix (the same as the `diagram/lookup_varied` criterion bench).
 //! Measured by the budget gate under callgrind at two N; see `cycle_benches::icount`.
 

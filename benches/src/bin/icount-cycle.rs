@@ -1,4 +1,4 @@
-//! Instruction-count workload: `icount_cycle N` runs N worst-case pre-crash cycles of the real
+//! Instruction-count workload: `icount-cycle N` runs N worst-case pre-crash cycles of the real
 //! ECU (`restraint::RestraintCycle::step` with a new object sample every cycle: track filter +
 //! LUT + state machine + command encode), set up by
 //! `cycle_benches::ecu_cycle::WorstCasePreCrash` exactly as the `cycle/full_precrash_worst_case`
@@ -20,7 +20,7 @@ fn main() {
     match run() {
         Ok(sent) => println!("{sent}"),
         Err(e) => {
-            eprintln!("icount_cycle: {e:#}");
+            eprintln!("icount-cycle: {e:#}");
             std::process::exit(2);
         }
     }
