@@ -161,6 +161,10 @@ def main():
     bench = meta.get("bench")
     if bench is None:
         fail("no `bench` metadata")
+    # The ECU's configuration, when the run folder has it, rides along verbatim.
+    config = a.run_dir / "ecu-config.toml"
+    if config.exists() and meta.get("ecu_config", {}).get("toml") != config.read_text():
+        fail("metadata `ecu_config` is not the run folder's ecu-config.toml")
     offset = int(bench["realtime_minus_monotonic_ns"]) if bench.get("realtime_minus_monotonic_ns") else 0
     if a.full:
         for f in ("commands.jsonl", "report.json"):

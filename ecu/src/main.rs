@@ -128,7 +128,16 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
     } else {
         None
     };
-    let outcome = app::run_ecu(&cfg, &mut activity, can, stop, !cli.run.quiet)?;
+    // The report carries what the loop ran with (a bench run saves it as ecu-config.toml).
+    let config = layers.show(&cfg);
+    let outcome = app::run_ecu(
+        &cfg,
+        &mut activity,
+        can,
+        stop,
+        !cli.run.quiet,
+        Some(&config),
+    )?;
     print!("{}", outcome.text);
     Ok(())
 }

@@ -48,3 +48,7 @@ pub const DIAGNOSTICS_LOG: &str = "diagnostics.postcard";
 
 /// File name of a run's recording in its folder.
 pub const RUN_MCAP: &str = "run.mcap";
+
+/// The configuration the ECU ran with in a run folder (`ecu --show-config`'s TOML, from its
+/// report): the recording carries it as the `ecu_config` metadata (key `toml`).
+pub const ECU_CONFIG: &str = "ecu-config.toml";

@@ -201,6 +201,12 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         name: "bench".to_owned(),
         metadata: bench,
     })?;
+    if let Ok(toml) = std::fs::read_to_string(dir.join(crate::ECU_CONFIG)) {
+        rec.w.write_metadata(&Metadata {
+            name: "ecu_config".to_owned(),
+            metadata: BTreeMap::from([("toml".to_owned(), toml)]),
+        })?;
+    }
 
     let to_mono = |realtime_ns: u64| -> u64 {
         offset.map_or(realtime_ns, |o| {

@@ -268,6 +268,7 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     for stale in [
         "report.json",
         "ecu-report.json",
+        record::ECU_CONFIG,
         "ecu-stderr.txt",
         "candump.log",
         "commands.jsonl",
@@ -477,9 +478,21 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
             .with_context(|| format!("reading {}", report_path.display()))?,
     )
     .with_context(|| format!("parsing {}", report_path.display()))?;
-    let ecu_report = std::fs::read_to_string(dir.join("ecu-report.json"))
-        .ok()
-        .and_then(|t| serde_json::from_str(&t).ok());
+    let ecu_report: Option<serde_json::Value> =
+        std::fs::read_to_string(dir.join("ecu-report.json"))
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok());
+    // The configuration the ECU ran with, beside its report (and in the recording's metadata).
+    if let Some(text) = ecu_report
+        .as_ref()
+        .and_then(|e| e.get("config"))
+        .and_then(|c| c.as_str())
+    {
+        let path = dir.join(record::ECU_CONFIG);
+        if let Err(e) = std::fs::write(&path, text) {
+            problems.push(format!("{}: {e}", path.display()));
+        }
+    }
     // The run's recording (record crate): everything above on one clock, for Foxglove and
     // any MCAP reader. A run that cannot be recorded is a problem of the run, not lost silently.
     let route = crate::Route::current();

@@ -270,6 +270,19 @@ pub fn summarise(
             rt("sched"),
             rt("mlockall")
         );
+        if let Some(config) = e.get("config").and_then(|c| c.as_str()) {
+            let changed = not_the_defaults(config);
+            let _ = writeln!(
+                s,
+                "  configuration: {} ({})",
+                record::ECU_CONFIG,
+                if changed.is_empty() {
+                    "every setting its default".to_owned()
+                } else {
+                    format!("not the defaults: {}", changed.join(", "))
+                }
+            );
+        }
         let route = Route::current();
         if route.timing_emulated() {
             let _ = writeln!(s, "  (route {}: {} — these timings describe the emulator; measure on the host: README, Timing)", route.name(), route.describe());
@@ -282,4 +295,52 @@ pub fn summarise(
     }
     let _ = writeln!(s, "output: {}", dir.display());
     s
+}
+
+/// The settings of `ecu --show-config`'s TOML that a layer other than the defaults set, as
+/// `table.key = value (layer)`: each value line ends in `# <layer>`, `# defaults` for a default;
+/// settings no layer set are comment lines.
+pub fn not_the_defaults(config: &str) -> Vec<String> {
+    let mut table = String::new();
+    let mut out = Vec::new();
+    for line in config.lines().map(str::trim) {
+        if let Some(name) = line.strip_prefix('[').and_then(|l| l.strip_suffix(']')) {
+            table = name.to_owned();
+            continue;
+        }
+        if line.starts_with('#') {
+            continue;
+        }
+        let Some((setting, layer)) = line.rsplit_once("  # ") else {
+            continue;
+        };
+        if layer == "defaults" {
+            continue;
+        }
+        let key = if table.is_empty() {
+            setting.to_owned()
+        } else {
+            format!("{table}.{setting}")
+        };
+        out.push(format!("{key} ({layer})"));
+    }
+    out
+}
+
+#[cfg(test)]
+mod config_tests {
+    use super::not_the_defaults;
+
+    #[test]
+    fn only_settings_a_layer_set_are_listed_with_their_table() {
+        let config = "# cycles = (not set)\nperiod_us = 500  # command line\n\n[rt]\nmlockall = false  # defaults\n\n[can]\ninterface = \"vcan1\"  # environment variable ECU_CAN__INTERFACE\n[cycle.track]\ngate_chi2 = 11.3  # config file\n";
+        assert_eq!(
+            not_the_defaults(config),
+            [
+                "period_us = 500 (command line)",
+                "can.interface = \"vcan1\" (environment variable ECU_CAN__INTERFACE)",
+                "cycle.track.gate_chi2 = 11.3 (config file)",
+            ]
+        );
+    }
 }

@@ -166,6 +166,28 @@ fn every_scenario_meets_its_declared_expectations() {
 }
 
 #[test]
+fn every_run_keeps_the_configuration_its_ecu_ran_with() {
+    for p in library() {
+        let name = p.file_stem().and_then(|s| s.to_str()).expect("name");
+        let dir = bench_run().join(name);
+        let config = std::fs::read_to_string(dir.join("ecu-config.toml"))
+            .unwrap_or_else(|e| panic!("{name}: ecu-config.toml: {e}"));
+        // What `ecu --show-config` prints: every table, the interface the run used from the
+        // command line (run.mcap's `ecu_config` metadata is checked by check_mcap.py).
+        assert!(
+            config.contains("[cycle]") && config.contains("[can]"),
+            "{name}: {config}"
+        );
+        assert!(config.contains("interface = \"vcan"), "{name}: {config}");
+        let summary = std::fs::read_to_string(dir.join("summary.txt")).expect("summary.txt");
+        assert!(
+            summary.contains("configuration: ecu-config.toml (not the defaults: "),
+            "{name}: {summary}"
+        );
+    }
+}
+
+#[test]
 fn every_run_s_json_results_carry_their_documented_schema_version() {
     let doc = |d: &str| {
         e2e_tests::docs::documented_schema_version(&root(), d)

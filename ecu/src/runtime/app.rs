@@ -66,6 +66,7 @@ pub fn run_ecu(
     can_port: Option<Box<dyn CanPort>>,
     stop: &AtomicBool,
     verbose: bool,
+    config: Option<&str>,
 ) -> anyhow::Result<RunOutcome> {
     let can = can_decision(cfg, can_port.is_some())?;
     let can_port = if can.enabled { can_port } else { None };
@@ -163,7 +164,7 @@ pub fn run_ecu(
     } else {
         "cycles"
     };
-    let report = TimingReport::new(
+    let mut report = TimingReport::new(
         &stats,
         loop_cfg.period_ns,
         activity.name(),
@@ -173,6 +174,7 @@ pub fn run_ecu(
         Some(ipc_status),
         stop_reason,
     );
+    report.config = config;
     let text = report.to_text();
     let json = report.to_json()?;
     if let Some(path) = &cfg.report_json {

@@ -157,6 +157,10 @@ pub struct TimingReport<'a> {
     pub ipc: Option<IpcStatus>,
     /// Why the loop ended (`cycles`, `signal`).
     pub stop_reason: &'static str,
+    /// The effective configuration the ECU ran with, as `ecu --show-config` prints it (TOML,
+    /// each value followed by the layer it came from; absent when the caller gave none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub config: Option<&'a str>,
 }
 
 impl<'a> TimingReport<'a> {
@@ -188,6 +192,7 @@ impl<'a> TimingReport<'a> {
             can,
             ipc,
             stop_reason,
+            config: None,
         }
     }
 

@@ -52,7 +52,7 @@ fn feed_to_ecu_to_diagnostics_subscriber() {
         let stop = stop.clone();
         std::thread::spawn(move || {
             let mut activity = PassthroughActivity::new();
-            app::run_ecu(&cfg, &mut activity, None, &stop, false).map(|o| o.json)
+            app::run_ecu(&cfg, &mut activity, None, &stop, false, None).map(|o| o.json)
         })
     };
 
