@@ -70,6 +70,30 @@ impl OfflineConfig {
             .map_err(|e| anyhow!("{}: {e}", path.display()))?;
         Ok(self)
     }
+
+    /// The decision settings, table and reference restraint of an ECU config file, read as
+    /// `ecu --config FILE` reads it (one reader, the ECU's own layers: the file over the
+    /// defaults, `ECU_*` variables over the file; the `[cycle]` table's files relative to the
+    /// file, or the nearest folder above it that holds them).
+    ///
+    /// # Errors
+    /// The file does not read or check as the ECU's config, or its table or reference
+    /// restraint does not load.
+    pub fn with_ecu_config_file(mut self, path: &std::path::Path) -> Result<Self> {
+        let at = |e: &dyn std::fmt::Display| anyhow!("{}: {e}", path.display());
+        let layers = ecu::runtime::Layers::new(Some(path), ecu::runtime::cli::RunArgs::default())
+            .map_err(|e| at(&e))?;
+        let mut cfg = layers.extract().map_err(|e| at(&e))?;
+        layers.resolve_files(&mut cfg);
+        let c = cfg.cycle;
+        let lut = diagram::Diagram::load(&c.lut)
+            .map_err(|e| at(&format!("cycle.lut {}: {e}", c.lut.display())))?;
+        self.reference = physics::reference::ReferenceRestraint::load(&c.reference)
+            .map_err(|e| at(&format!("cycle.reference {}: {e}", c.reference.display())))?;
+        self.lut = Some(lut);
+        self.cycle = c.decision;
+        Ok(self)
+    }
 }
 
 /// One offline run: what the modules did and how it came out.

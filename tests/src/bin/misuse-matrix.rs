@@ -56,6 +56,10 @@ struct Cli {
     /// replace the defaults: for calibrating thresholds on the matrix.
     #[arg(long, value_name = "FILE")]
     cycle_config: Option<PathBuf>,
+    /// An ECU config file (`ecu.toml`, as `ecu --config` takes it): its `[cycle]` table's
+    /// settings, table and reference restraint, read by the ECU's own reader.
+    #[arg(long, value_name = "FILE", conflicts_with = "cycle_config")]
+    config: Option<PathBuf>,
     /// Run the matrix as a Slurm job array of N tasks (`sbatch` / `squeue` from PATH, the
     /// caller's `SLURM_CONF` and `SBATCH_*`), wait for it, and print the same table a local run
     /// prints (the variants and their order do not depend on where they ran).
@@ -129,6 +133,9 @@ fn matrix_args(cli: &Cli, repo: &std::path::Path) -> Result<Vec<String>> {
     ];
     for f in &cli.families {
         a.extend(["--family".to_string(), f.clone()]);
+    }
+    if let Some(c) = &cli.config {
+        a.extend(["--config".to_string(), abs(c)?]);
     }
     if let Some(c) = &cli.cycle_config {
         a.extend(["--cycle-config".to_string(), abs(c)?]);
@@ -451,6 +458,9 @@ fn run_matrix() -> Result<()> {
     let mut cfg = OfflineConfig::shipped(&repo).context("offline bench configuration")?;
     if let Some(path) = &cli.cycle_config {
         cfg = cfg.with_cycle_file(path)?;
+    }
+    if let Some(path) = &cli.config {
+        cfg = cfg.with_ecu_config_file(path)?;
     }
     for f in &cli.families {
         anyhow::ensure!(

@@ -1,4 +1,4 @@
-//! `offline-bench [--scenario FILE …] [--no-lut] [--json FILE] [--cycle-config FILE] [--plot DIR]
+//! `offline-bench [--scenario FILE …] [--no-lut] [--json FILE] [--cycle-config FILE | --config FILE] [--plot DIR]
 //! [--record DIR] [--no-expect]`: runs scenarios through the restraint core under a simulated clock with the
 //! real sensor model and the actuator stubs' judge (`e2e_tests::offline`), prints the outcome
 //! table (one line per run, one indented line per restraint action) and judges every
@@ -43,6 +43,10 @@ struct Cli {
     /// replace the defaults: what a threshold change does to the library, before it is made.
     #[arg(long, value_name = "FILE")]
     cycle_config: Option<PathBuf>,
+    /// An ECU config file (`ecu.toml`, as `ecu --config` takes it): its `[cycle]` table's
+    /// settings, table and reference restraint, read by the ECU's own reader.
+    #[arg(long, value_name = "FILE", conflicts_with = "cycle_config")]
+    config: Option<PathBuf>,
     /// Draw each run to DIR/<scenario>.png: the accelerometers, the event's Δv against the
     /// boundaries and floors, the ECU's mode and every restraint action (created if missing).
     #[arg(long, value_name = "DIR")]
@@ -80,6 +84,9 @@ fn run_all() -> Result<bool> {
     let mut cfg = OfflineConfig::shipped(&repo)?;
     if let Some(path) = &cli.cycle_config {
         cfg = cfg.with_cycle_file(path)?;
+    }
+    if let Some(path) = &cli.config {
+        cfg = cfg.with_ecu_config_file(path)?;
     }
     if cli.no_lut {
         cfg.lut = None;

@@ -722,3 +722,71 @@ fn offline_bench_records_a_run_as_the_bench_does_on_its_simulated_clock() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A belted occupant's accelerometer-only airbag boundary no crash reaches, as `[cycle]` keys.
+const OUT_OF_REACH: &str = "fallback_dv_mps = [50.0, 50.0, 50.0, 50.0, 50.0, 50.0, 50.0, 50.0, \
+                            50.0, 50.0, 50.0, 50.0, 50.0, 50.0, 50.0, 50.0]\n";
+
+#[test]
+fn an_ecu_config_file_sets_what_the_ecu_reads_from_it() {
+    // `--config ecu.toml` reads the file as the ECU does: its `[cycle]` table's thresholds (here
+    // an accelerometer-only airbag boundary of 50 m/s, out of a 35 km/h barrier's reach) and its
+    // files (`data/default.lut`, found from the file's folder upwards). The same key as bare
+    // `--cycle-config` gives the same run; the shipped `ecu/ecu.toml` gives the defaults'.
+    let dir = std::env::temp_dir().join(format!("offline-ecu-config-{}", std::process::id()));
+    let nested = dir.join("a/b");
+    std::fs::create_dir_all(&nested).unwrap();
+    let ecu_toml = nested.join("ecu.toml");
+    let bare = dir.join("cycle.toml");
+    std::fs::write(
+        &ecu_toml,
+        format!(
+            "period_us = 1000\n[cycle]\nlut = \"{}\"\n{OUT_OF_REACH}",
+            root().join("data/default.lut").display()
+        ),
+    )
+    .unwrap();
+    std::fs::write(&bare, OUT_OF_REACH).unwrap();
+    let file = [root().join("scenarios/barrier-35-objects-dead.toml")];
+    let airbag = |v: &serde_json::Value| {
+        v[0]["actions"]
+            .as_array()
+            .expect("actions")
+            .iter()
+            .any(|a| a["what"] == "airbag_fire")
+    };
+    let (code, _, err, defaults) = offline_bench(&file, &["--no-expect"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        airbag(&defaults),
+        "the accelerometer-only airbag fires by default"
+    );
+    let (code, _, err, by_config) = offline_bench(
+        &file,
+        &["--no-expect", "--config", ecu_toml.to_str().unwrap()],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(!airbag(&by_config), "the file's floor holds it");
+    let (code, _, err, by_cycle) = offline_bench(
+        &file,
+        &["--no-expect", "--cycle-config", bare.to_str().unwrap()],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(by_config[0]["actions"], by_cycle[0]["actions"]);
+    let shipped = root().join("ecu/ecu.toml");
+    let (code, _, err, by_shipped) = offline_bench(
+        &file,
+        &["--no-expect", "--config", shipped.to_str().unwrap()],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(by_shipped[0]["actions"], defaults[0]["actions"]);
+    // A key the ECU does not know is the ECU's error, exit 2.
+    std::fs::write(&ecu_toml, "[cycle]\nno_such_key = 1\n").unwrap();
+    let (code, _, err, _) = offline_bench(
+        &file,
+        &["--no-expect", "--config", ecu_toml.to_str().unwrap()],
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("no_such_key"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
