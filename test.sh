@@ -57,12 +57,13 @@ target/release/budget --no-criterion --prebuilt
 
 step "worst-case search: a short run from the committed seeds, no case above the budget"
 # Seconds; the long search that found the seeds is in benches/README.md ("Worst case, searched").
+# Each search fails above the line benches/budgets.toml gives its seed's row (written once).
 target/release/worst-cycle search --generations 3 --population 16 --cycles no-crash \
-  --start benches/worst-case/seed.json --budget 9350
+  --start benches/worst-case/seed.json --budgets benches/budgets.toml
 target/release/worst-cycle search --generations 3 --population 16 --cycles no-crash \
-  --secoc on --start benches/worst-case/seed-secoc.json --budget 11980
+  --secoc on --start benches/worst-case/seed-secoc.json --budgets benches/budgets.toml
 target/release/worst-cycle search --generations 3 --population 16 --cycles crash \
-  --secoc on --start benches/worst-case/seed-crash-phase.json --budget 19850
+  --secoc on --start benches/worst-case/seed-crash-phase.json --budgets benches/budgets.toml
 
 step "robustness report (fault campaign of the tests above + fuzz smoke)"
 target/release/fault-campaign report --campaign target/robustness/campaign.json \

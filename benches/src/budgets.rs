@@ -128,6 +128,22 @@ impl Budgets {
         Ok(b)
     }
 
+    /// The instruction line of the `worst-cycle` row that evaluates the case file `seed` (its
+    /// `args` name the file; compared by file name): the one place the searched rows' lines are
+    /// written, for `worst-cycle search --budgets`.
+    pub fn worst_cycle_line(&self, seed: &Path) -> Option<f64> {
+        let name = seed.file_name()?;
+        self.icount
+            .iter()
+            .find(|r| {
+                r.bin == "worst-cycle"
+                    && r.args
+                        .iter()
+                        .any(|a| Path::new(a).file_name() == Some(name))
+            })
+            .map(|r| r.budget_instructions)
+    }
+
     /// Reads and parses a budgets file.
     ///
     /// # Errors
@@ -174,5 +190,21 @@ mod tests {
         let typo = format!("{base}[[criterion]]\nstage=\"s\"\nbench=\"b\"\nid=\"i\"\nbudget=1.0\n");
         assert!(Budgets::parse(&typo).is_err());
         assert!(Budgets::parse(base).is_ok());
+    }
+
+    #[test]
+    fn a_searched_row_s_line_is_found_by_its_seed_file() {
+        let b = Budgets::parse(
+            "[gate]\nstatistic = \"median\"\ncompare = \"point\"\n\
+             [[icount]]\nstage = \"a\"\nbin = \"worst-cycle\"\nbudget_instructions = 9350\n\
+             collect = \"f\"\nargs = [\"eval\", \"worst-case/seed.json\"]\n\
+             [[icount]]\nstage = \"b\"\nbin = \"worst-cycle\"\nbudget_instructions = 11980\n\
+             collect = \"f\"\nargs = [\"eval\", \"worst-case/seed-secoc.json\"]\n",
+        )
+        .unwrap();
+        let line = |p: &str| b.worst_cycle_line(Path::new(p));
+        assert_eq!(line("benches/worst-case/seed.json"), Some(9350.0));
+        assert_eq!(line("seed-secoc.json"), Some(11980.0));
+        assert_eq!(line("benches/worst-case/other.json"), None);
     }
 }

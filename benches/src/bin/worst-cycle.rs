@@ -4,10 +4,12 @@
 //!   runs its measured cycle once, printing its path; what the search and the gate run under
 //!   callgrind, which counts only `measured_step`.
 //! * `worst-cycle search [--generations G] [--population P] [--seed S] [--secoc on|off|any]
-//!   [--cycles all|no-crash|crash] [--start FILE]… [--budget N] [--out FILE]` — a seeded (μ + λ) evolution of cases,
+//!   [--cycles all|no-crash|crash] [--start FILE]… [--budget N | --budgets FILE] [--out FILE]` — a seeded (μ + λ) evolution of cases,
 //!   one callgrind run per generation; starts from the `--start` cases (the committed seeds)
 //!   and the hand-picked case plus random ones; writes the best case found to `--out`; exits 1
-//!   if any evaluated case exceeded `--budget` instructions (printing it).
+//!   if any evaluated case exceeded `--budget` instructions (printing it) — or, with
+//!   `--budgets benches/budgets.toml`, the line of the row that evaluates the first `--start`
+//!   file (the searched rows' lines are written once, there; test.sh searches that way).
 
 use anyhow::Context;
 use clap::{Parser, Subcommand, ValueEnum};
@@ -91,8 +93,12 @@ enum Cmd {
         #[arg(long)]
         start: Vec<PathBuf>,
         /// Fail (exit 1) if a case exceeds this many instructions.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "budgets")]
         budget: Option<u64>,
+        /// Fail (exit 1) if a case exceeds the line `FILE` (benches/budgets.toml) gives the
+        /// row that evaluates the first `--start` file: the lines written once, in that file.
+        #[arg(long, value_name = "FILE")]
+        budgets: Option<PathBuf>,
         /// Where to write the best case found.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -241,6 +247,26 @@ fn search(
     Ok(true)
 }
 
+/// The line the budgets file `budgets` gives the row that evaluates `start`'s first file.
+fn line_of(budgets: Option<&Path>, start: &[PathBuf]) -> anyhow::Result<Option<u64>> {
+    let Some(path) = budgets else {
+        return Ok(None);
+    };
+    let seed = start
+        .first()
+        .context("--budgets needs a --start file: the row is the one that evaluates it")?;
+    let line = cycle_benches::budgets::Budgets::load(path)?
+        .worst_cycle_line(seed)
+        .with_context(|| {
+            format!(
+                "{}: no worst-cycle row evaluates {}",
+                path.display(),
+                seed.display()
+            )
+        })?;
+    Ok(Some(line as u64))
+}
+
 fn main() {
     let cli = Cli::parse();
     let r = match cli.command {
@@ -258,17 +284,22 @@ fn main() {
             cycles,
             start,
             budget,
+            budgets,
             out,
-        } => search(
-            generations,
-            population,
-            seed,
-            secoc,
-            cycles,
-            &start,
-            budget,
-            out.as_deref(),
-        ),
+        } => line_of(budgets.as_deref(), &start)
+            .map(|line| line.or(budget))
+            .and_then(|budget| {
+                search(
+                    generations,
+                    population,
+                    seed,
+                    secoc,
+                    cycles,
+                    &start,
+                    budget,
+                    out.as_deref(),
+                )
+            }),
     };
     match r {
         Ok(true) => {}
