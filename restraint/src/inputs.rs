@@ -313,7 +313,9 @@ impl InputMonitor {
         }
     }
 
-    fn object_plausible(&self, o: &ObjectState, now: u64) -> bool {
+    /// Whether `o` is plausible (`vehicle_fresh`: the vehicle frame is fresh, so its ego speed
+    /// bounds the closing speed).
+    fn object_plausible(&self, o: &ObjectState, now: u64, vehicle_fresh: bool) -> bool {
         let f = [
             o.distance_m,
             o.closing_speed_mps,
@@ -333,7 +335,6 @@ impl InputMonitor {
             && (0.0..=1.0).contains(&o.confidence);
         // The measurement must be recent on our clock (same CLOCK_MONOTONIC on the bench).
         let age_ok = now.abs_diff(o.timestamp_ns) <= self.object_timeout_ns;
-        let vehicle_fresh = !self.vehicle_stale(now);
         let speed_ok =
             !vehicle_fresh || o.closing_speed_mps <= self.ego_speed_mps + MAX_OPPONENT_SPEED_MPS;
         ranges_ok && age_ok && speed_ok
@@ -358,8 +359,11 @@ impl InputMonitor {
             self.new_object = true;
             return;
         }
-        if self.object_plausible(o, now) {
-            self.object_standing = !self.vehicle_stale(now)
+        // The ego speed of a fresh vehicle frame bounds the closing speed and says whether the
+        // object stands: one freshness check for both.
+        let vehicle_fresh = !self.vehicle_stale(now);
+        if self.object_plausible(o, now, vehicle_fresh) {
+            self.object_standing = vehicle_fresh
                 && (o.closing_speed_mps - self.ego_speed_mps).abs() <= STANDING_SPEED_MPS;
             self.object = *o;
             self.object_present = f64::from(o.confidence) >= self.min_confidence;

@@ -85,9 +85,10 @@ use crate::settings::ms_to_ns;
 use crate::signals::psi5::{self, Psi5Word};
 use crate::signals::{SatelliteFrames, SatelliteSide};
 
-/// How long a relief is held after the severity last reached the lower line, ms: the
-/// accelerometer-only decision window (`fallback::WINDOW_MS`), so a crash is judged to its end
-/// with the evidence its first milliseconds gave.
+/// How long a relief is held after the severity last reached the lower line, ms: the span of
+/// the accelerometer-only boundary's knots (`fallback::WINDOW_MS`), so a crash is judged across
+/// them with the evidence its first milliseconds gave. In the late window past them
+/// (`fallback::LATE_WINDOW_MS`) a relief holds only while the severity keeps reaching the line.
 pub const RELIEF_HOLD_MS: f64 = 60.0;
 
 /// How long a satellite's status or corrupt frame, or an implausible crush, keeps it out of
