@@ -24,6 +24,8 @@ use world::{Scenario, Truth};
 /// Scenario time 0 on the simulated clock [ns] (any value clear of 0).
 pub const START_NS: u64 = 1_000_000_000;
 const MS: u64 = 1_000_000;
+/// Offset of the ECU's cycle grid after the feeds' tick grid, ns: half a tick.
+const ECU_PHASE_NS: u64 = MS / 2;
 
 /// What the offline bench runs the ECU core with.
 pub struct OfflineConfig {
@@ -51,7 +53,7 @@ impl OfflineConfig {
             reference: physics::reference::ReferenceRestraint::builtin()
                 .map_err(|e| anyhow!("reference restraint: {e}"))?,
             cycle: CycleConfig::default(),
-            ecu_phase_ns: MS / 2,
+            ecu_phase_ns: ECU_PHASE_NS,
         })
     }
 
@@ -79,7 +81,7 @@ impl OfflineConfig {
     /// # Errors
     /// The file does not read or check as the ECU's config, or its table or reference
     /// restraint does not load.
-    pub fn with_ecu_config_file(mut self, path: &std::path::Path) -> Result<Self> {
+    pub fn from_ecu_config_file(path: &std::path::Path) -> Result<Self> {
         let at = |e: &dyn std::fmt::Display| anyhow!("{}: {e}", path.display());
         let layers = ecu::runtime::Layers::new(Some(path), ecu::runtime::cli::RunArgs::default())
             .map_err(|e| at(&e))?;
@@ -88,11 +90,14 @@ impl OfflineConfig {
         let c = cfg.cycle;
         let lut = diagram::Diagram::load(&c.lut)
             .map_err(|e| at(&format!("cycle.lut {}: {e}", c.lut.display())))?;
-        self.reference = physics::reference::ReferenceRestraint::load(&c.reference)
+        let reference = physics::reference::ReferenceRestraint::load(&c.reference)
             .map_err(|e| at(&format!("cycle.reference {}: {e}", c.reference.display())))?;
-        self.lut = Some(lut);
-        self.cycle = c.decision;
-        Ok(self)
+        Ok(Self {
+            lut: Some(lut),
+            reference,
+            cycle: c.decision,
+            ecu_phase_ns: ECU_PHASE_NS,
+        })
     }
 }
 

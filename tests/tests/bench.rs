@@ -170,8 +170,8 @@ fn every_run_keeps_the_configuration_its_ecu_ran_with() {
     for p in library() {
         let name = p.file_stem().and_then(|s| s.to_str()).expect("name");
         let dir = bench_run().join(name);
-        let config = std::fs::read_to_string(dir.join("ecu-config.toml"))
-            .unwrap_or_else(|e| panic!("{name}: ecu-config.toml: {e}"));
+        let config = std::fs::read_to_string(dir.join(record::ECU_CONFIG))
+            .unwrap_or_else(|e| panic!("{name}: {}: {e}", record::ECU_CONFIG));
         // What `ecu --show-config` prints: every table, the interface the run used from the
         // command line (run.mcap's `ecu_config` metadata is checked by check_mcap.py).
         assert!(
@@ -181,7 +181,10 @@ fn every_run_keeps_the_configuration_its_ecu_ran_with() {
         assert!(config.contains("interface = \"vcan"), "{name}: {config}");
         let summary = std::fs::read_to_string(dir.join("summary.txt")).expect("summary.txt");
         assert!(
-            summary.contains("configuration: ecu-config.toml (not the defaults: "),
+            summary.contains(&format!(
+                "configuration: {} (not the defaults: ",
+                record::ECU_CONFIG
+            )),
             "{name}: {summary}"
         );
     }

@@ -455,12 +455,13 @@ fn run_matrix() -> Result<()> {
             host::check_output_file(p).with_context(|| format!("{flag} {}", p.display()))?;
         }
     }
-    let mut cfg = OfflineConfig::shipped(&repo).context("offline bench configuration")?;
+    // `--config` and `--cycle-config` exclude each other (clap).
+    let mut cfg = match &cli.config {
+        Some(path) => OfflineConfig::from_ecu_config_file(path)?,
+        None => OfflineConfig::shipped(&repo).context("offline bench configuration")?,
+    };
     if let Some(path) = &cli.cycle_config {
         cfg = cfg.with_cycle_file(path)?;
-    }
-    if let Some(path) = &cli.config {
-        cfg = cfg.with_ecu_config_file(path)?;
     }
     for f in &cli.families {
         anyhow::ensure!(

@@ -81,12 +81,13 @@ fn run_all() -> Result<bool> {
     if files.is_empty() {
         files = e2e_tests::library_files(&repo)?;
     }
-    let mut cfg = OfflineConfig::shipped(&repo)?;
+    // `--config` and `--cycle-config` exclude each other (clap).
+    let mut cfg = match &cli.config {
+        Some(path) => OfflineConfig::from_ecu_config_file(path)?,
+        None => OfflineConfig::shipped(&repo)?,
+    };
     if let Some(path) = &cli.cycle_config {
         cfg = cfg.with_cycle_file(path)?;
-    }
-    if let Some(path) = &cli.config {
-        cfg = cfg.with_ecu_config_file(path)?;
     }
     if cli.no_lut {
         cfg.lut = None;
