@@ -182,7 +182,7 @@ pub fn accel_only_fire_s(
                 floor_mps: relief.floor_mps,
                 boundary_scale: relief.boundary_scale,
                 // A car without satellites below the unguarded closing speed: no lift; a
-                // full-width crash: no one-sided fold.
+                // crash without a tracked prediction: no fold's scale.
                 ..Relief::NONE
             },
         );

@@ -321,17 +321,15 @@ pub struct CycleConfig {
     /// this line to `satellite_relief_full_mps` × this / `satellite_relief_from_mps` (the
     /// belted span scaled to the occupant's line).
     pub satellite_unbelted_crush_mps: f64,
-    /// One side folds (an offset or angled crash, `satellites`, "One side folds"): when one
-    /// satellite's crush Δv reaches this, m/s (*default* 2.0: a crush rate of ≈ 30 km/h at the
-    /// rail tip; a 24 km/h offset barrier's struck rail reaches 1.3) …
-    pub satellite_one_sided_crush_mps: f64,
-    /// … while the other's stays at most this, m/s (*default* 0.3: a full-width crash loads
-    /// both rails, a 14 km/h wall 0.45 m/s at each), and the tracked prediction is a must-fire
-    /// crash with the opponent's mass lowered by `mass_misreport_kg`, the accelerometer-only
-    /// boundary is scaled by the next key for as long as a relief holds.
-    pub satellite_one_sided_other_max_mps: f64,
-    /// What a one-sided fold scales the accelerometer-only boundary by (*default* 0.4; 1 = off).
-    pub satellite_one_sided_boundary_scale: f64,
+    /// The front end folds (`satellites`, "The front end folds"): when the larger crush Δv of
+    /// the two satellites reaches this, m/s (*default* 2.0: a crush rate of ≈ 30 km/h at the
+    /// rail tip; a 24 km/h offset barrier's struck rail reaches 1.3), and the tracked
+    /// prediction is a must-fire crash with the opponent's mass lowered by
+    /// `mass_misreport_kg`, the accelerometer-only boundary is scaled by the next key for as
+    /// long as a relief holds.
+    pub satellite_fold_crush_mps: f64,
+    /// What a fold scales the accelerometer-only boundary by (*default* 0.4; 1 = off).
+    pub satellite_fold_boundary_scale: f64,
 
     /// Crash accelerometer: no batch for this long → `ACCEL_STALE`, ms (*default* 50: batches
     /// come every ms, so 50 missed ones are a dead sensor; with one 20 ms `EcuStatus` period the
@@ -429,9 +427,8 @@ impl Default for CycleConfig {
             satellite_boundary_scale: 1.0,
             satellite_low_crush_lift_mps: 1.2,
             satellite_unbelted_crush_mps: 0.5,
-            satellite_one_sided_crush_mps: 2.0,
-            satellite_one_sided_other_max_mps: 0.3,
-            satellite_one_sided_boundary_scale: 0.4,
+            satellite_fold_crush_mps: 2.0,
+            satellite_fold_boundary_scale: 0.4,
             accel_timeout_ms: 50.0,
             accel_stuck_ms: 20.0,
             accel_full_scale_g: 200.0,
@@ -582,20 +579,14 @@ impl CycleConfig {
             1.0,
         )?;
         range(
-            "satellite_one_sided_crush_mps",
-            self.satellite_one_sided_crush_mps,
+            "satellite_fold_crush_mps",
+            self.satellite_fold_crush_mps,
             self.satellite_relief_from_mps,
             20.0,
         )?;
         range(
-            "satellite_one_sided_other_max_mps",
-            self.satellite_one_sided_other_max_mps,
-            0.0,
-            self.satellite_relief_from_mps,
-        )?;
-        range(
-            "satellite_one_sided_boundary_scale",
-            self.satellite_one_sided_boundary_scale,
+            "satellite_fold_boundary_scale",
+            self.satellite_fold_boundary_scale,
             0.2,
             1.0,
         )?;
@@ -743,9 +734,8 @@ impl CycleConfig {
             boundary_scale: self.satellite_boundary_scale,
             low_crush_lift_mps: self.satellite_low_crush_lift_mps,
             unbelted_crush_mps: self.satellite_unbelted_crush_mps,
-            one_sided_crush_mps: self.satellite_one_sided_crush_mps,
-            one_sided_other_max_mps: self.satellite_one_sided_other_max_mps,
-            one_sided_boundary_scale: self.satellite_one_sided_boundary_scale,
+            fold_crush_mps: self.satellite_fold_crush_mps,
+            fold_boundary_scale: self.satellite_fold_boundary_scale,
         }
     }
 

@@ -248,10 +248,10 @@ impl Activity for RestraintCycle<'_> {
         let satellites = &mut self.satellites;
         satellites.begin_cycle(now);
         io.drain_satellites(&mut |side, b| satellites.on_frames(side, b, now));
-        // A one-sided fold lowers the boundary only for a tracked crash that is a must-fire one
-        // even against the lightest opponent the object list's report allows; asked only while
-        // the crash detector judges an event (a fold needs milliseconds of crush anyway).
-        let one_sided_ok = self.crash.awake()
+        // A folding front end lowers the boundary only for a tracked crash that is a must-fire
+        // one even against the lightest opponent the object list's report allows; asked only
+        // while the crash detector judges an event (a fold needs milliseconds of crush anyway).
+        let fold_ok = self.crash.awake()
             && self.estimate.situation.as_ref().is_some_and(|s| {
                 must_fire_if_lightest(
                     s.closing_speed_mps,
@@ -260,7 +260,7 @@ impl Activity for RestraintCycle<'_> {
                     no_fire_ebs_kph,
                 )
             });
-        satellites.allow_one_sided(one_sided_ok);
+        satellites.allow_fold(fold_ok);
         // The satellites' crush and the road's roughness are measured on the tunnel: the crash
         // sensor, or the safing sensor while the crash sensor is known faulty (as of the
         // previous cycle).
@@ -577,7 +577,7 @@ impl Activity for RestraintCycle<'_> {
 
 /// Whether a tracked crash at `closing_mps` is a must-fire one (ego EBS at the no-fire line or
 /// above) against an opponent of `lightest_kg` — its reported mass less the planning margin:
-/// then one object fault cannot make a no-fire crash pass (`satellites`, "One side folds").
+/// then one object fault cannot make a no-fire crash pass (`satellites`, "The front end folds").
 fn must_fire_if_lightest(
     closing_mps: f64,
     lightest_kg: f64,

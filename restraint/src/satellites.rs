@@ -51,22 +51,27 @@
 //! 23–25 km/h crashes waited for the 1.25 m/s floor until +13–15 ms and bottomed out, where
 //! the reference airbag at +10 ms holds them.
 //!
-//! **One side folds.** An offset or angled crash loads the struck side's rail alone: its
-//! satellite folds at the crash's crush rate while the other moves with the body, the smaller
-//! crush Δv stays near 0 and the relief above never begins — and the tunnel, whose pulse such
-//! a crash holds low for its first tens of ms (a 64 km/h offset deformable barrier ≈ 9 g, a
-//! 16 km/h wall's first 20 ms), stays under its boundary. When one usable satellite's crush Δv
-//! reaches `satellite_one_sided_crush_mps` while the other's stays at most
-//! `satellite_one_sided_other_max_mps`, the accelerometer-only boundary is scaled by
-//! `satellite_one_sided_boundary_scale` (held [`RELIEF_HOLD_MS`]) and the low-crush lift is
-//! off — only while the tracked prediction is a must-fire crash with the opponent's reported
-//! mass lowered by the planning margin ([`Satellites::allow_one_sided`]). That condition is
-//! what one fault cannot pass: the tunnel and a struck rail read a light car struck offset at
-//! 30–45 km/h closing (its ego Δv below the no-fire line) as they read the 64 km/h offset
-//! barrier for its first 27 ms, and only the opponent's mass tells them apart; with the object
-//! list dead, or an opponent its report could make light enough, a one-sided fold changes
-//! nothing. The floors are never lowered by it: a misuse event stays under them whatever one
-//! satellite says.
+//! **The front end folds.** The relief above lowers the floors and leaves the boundary
+//! (`satellite_boundary_scale`: a light opponent at a high closing speed crushes the front as
+//! a must-fire crash does), and two kinds of crash still stay under the boundary for tens of
+//! ms. An offset or angled crash loads the struck side's rail alone: its satellite folds at the
+//! crash's crush rate while the other moves with the body, the smaller crush Δv stays near 0
+//! and the relief never begins — and the tunnel, whose pulse such a crash holds low for its
+//! first tens of ms (a 64 km/h offset deformable barrier ≈ 9 g, a 16 km/h wall's first 20 ms),
+//! stays under its boundary. And a full-width crash that a road's lobe or a kerb strike's
+//! ringing runs into is read with that event's forward swing in it (the segment restarts at
+//! the crush onset, below, and the ringing gives back what it took before): its Δv, less the
+//! swing, runs parallel to the boundary (a tracked 42 km/h wall on a 4 g rms road reached it
+//! at +58 ms, the occupant bottoming out). When the larger crush Δv of two usable satellites
+//! reaches `satellite_fold_crush_mps` — one side or both — the accelerometer-only boundary is
+//! scaled by `satellite_fold_boundary_scale` (held [`RELIEF_HOLD_MS`]) and the low-crush lift
+//! is off — only while the tracked prediction is a must-fire crash with the opponent's reported
+//! mass lowered by the planning margin ([`Satellites::allow_fold`]). That condition is what one
+//! fault cannot pass: the tunnel and a struck rail read a light car struck offset at 30–45 km/h
+//! closing (its ego Δv below the no-fire line) as they read the 64 km/h offset barrier for its
+//! first 27 ms, and only the opponent's mass tells them apart; with the object list dead, or an
+//! opponent its report could make light enough, a fold changes nothing. The floors are never
+//! lowered by it: a misuse event stays under them whatever one satellite says.
 //!
 //! **Crush onset.** The cycle bins also date the fold: walking back from the batch in which
 //! the severity first reaches the occupant's line, over the cycles in which every usable
@@ -124,9 +129,9 @@ pub struct Relief {
     /// crush as much as the relief's lower line, 0 from then on (while the relief holds) and
     /// with no usable satellite (module docs, "Low crush").
     pub boundary_lift_mps: f64,
-    /// What an offset or angled crash's one-sided fold scales the accelerometer-only boundary
-    /// by (module docs, "One side folds"): 1 = nothing.
-    pub one_sided_scale: f64,
+    /// What a tracked must-fire crash's folding front end scales the accelerometer-only
+    /// boundary by (module docs, "The front end folds"): 1 = nothing.
+    pub fold_scale: f64,
 }
 
 /// When the front end began to fold, as the satellites' cycle bins date it, and the tunnel's
@@ -149,7 +154,7 @@ impl Relief {
         floor_mps: 0.0,
         boundary_scale: 1.0,
         boundary_lift_mps: 0.0,
-        one_sided_scale: 1.0,
+        fold_scale: 1.0,
     };
 
     /// A severity floor `floor_mps` with the road's `lift_mps`, as relieved: the floor moves
@@ -168,7 +173,7 @@ impl Relief {
     /// A boundary value `threshold_mps`, as relieved.
     #[inline]
     pub fn boundary_mps(self, threshold_mps: f64) -> f64 {
-        threshold_mps * (1.0 - self.fraction * (1.0 - self.boundary_scale)) * self.one_sided_scale
+        threshold_mps * (1.0 - self.fraction * (1.0 - self.boundary_scale)) * self.fold_scale
     }
 }
 
@@ -195,12 +200,10 @@ pub struct SatelliteParams {
     pub low_crush_lift_mps: f64,
     /// Severity from which the lift ends for an occupant not known to be belted, m/s.
     pub unbelted_crush_mps: f64,
-    /// A one-sided fold: the struck side's crush Δv at least this, m/s …
-    pub one_sided_crush_mps: f64,
-    /// … while the other side's is at most this, m/s.
-    pub one_sided_other_max_mps: f64,
-    /// What a one-sided fold scales the boundary by.
-    pub one_sided_boundary_scale: f64,
+    /// The front end folds: the larger crush Δv of the two satellites at least this, m/s.
+    pub fold_crush_mps: f64,
+    /// What a fold scales the boundary by.
+    pub fold_boundary_scale: f64,
 }
 
 /// Index mask of the ring of bins.
@@ -354,10 +357,11 @@ pub struct Satellites {
     peak_mps: f64,
     /// The relief holds until, ns.
     hold_until_ns: Option<u64>,
-    /// The one-sided relief holds until, ns.
-    one_sided_until_ns: Option<u64>,
-    /// This cycle's tracked prediction allows a one-sided relief ([`Self::allow_one_sided`]).
-    one_sided_allowed: bool,
+    /// The fold's boundary scale holds until, ns.
+    fold_until_ns: Option<u64>,
+    /// This cycle's tracked prediction allows a fold to scale the boundary
+    /// ([`Self::allow_fold`]).
+    fold_allowed: bool,
     /// When the current relief began (the cycle, ns; 0: none yet), and the satellites usable
     /// then.
     relief_began_ns: u64,
@@ -390,13 +394,11 @@ fn crush_of(sums: [f64; 3]) -> [f64; 2] {
     [left - tunnel, right - tunnel]
 }
 
-/// One side folds and the other does not (module docs, "One side folds"): both usable, the
-/// larger crush Δv at least `one_sided_crush_mps`, the smaller at most
-/// `one_sided_other_max_mps`.
-fn one_sided_of(usable: [bool; 2], sums: [f64; 3], p: &SatelliteParams) -> bool {
+/// The front end folds (module docs, "The front end folds"): both usable, the larger crush Δv
+/// at least `fold_crush_mps`.
+fn folds(usable: [bool; 2], sums: [f64; 3], p: &SatelliteParams) -> bool {
     let [l, r] = crush_of(sums);
-    let (hi, lo) = if l > r { (l, r) } else { (r, l) };
-    usable == [true, true] && hi >= p.one_sided_crush_mps && lo <= p.one_sided_other_max_mps
+    usable == [true, true] && l.max(r) >= p.fold_crush_mps
 }
 
 impl Satellites {
@@ -409,8 +411,8 @@ impl Satellites {
             now_ns: 0,
             peak_mps: 0.0,
             hold_until_ns: None,
-            one_sided_until_ns: None,
-            one_sided_allowed: false,
+            fold_until_ns: None,
+            fold_allowed: false,
             relief_began_ns: 0,
             relief_began_usable: [false; 2],
             faults: SatelliteFaults::default(),
@@ -424,11 +426,11 @@ impl Satellites {
         self.now_ns = now;
     }
 
-    /// Whether this cycle's tracked prediction allows a one-sided relief: a crash that is a
-    /// must-fire one even if the object list over-reported the opponent's mass by the planning
-    /// margin (module docs, "One side folds").
-    pub fn allow_one_sided(&mut self, allowed: bool) {
-        self.one_sided_allowed = allowed;
+    /// Whether this cycle's tracked prediction allows a fold to scale the boundary: a crash
+    /// that is a must-fire one even if the object list over-reported the opponent's mass by
+    /// the planning margin (module docs, "The front end folds").
+    pub fn allow_fold(&mut self, allowed: bool) {
+        self.fold_allowed = allowed;
     }
 
     /// One batch of `side`'s frames received at `now`: data codes add their velocity change
@@ -540,16 +542,14 @@ impl Satellites {
             .window(now)
             .map(|(usable, sums)| (self.check_plausible(now, usable, sums), sums));
         let severity = judged.and_then(|(usable, sums)| severity_of(usable, sums));
-        if self.one_sided_until_ns.is_some_and(|t| now > t) {
-            self.one_sided_until_ns = None;
+        if self.fold_until_ns.is_some_and(|t| now > t) {
+            self.fold_until_ns = None;
         }
-        if self.one_sided_allowed
-            && judged.is_some_and(|(usable, sums)| one_sided_of(usable, sums, &p))
-        {
-            self.one_sided_until_ns = Some(now.saturating_add(ms_to_ns(RELIEF_HOLD_MS)));
+        if self.fold_allowed && judged.is_some_and(|(usable, sums)| folds(usable, sums, &p)) {
+            self.fold_until_ns = Some(now.saturating_add(ms_to_ns(RELIEF_HOLD_MS)));
         }
-        let one_sided_scale = if self.one_sided_until_ns.is_some() {
-            p.one_sided_boundary_scale
+        let fold_scale = if self.fold_until_ns.is_some() {
+            p.fold_boundary_scale
         } else {
             1.0
         };
@@ -572,14 +572,14 @@ impl Satellites {
             self.hold_until_ns = Some(now.saturating_add(ms_to_ns(RELIEF_HOLD_MS)));
         }
         if self.hold_until_ns.is_none() {
-            // Usable satellites that see no crush ahead: the whole lift — unless one side folds.
+            // Usable satellites that see no crush ahead: the whole lift — unless a fold scales.
             return Relief {
-                boundary_lift_mps: if severity.is_some() && one_sided_scale == 1.0 {
+                boundary_lift_mps: if severity.is_some() && fold_scale == 1.0 {
                     p.low_crush_lift_mps
                 } else {
                     0.0
                 },
-                one_sided_scale,
+                fold_scale,
                 ..Relief::NONE
             };
         }
@@ -599,7 +599,7 @@ impl Satellites {
             floor_mps: p.floor_mps,
             boundary_scale: p.boundary_scale,
             boundary_lift_mps: 0.0,
-            one_sided_scale,
+            fold_scale,
         }
     }
 
@@ -651,9 +651,8 @@ mod tests {
             boundary_scale: 0.5,
             low_crush_lift_mps: 0.0,
             unbelted_crush_mps: 0.5,
-            one_sided_crush_mps: 2.0,
-            one_sided_other_max_mps: 0.3,
-            one_sided_boundary_scale: 0.4,
+            fold_crush_mps: 2.0,
+            fold_boundary_scale: 0.4,
         }
     }
 
@@ -741,38 +740,40 @@ mod tests {
         assert!(!s.faulty(SatelliteSide::Right, 30 * MS));
     }
 
-    /// One side folds (an offset crash's struck rail), the other moves with the body: the
-    /// boundary is scaled, the floors are not, and only when the tracked prediction allows it.
-    /// Closed form: 60 g above the tunnel for 4 ms is 2.35 m/s of crush (≥ 2.0), the other
-    /// side 0 (≤ 0.3).
+    /// The front end folds — one side (an offset crash's struck rail, the other moving with
+    /// the body) or both: the boundary is scaled, the floors are not, and only when the tracked
+    /// prediction allows it and both satellites are usable. Closed form: 60 g above the tunnel
+    /// for 4 ms is 2.35 m/s of crush (≥ 2.0).
     #[test]
-    fn one_side_folding_scales_the_boundary_only_for_a_tracked_must_fire_crash() {
+    fn a_folding_front_end_scales_the_boundary_only_for_a_tracked_must_fire_crash() {
         let mut s = Satellites::new(params());
         // Not allowed (no tracked must-fire crash): nothing — the lying-satellite case.
         assert_eq!(run(&mut s, 1, 10, 69.0, 9.0, 9.0), Relief::NONE);
         let mut s = Satellites::new(params());
-        s.allow_one_sided(true);
+        s.allow_fold(true);
         let r = run(&mut s, 1, 10, 69.0, 9.0, 9.0);
-        assert_eq!(r.one_sided_scale, 0.4, "{r:?}");
+        assert_eq!(r.fold_scale, 0.4, "{r:?}");
         assert_eq!(r.fraction, 0.0, "the floors stay: {r:?}");
         assert_eq!(r.floor_mps(1.25, 0.3), 1.25 + 0.3);
         assert_eq!(r.boundary_lift_mps, 0.0);
         assert!((r.boundary_mps(2.0) - 0.8).abs() < 1e-12);
         // Held for the relief's hold after the fold was last seen, then gone.
         let held = run(&mut s, 11, 50, 9.0, 9.0, 9.0);
-        assert_eq!(held.one_sided_scale, 0.4);
+        assert_eq!(held.fold_scale, 0.4);
         let gone = run(&mut s, 61, 20, 9.0, 9.0, 9.0);
-        assert_eq!(gone.one_sided_scale, 1.0);
-        // Both sides folding is the full-width relief, not a one-sided one.
+        assert_eq!(gone.fold_scale, 1.0);
+        // Both sides folding: the full-width relief and the fold's scale together.
         let mut s = Satellites::new(params());
-        s.allow_one_sided(true);
+        s.allow_fold(true);
         let r = run(&mut s, 1, 10, 69.0, 69.0, 9.0);
-        assert_eq!((r.fraction, r.one_sided_scale), (1.0, 1.0), "{r:?}");
-        // The other side folding a little (a full-width low-speed crash with one satellite
-        // lying high): over the other side's line, nothing.
+        assert_eq!((r.fraction, r.fold_scale), (1.0, 0.4), "{r:?}");
+        // The whole relief's scale (0.5 here) and the fold's multiply: 2.0 · 0.5 · 0.4.
+        assert!((r.boundary_mps(2.0) - 0.4).abs() < 1e-12);
+        // Under the fold's line on both sides (1.96 m/s: 59 g over the tunnel for 4 ms):
+        // nothing scaled.
         let mut s = Satellites::new(params());
-        s.allow_one_sided(true);
-        assert_eq!(run(&mut s, 1, 10, 69.0, 20.0, 9.0).one_sided_scale, 1.0);
+        s.allow_fold(true);
+        assert_eq!(run(&mut s, 1, 10, 59.0, 9.0, 9.0).fold_scale, 1.0);
     }
 
     /// A satellite that lags the body by more than the implausibility line (dead at rest in a
