@@ -51,14 +51,14 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 venv="$here/target/pyenv"
-# cantools decodes the bus with the DBC; mcap reads the recordings (record/check_mcap.py,
-# record/plot_mcap.py with matplotlib), asammdf the MDF ones (record/check_mf4.py): independent of
-# the project's code.
-if ! "$venv/bin/python3" -c "import cantools, mcap, matplotlib, asammdf" 2>/dev/null; then
-    echo "setup: creating $venv with cantools, mcap, asammdf and matplotlib" >&2
+# cantools decodes the bus with the DBC; python-can sends on it (examples/python); mcap reads the
+# recordings (record/check_mcap.py, record/plot_mcap.py with matplotlib), asammdf the MDF ones
+# (record/check_mf4.py): independent of the project's code.
+if ! "$venv/bin/python3" -c "import can, cantools, mcap, matplotlib, asammdf" 2>/dev/null; then
+    echo "setup: creating $venv with python-can, cantools, mcap, asammdf and matplotlib" >&2
     [ -x "$venv/bin/pip" ] || python3 -m venv "$venv" >&2
-    "$venv/bin/pip" install -q --disable-pip-version-check "cantools>=39" "mcap>=1.2" "matplotlib>=3.7" \
-        "asammdf>=8.0" >&2
+    "$venv/bin/pip" install -q --disable-pip-version-check "python-can>=4.2" "cantools>=39" "mcap>=1.2" \
+        "matplotlib>=3.7" "asammdf>=8.0" >&2
 fi
 
 # The vcan route, prepared now (downloads happen here, not in the middle of a test) and named.
