@@ -159,10 +159,11 @@ impl LighterSet {
             .iter()
             .map(|p| cfg.earliest_airbag_s(&p.pulse))
             .collect();
-        // Where the ECU never fires an airbag it fires the reference's neither.
-        for (p, t) in set.points.iter_mut().zip(&earliest_airbag_s) {
-            if !t.is_finite() {
-                p.reference_without_airbag(occupant, reference, cfg.reserve_m)?;
+        // The reference as the ECU executes it at each truth: its airbag no earlier than the
+        // truth's pulse lets the ECU fire one, and none where it never does.
+        for (p, &t) in set.points.iter_mut().zip(&earliest_airbag_s) {
+            if !t.is_finite() || t > reference.airbag_time_s {
+                p.reference_as_executed(occupant, reference, t, cfg.reserve_m)?;
             }
         }
         Ok(Self {

@@ -123,17 +123,28 @@ pub(crate) struct Point {
 }
 
 impl Point {
-    /// The reference restraint here as the ECU executes it where it never fires an airbag
-    /// (`OptimiserConfig::earliest_airbag_s` infinite): the same belt, no airbag.
-    pub(crate) fn reference_without_airbag(
+    /// The reference restraint here as the ECU executes it, its airbag no earlier than
+    /// `earliest_airbag_s` (`OptimiserConfig::earliest_airbag_s`: when the accelerometer-only
+    /// path lets the ECU fire one for this pulse) and none where that is infinite (the ECU never
+    /// fires an airbag here): the same belt. A table's setting is executed the same way, so the
+    /// two are compared as the ECU runs them, with the table and without.
+    pub(crate) fn reference_as_executed(
         &mut self,
         occupant: &OccupantInput,
         reference: &RestraintSettings,
+        earliest_airbag_s: f64,
         reserve_m: f64,
     ) -> Result<()> {
-        let set = RestraintSettings {
-            airbag_force_n: 0.0,
-            ..*reference
+        let set = if earliest_airbag_s.is_finite() {
+            RestraintSettings {
+                airbag_time_s: reference.airbag_time_s.max(earliest_airbag_s),
+                ..*reference
+            }
+        } else {
+            RestraintSettings {
+                airbag_force_n: 0.0,
+                ..*reference
+            }
         };
         let r = simulate_occupant(
             &self.pulse.ego(),

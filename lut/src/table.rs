@@ -466,8 +466,13 @@ pub fn optimise_point(grid: &Grid, p: &GridPoint, cfg: &OptimiserConfig) -> Resu
 }
 
 /// The cell's optimum if it holds the planning margin over `span_kg` (`lut::margin`), else the
-/// robust setting over the lighter opponents when that one fails at fewer of them (a cell where
-/// no setting holds keeps the better of the two; `lut verify` reports it).
+/// robust setting over the lighter opponents if that one holds it, else the reference
+/// restraint. Why the reference: the margin compares a setting with the reference as the ECU
+/// executes both at every lighter truth (the airbag no earlier than that pulse lets the ECU
+/// fire one), so the reference, planned with the nominal pulse's airbag floor, holds it by
+/// construction — the cell gives up its benefit where no adaptive setting is safe against a
+/// misreported mass, never that safety. Where even the reference fails (it should not), the
+/// setting that fails at fewer truths; `lut verify` reports it.
 fn hold_margin(
     grid: &Grid,
     p: &GridPoint,
@@ -483,26 +488,54 @@ fn hold_margin(
     }
     let (robust, sims) = set.robust_optimum(cfg)?;
     let after = set.judge(p, &robust)?;
-    let failing = |r: &margin::MarginRow| r.bottoms_out_alone + r.strikes_deeper;
-    if failing(&after) >= failing(&before) {
-        return Ok(optimise::Optimum {
-            occupant_simulations: optimum.occupant_simulations + sims,
-            ..optimum
-        });
-    }
     let pulse = pulse_at(&grid.ego, &p.query)?;
+    let failing = |r: &margin::MarginRow| r.bottoms_out_alone + r.strikes_deeper;
+    let settings = if after.ok {
+        robust
+    } else {
+        // Its airbag planned no earlier than the nominal pulse lets the ECU fire one (plan =
+        // fire); where the ECU fires none at the nominal truth it is still planned, for a
+        // lighter truth the ECU does fire at, as the reference does there.
+        let floor_s = cfg.earliest_airbag_s(&pulse);
+        let planned_reference = RestraintSettings {
+            airbag_time_s: if floor_s.is_finite() {
+                reference.airbag_time_s.max(floor_s)
+            } else {
+                reference.airbag_time_s
+            },
+            ..reference
+        };
+        let with_reference = set.judge(p, &planned_reference)?;
+        let best = [
+            (failing(&before), None),
+            (failing(&after), Some(robust)),
+            (failing(&with_reference), Some(planned_reference)),
+        ]
+        .into_iter()
+        .min_by_key(|(n, _)| *n)
+        .and_then(|(_, s)| s);
+        match best {
+            Some(s) => s,
+            None => {
+                return Ok(optimise::Optimum {
+                    occupant_simulations: optimum.occupant_simulations + sims,
+                    ..optimum
+                })
+            }
+        }
+    };
     let case = Case {
         pulse: pulse.ego(),
         occupant: occupant_at(&p.query),
     };
     let (cost, outcomes) = optimise::evaluate(
         &[case],
-        &robust,
+        &settings,
         &RestraintHardware::default(),
         cfg.reserve_m,
     )?;
     Ok(optimise::Optimum {
-        settings: robust,
+        settings,
         cost,
         outcomes,
         occupant_simulations: optimum.occupant_simulations + sims + 1,

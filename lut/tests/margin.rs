@@ -90,6 +90,23 @@ fn the_reference_restraint_planned_anywhere_is_never_worse_than_itself() {
 }
 
 #[test]
+fn the_reference_restraint_executed_late_is_judged_against_itself_executed_late() {
+    // Oracle: with a high airbag floor (3 m/s of Δv before the ECU can fire) the airbag of
+    // every lighter truth goes out later than the reference's 10 ms — the reference's too, as
+    // the ECU executes it without a table — so the reference planned in every cell is the
+    // reference at every truth, and every cell holds.
+    let d = ci_table(Some(&reference()), "3.0", &[]);
+    let rows = verify::check_margin(&d, &reference(), 2400.0, 200.0).unwrap();
+    assert_eq!(rows.len(), 24);
+    for r in &rows {
+        assert!(r.ok, "{r:?}");
+        if r.coords[1] == 1 {
+            assert!(r.worst_change_pct.abs() < 1e-5, "{r:?}");
+        }
+    }
+}
+
+#[test]
 fn a_restraint_too_weak_for_a_crash_fails_where_the_reference_holds_the_occupant() {
     // 1 kN limiter, no airbag, pretensioner after the crash: the occupant strikes through at
     // 74 and 108 km/h where the reference restraint holds him.
@@ -268,6 +285,8 @@ fn a_grid_with_a_robust_span_builds_cells_that_hold_it_or_hold_it_better() {
         "the CI grid should have a cell the plain optimum fails"
     );
     assert!(changed > 0, "no failing cell was re-optimised");
+    // Where no adaptive setting holds, the reference restraint does: every cell holds.
+    assert!(rows_r.iter().all(|x| x.ok), "{rows_r:?}");
     // Grid validation: the span must be a positive, finite mass.
     for bad in ["0.0", "-10.0", "nan"] {
         let e = Grid::parse(
@@ -280,6 +299,36 @@ fn a_grid_with_a_robust_span_builds_cells_that_hold_it_or_hold_it_better() {
             "{e:#}"
         );
     }
+}
+
+#[test]
+fn a_cell_no_adaptive_setting_holds_gets_the_reference_restraint() {
+    // The shipped grid's 57 km/h cells planned for 1 200 kg with 90–105 kg occupants at 200 mm:
+    // the ECU fires no airbag at their own pulse (under the accelerometer-only boundary) but
+    // does at a 1 000 kg truth, late, and no adaptive setting holds the occupant there where
+    // the reference does. The build gives such a cell the reference restraint (its airbag
+    // planned as the ECU can fire it), which holds the span by construction.
+    let shipped = std::fs::read_to_string(workspace().join("data/default-grid.toml")).unwrap();
+    let text = shipped.split("[axes]").next().unwrap().to_string()
+        + "[axes]\nclosing_speed_kph = [48.5, 57.0]\nopponent_mass_kg = [1000.0, 1200.0]\n\
+           occupant_mass_kg = [90.0, 105.0]\nseat_distance_mm = [200.0, 250.0]\n\
+           [robust]\nlighter_opponent_kg = 2400.0\n";
+    let grid = Grid::parse("fast-end", &text).unwrap();
+    assert_eq!(grid.robust_lighter_opponent_kg, Some(2400.0));
+    let (d, _) = table::build_table(&grid, Some(2), true).unwrap();
+    let rows = verify::check_margin(&d, &reference(), 2400.0, margin::DEFAULT_STEP_KG).unwrap();
+    assert!(rows.iter().all(|r| r.ok), "{rows:?}");
+    let r = reference();
+    let as_reference = d
+        .cells()
+        .iter()
+        .filter(|c| {
+            c.belt_limiter_kn == (r.load_limiter_n * 1e-3) as f32
+                && c.airbag_level_kn == (r.airbag_force_n * 1e-3) as f32
+                && c.pretensioner_time_ms == (r.pretensioner_time_s * 1e3) as f32
+        })
+        .count();
+    assert!(as_reference > 0, "no cell fell back to the reference");
 }
 
 #[test]
