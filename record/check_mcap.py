@@ -22,7 +22,11 @@ Checked:
   * with diagnostics.postcard: /ecu/diagnostics holds as many records as the metadata says,
     each at its own timestamp_ns, with the schema's fields, cycle counts rising, the gaps as
     counted in the metadata; /ecu/predicted_pulse at diagnostics times, each pulse as long as
-    its pulse_points.
+    its pulse_points;
+  * /ecu/log (foxglove.Log): one message at each /ecu/diagnostics record whose mode or degraded
+    reasons differ from the one before (the first too), naming the new mode;
+  * every topic's schema offers its messages' fields: each key of each JSON message, nested
+    objects included, is a property of the channel's JSON Schema (what Foxglove's panels list).
 Prints one line per check and exits 1 on the first failure.
 """
 
@@ -135,6 +139,20 @@ def check_sensors(topics, bench, full):
             fail(f"/ecu/diagnostics: batches read but never published: {sorted(named - crash)[:5]}")
     print(f"check_mcap: /sensors: {n} publications of the feeds in order, samples before their publish; "
           f"every crash batch the ECU read is among them; {frames} satellite frames, parity and codes decoded alike")
+
+
+def fields_not_in_schema(msg, schema, path=""):
+    """The dotted paths of msg's object keys that the JSON Schema does not name."""
+    if not isinstance(msg, dict):
+        return []
+    props = schema.get("properties", {})
+    missing = []
+    for k, v in msg.items():
+        if k not in props:
+            missing.append(path + k)
+        else:
+            missing += fields_not_in_schema(v, props[k], path + k + ".")
+    return missing
 
 
 def main():
@@ -297,12 +315,34 @@ def main():
         stamps = {t for t, _, _, _ in diag}
         if any(t not in stamps for t, _, _, _ in pulses):
             fail("/ecu/predicted_pulse: a pulse at a time no diagnostics record has")
+        changes, before = [], None
+        for t, _, msg, _ in diag:
+            now = (msg["mode_name"], tuple(msg["degraded"]))
+            if now != before:
+                changes.append((t, msg["mode_name"]))
+            before = now
+        logs = topics.get("/ecu/log", [])
+        if len(logs) != len(changes) or any(s.name != "foxglove.Log" for _, _, _, s in logs):
+            fail(f"/ecu/log: {len(logs)} foxglove.Log messages, the diagnostics change {len(changes)} times")
+        for (t, mode), (lt, _, m, _) in zip(changes, logs):
+            stamp = m["timestamp"]["sec"] * 1_000_000_000 + m["timestamp"]["nsec"]
+            if lt != t or stamp != t or f"mode {mode}" not in m["message"] and f"-> {mode}" not in m["message"]:
+                fail(f"/ecu/log: {m} at {lt} is not the change to {mode} at {t}")
+        print(f"check_mcap: /ecu/log: {len(logs)} foxglove.Log messages, one per change of mode or degraded reasons")
         print(f"check_mcap: /ecu/diagnostics: {len(diag)} records at their timestamps, {gaps} cycles never published; {len(pulses)} predicted pulses")
         if a.full and not diag:
             fail("--full: no diagnostics")
     elif a.full:
         fail("--full: no diagnostics.postcard")
     check_sensors(topics, bench, a.full)
+    offered = 0
+    for topic, msgs in sorted(topics.items()):
+        for _, _, msg, schema in msgs:
+            missing = fields_not_in_schema(msg, json.loads(schema.data))
+            if missing:
+                fail(f"{topic}: fields {missing} are not in the schema {schema.name}")
+        offered += 1
+    print(f"check_mcap: every field of every message of {offered} topics is in its schema")
     if a.layout:
         layout = json.loads(a.layout.read_text())
         paths = []

@@ -10,6 +10,7 @@
 //! | `/stubs/actions` | `report.json` | action of a module (airbag fire, pretensioner fire / release …) |
 //! | `/stubs/verdict` | `report.json` | run: the occupant outcome, the modes, the required fire time and the airbag's margin |
 //! | `/ecu/diagnostics`, `/ecu/predicted_pulse` | `diagnostics.postcard` (the stubs' log) | cycle; change of the prediction |
+//! | `/ecu/log` (`foxglove.Log`) | `diagnostics.postcard` | change of mode or degraded reasons |
 //! | `/sensors/object`, `/sensors/crash_accel`, `/sensors/safing_accel`, `/sensors/satellite_left`, `/sensors/satellite_right` | `feeds.postcard` (`sensor-feeds --log`) | publication |
 //! | `/truth/world` | the scenario file | ms of the scenario |
 //!

@@ -2,7 +2,7 @@
 
 use bus::{MessageInfo, RawFrame, SignalInfo, CAN_EFF_FLAG};
 use serde_json::{json, Map, Value};
-use signals::{CrashAccelSample, EcuDiagnostics, ObjectState};
+use signals::{CrashAccelSample, EcuDiagnostics, EcuMode, ObjectState};
 
 /// Schema name of `/can/raw`.
 pub const RAW_FRAME_SCHEMA: &str = "restraint_bench.CanFrame";
@@ -181,6 +181,86 @@ pub fn diagnostics(d: &EcuDiagnostics) -> crate::diag_fields::DiagnosticsMessage
     crate::diag_fields::DiagnosticsMessage(d)
 }
 
+/// Schema name of `/ecu/log`: Foxglove's well-known log message, shown in its Log panel.
+pub const LOG_SCHEMA: &str = "foxglove.Log";
+
+/// Foxglove's `foxglove.Log` JSON Schema (foxglove/schemas, `jsonschema/Log.json`).
+pub fn log_schema() -> Value {
+    json!({
+        "title": LOG_SCHEMA,
+        "description": "A log message",
+        "type": "object",
+        "properties": {
+            "timestamp": {
+                "type": "object",
+                "title": "time",
+                "properties": {
+                    "sec": { "type": "integer", "minimum": 0 },
+                    "nsec": { "type": "integer", "minimum": 0, "maximum": 999_999_999 }
+                },
+                "description": "Timestamp of log message"
+            },
+            "level": {
+                "title": "foxglove.LogLevel",
+                "description": "Log level",
+                "oneOf": [
+                    { "title": "UNKNOWN", "const": 0 },
+                    { "title": "DEBUG", "const": 1 },
+                    { "title": "INFO", "const": 2 },
+                    { "title": "WARNING", "const": 3 },
+                    { "title": "ERROR", "const": 4 },
+                    { "title": "FATAL", "const": 5 }
+                ]
+            },
+            "message": { "type": "string", "description": "Log message" },
+            "name": { "type": "string", "description": "Process or node name" },
+            "file": { "type": "string", "description": "Filename" },
+            "line": { "type": "integer", "minimum": 0, "description": "Line number in the file" }
+        }
+    })
+}
+
+/// The `/ecu/log` message of a diagnostics record whose mode or degraded reasons differ from
+/// the previous record's (`prev`; `None` for the first): the new mode and reasons, at WARNING
+/// while degraded, INFO otherwise.
+pub fn mode_change_log(prev: Option<&EcuDiagnostics>, d: &EcuDiagnostics) -> Option<Value> {
+    if prev.is_some_and(|p| p.mode == d.mode && p.degraded_reasons == d.degraded_reasons) {
+        return None;
+    }
+    let mode = EcuMode::from_u8(d.mode).map_or("unknown", EcuMode::name);
+    let reasons: Vec<String> = d
+        .degraded()
+        .iter_names()
+        .map(|(n, _)| n.to_ascii_lowercase())
+        .collect();
+    let mut message = match prev.and_then(|p| EcuMode::from_u8(p.mode)) {
+        Some(p) if p as u8 != d.mode => format!("mode {} -> {mode}", p.name()),
+        Some(_) => format!("mode {mode}"),
+        None => format!("mode {mode} (first record)"),
+    };
+    if !reasons.is_empty() {
+        message.push_str(&format!("; degraded: {}", reasons.join(", ")));
+    } else if prev.is_some_and(|p| p.degraded_reasons != 0) {
+        message.push_str("; no degraded reason");
+    }
+    let level = if d.mode == EcuMode::Degraded as u8 || !reasons.is_empty() {
+        3
+    } else {
+        2
+    };
+    Some(json!({
+        "timestamp": {
+            "sec": d.timestamp_ns / 1_000_000_000,
+            "nsec": d.timestamp_ns % 1_000_000_000
+        },
+        "level": level,
+        "message": message,
+        "name": "ecu",
+        "file": "",
+        "line": 0
+    }))
+}
+
 /// Schema name of `/sensors/object`.
 pub const OBJECT_SCHEMA: &str = "restraint_bench.ObjectState";
 /// Schema name of `/sensors/crash_accel` and `/sensors/safing_accel`.
@@ -300,6 +380,45 @@ pub fn accel_batch_schema() -> Value {
     )
 }
 
+/// JSON Schema of a topic whose messages are another process's JSON records (the actuator
+/// stubs' commands, actions and verdict): the union of every message's fields, so a reader
+/// (Foxglove's panels, any MCAP tool) is offered each of them — one message may lack a field
+/// another has (an action without a force, a command without a SecOC verdict).
+pub fn records_schema<'a>(
+    messages: impl IntoIterator<Item = &'a Value>,
+    title: &str,
+    description: &str,
+) -> Value {
+    let mut union = Value::Null;
+    for m in messages {
+        merge_shape(&mut union, m);
+    }
+    if !union.is_object() {
+        union = json!({});
+    }
+    titled(schema_of(&union), title, description)
+}
+
+/// Widens `into` by `v`'s shape: objects take every key of both, a missing or null value takes
+/// the other's, an integer meeting a float becomes the float, arrays merge their first items.
+fn merge_shape(into: &mut Value, v: &Value) {
+    match (into, v) {
+        (Value::Object(a), Value::Object(b)) => {
+            for (k, x) in b {
+                merge_shape(a.entry(k.clone()).or_insert(Value::Null), x);
+            }
+        }
+        (Value::Array(a), Value::Array(b)) => match (a.first_mut(), b.first()) {
+            (Some(x), Some(y)) => merge_shape(x, y),
+            (None, Some(y)) => a.push(y.clone()),
+            _ => {}
+        },
+        (slot @ Value::Null, x) => *slot = x.clone(),
+        (slot @ Value::Number(_), Value::Number(n)) if n.is_f64() => *slot = v.clone(),
+        _ => {}
+    }
+}
+
 fn titled(mut s: Value, title: &str, description: &str) -> Value {
     if let Some(o) = s.as_object_mut() {
         o.insert("title".into(), json!(title));
@@ -343,6 +462,69 @@ fn schema_of(v: &Value) -> Value {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_log_message_marks_each_change_of_mode_or_degraded_reasons() {
+        use signals::{Degraded, EcuDiagnostics, EcuMode};
+        let at = |t_ns: u64, mode: EcuMode, reasons: Degraded| EcuDiagnostics {
+            timestamp_ns: t_ns,
+            mode: mode as u8,
+            degraded_reasons: reasons.bits(),
+            ..EcuDiagnostics::ZERO
+        };
+        let a = at(1_500_000_000, EcuMode::Monitoring, Degraded::empty());
+        let b = at(2_000_000_001, EcuMode::PreCrash, Degraded::empty());
+        let c = at(2_001_000_000, EcuMode::PreCrash, Degraded::OBJECT_STALE);
+        let first = super::mode_change_log(None, &a).unwrap();
+        assert_eq!(first["message"], "mode monitoring (first record)");
+        assert_eq!(first["level"], 2);
+        assert_eq!(first["timestamp"], json!({ "sec": 1, "nsec": 500_000_000 }));
+        assert!(
+            super::mode_change_log(Some(&a), &a).is_none(),
+            "no change, no message"
+        );
+        let m = super::mode_change_log(Some(&a), &b).unwrap();
+        assert_eq!(m["message"], "mode monitoring -> pre-crash");
+        assert_eq!(m["timestamp"], json!({ "sec": 2, "nsec": 1 }));
+        let d = super::mode_change_log(Some(&b), &c).unwrap();
+        assert_eq!(d["message"], "mode pre-crash; degraded: object_stale");
+        assert_eq!(d["level"], 3, "a degraded reason is a warning");
+        let back = super::mode_change_log(Some(&c), &b).unwrap();
+        assert_eq!(back["message"], "mode pre-crash; no degraded reason");
+        // Every message is what the schema names.
+        let s = super::log_schema();
+        for k in first.as_object().unwrap().keys() {
+            assert!(s["properties"].get(k).is_some(), "{k}");
+        }
+    }
+
+    #[test]
+    fn a_records_schema_offers_every_field_any_message_has() {
+        let msgs = [
+            json!({ "t_ms": 1, "kind": "airbag_fire", "force_kn": null, "stage": { "n": 1 } }),
+            json!({ "t_ms": 2.5, "kind": "release", "extra": [1, 2], "stage": { "m": true } }),
+            json!({ "force_kn": 12.0 }),
+        ];
+        let s = super::records_schema(&msgs, "T", "D");
+        let p = &s["properties"];
+        assert_eq!(s["title"], "T");
+        assert_eq!(
+            p["t_ms"]["type"],
+            json!(["number", "null"]),
+            "int then float: a number"
+        );
+        assert_eq!(p["kind"]["type"], "string");
+        assert_eq!(
+            p["force_kn"]["type"],
+            json!(["number", "null"]),
+            "null, then a value"
+        );
+        assert_eq!(p["extra"]["items"]["type"], "integer");
+        let stage = &p["stage"]["properties"];
+        assert!(stage.get("n").is_some() && stage.get("m").is_some(), "{s}");
+        // No message at all: still an object schema.
+        assert_eq!(super::records_schema(&[], "T", "D")["title"], "T");
+    }
+
     use super::*;
 
     #[test]

@@ -5,7 +5,7 @@ use crate::schema;
 use anyhow::{bail, Context, Result};
 use mcap::records::MessageHeader;
 use mcap::write::{Metadata, Writer};
-use serde_json::{json, Value};
+use serde_json::Value;
 use signals::FeedItem;
 use std::collections::{BTreeMap, HashMap};
 use std::io::BufWriter;
@@ -257,8 +257,21 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
 
     let diag_schema = schema::diagnostics_schema();
     let pulse_schema = schema::predicted_pulse_schema();
+    let log_schema = schema::log_schema();
     let mut last_pulse: Option<schema::PulseMessage> = None;
+    let mut prev = None;
     for d in &diagnostics.0 {
+        if let Some(log) = schema::mode_change_log(prev, d) {
+            rec.write(
+                "/ecu/log",
+                schema::LOG_SCHEMA,
+                &log_schema,
+                d.timestamp_ns,
+                d.timestamp_ns,
+                &log,
+            )?;
+        }
+        prev = Some(d);
         let pulse = schema::predicted_pulse(d);
         if last_pulse.as_ref() != Some(&pulse) {
             rec.write(
@@ -327,7 +340,11 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         }
     }
 
-    let any = json!({ "type": "object" });
+    let commands_schema = schema::records_schema(
+        &commands,
+        "restraint_bench.StubsCommand",
+        "One command frame the actuator stubs received (CLOCK_MONOTONIC receive time), decoded, with its E2E and SecOC verdict (actuator-stubs/README.md)",
+    );
     // The truth of a scenario that cannot be loaded (a damaged file of the campaign) is left
     // out and said so in the metadata; everything else is still recorded.
     let truth = meta.scenario.as_ref().map(|path| {
@@ -365,7 +382,7 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         rec.write(
             "/stubs/commands",
             "restraint_bench.StubsCommand",
-            &any,
+            &commands_schema,
             t,
             t,
             c,
@@ -374,18 +391,26 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
     if let Some((r, report_json)) = &report {
         // The channel exists in a run without actions too (no fire is an outcome; a layout's
         // panel then shows an empty topic, not a missing one).
-        rec.topic("/stubs/actions", "restraint_bench.StubsAction", &any)?;
-        for (a, v) in r.actions.iter().zip(
-            report_json["actions"]
-                .as_array()
-                .map(Vec::as_slice)
-                .unwrap_or(&[]),
-        ) {
+        let actions = report_json["actions"]
+            .as_array()
+            .map(Vec::as_slice)
+            .unwrap_or(&[]);
+        let actions_schema = schema::records_schema(
+            actions,
+            "restraint_bench.StubsAction",
+            "One action of a restraint module the stubs act as (airbag fire, pretensioner fire or release …), at the stubs' clock",
+        );
+        rec.topic(
+            "/stubs/actions",
+            "restraint_bench.StubsAction",
+            &actions_schema,
+        )?;
+        for (a, v) in r.actions.iter().zip(actions) {
             let t = r.start_ns.saturating_add((a.t_ms * 1e6).round() as u64);
             rec.write(
                 "/stubs/actions",
                 "restraint_bench.StubsAction",
-                &any,
+                &actions_schema,
                 t,
                 t,
                 v,
@@ -399,10 +424,15 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         if let Some(o) = verdict.as_object_mut() {
             o.remove("actions");
         }
+        let verdict_schema = schema::records_schema(
+            [&verdict],
+            "restraint_bench.StubsReport",
+            "The stubs' verdict on the run: the occupant outcome with the adaptive and the reference restraint, the modes, the required fire time and the airbag's margin (report.json without its actions)",
+        );
         rec.write(
             "/stubs/verdict",
             "restraint_bench.StubsReport",
-            &any,
+            &verdict_schema,
             end,
             end,
             &verdict,
