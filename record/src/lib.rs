@@ -35,6 +35,7 @@ pub mod schema;
 pub mod write;
 
 pub use mf4::{summary_line as mf4_summary_line, write_run_mf4, Mf4Summary, RUN_MF4};
+pub use run_folder::run_clock_offset_ns;
 pub use write::{write_run, RunMeta, WriteSummary};
 
 /// The sensor feeds' log of what they published in a run folder (`sensor-feeds --log`,

@@ -92,6 +92,24 @@ impl RunFiles {
     }
 }
 
+/// A run folder's CLOCK_REALTIME − CLOCK_MONOTONIC offset, ns, as its recordings use it — from
+/// `candump.log` and `commands.jsonl` alone (`None`: no frame both saw, or no commands): what
+/// puts a bench time on candump's clock.
+///
+/// # Errors
+/// `candump.log` or `commands.jsonl` cannot be read.
+pub fn run_clock_offset_ns(dir: &Path) -> Result<Option<i64>> {
+    let candump_path = dir.join("candump.log");
+    let log = CandumpLog::read(&candump_path)
+        .with_context(|| format!("reading {}", candump_path.display()))?;
+    let commands_path = dir.join("commands.jsonl");
+    if !commands_path.exists() {
+        return Ok(None);
+    }
+    let (commands, _) = read_jsonl(&commands_path)?;
+    Ok(clock_offset_ns(&log, &commands))
+}
+
 /// candump's realtime stamps against the stubs' monotonic times of the same frames: the median
 /// difference, ns (module docs).
 fn clock_offset_ns(log: &CandumpLog, commands: &[Value]) -> Option<i64> {

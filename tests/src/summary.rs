@@ -68,9 +68,22 @@ pub fn summarise(
         );
     }
     if r.contact_ns != 0 {
+        // On candump's clock too (its `-L` stamps are CLOCK_REALTIME), to find the contact in
+        // the bus log: the bench's monotonic time plus the offset the recordings measure.
+        let stamp = record::run_clock_offset_ns(dir)
+            .ok()
+            .flatten()
+            .and_then(|o| r.contact_ns.checked_add_signed(o))
+            .map_or_else(String::new, |t| {
+                format!(
+                    "  (candump -L stamp ({}.{:06}))",
+                    t / 1_000_000_000,
+                    t % 1_000_000_000 / 1_000
+                )
+            });
         let _ = writeln!(
             s,
-            "  contact                                          {}",
+            "  contact                                          {}{stamp}",
             ms(Some(0.0))
         );
     } else {

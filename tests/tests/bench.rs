@@ -165,6 +165,57 @@ fn every_scenario_meets_its_declared_expectations() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// The summary puts the contact on candump's clock: the first AirbagStageCmd with Fire in the
+/// run's candump.log is stamped the airbag's time after contact (the stubs' receive time, on
+/// the bench's monotonic clock) after it, within 1 ms.
+#[test]
+fn the_summary_gives_the_contact_on_candumps_clock() {
+    let mut checked = 0;
+    for (_, r) in all() {
+        let Some(fire) = r.action("airbag_fire") else {
+            continue;
+        };
+        let Some(after_ms) = fire.after_contact_ms else {
+            continue;
+        };
+        let dir = bench_run().join(&r.scenario);
+        let summary = std::fs::read_to_string(dir.join("summary.txt")).expect("summary.txt");
+        let line = summary
+            .lines()
+            .find(|l| l.trim_start().starts_with("contact "))
+            .unwrap_or_else(|| panic!("{}: no contact line\n{summary}", r.scenario));
+        let stamp = line
+            .split("candump -L stamp (")
+            .nth(1)
+            .and_then(|t| t.split(')').next())
+            .and_then(|t| t.parse::<f64>().ok())
+            .unwrap_or_else(|| panic!("{}: no candump stamp in {line:?}", r.scenario));
+        let log = bus::candump::CandumpLog::read(&dir.join("candump.log")).expect("candump.log");
+        let fired_s = log
+            .frames
+            .iter()
+            .find(|f| {
+                f.frame.id == bus::AirbagStageCmd::RAW_ID
+                    && matches!(
+                        bus::decode(f.frame.id, &f.frame.data[..usize::from(f.frame.len)]),
+                        Ok(bus::Messages::AirbagStageCmd(m))
+                            if matches!(m.fire(), bus::codec::AirbagStageCmdFire::Fire)
+                    )
+            })
+            .map(|f| f.t_us as f64 * 1e-6)
+            .unwrap_or_else(|| panic!("{}: no Fire frame in candump.log", r.scenario));
+        let got_ms = (fired_s - stamp) * 1e3;
+        assert!(
+            (got_ms - after_ms).abs() <= 1.0,
+            "{}: the Fire frame is {got_ms:+.3} ms after the summary's contact stamp, the stubs \
+             received it {after_ms:+.3} ms after contact",
+            r.scenario
+        );
+        checked += 1;
+    }
+    assert!(checked >= 5, "only {checked} runs fired an airbag");
+}
+
 #[test]
 fn every_run_keeps_the_configuration_its_ecu_ran_with() {
     for p in library() {
