@@ -13,7 +13,8 @@ Checked:
   * every frame's log time is its publish time minus the file's realtime − monotonic offset
     (metadata `bench`), the same for every frame;
   * every frame of a DBC message is on /can/<name> with the same times, and each signal's value
-    equals cantools' decode of the same bytes (scaled, no value-table names);
+    equals cantools' decode of the same bytes (scaled, no value-table names), and each
+    value-table signal's schema names its values as cantools' choices do;
   * with commands.jsonl: every record is on /stubs/commands unchanged, at its rx_mono_ns;
   * with report.json: one /stubs/actions message per action, one /stubs/verdict carrying the
     report's required fire time (true_crash.required_ms) and margin_ms; /truth/world
@@ -222,7 +223,16 @@ def main():
                 if not math.isclose(float(msg[sig]), float(v), rel_tol=1e-9, abs_tol=1e-9):
                     fail(f"/can/{name}.{sig}: {msg[sig]} vs cantools {v} ({fr['data'].hex()})")
             decoded += 1
-    print(f"check_mcap: /can/<message>: {decoded} frames of {len(by_id)} DBC messages, every signal equals cantools' decode")
+        # The schema names each value-table signal's values as cantools' choices do.
+        if got:
+            props = json.loads(got[0][3].data)["properties"]
+            m = items[0][1]
+            for sig in m.signals:
+                want = {int(k): str(v) for k, v in (sig.choices or {}).items()}
+                have = {int(e["const"]): e["title"] for e in props[sig.name].get("oneOf", [])}
+                if have != want:
+                    fail(f"/can/{name}.{sig.name}: schema values {have} vs the DBC's {want}")
+    print(f"check_mcap: /can/<message>: {decoded} frames of {len(by_id)} DBC messages, every signal equals cantools' decode, every value table named in the schema")
 
     cmd_path = a.run_dir / "commands.jsonl"
     if cmd_path.exists():

@@ -49,7 +49,9 @@ pub fn message_schema_name(m: &MessageInfo) -> String {
 }
 
 /// JSON Schema of a DBC message's topic: one number per signal (its physical value), described
-/// by unit, range and bit layout.
+/// by unit, range and bit layout, and a signal with a value table (`VAL_`) by its names: each
+/// value a `oneOf` entry titled with the DBC's name (as cantools' `decode_choices` gives it),
+/// listed in the description too.
 pub fn message_schema(m: &MessageInfo, signals: &[SignalInfo]) -> Value {
     let mut props = Map::new();
     for s in signals {
@@ -61,19 +63,32 @@ pub fn message_schema(m: &MessageInfo, signals: &[SignalInfo]) -> Value {
         );
         p.insert(
             "description".into(),
-            json!(format!(
-                "{}{}[{} … {}], bits {}+{}{}, phys = raw × {} + {}",
-                s.unit,
-                if s.unit.is_empty() { "" } else { ", " },
-                s.min,
-                s.max,
-                s.start_bit,
-                s.size,
-                if s.signed { " signed" } else { "" },
-                s.factor,
-                s.offset
-            )),
+            json!(
+                format!(
+                    "{}{}[{} … {}], bits {}+{}{}, phys = raw × {} + {}",
+                    s.unit,
+                    if s.unit.is_empty() { "" } else { ", " },
+                    s.min,
+                    s.max,
+                    s.start_bit,
+                    s.size,
+                    if s.signed { " signed" } else { "" },
+                    s.factor,
+                    s.offset
+                ) + &value_names(s)
+            ),
         );
+        if !s.values.is_empty() {
+            p.insert(
+                "oneOf".into(),
+                Value::Array(
+                    s.values
+                        .iter()
+                        .map(|&(raw, name)| json!({ "const": phys_of(s, raw), "title": name }))
+                        .collect(),
+                ),
+            );
+        }
         props.insert(s.name.into(), Value::Object(p));
     }
     json!({
@@ -86,6 +101,30 @@ pub fn message_schema(m: &MessageInfo, signals: &[SignalInfo]) -> Value {
         "properties": props,
         "required": signals.iter().map(|s| s.name).collect::<Vec<_>>(),
     })
+}
+
+/// A value-table signal's names for its description: "; values: 0 = NoFire, 1 = Fire".
+fn value_names(s: &SignalInfo) -> String {
+    if s.values.is_empty() {
+        return String::new();
+    }
+    let names: Vec<String> = s
+        .values
+        .iter()
+        .map(|&(raw, name)| format!("{} = {name}", phys_of(s, raw)))
+        .collect();
+    format!("; values: {}", names.join(", "))
+}
+
+/// A raw value's physical value, as the topic's message carries it (an integer where the
+/// signal decodes to integers).
+fn phys_of(s: &SignalInfo, raw: i64) -> Value {
+    let v = raw as f64 * s.factor + s.offset;
+    if decodes_to_integer(s) {
+        json!(v as i64)
+    } else {
+        json!(v)
+    }
 }
 
 /// Integral step and offset: the signal decodes to integers, as cantools gives them (schema
@@ -536,8 +575,35 @@ mod tests {
             assert_eq!(props.len(), sigs.len(), "{}", m.name);
             for sig in sigs {
                 assert!(props.contains_key(sig.name), "{}.{}", m.name, sig.name);
+                // A value table: every DBC name, at its raw value.
+                let one_of = props[sig.name]["oneOf"]
+                    .as_array()
+                    .map_or(&[][..], Vec::as_slice);
+                assert_eq!(one_of.len(), sig.values.len(), "{}.{}", m.name, sig.name);
+                for (&(raw, name), e) in sig.values.iter().zip(one_of) {
+                    assert_eq!(e["title"], name, "{}.{}", m.name, sig.name);
+                    assert_eq!(
+                        e["const"].as_f64(),
+                        Some(raw as f64),
+                        "{}.{}",
+                        m.name,
+                        sig.name
+                    );
+                }
             }
         }
+        // Read from the DBC's own text: `VAL_ 48 Fire 0 "NoFire" 1 "Fire" ;`.
+        let m = bus::message_info(bus::AirbagStageCmd::RAW_ID).unwrap();
+        let s = message_schema(m, bus::signals_of(m.id).unwrap());
+        let fire = s["properties"]["Fire"]["oneOf"].as_array().unwrap();
+        assert!(
+            fire.contains(&serde_json::json!({ "const": 1, "title": "Fire" })),
+            "{s}"
+        );
+        assert!(
+            fire.contains(&serde_json::json!({ "const": 0, "title": "NoFire" })),
+            "{s}"
+        );
     }
 
     #[test]
