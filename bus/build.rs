@@ -233,11 +233,12 @@ fn generate_meta(dbc: &Dbc) -> String {
             } else {
                 "&[]".to_owned()
             };
+            let comment = dbc.signal_comment(msg.id, &s.name).unwrap_or("");
             writeln!(
                 sig_rows,
                 "    SignalInfo {{ name: {:?}, start_bit: {}, size: {}, signed: {signed}, factor: {:?}, \
                  offset: {:?}, min: {min:?}, max: {max:?}, raw_min: {raw_min}, raw_max: {raw_max}, unit: {:?}, \
-                 values: {values} }},",
+                 values: {values}, comment: {comment:?} }},",
                 s.name, s.start_bit, s.size, s.factor, s.offset, s.unit
             )
             .unwrap();

@@ -14,7 +14,8 @@ Checked:
     (metadata `bench`), the same for every frame;
   * every frame of a DBC message is on /can/<name> with the same times, and each signal's value
     equals cantools' decode of the same bytes (scaled, no value-table names), and each
-    value-table signal's schema names its values as cantools' choices do;
+    value-table signal's schema names its values as cantools' choices do, and each schema
+    carries the signal's DBC comment;
   * with commands.jsonl: every record is on /stubs/commands unchanged, at its rx_mono_ns;
   * with report.json: one /stubs/actions message per action, one /stubs/verdict carrying the
     report's required fire time (true_crash.required_ms) and margin_ms; /truth/world
@@ -228,11 +229,13 @@ def main():
             props = json.loads(got[0][3].data)["properties"]
             m = items[0][1]
             for sig in m.signals:
+                if sig.comment and not props[sig.name].get("description", "").startswith(sig.comment):
+                    fail(f"/can/{name}.{sig.name}: the schema's description does not carry the DBC comment")
                 want = {int(k): str(v) for k, v in (sig.choices or {}).items()}
                 have = {int(e["const"]): e["title"] for e in props[sig.name].get("oneOf", [])}
                 if have != want:
                     fail(f"/can/{name}.{sig.name}: schema values {have} vs the DBC's {want}")
-    print(f"check_mcap: /can/<message>: {decoded} frames of {len(by_id)} DBC messages, every signal equals cantools' decode, every value table named in the schema")
+    print(f"check_mcap: /can/<message>: {decoded} frames of {len(by_id)} DBC messages, every signal equals cantools' decode, every value table and comment in the schema")
 
     cmd_path = a.run_dir / "commands.jsonl"
     if cmd_path.exists():

@@ -48,6 +48,8 @@ pub struct SignalInfo {
     pub unit: &'static str,
     /// The signal's value table (`VAL_`: raw value → DBC name; empty when it has none).
     pub values: &'static [(i64, &'static str)],
+    /// The DBC's comment on the signal (`CM_ SG_`; empty when it has none).
+    pub comment: &'static str,
 }
 
 impl SignalInfo {

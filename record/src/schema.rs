@@ -49,7 +49,8 @@ pub fn message_schema_name(m: &MessageInfo) -> String {
 }
 
 /// JSON Schema of a DBC message's topic: one number per signal (its physical value), described
-/// by unit, range and bit layout, and a signal with a value table (`VAL_`) by its names: each
+/// by the DBC's comment, unit, range and bit layout, and a signal with a value table (`VAL_`)
+/// by its names: each
 /// value a `oneOf` entry titled with the DBC's name (as cantools' `decode_choices` gives it),
 /// listed in the description too.
 pub fn message_schema(m: &MessageInfo, signals: &[SignalInfo]) -> Value {
@@ -65,7 +66,9 @@ pub fn message_schema(m: &MessageInfo, signals: &[SignalInfo]) -> Value {
             "description".into(),
             json!(
                 format!(
-                    "{}{}[{} … {}], bits {}+{}{}, phys = raw × {} + {}",
+                    "{}{}{}{}[{} … {}], bits {}+{}{}, phys = raw × {} + {}",
+                    s.comment,
+                    if s.comment.is_empty() { "" } else { " — " },
                     s.unit,
                     if s.unit.is_empty() { "" } else { ", " },
                     s.min,
@@ -592,9 +595,15 @@ mod tests {
                 }
             }
         }
-        // Read from the DBC's own text: `VAL_ 48 Fire 0 "NoFire" 1 "Fire" ;`.
+        // Read from the DBC's own text: `CM_ SG_ 48 Arm "Arming: …"` and
+        // `VAL_ 48 Fire 0 "NoFire" 1 "Fire" ;`.
         let m = bus::message_info(bus::AirbagStageCmd::RAW_ID).unwrap();
         let s = message_schema(m, bus::signals_of(m.id).unwrap());
+        let arm = s["properties"]["Arm"]["description"].as_str().unwrap();
+        assert!(
+            arm.starts_with("Arming: the module may only fire while armed. — "),
+            "{arm}"
+        );
         let fire = s["properties"]["Fire"]["oneOf"].as_array().unwrap();
         assert!(
             fire.contains(&serde_json::json!({ "const": 1, "title": "Fire" })),
