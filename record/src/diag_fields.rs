@@ -105,13 +105,24 @@ impl Serialize for DiagnosticsMessage<'_> {
                 Num::F(_) => m.serialize_entry(f.name, &())?,
             }
         }
-        m.serialize_entry(
-            "mode_name",
-            EcuMode::from_u8(d.mode).map_or("unknown", EcuMode::name),
-        )?;
+        m.serialize_entry("mode_name", mode_name(d.mode))?;
         m.serialize_entry("degraded", &DegradedNames(d.degraded_reasons))?;
         m.end()
     }
+}
+
+/// A mode byte's name (`unknown` for a byte no mode has): the diagnostics' `mode_name` and the
+/// mode-change log's.
+pub(crate) fn mode_name(mode: u8) -> &'static str {
+    EcuMode::from_u8(mode).map_or("unknown", EcuMode::name)
+}
+
+/// The names of the degraded-reason bits set in `bits`, lower case (unknown bits dropped): the
+/// diagnostics' `degraded` and the mode-change log's.
+pub(crate) fn degraded_names(bits: u32) -> impl Iterator<Item = String> {
+    Degraded::from_bits_truncate(bits)
+        .iter_names()
+        .map(|(n, _)| n.to_ascii_lowercase())
 }
 
 /// The names of the degraded-reason bits, lower case.
@@ -119,11 +130,7 @@ struct DegradedNames(u32);
 
 impl Serialize for DegradedNames {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.collect_seq(
-            Degraded::from_bits_truncate(self.0)
-                .iter_names()
-                .map(|(n, _)| n.to_ascii_lowercase()),
-        )
+        s.collect_seq(degraded_names(self.0))
     }
 }
 

@@ -119,14 +119,14 @@ fn value_names(s: &SignalInfo) -> String {
     format!("; values: {}", names.join(", "))
 }
 
-/// A raw value's physical value, as the topic's message carries it (an integer where the
-/// signal decodes to integers).
+/// A raw value's physical value as the topic's messages and its value table carry it: an
+/// integer where the signal decodes to integers, else `raw · factor + offset`
+/// ([`SignalInfo::value`]'s).
 fn phys_of(s: &SignalInfo, raw: i64) -> Value {
-    let v = raw as f64 * s.factor + s.offset;
     if decodes_to_integer(s) {
-        json!(v as i64)
+        json!(raw * s.factor as i64 + s.offset as i64)
     } else {
-        json!(v)
+        json!(raw as f64 * s.factor + s.offset)
     }
 }
 
@@ -142,12 +142,7 @@ fn decodes_to_integer(s: &SignalInfo) -> bool {
 pub fn message_values(signals: &[SignalInfo], payload: &[u8]) -> Value {
     let mut o = Map::new();
     for s in signals {
-        let v = if decodes_to_integer(s) {
-            json!(s.raw(payload) * s.factor as i64 + s.offset as i64)
-        } else {
-            json!(s.value(payload))
-        };
-        o.insert(s.name.into(), v);
+        o.insert(s.name.into(), phys_of(s, s.raw(payload)));
     }
     Value::Object(o)
 }
@@ -269,12 +264,8 @@ pub fn mode_change_log(prev: Option<&EcuDiagnostics>, d: &EcuDiagnostics) -> Opt
     if prev.is_some_and(|p| p.mode == d.mode && p.degraded_reasons == d.degraded_reasons) {
         return None;
     }
-    let mode = EcuMode::from_u8(d.mode).map_or("unknown", EcuMode::name);
-    let reasons: Vec<String> = d
-        .degraded()
-        .iter_names()
-        .map(|(n, _)| n.to_ascii_lowercase())
-        .collect();
+    let mode = crate::diag_fields::mode_name(d.mode);
+    let reasons: Vec<String> = crate::diag_fields::degraded_names(d.degraded_reasons).collect();
     let mut message = match prev.and_then(|p| EcuMode::from_u8(p.mode)) {
         Some(p) if p as u8 != d.mode => format!("mode {} -> {mode}", p.name()),
         Some(_) => format!("mode {mode}"),
