@@ -73,6 +73,28 @@ impl OfflineConfig {
         Ok(self)
     }
 
+    /// What the offline tools run with from their flags: the ECU config file `config`
+    /// (`--config`, [`Self::from_ecu_config_file`]) or the shipped configuration
+    /// ([`Self::shipped`]), with `cycle_config`'s `[cycle]` keys over it (`--cycle-config`,
+    /// [`Self::with_cycle_file`]; the tools let only one of the two files be given).
+    ///
+    /// # Errors
+    /// As the three constructors.
+    pub fn from_flags(
+        repo: &std::path::Path,
+        config: Option<&std::path::Path>,
+        cycle_config: Option<&std::path::Path>,
+    ) -> Result<Self> {
+        let cfg = match config {
+            Some(path) => Self::from_ecu_config_file(path)?,
+            None => Self::shipped(repo).context("offline bench configuration")?,
+        };
+        match cycle_config {
+            Some(path) => cfg.with_cycle_file(path),
+            None => Ok(cfg),
+        }
+    }
+
     /// The decision settings, table and reference restraint of an ECU config file, read as
     /// `ecu --config FILE` reads it (one reader, the ECU's own layers: the file over the
     /// defaults, `ECU_*` variables over the file; the `[cycle]` table's files relative to the

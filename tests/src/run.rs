@@ -502,6 +502,8 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
         scenario: Some(cfg.scenario.clone()),
         simulated_start_ns: None,
     };
+    // The realtime − monotonic offset the recording measured (None: it is written later).
+    let mut written_offset: Option<Option<i64>> = None;
     let recording = if record::pending::deferred() {
         // The caller writes it on the host when the guest has ended (record::pending).
         record::pending::defer(&dir, &meta).map(|()| {
@@ -514,6 +516,7 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     } else {
         let recording_started = std::time::Instant::now();
         record::write_run(&dir, &dir.join(record::RUN_MCAP), &meta).map(|s| {
+            written_offset = Some(s.realtime_minus_monotonic_ns);
             // Its cost, on the clock the run ran on (the guest's own on an emulated route),
             // against the whole run's (≤ 5 %).
             let recording_s = recording_started.elapsed().as_secs_f64();
@@ -528,7 +531,18 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
     let recording = recording
         .map_err(|e| problems.push(format!("recording: {e:#}")))
         .ok();
-    let mut summary = summarise(&scenario, &report, ecu_report.as_ref(), &dir, &problems);
+    // The summary puts the contact on candump's clock with the recording's offset, measured
+    // from the run folder only when the recording has not been written yet.
+    let clock_offset_ns =
+        || written_offset.unwrap_or_else(|| record::run_clock_offset_ns(&dir).ok().flatten());
+    let mut summary = summarise(
+        &scenario,
+        &report,
+        ecu_report.as_ref(),
+        &dir,
+        &clock_offset_ns,
+        &problems,
+    );
     if let Some(line) = recording {
         let _ = writeln!(summary, "{line}");
     }

@@ -9,12 +9,14 @@ fn ms(v: Option<f64>) -> String {
     v.map_or_else(|| "—".to_owned(), |x| format!("{x:+8.1} ms"))
 }
 
-/// The readable summary of one run.
+/// The readable summary of one run (`clock_offset_ns`: the run's CLOCK_REALTIME −
+/// CLOCK_MONOTONIC offset, asked only for a run with a contact).
 pub fn summarise(
     scenario: &world::Scenario,
     r: &Report,
     ecu: Option<&serde_json::Value>,
     dir: &Path,
+    clock_offset_ns: &dyn Fn() -> Option<i64>,
     problems: &[String],
 ) -> String {
     let mut s = String::new();
@@ -70,9 +72,7 @@ pub fn summarise(
     if r.contact_ns != 0 {
         // On candump's clock too (its `-L` stamps are CLOCK_REALTIME), to find the contact in
         // the bus log: the bench's monotonic time plus the offset the recordings measure.
-        let stamp = record::run_clock_offset_ns(dir)
-            .ok()
-            .flatten()
+        let stamp = clock_offset_ns()
             .and_then(|o| r.contact_ns.checked_add_signed(o))
             .map_or_else(String::new, |t| {
                 format!(

@@ -191,18 +191,8 @@ fn the_summary_gives_the_contact_on_candumps_clock() {
             .and_then(|t| t.parse::<f64>().ok())
             .unwrap_or_else(|| panic!("{}: no candump stamp in {line:?}", r.scenario));
         let log = bus::candump::CandumpLog::read(&dir.join("candump.log")).expect("candump.log");
-        let fired_s = log
-            .frames
-            .iter()
-            .find(|f| {
-                f.frame.id == bus::AirbagStageCmd::RAW_ID
-                    && matches!(
-                        bus::decode(f.frame.id, &f.frame.data[..usize::from(f.frame.len)]),
-                        Ok(bus::Messages::AirbagStageCmd(m))
-                            if matches!(m.fire(), bus::codec::AirbagStageCmdFire::Fire)
-                    )
-            })
-            .map(|f| f.t_us as f64 * 1e-6)
+        let fired_s = e2e_tests::faults::first_airbag_fire(&log)
+            .map(|k| log.frames[k].t_us as f64 * 1e-6)
             .unwrap_or_else(|| panic!("{}: no Fire frame in candump.log", r.scenario));
         let got_ms = (fired_s - stamp) * 1e3;
         assert!(

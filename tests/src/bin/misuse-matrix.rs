@@ -456,13 +456,7 @@ fn run_matrix() -> Result<()> {
         }
     }
     // `--config` and `--cycle-config` exclude each other (clap).
-    let mut cfg = match &cli.config {
-        Some(path) => OfflineConfig::from_ecu_config_file(path)?,
-        None => OfflineConfig::shipped(&repo).context("offline bench configuration")?,
-    };
-    if let Some(path) = &cli.cycle_config {
-        cfg = cfg.with_cycle_file(path)?;
-    }
+    let cfg = OfflineConfig::from_flags(&repo, cli.config.as_deref(), cli.cycle_config.as_deref())?;
     for f in &cli.families {
         anyhow::ensure!(
             misuse::family(f).is_some(),

@@ -82,13 +82,8 @@ fn run_all() -> Result<bool> {
         files = e2e_tests::library_files(&repo)?;
     }
     // `--config` and `--cycle-config` exclude each other (clap).
-    let mut cfg = match &cli.config {
-        Some(path) => OfflineConfig::from_ecu_config_file(path)?,
-        None => OfflineConfig::shipped(&repo)?,
-    };
-    if let Some(path) = &cli.cycle_config {
-        cfg = cfg.with_cycle_file(path)?;
-    }
+    let mut cfg =
+        OfflineConfig::from_flags(&repo, cli.config.as_deref(), cli.cycle_config.as_deref())?;
     if cli.no_lut {
         cfg.lut = None;
     }

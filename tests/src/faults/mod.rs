@@ -33,7 +33,7 @@ pub use cases::*;
 pub use judge::judge;
 pub(crate) use mutations::frozen_scenario;
 use mutations::{damaged_lut, forged_frames};
-pub use mutations::{lengthened_scenario, recorded_fire_pair, variant_scenario};
+pub use mutations::{first_airbag_fire, lengthened_scenario, recorded_fire_pair, variant_scenario};
 pub use report::report_text;
 
 use crate::{Disturbance, RunConfig, RunCtx, RunResult, SideProcess};

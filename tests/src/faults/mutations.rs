@@ -189,24 +189,34 @@ pub fn lengthened_scenario(src: &Path, dir: &Path, extra_s: f64) -> Result<PathB
     Ok(path)
 }
 
+/// Where the first airbag Fire command is in a candump log (an `AirbagStageCmd` whose `Fire`
+/// signal says Fire, as the bits lie).
+pub fn first_airbag_fire(log: &bus::candump::CandumpLog) -> Option<usize> {
+    log.frames.iter().position(|l| {
+        let f = &l.frame;
+        f.id == bus::AirbagStageCmd::RAW_ID
+            && matches!(
+                bus::decode(f.id, f.payload()),
+                Ok(bus::Messages::AirbagStageCmd(m))
+                    if matches!(m.fire(), bus::codec::AirbagStageCmdFire::Fire)
+            )
+    })
+}
+
 /// The first Fire command of a candump log and the authenticator after it, as cansend args.
 pub fn recorded_fire_pair(candump_log: &Path) -> Result<(String, String)> {
     let log = bus::candump::CandumpLog::read(candump_log)
         .with_context(|| format!("reading {}", candump_log.display()))?;
-    let mut fire: Option<&bus::RawFrame> = None;
-    for f in log.frames.iter().map(|l| &l.frame) {
-        match (f.id, fire) {
-            (bus::AirbagStageCmd::RAW_ID, None) => {
-                if let Ok(bus::Messages::AirbagStageCmd(m)) = bus::decode(f.id, f.payload()) {
-                    if matches!(m.fire(), bus::codec::AirbagStageCmdFire::Fire) {
-                        fire = Some(f);
-                    }
-                }
-            }
-            (bus::AirbagStageAuth::RAW_ID, Some(cmd)) => {
-                return Ok((bus::candump::cansend_arg(cmd), bus::candump::cansend_arg(f)))
-            }
-            _ => {}
+    if let Some(k) = first_airbag_fire(&log) {
+        let cmd = &log.frames[k].frame;
+        if let Some(auth) = log.frames[k + 1..]
+            .iter()
+            .find(|l| l.frame.id == bus::AirbagStageAuth::RAW_ID)
+        {
+            return Ok((
+                bus::candump::cansend_arg(cmd),
+                bus::candump::cansend_arg(&auth.frame),
+            ));
         }
     }
     bail!(
