@@ -4,7 +4,7 @@ use crate::plot;
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use physics::{
-    derive::{derive_curve, parse_trace_csv, DeriveOptions},
+    derive::{derive_curve, DeriveOptions},
     j211::Cfc,
     kph_to_mps,
 };
@@ -14,15 +14,16 @@ use std::path::PathBuf;
 #[derive(Subcommand, Debug)]
 pub enum StiffnessCommand {
     /// Force-deflection curve from a rigid-barrier accelerometer trace (CSV with header
-    /// `time_s,accel_g` | `time_s,accel_mps2` | `time_ms,...`; J211 sign: deceleration negative).
+    /// `time_s,accel_g` | `time_s,accel_mps2` | `time_ms,...`, or an ISO-MME channel file;
+    /// J211 sign: deceleration negative).
     /// Prints the curve in the data/stiffness-classes.toml schema.
     Derive(DeriveArgs),
 }
 
 #[derive(Args, Debug)]
 pub struct DeriveArgs {
-    /// The trace file (CSV).
-    #[arg(long, value_name = "FILE.csv")]
+    /// The trace file (CSV or ISO-MME channel file).
+    #[arg(long, value_name = "FILE")]
     pub trace: PathBuf,
     /// Test mass [kg].
     #[arg(long)]
@@ -50,8 +51,8 @@ pub fn run(cmd: &StiffnessCommand) -> Result<()> {
 fn derive(args: &DeriveArgs) -> Result<()> {
     let text = std::fs::read_to_string(&args.trace)
         .with_context(|| format!("cannot read trace {}", args.trace.display()))?;
-    let trace =
-        parse_trace_csv(&text).map_err(|e| anyhow::anyhow!("{}: {e}", args.trace.display()))?;
+    let trace = physics::trace::parse(&text)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", args.trace.display()))?;
     let opts = DeriveOptions {
         mass_kg: args.mass_kg,
         impact_speed_mps: kph_to_mps(args.impact_kph),

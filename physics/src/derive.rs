@@ -10,21 +10,12 @@
 //!    make the curve monotone (running maximum, strictly increasing) so that it satisfies the
 //!    class-file schema and the series combination.
 //!
-//! Trace sign convention: SAE J211 vehicle axis (x forward), so crash deceleration is negative.
+//! The trace ([`crate::trace`]) is integrated from its first sample. Sign convention: SAE J211 vehicle axis (x forward), so crash deceleration is negative.
 //! A trace recorded with the opposite sign is detected (its integral would speed the car up)
 //! and flipped; [`DerivedCurve::sign_flipped`] reports it.
 
-use crate::{j211, stiffness::Curve, PhysicsError};
-use std::{string::String, vec::Vec};
-
-/// An accelerometer trace at a uniform step, first sample at (or before) first contact.
-#[derive(Clone, Debug, PartialEq)]
-pub struct BarrierTrace {
-    /// Sampling step [s].
-    pub step_s: f64,
-    /// Compartment acceleration [m/s²].
-    pub accel_mps2: Vec<f64>,
-}
+use crate::{j211, stiffness::Curve, trace::Trace, PhysicsError};
+use std::vec::Vec;
 
 /// Options of the derivation.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -54,85 +45,8 @@ pub struct DerivedCurve {
     pub sign_flipped: bool,
 }
 
-/// Parse a CSV trace: header `time_s,accel_g` or `time_s,accel_mps2` (or `time_ms` for the
-/// first column); then one sample per line; `#` comments and blank lines ignored. The step must
-/// be uniform within 1 %.
-pub fn parse_trace_csv(text: &str) -> Result<BarrierTrace, String> {
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let (_, header) = lines.next().ok_or("empty trace file")?;
-    let cols: Vec<String> = header
-        .split(',')
-        .map(|c| c.trim().to_ascii_lowercase())
-        .collect();
-    if cols.len() < 2 {
-        return Err(format!("header must name two columns, got `{header}`"));
-    }
-    let time_scale = match cols[0].as_str() {
-        "time_s" | "t_s" => 1.0,
-        "time_ms" | "t_ms" => 1.0e-3,
-        other => {
-            return Err(format!(
-                "first column must be time_s or time_ms, got `{other}`"
-            ))
-        }
-    };
-    let accel_scale = match cols[1].as_str() {
-        "accel_g" | "a_g" => crate::defaults::STANDARD_GRAVITY_MPS2,
-        "accel_mps2" | "a_mps2" => 1.0,
-        other => {
-            return Err(format!(
-                "second column must be accel_g or accel_mps2, got `{other}`"
-            ))
-        }
-    };
-    let mut times = Vec::new();
-    let mut accel = Vec::new();
-    for (line_no, line) in lines {
-        let mut it = line.split(',');
-        let parse = |s: Option<&str>| -> Result<f64, String> {
-            let s = s.ok_or(format!("line {line_no}: missing column"))?.trim();
-            let v: f64 = s
-                .parse()
-                .map_err(|_| format!("line {line_no}: not a number: `{s}`"))?;
-            if v.is_finite() {
-                Ok(v)
-            } else {
-                Err(format!("line {line_no}: non-finite value"))
-            }
-        };
-        times.push(parse(it.next())? * time_scale);
-        accel.push(parse(it.next())? * accel_scale);
-    }
-    if times.len() < 16 {
-        return Err(format!(
-            "trace has {} samples, need at least 16",
-            times.len()
-        ));
-    }
-    let step_s = (times[times.len() - 1] - times[0]) / (times.len() - 1) as f64;
-    if !(step_s > 0.0) {
-        return Err("time column must increase".into());
-    }
-    for (i, w) in times.windows(2).enumerate() {
-        if ((w[1] - w[0]) - step_s).abs() > 0.01 * step_s {
-            return Err(format!("non-uniform time step at sample {}", i + 2));
-        }
-    }
-    Ok(BarrierTrace {
-        step_s,
-        accel_mps2: accel,
-    })
-}
-
 /// Derive a force-deflection curve from a barrier trace.
-pub fn derive_curve(
-    trace: &BarrierTrace,
-    opts: &DeriveOptions,
-) -> Result<DerivedCurve, PhysicsError> {
+pub fn derive_curve(trace: &Trace, opts: &DeriveOptions) -> Result<DerivedCurve, PhysicsError> {
     if !(opts.mass_kg.is_finite() && opts.mass_kg > 0.0) {
         return Err(PhysicsError::InvalidInput(
             "test mass must be finite and > 0",

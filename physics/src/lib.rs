@@ -12,7 +12,9 @@
 //!   class curve each engages, and when.
 //! * [`crush_zone`] (feature `std`) — what a crush-zone (upfront) satellite feels ahead of the
 //!   body: the front structure's graded fold from the ego's crush.
+//! * [`measured`] — a measured crash pulse as the collision (the ego's pulse from a crash test).
 //! * [`j211`] — SAE J211 CFC filter (phaseless, in place, no allocation).
+//! * [`trace`] (feature `std`) — a measured accelerometer channel: CSV or ISO-MME.
 //! * [`derive`] (feature `std`) — force-deflection curve from a rigid-barrier accelerometer trace.
 //! * [`deadline`] — the classic required fire time of a frontal airbag, "127 mm − 30 ms".
 //! * [`defaults`] — every modelling default in one place.
@@ -37,12 +39,15 @@ pub mod derive;
 mod error;
 pub mod exact;
 pub mod j211;
+pub mod measured;
 pub mod occupant;
 pub mod paper;
 #[cfg(feature = "std")]
 pub mod reference;
 pub mod reference_settings;
 pub mod stiffness;
+#[cfg(feature = "std")]
+pub mod trace;
 
 pub use collision::{
     simulate_collision, CollisionInput, CollisionSummary, CompartmentPulse, DefaultPulseBuffer,

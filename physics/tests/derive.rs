@@ -3,8 +3,9 @@
 
 use physics::{
     collision::{simulate_collision, CollisionInput, PulseBuffer},
-    derive::{derive_curve, parse_trace_csv, BarrierTrace, DeriveOptions},
+    derive::{derive_curve, DeriveOptions},
     j211::Cfc,
+    trace::{parse_csv as parse_trace_csv, Trace as BarrierTrace},
     CombinedSpring, Curve,
 };
 
@@ -45,6 +46,7 @@ fn barrier_trace(curve: &Curve, mass_kg: f64, speed_mps: f64, noise_g: f64) -> (
         .collect();
     (
         BarrierTrace {
+            start_s: 0.0,
             step_s: 1e-4,
             accel_mps2: accel,
         },

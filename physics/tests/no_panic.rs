@@ -144,14 +144,14 @@ proptest! {
     #[test]
     fn derive_never_panics(a in proptest::collection::vec(any_f64(), 0..300), dt in any_f64(),
                            m in any_f64(), v in any_f64(), n in 0usize..20) {
-        let trace = physics::derive::BarrierTrace { step_s: dt, accel_mps2: a };
+        let trace = physics::trace::Trace { start_s: 0.0, step_s: dt, accel_mps2: a };
         let opts = physics::derive::DeriveOptions { mass_kg: m, impact_speed_mps: v, points: n, cfc: j211::Cfc::Cfc60 };
         let _ = physics::derive::derive_curve(&trace, &opts);
     }
 
     #[test]
     fn csv_parser_never_panics(s in ".{0,400}") {
-        let _ = physics::derive::parse_trace_csv(&s);
+        let _ = physics::trace::parse(&s);
         let _ = physics::stiffness::parse_class_file(&s);
     }
 }

@@ -156,35 +156,17 @@ impl Truth {
         truth.contact_s = Some(tc);
         truth.ego_speed_at_contact_mps = ve;
         truth.opp_speed_at_contact_mps = vo;
-        let mode = scenario.crash_mode();
-        let engaged = mode
-            .engage(scenario.ego_class().curve(), scenario.ego.width_m)
-            .map_err(|e| format!("crash mode: {e:?}"))?;
-        let face = scenario
-            .opponent_face()
-            .map_err(|e| format!("opponent face: {e:?}"))?;
-        let spring =
-            CombinedSpring::series(&engaged.curve, face.as_ref()).map_err(|e| format!("{e:?}"))?;
-        let mut input = CollisionInput::with_defaults(
-            &spring,
-            scenario.ego.mass_kg,
-            scenario.opponent_mass_kg(),
-            // Along the collision's normal: an angled wall arrests only that share.
-            closing * engaged.axis_cos,
-        );
-        if mode != CrashMode::FullFrontal {
-            // The partial modes' soft stages last longer than the full frontal's 150 ms: the
-            // whole buffer, so the pulse ends with the contact.
-            input.duration_s = (truth.pulse.capacity() - 1) as f64 * input.step_s;
-        }
-        let mut summary = physics::simulate_collision(&input, &mut truth.pulse)
-            .map_err(|e| format!("true collision physics: {e:?}"))?;
-        truth.pulse.project_ego_onto_axis(engaged.axis_cos);
-        let c = engaged.axis_cos;
-        summary.vehicle.a_max_mps2 *= c;
-        summary.vehicle.a_mean_mps2 *= c;
-        summary.vehicle.delta_v_mps *= c;
-        summary.vehicle.crush_m /= c;
+        let summary = match &scenario.pulse {
+            Some(p) => physics::measured::measured_collision(
+                &p.accel_mps2,
+                physics::defaults::STEP_S,
+                closing,
+                scenario.ego.mass_kg,
+                &mut truth.pulse,
+            )
+            .map_err(|e| format!("measured pulse: {e}"))?,
+            None => truth.modelled_collision(closing)?,
+        };
         truth.collision = Some(summary);
         for side in [FrontSide::Left, FrontSide::Right] {
             let crush = satellite_crush_m(scenario, side, truth.pulse.ego_crush_m());
@@ -195,6 +177,42 @@ impl Truth {
             );
         }
         Ok(truth)
+    }
+
+    /// The two-mass model's crash at `closing` m/s (the crash mode's engaged curve in series
+    /// with the opponent's face), its pulse written into `self.pulse`.
+    fn modelled_collision(&mut self, closing: f64) -> Result<CollisionSummary, String> {
+        let mode = self.scenario.crash_mode();
+        let engaged = mode
+            .engage(self.scenario.ego_class().curve(), self.scenario.ego.width_m)
+            .map_err(|e| format!("crash mode: {e:?}"))?;
+        let face = self
+            .scenario
+            .opponent_face()
+            .map_err(|e| format!("opponent face: {e:?}"))?;
+        let spring =
+            CombinedSpring::series(&engaged.curve, face.as_ref()).map_err(|e| format!("{e:?}"))?;
+        let mut input = CollisionInput::with_defaults(
+            &spring,
+            self.scenario.ego.mass_kg,
+            self.scenario.opponent_mass_kg(),
+            // Along the collision's normal: an angled wall arrests only that share.
+            closing * engaged.axis_cos,
+        );
+        if mode != CrashMode::FullFrontal {
+            // The partial modes' soft stages last longer than the full frontal's 150 ms: the
+            // whole buffer, so the pulse ends with the contact.
+            input.duration_s = (self.pulse.capacity() - 1) as f64 * input.step_s;
+        }
+        let mut summary = physics::simulate_collision(&input, &mut self.pulse)
+            .map_err(|e| format!("true collision physics: {e:?}"))?;
+        self.pulse.project_ego_onto_axis(engaged.axis_cos);
+        let c = engaged.axis_cos;
+        summary.vehicle.a_max_mps2 *= c;
+        summary.vehicle.a_mean_mps2 *= c;
+        summary.vehicle.delta_v_mps *= c;
+        summary.vehicle.crush_m /= c;
+        Ok(summary)
     }
 
     /// The scenario this truth was solved for.

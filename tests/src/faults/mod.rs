@@ -587,6 +587,19 @@ mod tests {
         assert!(!orig.sensor.frozen(0.5));
     }
 
+    /// A variant written elsewhere plays the same measured pulse as its original.
+    #[test]
+    fn a_variant_of_a_measured_pulse_scenario_reads_the_same_pulse() {
+        let d = tmp("frozen-pulse");
+        let src = crate::repo_root().join("scenarios/measured-pulse-half-sine-56.toml");
+        let p = frozen_scenario(&src, &d, 0.4, 0.7).expect("variant");
+        let orig = world::Scenario::load(&src).expect("original");
+        let s = world::Scenario::load(&p).expect("variant parses and validates");
+        let (a, b) = (orig.pulse.expect("pulse"), s.pulse.expect("pulse"));
+        assert!(Path::new(&b.file).is_absolute(), "{}", b.file);
+        assert_eq!(a.accel_mps2, b.accel_mps2);
+    }
+
     #[test]
     fn scenario_variants_change_what_they_say_and_expect_what_they_must() {
         let d = tmp("variants");

@@ -46,10 +46,7 @@ pub(crate) fn frozen_scenario(src: &Path, dir: &Path, from_s: f64, to_s: f64) ->
         "freezes".into(),
         toml::Value::Array(vec![toml::Value::Table(w)]),
     );
-    std::fs::create_dir_all(dir)?;
-    let path = dir.join(src.file_name().context("scenario file name")?);
-    std::fs::write(&path, toml::to_string(&doc)?)?;
-    Ok(path)
+    write_variant(src, dir, doc)
 }
 
 /// The variant of a scenario a [`Fault::Variant`] plays, written to `dir`, with the `[expect]`
@@ -131,10 +128,7 @@ pub fn variant_scenario(src: &Path, dir: &Path, v: Variant) -> Result<PathBuf> {
     }
     doc.insert("sensor".into(), toml::Value::Table(sensor));
     doc.insert("expect".into(), toml::Value::Table(expect));
-    std::fs::create_dir_all(dir)?;
-    let path = dir.join(src.file_name().context("scenario file name")?);
-    std::fs::write(&path, toml::to_string(&doc)?)?;
-    Ok(path)
+    write_variant(src, dir, doc)
 }
 
 /// A number from a TOML table (integers are numbers too).
@@ -183,10 +177,7 @@ pub fn lengthened_scenario(src: &Path, dir: &Path, extra_s: f64) -> Result<PathB
             );
         }
     }
-    std::fs::create_dir_all(dir)?;
-    let path = dir.join(src.file_name().context("scenario file name")?);
-    std::fs::write(&path, toml::to_string(&doc)?)?;
-    Ok(path)
+    write_variant(src, dir, doc)
 }
 
 /// Where the first airbag Fire command is in a candump log (an `AirbagStageCmd` whose `Fire`
@@ -247,4 +238,24 @@ pub(super) fn forged_frames(bin_dir: &Path, pairs: u32) -> Result<Vec<String>> {
         );
     }
     Ok(v)
+}
+
+/// Writes a variant `doc` of the scenario `src` to `dir` under its file name. A `[pulse]` file
+/// named relative to the scenario's folder is named absolutely, so the variant elsewhere reads
+/// the same pulse.
+fn write_variant(src: &Path, dir: &Path, mut doc: toml::Table) -> Result<PathBuf> {
+    let folder = src.parent().unwrap_or(Path::new(""));
+    if let Some(file) = doc
+        .get_mut("pulse")
+        .and_then(|p| p.as_table_mut())
+        .and_then(|p| p.get_mut("file"))
+    {
+        if let Some(rel) = file.as_str().filter(|f| Path::new(f).is_relative()) {
+            *file = toml::Value::String(folder.join(rel).display().to_string());
+        }
+    }
+    std::fs::create_dir_all(dir)?;
+    let path = dir.join(src.file_name().context("scenario file name")?);
+    std::fs::write(&path, toml::to_string(&doc)?)?;
+    Ok(path)
 }

@@ -7,10 +7,12 @@
 //! that ends before it starts) are located by the span of their key in the parsed document.
 
 mod location;
+mod pulse;
 mod sensor_model;
 mod validate;
 
 pub use location::ScenarioError;
+pub use pulse::MeasuredPulse;
 
 /// Longest scenario `name` [bytes]: what the bench truth record carries
 /// (`ipc::SCENARIO_NAME_CAPACITY`; `sensor-feeds` asserts the two agree at compile time).
@@ -53,6 +55,10 @@ pub struct Scenario {
     /// opponent-mass source, independent of the object list ([`V2x`]).
     #[serde(default)]
     pub v2x: Option<V2x>,
+    /// A measured crash pulse for the ego from the contact on (`[pulse]`; absent: the
+    /// two-mass model's, [`MeasuredPulse`]).
+    #[serde(default)]
+    pub pulse: Option<MeasuredPulse>,
 }
 
 /// The ego's V2X receiver and what the station ahead says of itself (`V2xOpponentMass` on
@@ -649,7 +655,7 @@ impl Scenario {
 
     /// Parses and validates scenario text; `file` names the source in errors.
     pub fn parse(file: &str, text: &str) -> Result<Self, ScenarioError> {
-        let scenario: Scenario = toml::from_str(text).map_err(|e| {
+        let mut scenario: Scenario = toml::from_str(text).map_err(|e| {
             let (line, column) = e
                 .span()
                 .map(|s| toml_location::line_col(text, s.start))
@@ -677,6 +683,15 @@ impl Scenario {
                 field: Some(field),
                 message,
             })?;
+        if let Some(p) = scenario.pulse.as_mut() {
+            p.read(file).map_err(|message| ScenarioError {
+                file: file.to_owned(),
+                line: toml_location::line_of_field(text, "pulse.file"),
+                column: None,
+                field: Some("pulse.file".to_owned()),
+                message,
+            })?;
+        }
         Ok(scenario)
     }
 
