@@ -60,6 +60,9 @@ pub const DBC_TEXT: &str = include_str!("../restraint.dbc");
 /// Linux `can_id` flag for 29-bit identifiers; frames carrying it are never ours.
 pub const CAN_EFF_FLAG: u32 = 0x8000_0000;
 
+/// The DBC's node name of the restraint ECU: every other transmitter's message is an input.
+pub const ECU_NODE: &str = "RestraintEcu";
+
 mod e2e;
 mod frame;
 mod rx;
@@ -101,7 +104,7 @@ mod tests {
         // Safety outputs outrank everything else on the bus (lower id wins arbitration).
         let max_cmd = [AirbagStageCmd::MESSAGE_ID, BeltLimiterCmd::MESSAGE_ID];
         for m in MESSAGES {
-            if m.transmitter != "RestraintEcu" {
+            if m.transmitter != ECU_NODE {
                 for c in max_cmd {
                     let embedded_can::Id::Standard(c) = c else {
                         panic!()

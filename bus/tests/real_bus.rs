@@ -157,7 +157,7 @@ fn real_bus_worker_body() {
     // our rx socket with a kernel filter for the ECU's inputs only
     let input_ids: Vec<u32> = MESSAGES
         .iter()
-        .filter(|m| m.transmitter != "RestraintEcu")
+        .filter(|m| m.transmitter != bus::ECU_NODE)
         .map(|m| m.id)
         .collect();
     let mut rx = BusSocket::open(&iface, &input_ids).expect("open rx socket");
@@ -304,7 +304,7 @@ fn cantools_requests() -> (Vec<serde_json::Value>, Vec<(u32, Vec<f64>)>) {
     let mut reqs = Vec::new();
     let mut want = Vec::new();
     for k in 0..CANTOOLS_PER_MESSAGE {
-        for m in MESSAGES.iter().filter(|m| m.transmitter != "RestraintEcu") {
+        for m in MESSAGES.iter().filter(|m| m.transmitter != bus::ECU_NODE) {
             let (_, phys) = build(m.id, k + 100);
             let sigs = signals_of(m.id).unwrap();
             let mut obj = serde_json::Map::new();

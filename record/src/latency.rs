@@ -211,7 +211,7 @@ pub fn latency(path: &Path) -> Result<Latency> {
     let mut rows = Vec::new();
     let from_ecu: Vec<&str> = bus::MESSAGES
         .iter()
-        .filter(|m| m.transmitter == "RestraintEcu")
+        .filter(|m| m.transmitter == bus::ECU_NODE)
         .map(|m| m.name)
         .collect();
     let mut fires: BTreeMap<&str, Vec<(f64, Option<f64>)>> = BTreeMap::new();

@@ -30,6 +30,7 @@ mod diag_fields;
 pub mod latency;
 mod mf4;
 pub mod pending;
+pub mod read;
 mod run_folder;
 pub mod schema;
 pub mod write;

@@ -405,7 +405,7 @@ pub fn write_run_mf4(dir: &Path, out: &Path) -> Result<Mf4Summary> {
     chain.extend(diag_channels);
     let first = f.channels(&chain, NIL);
     let ecu = f.source(
-        "RestraintEcu",
+        bus::ECU_NODE,
         "iceoryx2 diagnostics, as the actuator stubs received them",
         SI_TYPE_ECU,
         SI_BUS_NONE,

@@ -128,6 +128,13 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
     } else {
         offset
     };
+    // The truth of a scenario that cannot be loaded (a damaged file of the campaign) is left
+    // out and said so in the metadata; everything else is still recorded.
+    let truth = meta.scenario.as_ref().map(|path| {
+        world::Scenario::load(path)
+            .map_err(|e| e.to_string())
+            .and_then(|s| world::Truth::new(&s).map(|t| (s, t)))
+    });
     let file = std::fs::File::create(out).with_context(|| out.display().to_string())?;
     let mut rec = Recording {
         w: Writer::new(BufWriter::new(file))?,
@@ -195,7 +202,16 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         bench.insert("start_ns".to_owned(), r.start_ns.to_string());
         bench.insert("contact_ns".to_owned(), r.contact_ns.to_string());
     } else if let Some(start) = meta.simulated_start_ns {
+        // A run without the stubs' report (the offline bench): the scenario's name and its
+        // true contact from the truth, on the simulated clock.
         bench.insert("start_ns".to_owned(), start.to_string());
+        if let Some(Ok((s, t))) = &truth {
+            bench.insert("scenario".to_owned(), s.name.clone());
+            let contact = t
+                .contact_s
+                .map_or(0, |c| start.saturating_add((c * 1e9).round() as u64));
+            bench.insert("contact_ns".to_owned(), contact.to_string());
+        }
     }
     rec.w.write_metadata(&Metadata {
         name: "bench".to_owned(),
@@ -345,13 +361,6 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         "restraint_bench.StubsCommand",
         "One command frame the actuator stubs received (CLOCK_MONOTONIC receive time), decoded, with its E2E and SecOC verdict (actuator-stubs/README.md)",
     );
-    // The truth of a scenario that cannot be loaded (a damaged file of the campaign) is left
-    // out and said so in the metadata; everything else is still recorded.
-    let truth = meta.scenario.as_ref().map(|path| {
-        world::Scenario::load(path)
-            .map_err(|e| e.to_string())
-            .and_then(|s| world::Truth::new(&s).map(|t| (s, t)))
-    });
     if let Some(Err(e)) = &truth {
         rec.w.write_metadata(&Metadata {
             name: "truth".to_owned(),

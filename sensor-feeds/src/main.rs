@@ -15,6 +15,7 @@ use ipc::{
     SatelliteLeftPublisher, SatelliteRightPublisher, ServiceNames,
 };
 use sensor_feeds::player::TICK_NS;
+use sensor_feeds::replay::Item;
 use sensor_feeds::{monotonic_ns, sleep_until_ns, Player, TickOutput};
 use signals::{FeedItem, FeedLogRecord};
 use std::path::PathBuf;
@@ -27,8 +28,14 @@ use world::{Scenario, Truth};
 #[command(name = "sensor-feeds", version)]
 struct Cli {
     /// Scenario file (TOML, schema in scenarios/README.md).
-    #[arg(long)]
-    scenario: PathBuf,
+    #[arg(long, required_unless_present = "replay", conflicts_with = "replay")]
+    scenario: Option<PathBuf>,
+    /// Play a recorded run instead of a scenario: its `run.mcap`'s object list, both
+    /// accelerometers, the satellites and the CAN frames the ECU received, at their recorded
+    /// times moved to now (or to `--epoch-ns`), with a bench truth of its scenario's name and
+    /// contact for the actuator stubs (README.md, "Replay").
+    #[arg(long, value_name = "RUN.mcap", conflicts_with = "check")]
+    replay: Option<PathBuf>,
     /// CAN interface for the vehicle and occupant frames.
     #[arg(long, default_value = "vcan0", conflicts_with = "no_can")]
     can: String,
@@ -118,13 +125,190 @@ fn describe_event(i: usize, e: &AccelEvent) -> String {
     )
 }
 
+/// Where the feeds go: the iceoryx2 publishers, the CAN socket and the publish log.
+struct Transports {
+    objects: ObjectPublisher,
+    accel: AccelPublisher,
+    safing: SafingPublisher,
+    satellite_left: SatelliteLeftPublisher,
+    satellite_right: SatelliteRightPublisher,
+    truth: BenchTruthPublisher,
+    can: Option<bus::socket::BusSocket>,
+    log: FeedLog,
+    counts: Counts,
+    // Last: the publishers above are dropped before their node.
+    _node: ipc::IpcNode,
+}
+
+impl Transports {
+    fn open(cli: &Cli) -> Result<Self> {
+        let names = ServiceNames::with_prefix(&cli.service_prefix);
+        let node_name = format!("sensor-feeds-{}", std::process::id());
+        let (node, _) = ipc::create_node(&node_name, false)?;
+        let can = if cli.no_can {
+            None
+        } else {
+            Some(
+                bus::socket::BusSocket::open(&cli.can, &[]).with_context(|| {
+                    format!(
+                        "CAN interface {} (bring it up with ./vcan-setup.sh, or pass --no-can)",
+                        cli.can
+                    )
+                })?,
+            )
+        };
+        Ok(Self {
+            objects: ObjectPublisher::new(&node, &names)?,
+            accel: AccelPublisher::new(&node, &names)?,
+            safing: SafingPublisher::new(&node, &names)?,
+            satellite_left: SatelliteLeftPublisher::new(&node, &names)?,
+            satellite_right: SatelliteRightPublisher::new(&node, &names)?,
+            truth: BenchTruthPublisher::new(&node, &names)?,
+            can,
+            log: FeedLog::open(cli.log.as_deref())?,
+            counts: Counts::default(),
+            _node: node,
+        })
+    }
+
+    /// Publishes one feed record and logs it (a failed publish is counted, not logged).
+    fn publish(&mut self, item: FeedItem) {
+        let sent = match item {
+            FeedItem::Object(o) => self.objects.publish(o).is_ok(),
+            FeedItem::CrashAccel(b) => self.accel.publish(b).is_ok(),
+            FeedItem::SafingAccel(b) => self.safing.publish(b).is_ok(),
+            FeedItem::SatelliteLeft(b) => self.satellite_left.publish(b).is_ok(),
+            FeedItem::SatelliteRight(b) => self.satellite_right.publish(b).is_ok(),
+        };
+        if sent {
+            self.log.write(item);
+        } else {
+            self.counts.ipc_errors += 1;
+        }
+    }
+
+    fn send_can(&mut self, f: &bus::RawFrame) {
+        if let Some(sock) = self.can.as_mut() {
+            match sock.send(f) {
+                Ok(()) => self.counts.can_frames += 1,
+                Err(_) => self.counts.can_errors += 1,
+            }
+        }
+    }
+
+    fn publish_truth(&mut self, t: &mut BenchTruth) {
+        t.sequence += 1;
+        t.timestamp_ns = monotonic_ns();
+        if self.truth.publish(*t).is_err() {
+            self.counts.ipc_errors += 1;
+        }
+    }
+
+    /// The final truth (with `done`), a few times so a busy subscriber cannot miss it, then
+    /// the publishers stay a moment so subscribers can read the last samples.
+    fn finish(&mut self, t: &mut BenchTruth) {
+        t.done = 1;
+        for _ in 0..3 {
+            self.publish_truth(t);
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        self.log.finish();
+    }
+}
+
+/// Prints the time base for orchestrators on stdout (the fault campaign starts its injectors
+/// and restarts killed feeds on it); everything else goes to stderr.
+fn announce_epoch(start_ns: u64) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(out, "epoch_ns {start_ns}");
+    let _ = out.flush();
+}
+
+/// `--replay`: the recorded run's publications at their recorded times, moved to now.
+fn replay(cli: &Cli, path: &std::path::Path) -> Result<()> {
+    let bytes = std::fs::read(path).with_context(|| format!("--replay {}", path.display()))?;
+    let rec = sensor_feeds::replay::read(&bytes)
+        .with_context(|| format!("--replay {}", path.display()))?;
+    let last_ns = rec.items.last().map_or(rec.start_ns, |(t, _)| *t);
+    eprintln!(
+        "sensor-feeds: replaying {}: scenario {}, {} messages over {:.3} s, {}",
+        path.display(),
+        rec.scenario,
+        rec.items.len(),
+        last_ns.saturating_sub(rec.start_ns) as f64 * 1e-9,
+        rec.contact_ns.map_or("no contact".to_owned(), |c| format!(
+            "contact at {:.3} s",
+            c.saturating_sub(rec.start_ns) as f64 * 1e-9
+        ))
+    );
+    let stop = host::install_stop_signals().context("installing signal handler")?;
+    let mut io = Transports::open(cli)?;
+    let start_ns = cli.epoch_ns.unwrap_or(monotonic_ns() + TICK_NS);
+    let offset_ns = start_ns as i64 - rec.start_ns as i64;
+    announce_epoch(start_ns);
+    let mut truth = BenchTruth::EMPTY;
+    truth.set_scenario_name(&rec.scenario);
+    truth.start_ns = start_ns;
+    let contact_ns = rec.contact_ns.map(|c| c.saturating_add_signed(offset_ns));
+    let mut next_truth_ns = start_ns;
+    let mut truth_due = |io: &mut Transports, until_ns: u64, truth: &mut BenchTruth| {
+        while next_truth_ns <= until_ns {
+            sleep_until_ns(next_truth_ns);
+            if let Some(c) = contact_ns.filter(|c| *c <= next_truth_ns) {
+                truth.contact_ns = c;
+            }
+            io.publish_truth(truth);
+            next_truth_ns += TRUTH_PERIOD_TICKS * TICK_NS;
+        }
+    };
+    for (t, item) in &rec.items {
+        if stop.load(Ordering::Relaxed) {
+            eprintln!("sensor-feeds: replay stopped by signal");
+            break;
+        }
+        let at_ns = t.saturating_add_signed(offset_ns);
+        truth_due(&mut io, at_ns, &mut truth);
+        sleep_until_ns(at_ns);
+        match item.shifted(offset_ns) {
+            Item::Object(o) => io.publish(FeedItem::Object(o)),
+            Item::CrashAccel(b) => io.publish(FeedItem::CrashAccel(b)),
+            Item::SafingAccel(b) => io.publish(FeedItem::SafingAccel(b)),
+            Item::SatelliteLeft(b) => io.publish(FeedItem::SatelliteLeft(b)),
+            Item::SatelliteRight(b) => io.publish(FeedItem::SatelliteRight(b)),
+            Item::Can(f) => io.send_can(&f),
+        }
+    }
+    truth_due(
+        &mut io,
+        last_ns.saturating_add_signed(offset_ns),
+        &mut truth,
+    );
+    if let Some(c) = contact_ns {
+        truth.contact_ns = c;
+    }
+    io.finish(&mut truth);
+    eprintln!(
+        "sensor-feeds: replay done: {} messages, {} CAN frames, {} CAN errors, {} IPC errors",
+        rec.items.len(),
+        io.counts.can_frames,
+        io.counts.can_errors,
+        io.counts.ipc_errors
+    );
+    std::thread::sleep(std::time::Duration::from_millis(50));
+    Ok(())
+}
+
 fn run(cli: &Cli) -> Result<()> {
-    let scenario = Scenario::load(&cli.scenario)?;
+    if let Some(path) = &cli.replay {
+        return replay(cli, path);
+    }
+    let path = cli.scenario.as_ref().context("--scenario or --replay")?;
+    let scenario = Scenario::load(path)?;
     if !(cli.speedup.is_finite() && cli.speedup >= 0.1 && cli.speedup <= 100.0) {
         anyhow::bail!("--speedup must be within 0.1..=100");
     }
-    let truth =
-        Truth::new(&scenario).map_err(|e| anyhow::anyhow!("{}: {e}", cli.scenario.display()))?;
+    let truth = Truth::new(&scenario).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let mut lines = vec![describe(&truth)];
     lines.extend(
         scenario
@@ -138,7 +322,7 @@ fn run(cli: &Cli) -> Result<()> {
         for l in &lines {
             println!("{l}");
         }
-        println!("{}: valid", cli.scenario.display());
+        println!("{}: valid", path.display());
         return Ok(());
     }
     for l in &lines {
@@ -149,27 +333,7 @@ fn run(cli: &Cli) -> Result<()> {
 
     let stop = host::install_stop_signals().context("installing signal handler")?;
 
-    let names = ServiceNames::with_prefix(&cli.service_prefix);
-    let node_name = format!("sensor-feeds-{}", std::process::id());
-    let (node, _) = ipc::create_node(&node_name, false)?;
-    let mut objects = ObjectPublisher::new(&node, &names)?;
-    let mut accel = AccelPublisher::new(&node, &names)?;
-    let mut safing = SafingPublisher::new(&node, &names)?;
-    let mut satellite_left = SatelliteLeftPublisher::new(&node, &names)?;
-    let mut satellite_right = SatelliteRightPublisher::new(&node, &names)?;
-    let mut truth_pub = BenchTruthPublisher::new(&node, &names)?;
-    let mut can = if cli.no_can {
-        None
-    } else {
-        Some(
-            bus::socket::BusSocket::open(&cli.can, &[]).with_context(|| {
-                format!(
-                    "CAN interface {} (bring it up with ./vcan-setup.sh, or pass --no-can)",
-                    cli.can
-                )
-            })?,
-        )
-    };
+    let mut io = Transports::open(cli)?;
 
     let scale = 1.0 / cli.speedup;
     let to_ns = |t_s: f64| (t_s * 1e9 * scale).round() as u64;
@@ -189,14 +353,7 @@ fn run(cli: &Cli) -> Result<()> {
             scenario.duration_s
         );
     }
-    // Machine-readable time base for orchestrators (the fault campaign starts its injectors
-    // and restarts killed feeds on it); everything else goes to stderr.
-    {
-        use std::io::Write;
-        let mut out = std::io::stdout().lock();
-        let _ = writeln!(out, "epoch_ns {start_ns}");
-        let _ = out.flush();
-    }
+    announce_epoch(start_ns);
     if first_tick > 0 {
         eprintln!(
             "sensor-feeds: resuming at t = {:.3} s (epoch {start_ns} ns)",
@@ -205,14 +362,12 @@ fn run(cli: &Cli) -> Result<()> {
     }
     let mut player = Player::new(truth, start_ns, scale, first_tick);
     let mut out = TickOutput::default();
-    let mut counts = Counts::default();
     let mut truth_rec = BenchTruth::EMPTY;
     truth_rec.set_scenario_name(&scenario.name);
     truth_rec.start_ns = start_ns;
     truth_rec.ego_mass_kg = scenario.ego.mass_kg as f32;
     truth_rec.opponent_mass_kg = scenario.opponent_mass_kg() as f32;
     let mut contact_announced = false;
-    let mut log = FeedLog::open(cli.log.as_deref())?;
 
     for tick in first_tick..=total_ticks {
         if stop.load(Ordering::Relaxed) {
@@ -225,52 +380,27 @@ fn run(cli: &Cli) -> Result<()> {
             .tick(tick, &mut out)
             .map_err(|e| anyhow::anyhow!("{e:?}"))?;
         for o in &out.objects {
-            if objects.publish(*o).is_err() {
-                counts.ipc_errors += 1;
-            } else {
-                log.write(FeedItem::Object(*o));
-            }
+            io.publish(FeedItem::Object(*o));
         }
         for b in &out.accel {
-            if accel.publish(*b).is_err() {
-                counts.ipc_errors += 1;
-            } else {
-                log.write(FeedItem::CrashAccel(*b));
-            }
+            io.publish(FeedItem::CrashAccel(*b));
         }
         for b in &out.safing {
-            if safing.publish(*b).is_err() {
-                counts.ipc_errors += 1;
-            } else {
-                log.write(FeedItem::SafingAccel(*b));
-            }
+            io.publish(FeedItem::SafingAccel(*b));
         }
         let [left, right] = &out.satellites;
         for b in left {
-            if satellite_left.publish(*b).is_err() {
-                counts.ipc_errors += 1;
-            } else {
-                log.write(FeedItem::SatelliteLeft(*b));
-            }
+            io.publish(FeedItem::SatelliteLeft(*b));
         }
         for b in right {
-            if satellite_right.publish(*b).is_err() {
-                counts.ipc_errors += 1;
-            } else {
-                log.write(FeedItem::SatelliteRight(*b));
-            }
+            io.publish(FeedItem::SatelliteRight(*b));
         }
         // Every 10 ms: a feed killed mid-run (the fault campaign does) loses ≤ 10 ms of its log.
         if tick % 10 == 0 {
-            log.flush();
+            io.log.flush();
         }
-        if let Some(sock) = can.as_mut() {
-            for f in &out.can {
-                match sock.send(f) {
-                    Ok(()) => counts.can_frames += 1,
-                    Err(_) => counts.can_errors += 1,
-                }
-            }
+        for f in &out.can {
+            io.send_can(f);
         }
         // Bench truth.
         let mut announce = false;
@@ -281,29 +411,16 @@ fn run(cli: &Cli) -> Result<()> {
             truth_rec.closing_speed_at_contact_mps = closing_at_contact_mps as f32;
         }
         if announce || tick % TRUTH_PERIOD_TICKS == 0 {
-            truth_rec.sequence += 1;
-            truth_rec.timestamp_ns = monotonic_ns();
-            if truth_pub.publish(truth_rec).is_err() {
-                counts.ipc_errors += 1;
-            }
+            io.publish_truth(&mut truth_rec);
         }
     }
-    // Done: the final truth (with `done`), a few times so a busy subscriber cannot miss it.
-    truth_rec.done = 1;
-    for _ in 0..3 {
-        truth_rec.sequence += 1;
-        truth_rec.timestamp_ns = monotonic_ns();
-        if truth_pub.publish(truth_rec).is_err() {
-            counts.ipc_errors += 1;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(5));
-    }
+    io.finish(&mut truth_rec);
+    let counts = &io.counts;
     let p = player.counts();
     eprintln!(
         "sensor-feeds: done: {} objects ({} dropped, {} stale repeats), {} accel samples ({} faulty), {} safing samples ({} faulty), {} satellite frames, {} spikes, {} CAN frames, {} CAN errors, {} IPC errors",
         p.objects, p.objects_dropped, p.objects_frozen, p.accel_samples, p.accel_faulty, p.safing_samples, p.safing_faulty, p.satellite_frames, p.spikes, counts.can_frames, counts.can_errors, counts.ipc_errors
     );
-    log.finish();
     // Keep the publishers alive a moment so subscribers can read the last samples.
     std::thread::sleep(std::time::Duration::from_millis(50));
     Ok(())

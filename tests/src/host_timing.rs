@@ -133,6 +133,7 @@ pub fn run_host_timing(cfg: &HostTimingConfig) -> Result<HostTiming> {
             ecu_args: Vec::new(),
             ecu_cwd: cfg.repo.clone(),
             stubs_args: Vec::new(),
+            replay: None,
         };
         let mut dist = CaseDisturbance {
             fault: &fault,

@@ -15,6 +15,7 @@ pub mod host_timing;
 pub mod misuse;
 pub mod offline;
 pub mod offline_plot;
+pub mod replay;
 pub mod route;
 mod run;
 mod summary;

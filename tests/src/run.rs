@@ -29,6 +29,9 @@ pub struct RunConfig {
     pub ecu_cwd: PathBuf,
     /// Extra arguments for the actuator stubs (see [`default_stubs_args`]).
     pub stubs_args: Vec<String>,
+    /// A recorded run (`run.mcap`) the feeds replay instead of playing `scenario`
+    /// (`sensor-feeds --replay`); the stubs still judge against `scenario`.
+    pub replay: Option<PathBuf>,
 }
 
 /// The ECU as it is meant to run: SCHED_FIFO 80 and locked memory. Without the privileges
@@ -224,7 +227,10 @@ fn wait_ready(ready: std::sync::mpsc::Receiver<()>, child: &mut Child, what: &st
 /// (`None`: the feeds choose it and announce it) and the log of what they publish (`--log`).
 pub fn feeds_command(cfg: &RunConfig, epoch_ns: Option<u64>, log: Option<&Path>) -> Command {
     let mut c = Command::new(cfg.bin_dir.join("sensor-feeds"));
-    c.arg("--scenario").arg(&cfg.scenario);
+    match &cfg.replay {
+        Some(run) => c.arg("--replay").arg(run),
+        None => c.arg("--scenario").arg(&cfg.scenario),
+    };
     if cfg.can.is_empty() {
         c.arg("--no-can");
     } else {

@@ -669,3 +669,60 @@ fn a_python_can_sender_keeps_the_ecus_inputs_alive_with_no_e2e_rejection() {
     assert!(rejected.is_empty(), "{rejected:?}\n{sent}");
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn a_recorded_run_replayed_into_the_ecu_fires_as_it_did() {
+    // The demo's scenario as the library run recorded it, replayed from its run.mcap alone
+    // (`sensor-feeds --replay`) into a new ECU on vcan: every restraint action within one cycle
+    // of its recorded time after the contact, the same modes (`hil-bench --replay` says so and
+    // exits 0).
+    let out = bench_run();
+    let name = "taurus-48-48-abs";
+    let recording = out.join(name).join("run.mcap");
+    assert!(recording.is_file(), "{}", recording.display());
+    let into = out.join("replay");
+    let bins = harness::bin_dir();
+    let o = harness::run_in_guests(
+        "hil-bench --replay",
+        out,
+        vec![vec![
+            bins.join("hil-bench").into(),
+            "--replay".into(),
+            recording.clone().into(),
+            "--out".into(),
+            into.clone().into(),
+            "--repo".into(),
+            root().into(),
+            "--brief".into(),
+        ]],
+    )
+    .remove(0);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        stdout.contains(&format!("{name}: replay: no difference")),
+        "{stdout}"
+    );
+    let recorded: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join(name).join("report.json")).unwrap())
+            .unwrap();
+    let replayed: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(into.join(name).join("report.json")).unwrap(),
+    )
+    .unwrap();
+    let airbag = |r: &serde_json::Value| {
+        r["actions"]
+            .as_array()
+            .and_then(|a| a.iter().find(|a| a["what"] == "airbag_fire"))
+            .and_then(|a| a["after_contact_ms"].as_f64())
+            .expect("an airbag fire")
+    };
+    assert!(
+        (airbag(&recorded) - airbag(&replayed)).abs() <= e2e_tests::replay::TOLERANCE_MS,
+        "{stdout}"
+    );
+}

@@ -4,6 +4,12 @@
 //! Every scenario's `[expect]` keys are judged (`e2e_tests::expect`, as `offline-bench` does;
 //! `--no-expect` skips it): a miss is printed (`hil-bench: MISSED <scenario>: [expect] <key> =
 //! <expected>, measured <value>`) and the exit status is 1.
+//!
+//! `hil-bench --replay OUT/<name>/run.mcap --out DIR`: the recorded run's feeds and CAN inputs
+//! played into the ECU again (`sensor-feeds --replay`), the stubs judging against its scenario
+//! (`--scenario`, default the repository's `scenarios/<name>.toml`), and the new run compared
+//! with the recorded one (`e2e_tests::replay`): every restraint action within one ECU cycle of
+//! its recorded time after the contact, the same modes. A difference is listed and exits 1.
 
 use anyhow::{Context, Result};
 use clap::Parser;
@@ -14,9 +20,13 @@ use std::path::PathBuf;
 #[derive(Parser, Debug)]
 #[command(name = "hil-bench", version)]
 struct Cli {
-    /// Scenario file(s), run one after the other.
-    #[arg(long, required = true)]
+    /// Scenario file(s), run one after the other (with `--replay`: the scenario the stubs
+    /// judge against, default the repository's `scenarios/<recorded name>.toml`).
+    #[arg(long, required_unless_present = "replay")]
     scenario: Vec<PathBuf>,
+    /// Replay a recorded run (its `run.mcap`) into the ECU and compare the new run with it.
+    #[arg(long, value_name = "RUN.mcap")]
+    replay: Option<PathBuf>,
     /// Output root; each scenario writes OUT/<name>/.
     #[arg(long, default_value = "out")]
     out: PathBuf,
@@ -114,9 +124,81 @@ fn record_retries(path: &std::path::Path, earlier: &[String]) -> Result<()> {
     Ok(())
 }
 
+/// `--replay`: one run of the recording's feeds, compared with the recorded run.
+fn replay(cli: &Cli, run: &std::path::Path, bin_dir: PathBuf, can: String) -> Result<bool> {
+    let bytes = std::fs::read(run).with_context(|| format!("--replay {}", run.display()))?;
+    let recorded =
+        record::read::report(&bytes).with_context(|| format!("--replay {}", run.display()))?;
+    let name = recorded["scenario"]
+        .as_str()
+        .with_context(|| format!("--replay {}: its report names no scenario", run.display()))?
+        .to_owned();
+    let repo = e2e_tests::repo_or_default(cli.repo.clone())?;
+    let scenario = match cli.scenario.as_slice() {
+        [] => repo.join("scenarios").join(format!("{name}.toml")),
+        [one] => one.clone(),
+        _ => anyhow::bail!("--replay takes one --scenario at most"),
+    };
+    if !scenario.is_file() {
+        anyhow::bail!(
+            "the recording's scenario `{name}` is not {}: name its file with --scenario",
+            scenario.display()
+        );
+    }
+    // The recording's own folder is not overwritten by its replay.
+    let into = cli.out.join(&name);
+    if let (Ok(a), Some(Ok(b))) = (
+        into.canonicalize(),
+        run.parent().map(std::path::Path::canonicalize),
+    ) {
+        if a == b {
+            anyhow::bail!(
+                "--out {} would overwrite the recording it replays: give another --out",
+                cli.out.display()
+            );
+        }
+    }
+    let cfg = RunConfig {
+        scenario,
+        out: cli.out.clone(),
+        can,
+        bin_dir,
+        service_prefix: format!("hil-bench-{}-replay", std::process::id()),
+        ecu_args: [e2e_tests::default_ecu_args(), cli.ecu_arg.clone()].concat(),
+        ecu_cwd: repo,
+        stubs_args: e2e_tests::default_stubs_args(),
+        replay: Some(run.to_path_buf()),
+    };
+    let r = run_scenario(&cfg)?;
+    let path = r.dir.join("report.json");
+    let replayed: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(&path).with_context(|| path.display().to_string())?,
+    )
+    .with_context(|| path.display().to_string())?;
+    let c = e2e_tests::replay::compare(&recorded, &replayed);
+    if !cli.brief {
+        println!("{}", r.summary);
+    }
+    println!("replay of {} into {}:", run.display(), r.dir.display());
+    for l in &c.lines {
+        println!("  {l}");
+    }
+    if c.differences.is_empty() {
+        println!(
+            "{name}: replay: no difference (every action within {} ms of its recorded time, the same modes)",
+            e2e_tests::replay::TOLERANCE_MS
+        );
+    } else {
+        for d in &c.differences {
+            println!("{name}: replay: DIFFERENT: {d}");
+        }
+    }
+    Ok(c.differences.is_empty() && r.problems.is_empty())
+}
+
 fn run() -> Result<bool> {
     let cli = Cli::parse();
-    let bin_dir = match cli.bin_dir {
+    let bin_dir = match cli.bin_dir.clone() {
         Some(d) => d,
         None => std::env::current_exe()?
             .parent()
@@ -125,10 +207,14 @@ fn run() -> Result<bool> {
     };
     let can = cli
         .can
+        .clone()
         .or_else(|| std::env::var("VCAN").ok())
         .unwrap_or_else(|| "vcan0".into());
     // The output folder is checked before the runs, not after them.
     host::check_output_dir(&cli.out).with_context(|| format!("--out {}", cli.out.display()))?;
+    if let Some(run) = &cli.replay {
+        return replay(&cli, run, bin_dir, can);
+    }
     let mut all_ok = true;
     let mut errors = 0;
     for (i, scenario) in cli.scenario.iter().enumerate() {
@@ -141,6 +227,7 @@ fn run() -> Result<bool> {
             ecu_args: [e2e_tests::default_ecu_args(), cli.ecu_arg.clone()].concat(),
             ecu_cwd: e2e_tests::repo_or_default(cli.repo.clone())?,
             stubs_args: e2e_tests::default_stubs_args(),
+            replay: None,
         };
         match run_until_measured(&cfg) {
             Ok((r, retries)) => {

@@ -482,6 +482,7 @@ fn run_case(
         ecu_args,
         ecu_cwd: cfg.repo.clone(),
         stubs_args: crate::default_stubs_args(),
+        replay: None,
     };
     let mut dist = CaseDisturbance {
         fault: &case.fault,

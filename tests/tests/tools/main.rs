@@ -11,6 +11,7 @@ mod matrix_slurm;
 mod offline;
 mod one_build;
 mod recording;
+mod replay;
 mod schema_versions;
 
 /// Runs the binary `exe` with `args`: its exit code (−1 when killed), stdout and stderr.

@@ -92,7 +92,7 @@ fn log_times_are_on_the_monotonic_clock_the_stubs_measured() {
         let Some(m) = bus::message_info(f.frame.id) else {
             continue;
         };
-        if m.transmitter != "RestraintEcu" {
+        if m.transmitter != bus::ECU_NODE {
             continue;
         }
         let mono = (f.t_us * 1_000) as i64 - OFFSET_NS;
