@@ -2,12 +2,12 @@
 # vcan-setup.sh — where the bench finds vcan: the host's own kernel, or a QEMU guest running
 # a real Debian kernel (PREEMPT_RT flavour) with vcan up.
 #
-#   ./vcan-setup.sh [--iface NAME]                  set up (idempotent): host vcan, else prepare the guest; name the route
-#   ./vcan-setup.sh [--iface NAME] --check          print the route and its clock ("qemu-tcg virtual",
+#   ./vcan-setup.sh [--can NAME]                    set up (idempotent): host vcan, else prepare the guest; name the route
+#   ./vcan-setup.sh [--can NAME] --check            print the route and its clock ("qemu-tcg virtual",
 #                                                   "qemu-kvm host", "host host"); exit 0 host, 3 guest,
 #                                                   4 none (reason on stderr)
-#   ./vcan-setup.sh [--iface NAME] --run -- CMD…    run CMD where vcan is: on the host, else inside the guest
-#   ./vcan-setup.sh [--iface NAME] --guest -- CMD…  always inside the guest (tests of the guest route)
+#   ./vcan-setup.sh [--can NAME] --run -- CMD…      run CMD where vcan is: on the host, else inside the guest
+#   ./vcan-setup.sh [--can NAME] --guest -- CMD…    always inside the guest (tests of the guest route)
 #
 # Routes (printed as route=…, and given to the command as $VCAN_ROUTE):
 #   host      the host kernel has SocketCAN: vcan is created here. Real timing.
@@ -58,7 +58,8 @@ usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d' | sed 's/^# \{0,1\}//'; }
 
 while [ $# -gt 0 ]; do
   case "$1" in
-    --iface) [ $# -ge 2 ] || { usage >&2; exit 2; }; IFACE=$2; shift 2 ;;
+    --can|--iface) [ $# -ge 2 ] || { usage >&2; exit 2; }; IFACE=$2; shift 2 ;;
+    --can=*) IFACE=${1#--can=}; shift ;;
     --iface=*) IFACE=${1#--iface=}; shift ;;
     --check) MODE=check; shift ;;
     --run|run) MODE=run; shift ;;
@@ -545,7 +546,7 @@ case "$MODE" in
     choose_accel
     prepare_guest
     say "route=$(route_name): the bench and the tests run inside a $(route_words)"
-    say "run a command there with: $0 --iface $IFACE --run -- CMD [ARG...]"
+    say "run a command there with: $0 --can $IFACE --run -- CMD [ARG...]"
     exit 0 ;;
   guest)
     choose_accel

@@ -32,9 +32,9 @@ struct Cli {
     /// Scenario file (the same the sensor feeds play).
     #[arg(long, required = true)]
     scenario: Option<PathBuf>,
-    /// CAN interface.
-    #[arg(long, default_value = "vcan0")]
-    can: String,
+    /// CAN interface (default: $VCAN or vcan0).
+    #[arg(long, value_name = "IFACE")]
+    can: Option<String>,
     /// Output folder (commands.jsonl, report.json, outcome.png).
     #[arg(long, required = true)]
     out: Option<PathBuf>,
@@ -159,12 +159,14 @@ fn run(cli: &Cli) -> Result<()> {
     let keys = load_keys(cli)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let stop = host::install_stop_signals().context("installing signal handler")?;
-    let mut sock = BusSocket::open(&cli.can, &RX_IDS).with_context(|| {
-        format!(
-            "CAN interface {} (bring it up with ./vcan-setup.sh)",
-            cli.can
-        )
-    })?;
+    // `--can`, else `$VCAN` (what `./vcan-setup.sh` exports), else vcan0.
+    let can = cli
+        .can
+        .clone()
+        .or_else(|| std::env::var("VCAN").ok().filter(|v| !v.is_empty()))
+        .unwrap_or_else(|| "vcan0".to_owned());
+    let mut sock = BusSocket::open(&can, &RX_IDS)
+        .with_context(|| format!("CAN interface {can} (bring it up with ./vcan-setup.sh)"))?;
     // A deep receive queue: the stubs log every frame and may be descheduled for a while on a
     // loaded bench (a flooded bus, one emulated CPU); the ECU's commands must still all arrive.
     match sock.set_receive_buffer(RX_QUEUE_BYTES) {
@@ -215,7 +217,7 @@ fn run(cli: &Cli) -> Result<()> {
     eprintln!(
         "{} {} for {}",
         actuator_stubs::READY_PREFIX,
-        cli.can,
+        can,
         scenario.name
     );
     let mut done = false;

@@ -155,7 +155,7 @@ impl CyclictestHistogram {
     }
 }
 
-/// The parts of the ECU's `--report-json` the harness uses.
+/// The parts of the ECU's `--json` the harness uses.
 #[derive(Debug, Clone, Deserialize)]
 pub struct EcuReport {
     /// Cycles run.

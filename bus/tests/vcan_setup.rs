@@ -126,7 +126,7 @@ fn check_prints_the_route_and_its_exit_code() {
 fn run_mode_propagates_exit_code_streams_env_and_iface() {
     let _guest = guest_slot();
     let o = Command::new(script())
-        .args(["--iface", "vcan7", "--run", "--", "sh", "-c"])
+        .args(["--can", "vcan7", "--run", "--", "sh", "-c"])
         .arg("ip -d link show \"$VCAN\" | grep -q 'vcan' && echo \"iface=$VCAN bench=$BENCH_PROBE arg=$0 pwd=$(pwd) route=$VCAN_ROUTE\"; echo oops >&2; exit 42")
         .arg("two words")
         .env("BENCH_PROBE", "x'y z")

@@ -94,9 +94,9 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
         return Ok(());
     }
     // Every output path is checked before the run, not at its end.
-    if let Some(path) = &cfg.report_json {
+    if let Some(path) = cfg.report_json.as_ref().filter(|p| p.as_os_str() != "-") {
         host::check_output_file(path)
-            .map_err(|e| anyhow::anyhow!("--report-json {}: {e}", path.display()))?;
+            .map_err(|e| anyhow::anyhow!("--json {}: {e}", path.display()))?;
     }
     let secoc = load_secoc(&cfg, cli.run.no_secoc)?;
     let lut = load_lut(&cfg, cli.run.no_lut)?;
@@ -139,5 +139,12 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
         Some(&config),
     )?;
     print!("{}", outcome.text);
+    if cfg
+        .report_json
+        .as_ref()
+        .is_some_and(|p| p.as_os_str() == "-")
+    {
+        println!("{}", outcome.json);
+    }
     Ok(())
 }

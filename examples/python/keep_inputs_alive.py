@@ -20,7 +20,7 @@ Usage (the venv the set-up makes has python-can and cantools):
 With the ECU running on the same interface (`ecu --can vcan0`), its report counts every frame
 as accepted (`can_accepted`, no `can_rejected_*`) and EcuStatus.FaultVehicleInput /
 FaultOccupantInput stay clear. The values are a belted mid-size adult at 300 mm from the wheel,
-in a car driving at `--speed-kph`; change them in `inputs()`.
+in a car driving at `--ego-speed-kph`; change them in `inputs()`.
 """
 import argparse
 import os
@@ -90,11 +90,11 @@ def main() -> int:
     ap.add_argument("--can", default=os.environ.get("VCAN", "vcan0"), help="SocketCAN interface (default $VCAN or vcan0)")
     ap.add_argument("--dbc", default=str(REPO / "bus" / "restraint.dbc"), help="the bus's DBC (default: the repository's)")
     ap.add_argument("--duration-s", type=float, default=10.0, help="how long to send, s (default 10)")
-    ap.add_argument("--speed-kph", type=float, default=50.0, help="the ego speed sent, km/h (default 50)")
+    ap.add_argument("--ego-speed-kph", type=float, default=50.0, help="the ego speed sent, km/h (default 50)")
     args = ap.parse_args()
 
     db = cantools.database.load_file(args.dbc)
-    signals = inputs(args.speed_kph)
+    signals = inputs(args.ego_speed_kph)
     senders = [E2eSender(db.get_message_by_name(name)) for name in signals]
     sent = {s.msg.name: 0 for s in senders}
     try:

@@ -1,5 +1,5 @@
 //! The JSON results the tools write (`report.json`, `campaign.json`, the ECU's
-//! `--report-json`, …): each document carries `schema_version` as its first key, the version
+//! `--json`, …): each document carries `schema_version` as its first key, the version
 //! of its own fields, so a script that reads it can refuse a layout it does not know. Each
 //! document's version is a constant next to its type; docs/using.md, "JSON results", lists
 //! them, and the tests check the two agree.

@@ -157,7 +157,11 @@ fn round(x: f64, digits: i32) -> f64 {
 #[derive(Args, Debug)]
 pub struct OptimiseArgs {
     /// Car-to-car closing speed [km/h] (with --barrier: barrier impact speed).
-    #[arg(long)]
+    #[arg(
+        long = "closing-speed-kph",
+        alias = "closing-kph",
+        value_name = "CLOSING_SPEED_KPH"
+    )]
     pub closing_kph: f64,
     /// Opponent mass [kg] (ignored with --barrier).
     #[arg(long, default_value_t = 1785.0)]
@@ -166,7 +170,12 @@ pub struct OptimiseArgs {
     #[arg(long)]
     pub barrier: bool,
     /// Occupant mass [kg].
-    #[arg(long, default_value_t = 75.0)]
+    #[arg(
+        long = "occupant-mass-kg",
+        alias = "occupant-kg",
+        default_value_t = 75.0,
+        value_name = "OCCUPANT_MASS_KG"
+    )]
     pub occupant_kg: f64,
     /// Seat distance chest to wheel [mm].
     #[arg(long, default_value_t = 300.0)]

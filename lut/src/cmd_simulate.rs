@@ -17,16 +17,28 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub ego_mass_kg: f64,
     /// Opponent vehicle mass [kg].
-    #[arg(long)]
+    #[arg(
+        long = "opponent-mass-kg",
+        alias = "opp-mass-kg",
+        value_name = "OPPONENT_MASS_KG"
+    )]
     pub opp_mass_kg: f64,
     /// Closing speed [km/h] (sum of both vehicles' speeds).
-    #[arg(long)]
+    #[arg(
+        long = "closing-speed-kph",
+        alias = "closing-kph",
+        value_name = "CLOSING_SPEED_KPH"
+    )]
     pub closing_kph: f64,
     /// Ego stiffness class 1..6 (default: looked up from the mass).
     #[arg(long)]
     pub ego_class: Option<u8>,
     /// Opponent stiffness class 1..6 (default: looked up from the mass).
-    #[arg(long)]
+    #[arg(
+        long = "opponent-class",
+        alias = "opp-class",
+        value_name = "OPPONENT_CLASS"
+    )]
     pub opp_class: Option<u8>,
     /// Use one linear combined spring of this stiffness [kN/m] instead of the class curves
     /// (split as two equal fronts of twice the stiffness, so each vehicle takes half the crush).
@@ -35,9 +47,9 @@ pub struct SimulateArgs {
     /// Coefficient of restitution (default 0.1).
     #[arg(long, default_value_t = defaults::RESTITUTION)]
     pub restitution: f64,
-    /// Print JSON instead of a table.
-    #[arg(long)]
-    pub json: bool,
+    /// JSON instead of the table: into FILE, or on stdout without one (or with `-`).
+    #[arg(long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
+    pub json: Option<PathBuf>,
     /// Draw acceleration and velocity over time (SVG if the name ends in .svg, else PNG).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
@@ -97,7 +109,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         .collect();
     let g = |v: &[f64]| v.iter().map(|a| mps2_to_g(*a)).collect::<Vec<_>>();
     let mm = |v: &[f64]| v.iter().map(|a| a * 1e3).collect::<Vec<_>>();
-    if args.json {
+    if let Some(to) = &args.json {
         let out = json!({
             "inputs": {
                 "ego_mass_kg": args.ego_mass_kg, "opp_mass_kg": args.opp_mass_kg,
@@ -117,7 +129,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
                 "opponent": { "accel_g": g(buf.opp_accel_mps2()), "vel_mps": buf.opp_vel_mps(), "crush_mm": mm(buf.opp_crush_m()) },
             },
         });
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        lut::json_out::write(to, &out)?;
     } else {
         print_table(args, ego_class, opp_class, &s);
     }

@@ -76,9 +76,9 @@ pub enum SlurmCommand {
     Status {
         /// Work directory (OUT.slurm by default).
         dir: PathBuf,
-        /// JSON output.
-        #[arg(long)]
-        json: bool,
+        /// JSON instead of the table: into FILE, or on stdout without one (or with `-`).
+        #[arg(long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
+        json: Option<PathBuf>,
     },
     /// Merge and check the shards of a work directory and write its output (what the collect
     /// job runs; also usable by hand once every shard is done).
@@ -105,8 +105,8 @@ pub fn run(cmd: &SlurmCommand) -> Result<()> {
     match cmd {
         SlurmCommand::Status { dir, json } => {
             let st = Work::open(dir)?.status(true)?;
-            if *json {
-                println!("{}", serde_json::to_string_pretty(&st)?);
+            if let Some(to) = json {
+                lut::json_out::write(to, &st)?;
             } else {
                 print!("{}", st.report());
             }

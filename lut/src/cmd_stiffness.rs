@@ -26,17 +26,22 @@ pub struct DeriveArgs {
     #[arg(long, value_name = "FILE")]
     pub trace: PathBuf,
     /// Test mass [kg].
-    #[arg(long)]
+    #[arg(long = "ego-mass-kg", alias = "mass-kg", value_name = "EGO_MASS_KG")]
     pub mass_kg: f64,
     /// Impact speed of the test [km/h] (NCAP / FMVSS 208 full frontal: 56).
-    #[arg(long, default_value_t = 56.0)]
+    #[arg(
+        long = "closing-speed-kph",
+        alias = "impact-kph",
+        default_value_t = 56.0,
+        value_name = "CLOSING_SPEED_KPH"
+    )]
     pub impact_kph: f64,
     /// Number of curve points including the origin (3..=16).
     #[arg(long, default_value_t = 12)]
     pub points: usize,
-    /// Print JSON instead of TOML.
-    #[arg(long)]
-    pub json: bool,
+    /// JSON instead of the table: into FILE, or on stdout without one (or with `-`).
+    #[arg(long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
+    pub json: Option<PathBuf>,
     /// Plot raw loading-phase force and the derived curve over crush (SVG if .svg, else PNG).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
@@ -76,10 +81,10 @@ fn derive(args: &DeriveArgs) -> Result<()> {
     if d.sign_flipped {
         eprintln!("note: trace had deceleration positive (not SAE J211 sign); flipped");
     }
-    if args.json {
+    if let Some(to) = &args.json {
         let out = json!({ "mass_kg": args.mass_kg, "impact_kph": args.impact_kph, "max_crush_mm": d.max_crush_m * 1e3,
                           "sign_flipped": d.sign_flipped, "deflection_mm": mm, "force_kn": kn });
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        lut::json_out::write(to, &out)?;
     } else {
         let list = |v: &[f64]| {
             v.iter()

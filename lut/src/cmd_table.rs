@@ -163,9 +163,9 @@ pub struct VerifyArgs {
     /// Seed for the cell choice and the independent re-optimisations.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Print the rows as JSON.
-    #[arg(long)]
-    pub json: bool,
+    /// JSON instead of the table: into FILE, or on stdout without one (or with `-`).
+    #[arg(long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
+    pub json: Option<PathBuf>,
     /// The planning margin's check over every cell: a setting planned for opponent mass M
     /// judged at every true opponent from M − this down to M (`lut::margin`). Default: the span
     /// the table states in its header (then enforced), else 2 400 kg (then reported only).
@@ -180,8 +180,8 @@ pub struct VerifyArgs {
 pub fn run_verify(a: &VerifyArgs) -> Result<()> {
     let d = Diagram::load_any(&a.file)?;
     let rows = verify::verify(&d, a.cells, a.seed)?;
-    if a.json {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
+    if let Some(to) = &a.json {
+        lut::json_out::write(to, &rows)?;
     } else {
         println!(
             "{:>6} {:<14} {:>9} {:>9} {:>9} {:>6} {:>6}  result",
@@ -294,9 +294,9 @@ pub struct InspectArgs {
     /// Table file (.lut or .json).
     #[arg(value_parser = lut::paths::input_file)]
     pub file: PathBuf,
-    /// JSON output.
-    #[arg(long)]
-    pub json: bool,
+    /// JSON instead of the table: into FILE, or on stdout without one (or with `-`).
+    #[arg(long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
+    pub json: Option<PathBuf>,
 }
 
 fn field_stats(cells: &[Cell]) -> Vec<(&'static str, f64, f64, f64)> {
@@ -327,7 +327,7 @@ pub fn run_inspect(a: &InspectArgs) -> Result<()> {
         .count();
     let stats = field_stats(cells);
     let axes = d.axes();
-    if a.json {
+    if let Some(to) = &a.json {
         let v = serde_json::json!({
             "file": a.file.display().to_string(),
             "lut_id": d.lut_id(),
@@ -339,7 +339,7 @@ pub fn run_inspect(a: &InspectArgs) -> Result<()> {
             "airbag_no_fire_cells": no_fire,
             "fields": stats.iter().map(|(n, lo, mean, hi)| serde_json::json!({"field": n, "min": lo, "mean": mean, "max": hi})).collect::<Vec<_>>(),
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        lut::json_out::write(to, &v)?;
         return Ok(());
     }
     println!("file            {}", a.file.display());
@@ -392,7 +392,7 @@ pub struct ExportArgs {
     #[arg(value_parser = lut::paths::input_file)]
     pub file: PathBuf,
     /// JSON output file.
-    #[arg(long)]
+    #[arg(long = "json", alias = "out", value_name = "FILE")]
     pub out: PathBuf,
 }
 
@@ -422,7 +422,7 @@ pub struct PlotArgs {
     #[arg(long = "slice", value_name = "AXIS=VALUE")]
     pub slice: Vec<String>,
     /// Output picture (.png or .svg).
-    #[arg(long)]
+    #[arg(long = "plot", alias = "out", value_name = "FILE")]
     pub out: PathBuf,
 }
 

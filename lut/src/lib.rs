@@ -32,6 +32,7 @@ pub mod estimation;
 pub mod fallback_study;
 pub mod fire_floor;
 pub mod hash;
+pub mod json_out;
 pub mod limiter_switch;
 pub mod margin;
 pub mod optimise;

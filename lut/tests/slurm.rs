@@ -273,11 +273,11 @@ fn distributed_build_and_study_on_a_one_node_slurm_cluster() {
         c.args(["study", "robustness", "--table"])
             .arg(tmp.join("ci.lut"))
             .args([
-                "--closing-kph",
+                "--closing-speed-kph",
                 "74",
                 "--opponent-mass-kg",
                 "1800",
-                "--occupant-kg",
+                "--occupant-mass-kg",
                 "75",
                 "--seat-mm",
                 "300",

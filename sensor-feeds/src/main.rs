@@ -36,9 +36,9 @@ struct Cli {
     /// contact for the actuator stubs (README.md, "Replay").
     #[arg(long, value_name = "RUN.mcap", conflicts_with = "check")]
     replay: Option<PathBuf>,
-    /// CAN interface for the vehicle and occupant frames.
-    #[arg(long, default_value = "vcan0", conflicts_with = "no_can")]
-    can: String,
+    /// CAN interface for the vehicle and occupant frames (default: $VCAN or vcan0).
+    #[arg(long, value_name = "IFACE", conflicts_with = "no_can")]
+    can: Option<String>,
     /// Do not send CAN frames (iceoryx2 feeds only).
     #[arg(long)]
     no_can: bool,
@@ -67,6 +67,13 @@ struct Cli {
 }
 
 const TRUTH_PERIOD_TICKS: u64 = 10;
+
+/// The CAN interface: `--can`, else `$VCAN` (what `./vcan-setup.sh` exports), else vcan0.
+fn can_interface(flag: Option<&str>) -> String {
+    flag.map(str::to_owned)
+        .or_else(|| std::env::var("VCAN").ok().filter(|v| !v.is_empty()))
+        .unwrap_or_else(|| "vcan0".to_owned())
+}
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
@@ -149,12 +156,13 @@ impl Transports {
             None
         } else {
             Some(
-                bus::socket::BusSocket::open(&cli.can, &[]).with_context(|| {
-                    format!(
-                        "CAN interface {} (bring it up with ./vcan-setup.sh, or pass --no-can)",
-                        cli.can
-                    )
-                })?,
+                bus::socket::BusSocket::open(&can_interface(cli.can.as_deref()), &[])
+                    .with_context(|| {
+                        format!(
+                            "CAN interface {} (bring it up with ./vcan-setup.sh, or pass --no-can)",
+                            can_interface(cli.can.as_deref())
+                        )
+                    })?,
             )
         };
         Ok(Self {

@@ -148,7 +148,7 @@ pub fn run_host_timing(cfg: &HostTimingConfig) -> Result<HostTiming> {
             .args(["--service-prefix", &run.service_prefix])
             .arg("--node-name")
             .arg(format!("ecu-timing-{}", std::process::id()))
-            .arg("--report-json")
+            .arg("--json")
             .arg(&report)
             .current_dir(&cfg.repo)
             .stdout(Stdio::null())

@@ -1,7 +1,7 @@
 //! End-to-end tests of the real bench processes (see tests/tests/) and the bench orchestration
 //! they share with the demo (`hil-bench`).
 //!
-//! One scenario run: `candump -L IF > candump.log`, `actuator-stubs`, `ecu --report-json`, then
+//! One scenario run: `candump -L IF > candump.log`, `actuator-stubs`, `ecu --json`, then
 //! `sensor-feeds` (which plays the scenario in real time); when the feeds finish the stubs see
 //! the bench truth's `done` and judge; then the ECU and candump get SIGTERM. Everything a run
 //! produced lands in `OUT/<scenario>/`. Every run uses its own iceoryx2 service prefix, so

@@ -376,7 +376,7 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
             ])
             .arg("--node-name")
             .arg(format!("ecu-{}", std::process::id()))
-            .arg("--report-json")
+            .arg("--json")
             .arg(dir.join("ecu-report.json"))
             .args(&cfg.ecu_args)
             .current_dir(&cfg.ecu_cwd)

@@ -96,7 +96,7 @@ fn a_run_whose_ecu_does_not_start_is_aborted_and_exits_2() {
         out.clone().into(),
         "--repo".into(),
         root().into(),
-        "--brief".into(),
+        "--quiet".into(),
         "--scenario".into(),
         root().join("scenarios/taurus-48-48-abs.toml").into(),
         "--ecu-arg=--config".into(),
@@ -629,7 +629,7 @@ fn a_python_can_sender_keeps_the_ecus_inputs_alive_with_no_e2e_rejection() {
     // The ECU runs until the sender is done (python's start-up takes seconds of the emulated
     // guest's time), then stops on SIGTERM and writes its report.
     let script = format!(
-        "{ecu} --can vcan0 --quiet --report-json {report} & ecu=$!; \
+        "{ecu} --can vcan0 --quiet --json {report} & ecu=$!; \
          {python} {example} --can vcan0 --duration-s 3 > {sent}; s=$?; kill -TERM $ecu; \
          wait $ecu; e=$?; exit $((s > e ? s : e))",
         ecu = harness::bin_dir().join("ecu").display(),
@@ -693,7 +693,7 @@ fn a_recorded_run_replayed_into_the_ecu_fires_as_it_did() {
             into.clone().into(),
             "--repo".into(),
             root().into(),
-            "--brief".into(),
+            "--quiet".into(),
         ]],
     )
     .remove(0);

@@ -2,8 +2,8 @@
 //! machine, same session, same period, policy, priority, CPU, memory locking, PM-QoS and count.
 //!
 //! `target/release/loop-vs-cyclictest --cycles 20000 --period-us 1000 [--sched-fifo 80]
-//! [--cpu 1] [--out DIR] [--png FILE]` (the ECU is the `ecu` built beside it; the PNG and the
-//! raw data go to `--out`, never over the committed docs/img picture unless `--png` says so).
+//! [--cpu 1] [--out DIR] [--plot FILE]` (the ECU is the `ecu` built beside it; the PNG and the
+//! raw data go to `--out`, never over the committed docs/img picture unless `--plot` says so).
 //!
 //! cyclictest measures the OS floor: a thread that does nothing but sleep to an absolute
 //! deadline (clock_nanosleep TIMER_ABSTIME) and read the clock. The ECU loop does the same plus
@@ -47,7 +47,7 @@ struct Args {
     #[arg(long, default_value_t = 10_000)]
     hist_max_us: u64,
     /// Output PNG (default: timing-loop-vs-cyclictest.png in --out).
-    #[arg(long, value_name = "FILE")]
+    #[arg(long = "plot", alias = "png", value_name = "FILE")]
     png: Option<PathBuf>,
     /// Folder for the plot, the raw cyclictest histogram and the ECU report JSON.
     #[arg(
@@ -130,7 +130,7 @@ fn run() -> anyhow::Result<()> {
         .arg(a.cycles.to_string())
         .arg("--period-us")
         .arg(a.period_us.to_string())
-        .arg("--report-json")
+        .arg("--json")
         .arg(&report_path)
         .arg("--service-prefix")
         .arg(format!("loop-vs-cyclictest-{}", std::process::id()));

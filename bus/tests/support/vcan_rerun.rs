@@ -42,7 +42,7 @@ pub fn run_here_or_in_guest(worker_test: &str, worker: impl FnOnce()) {
         iface()
     );
     let out = Command::new(repo_root().join("vcan-setup.sh"))
-        .args(["--iface", &iface(), "--run", "--"])
+        .args(["--can", &iface(), "--run", "--"])
         .arg(std::env::current_exe().unwrap())
         .args([
             "--exact",

@@ -69,8 +69,8 @@ pub struct RunArgs {
     /// Stop after N cycles and print the report (default: until SIGINT/SIGTERM).
     #[arg(long, value_name = "N")]
     pub cycles: Option<u64>,
-    /// Also write the timing report as JSON to FILE.
-    #[arg(long, value_name = "FILE")]
+    /// Also write the timing report as JSON to FILE (`-`: stdout, after the text report).
+    #[arg(long = "json", alias = "report-json", value_name = "FILE")]
     pub report_json: Option<PathBuf>,
     /// Request SCHED_FIFO at this priority (1..=99); degrades with a message if denied.
     #[arg(long, value_name = "PRIO")]

@@ -1,4 +1,4 @@
-//! The timing report (text on stdout, JSON with `--report-json`).
+//! The timing report (text on stdout, JSON with `--json`).
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -196,7 +196,7 @@ impl<'a> TimingReport<'a> {
         }
     }
 
-    /// `schema_version` of the `--report-json` document (docs/using.md, "JSON results").
+    /// `schema_version` of the `--json` document (docs/using.md, "JSON results").
     pub const SCHEMA_VERSION: u32 = 1;
 
     /// Pretty JSON, `schema_version` first.

@@ -32,7 +32,7 @@ fn help_lists_the_flags() {
         "--config",
         "--period-us",
         "--cycles",
-        "--report-json",
+        "--json",
         "--sched-fifo",
         "--mlockall",
         "--cpu",
@@ -152,7 +152,7 @@ fn cycles_run_writes_json_report_and_monitor_shows_it() {
             "--node-name",
             &format!("{pfx}-ecu"),
         ])
-        .arg("--report-json")
+        .arg("--json")
         .arg(&report)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -350,7 +350,7 @@ fn an_output_path_is_checked_before_the_run_and_config_paths_follow_their_file()
         &here,
         "badout",
         // A folder nobody can make (its missing folders are made otherwise, as every tool's).
-        &["--report-json", "/proc/no-such-dir/r.json"],
+        &["--json", "/proc/no-such-dir/r.json"],
     );
     assert!(!ok, "{err}");
     assert!(err.contains("/proc/no-such-dir/r.json"), "{err}");

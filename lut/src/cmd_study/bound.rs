@@ -11,7 +11,7 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct BoundArgs {
     /// The table.
-    #[arg(long, default_value = "data/default.lut", value_parser = lut::paths::input_file)]
+    #[arg(long = "lut", alias = "table", default_value = "data/default.lut", value_parser = lut::paths::input_file, value_name = "FILE")]
     pub table: PathBuf,
     /// Cells re-optimised under each lever.
     #[arg(long, default_value_t = 24)]
@@ -19,20 +19,17 @@ pub struct BoundArgs {
     /// Seed of the cell sample.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Print JSON instead of tables.
-    #[arg(long)]
-    pub json: bool,
+    /// JSON instead of the table: into FILE, or on stdout without one (or with `-`).
+    #[arg(long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
+    pub json: Option<PathBuf>,
 }
 
 pub fn run(a: &BoundArgs) -> Result<()> {
     let d = Diagram::load_any(&a.table).map_err(|e| anyhow!("{}: {e}", a.table.display()))?;
     let t = table_ratios(&d)?;
     let rows = levers(&d, a.samples, a.seed)?;
-    if a.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&json!({ "table": t, "levers": rows }))?
-        );
+    if let Some(to) = &a.json {
+        lut::json_out::write(to, &json!({ "table": t, "levers": rows }))?;
         return Ok(());
     }
     let at = |q: &diagram::Query| {

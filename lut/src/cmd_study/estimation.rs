@@ -18,7 +18,7 @@ pub struct EstimationArgs {
     #[arg(long, default_value = "scenarios", value_parser = lut::paths::input_file)]
     pub scenarios: PathBuf,
     /// The table the occupant outcome is looked up in.
-    #[arg(long, default_value = "data/default.lut", value_parser = lut::paths::input_file)]
+    #[arg(long = "lut", alias = "table", default_value = "data/default.lut", value_parser = lut::paths::input_file, value_name = "FILE")]
     pub table: PathBuf,
     /// Noise seeds per scenario and variation.
     #[arg(long, default_value_t = 40)]
@@ -27,7 +27,12 @@ pub struct EstimationArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Result file (JSON).
-    #[arg(long, default_value = "estimation.json")]
+    #[arg(
+        long = "json",
+        alias = "out",
+        value_name = "FILE",
+        default_value = "estimation.json"
+    )]
     pub out: PathBuf,
     /// Worker threads [default: all cores].
     #[arg(long)]

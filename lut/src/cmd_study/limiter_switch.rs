@@ -27,10 +27,10 @@ pub struct LimiterSwitchArgs {
     #[arg(long, value_delimiter = ',', default_values_t = [30.0, 40.0, 50.0])]
     pub switch_ms: Vec<f64>,
     /// Opponent mass half-width of the set (and the margin of today's rule) [kg].
-    #[arg(long, default_value_t = Uncertainty::MISREPORT.mass_kg)]
+    #[arg(long = "mass-error-kg", alias = "mass-kg", default_value_t = Uncertainty::MISREPORT.mass_kg, value_name = "MASS_ERROR_KG")]
     pub mass_kg: f64,
     /// Closing speed half-width of the set [km/h].
-    #[arg(long, default_value_t = Uncertainty::MISREPORT.speed_kph)]
+    #[arg(long = "speed-error-kph", alias = "speed-kph", default_value_t = Uncertainty::MISREPORT.speed_kph, value_name = "SPEED_ERROR_KPH")]
     pub speed_kph: f64,
     /// The measured speed loss reads this much low [%] (sensitivity error of the accelerometer,
     /// in the direction that switches a heavy crash down).
@@ -39,9 +39,9 @@ pub struct LimiterSwitchArgs {
     /// Both errors at once (the box's corners), not only one at a time.
     #[arg(long)]
     pub corners: bool,
-    /// JSON output.
-    #[arg(long)]
-    pub json: bool,
+    /// JSON instead of the table: into FILE, or on stdout without one (or with `-`).
+    #[arg(long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
+    pub json: Option<PathBuf>,
     /// Also plot (SVG if .svg, else PNG) how little the heavier opponent shows in the speed the
     /// ego has lost, for the 48 + 48 km/h Taurus case.
     #[arg(long, value_name = "FILE")]
@@ -108,7 +108,7 @@ pub fn run(a: &LimiterSwitchArgs) -> Result<()> {
             })
         })
         .collect::<Result<_>>()?;
-    if a.json {
+    if let Some(to) = &a.json {
         let v: Vec<_> = rows
             .iter()
             .map(|r| {
@@ -120,10 +120,7 @@ pub fn run(a: &LimiterSwitchArgs) -> Result<()> {
                 json!({ "case": r.name, "no margin": r.none, "+mass margin": r.margin, "two-level": sw })
             })
             .collect();
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&json!({ "set": u, "cases": v }))?
-        );
+        lut::json_out::write(to, &json!({ "set": u, "cases": v }))?;
         return Ok(());
     }
     print_table(a, &u, &rows);

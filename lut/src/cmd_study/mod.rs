@@ -51,9 +51,9 @@ pub enum StudyCommand {
 
 #[derive(Args, Debug)]
 pub struct StiffnessStudyArgs {
-    /// Print JSON instead of a table.
-    #[arg(long)]
-    pub json: bool,
+    /// JSON instead of the table: into FILE, or on stdout without one (or with `-`).
+    #[arg(long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
+    pub json: Option<PathBuf>,
     /// Plot the vehicle pulses of all classes (SVG if .svg, else PNG).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
@@ -117,8 +117,8 @@ fn stiffness_study(args: &StiffnessStudyArgs) -> Result<()> {
         let a: Vec<f64> = buf.ego_accel_mps2().iter().map(|x| mps2_to_g(*x)).collect();
         pulses.push((format!("class {}", p.class), t, a));
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
+    if let Some(to) = &args.json {
+        lut::json_out::write(to, &rows)?;
     } else {
         println!(
             "Table 5 case: {} kg vs {} kg, {} km/h, e = {}",

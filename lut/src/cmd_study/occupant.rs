@@ -75,17 +75,27 @@ pub struct OpponentMassArgs {
     #[arg(long, default_value_t = DEFAULT_EGO_CLASS)]
     pub ego_class: u8,
     /// Closing speed [km/h].
-    #[arg(long, default_value_t = 108.0)]
+    #[arg(
+        long = "closing-speed-kph",
+        alias = "closing-kph",
+        default_value_t = 108.0,
+        value_name = "CLOSING_SPEED_KPH"
+    )]
     pub closing_kph: f64,
     /// Occupant mass [kg].
-    #[arg(long, default_value_t = 75.0)]
+    #[arg(
+        long = "occupant-mass-kg",
+        alias = "occupant-kg",
+        default_value_t = 75.0,
+        value_name = "OCCUPANT_MASS_KG"
+    )]
     pub occupant_kg: f64,
     /// Seat distance [mm].
     #[arg(long, default_value_t = 300.0)]
     pub seat_mm: f64,
-    /// JSON output.
-    #[arg(long)]
-    pub json: bool,
+    /// JSON instead of the table: into FILE, or on stdout without one (or with `-`).
+    #[arg(long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
+    pub json: Option<PathBuf>,
     /// Plot file (.png/.svg).
     #[arg(long)]
     pub plot: Option<PathBuf>,
@@ -117,8 +127,8 @@ pub fn opponent_mass(a: &OpponentMassArgs) -> Result<()> {
             })
         })
         .collect();
-    if a.json {
-        println!("{}", serde_json::to_string_pretty(&json_rows)?);
+    if let Some(to) = &a.json {
+        lut::json_out::write(to, &json_rows)?;
     } else {
         println!(
             "ego {} kg class {}, {} km/h closing, occupant {} kg at {} mm (adaptive optimum)",
@@ -197,9 +207,9 @@ pub struct ReductionArgs {
     /// Seat distance [mm].
     #[arg(long, default_value_t = 300.0)]
     pub seat_mm: f64,
-    /// JSON output.
-    #[arg(long)]
-    pub json: bool,
+    /// JSON instead of the table: into FILE, or on stdout without one (or with `-`).
+    #[arg(long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
+    pub json: Option<PathBuf>,
     /// Heat-map picture of the reductions (.png/.svg).
     #[arg(long)]
     pub plot: Option<PathBuf>,
@@ -261,8 +271,8 @@ pub fn reduction(a: &ReductionArgs) -> Result<()> {
             })
         })
         .collect();
-    if a.json {
-        println!("{}", serde_json::to_string_pretty(&json_rows)?);
+    if let Some(to) = &a.json {
+        lut::json_out::write(to, &json_rows)?;
     } else {
         println!("reduction of occupant a_max / a_mean, adaptive vs reference ({}), opponent {} kg, seat {} mm", a.reference.display(), a.opponent_mass_kg, a.seat_mm);
         println!(

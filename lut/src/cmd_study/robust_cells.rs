@@ -24,17 +24,17 @@ pub struct RobustCellsArgs {
     #[arg(long, default_value = "data/default-grid.toml", value_parser = lut::paths::input_file)]
     pub grid: PathBuf,
     /// Opponent mass half-width of the set [kg].
-    #[arg(long, default_value_t = Uncertainty::MISREPORT.mass_kg)]
+    #[arg(long = "mass-error-kg", alias = "mass-kg", default_value_t = Uncertainty::MISREPORT.mass_kg, value_name = "MASS_ERROR_KG")]
     pub mass_kg: f64,
     /// Closing speed half-width of the set [km/h].
-    #[arg(long, default_value_t = Uncertainty::MISREPORT.speed_kph)]
+    #[arg(long = "speed-error-kph", alias = "speed-kph", default_value_t = Uncertainty::MISREPORT.speed_kph, value_name = "SPEED_ERROR_KPH")]
     pub speed_kph: f64,
     /// Both errors at once (the box's corners), not only one at a time.
     #[arg(long)]
     pub corners: bool,
-    /// JSON output.
-    #[arg(long)]
-    pub json: bool,
+    /// JSON instead of the table: into FILE, or on stdout without one (or with `-`).
+    #[arg(long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
+    pub json: Option<PathBuf>,
 }
 
 /// The reference restraint's settings and the grid's optimiser settings the margin studies
@@ -77,15 +77,12 @@ pub fn run(a: &RobustCellsArgs) -> Result<()> {
         })
         .collect::<Result<_>>()?;
     const RULES: [&str; 3] = ["no margin", "+mass margin", "robust cell"];
-    if a.json {
+    if let Some(to) = &a.json {
         let v: Vec<_> = rows
             .iter()
             .map(|(n, j)| json!({ "case": n, RULES[0]: j[0], RULES[1]: j[1], RULES[2]: j[2] }))
             .collect();
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&json!({ "set": u, "cases": v }))?
-        );
+        lut::json_out::write(to, &json!({ "set": u, "cases": v }))?;
         return Ok(());
     }
     println!(

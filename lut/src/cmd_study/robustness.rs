@@ -13,16 +13,26 @@ use std::path::{Path, PathBuf};
 #[derive(Args, Debug)]
 pub struct RobustnessArgs {
     /// The table the ECU uses.
-    #[arg(long, default_value = "data/default.lut", value_parser = lut::paths::input_file)]
+    #[arg(long = "lut", alias = "table", default_value = "data/default.lut", value_parser = lut::paths::input_file, value_name = "FILE")]
     pub table: PathBuf,
     /// True closing speed [km/h].
-    #[arg(long, default_value_t = 91.0)]
+    #[arg(
+        long = "closing-speed-kph",
+        alias = "closing-kph",
+        default_value_t = 91.0,
+        value_name = "CLOSING_SPEED_KPH"
+    )]
     pub closing_kph: f64,
     /// True opponent mass [kg].
     #[arg(long, default_value_t = 1800.0)]
     pub opponent_mass_kg: f64,
     /// Occupant mass [kg].
-    #[arg(long, default_value_t = 75.0)]
+    #[arg(
+        long = "occupant-mass-kg",
+        alias = "occupant-kg",
+        default_value_t = 75.0,
+        value_name = "OCCUPANT_MASS_KG"
+    )]
     pub occupant_kg: f64,
     /// Seat distance chest to wheel [mm].
     #[arg(long, default_value_t = 300.0)]
@@ -46,7 +56,12 @@ pub struct RobustnessArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Result file (JSON).
-    #[arg(long, default_value = "robustness.json")]
+    #[arg(
+        long = "json",
+        alias = "out",
+        value_name = "FILE",
+        default_value = "robustness.json"
+    )]
     pub out: PathBuf,
     /// Worker threads of a local run [default: all cores].
     #[arg(long)]

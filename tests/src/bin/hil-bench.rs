@@ -45,7 +45,7 @@ struct Cli {
     #[arg(long)]
     repo: Option<PathBuf>,
     /// Print only the one-line verdicts, not the full summaries.
-    #[arg(long)]
+    #[arg(long = "quiet", alias = "brief")]
     brief: bool,
     /// Do not judge the scenarios' `[expect]` blocks (by default every key is asserted, with
     /// the judge `offline-bench` uses, and a miss exits 1).
@@ -67,7 +67,7 @@ fn main() -> std::process::ExitCode {
 /// ([`e2e_tests::route::starved_run`]) is run again, up to the route's allowance — but never a
 /// run whose fire / no-fire outcome contradicts the scenario's `[expect] airbag_fires`: that
 /// verdict stands as measured. Every retry is in the summary, in `report.json`
-/// (`retries`: why each earlier run was not taken) and on the `--brief` line. With real
+/// (`retries`: why each earlier run was not taken) and on the `--quiet` line. With real
 /// timers: one run, judged as it is.
 fn run_until_measured(cfg: &RunConfig) -> Result<(e2e_tests::RunResult, Vec<String>)> {
     let route = e2e_tests::Route::current();
@@ -311,7 +311,7 @@ fn run() -> Result<bool> {
             }
             Err(e) => {
                 // A run that could not be made (the ECU did not start, a process failed) is an
-                // error, not a verdict: said on --brief's line too, and the exit status is 2.
+                // error, not a verdict: said on --quiet's line too, and the exit status is 2.
                 if cli.brief {
                     println!("{}: run aborted: {e:#}", scenario.display());
                 }

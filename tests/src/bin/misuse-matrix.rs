@@ -43,7 +43,7 @@ struct Cli {
     #[arg(long)]
     repo: Option<PathBuf>,
     /// Also write the table and every failing variant as JSON.
-    #[arg(long)]
+    #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
     /// The table only: no progress bar, no failing scenarios on stderr (their count stays).
     #[arg(long)]

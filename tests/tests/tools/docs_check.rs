@@ -26,7 +26,7 @@ b
 
 <!-- docs: not run: needs a bench -->
 ```sh
-./vcan-setup.sh --run -- target/release/lut plot data/default.lut --field a_max_g --out x.png
+./vcan-setup.sh --run -- target/release/lut plot data/default.lut --field a_max_g --plot x.png
 candump -L vcan0 | sh -c cat
 ```
 
@@ -36,7 +36,7 @@ sensor-feeds --scenario F [--can IF | --no-can]
              [--check]
 ```
 
-In prose: `lut plot FILE [--field F] --out P.png\\|.svg`, `ecu --no-can`, `ecu`, `x --y`.
+In prose: `lut plot FILE [--field F] --plot P.png\\|.svg`, `ecu --no-can`, `ecu`, `x --y`.
 ";
 
 const BAD: &str = "\
@@ -57,7 +57,7 @@ b
 
 <!-- docs: not run: needs a bench -->
 ```sh
-target/release/lut plot data/default.lut --fields a_max_g --out x.png
+target/release/lut plot data/default.lut --fields a_max_g --plot x.png
 no-such-program-x9 --x
 ```
 

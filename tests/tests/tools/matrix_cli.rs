@@ -193,14 +193,20 @@ fn long_flags(bin: &std::path::Path) -> Vec<(String, String)> {
         let out = Command::new(bin).args(args).output().expect("runs");
         String::from_utf8_lossy(&out.stdout).into_owned()
     };
-    let top = help(&["--help"]);
-    let mut pages = vec![(String::new(), top.clone())];
-    for s in e2e_tests::docs::subcommands(&top)
-        .into_iter()
-        .filter(|s| s != "help")
-    {
-        let page = help(&[&s, "--help"]);
-        pages.push((s, page));
+    // Every page, subcommands of subcommands included (`lut study robustness`).
+    let mut pages = Vec::new();
+    let mut todo = vec![String::new()];
+    while let Some(sub) = todo.pop() {
+        let mut args: Vec<&str> = sub.split_whitespace().collect();
+        args.push("--help");
+        let page = help(&args);
+        for s in e2e_tests::docs::subcommands(&page)
+            .into_iter()
+            .filter(|s| s != "help")
+        {
+            todo.push(format!("{sub} {s}").trim().to_owned());
+        }
+        pages.push((sub, page));
     }
     let mut flags = Vec::new();
     for (sub, page) in pages {
@@ -218,7 +224,24 @@ fn one_flag_vocabulary_across_tools() {
     // `ecu --can-interface` vs `--can`, `loop-vs-cyclictest --fifo` /
     // `--no-mlock` / `--out-dir` vs `--sched-fifo` / `--no-mlockall` / `--out`, `bus-inject
     // mirror --id` (a number, not a DBC name). The old spellings stay as hidden aliases.
-    const SYNONYMS: [(&str, &str); 8] = [
+    // And the names one concept had in different tools: the table, JSON and picture outputs,
+    // the opponent's mass, the speeds, the CAN interface, the quiet switch.
+    const SYNONYMS: [(&str, &str); 20] = [
+        ("--table", "--lut"),
+        ("--report-json", "--json FILE"),
+        ("--png", "--plot"),
+        ("--opp-mass-kg", "--opponent-mass-kg"),
+        ("--opp-class", "--opponent-class"),
+        ("--occupant-kg", "--occupant-mass-kg"),
+        (
+            "--mass-kg",
+            "--ego-mass-kg, --opponent-mass-kg or --mass-error-kg",
+        ),
+        ("--closing-kph", "--closing-speed-kph"),
+        ("--impact-kph", "--closing-speed-kph"),
+        ("--speed-kph", "--ego-speed-kph or --speed-error-kph"),
+        ("--iface", "--can"),
+        ("--brief", "--quiet"),
         ("--can-interface", "--can"),
         ("--interface", "--can"),
         ("--fifo", "--sched-fifo"),
@@ -243,6 +266,36 @@ fn one_flag_vocabulary_across_tools() {
         }
     }
     assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    // Every JSON output takes its file (`-` or none: stdout).
+    for tool in TOOLS {
+        let bin = release.join(tool);
+        let mut pages = vec![String::new()];
+        let mut seen = Vec::new();
+        while let Some(sub) = pages.pop() {
+            let mut args: Vec<&str> = sub.split_whitespace().collect();
+            args.push("--help");
+            let out = Command::new(&bin).args(&args).output().expect("runs");
+            let page = String::from_utf8_lossy(&out.stdout).into_owned();
+            for s in e2e_tests::docs::subcommands(&page)
+                .into_iter()
+                .filter(|s| s != "help")
+            {
+                pages.push(format!("{sub} {s}").trim().to_owned());
+            }
+            for line in page.lines().map(str::trim_start) {
+                if let Some(rest) = line.strip_prefix("--json") {
+                    seen.push(format!("{tool} {sub}"));
+                    assert!(
+                        rest.starts_with(" <FILE>") || rest.starts_with(" [<FILE>]"),
+                        "{tool} {sub}: `{line}` (the bench says --json FILE)"
+                    );
+                }
+            }
+        }
+        if matches!(tool, "lut" | "ecu" | "offline-bench" | "misuse-matrix") {
+            assert!(!seen.is_empty(), "{tool}: no --json read");
+        }
+    }
     // The aliases still parse (scripts written against the old names keep working).
     let out = Command::new(release.join("ecu"))
         .args(["--can-interface", "vcan9", "--show-config"])
@@ -250,6 +303,16 @@ fn one_flag_vocabulary_across_tools() {
         .expect("runs");
     let shown = String::from_utf8_lossy(&out.stdout);
     assert!(shown.contains("vcan9"), "{shown}");
+    let out = Command::new(release.join("lut"))
+        .args(["simulate", "--ego-mass-kg", "1785", "--opp-mass-kg", "1500"])
+        .args(["--closing-kph", "56", "--json"])
+        .output()
+        .expect("runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && text.trim_start().starts_with('{'),
+        "{text}"
+    );
 }
 
 /// Runs a just-written executable. Another test thread that forks while the copy's file is
