@@ -5,13 +5,16 @@ code: Foxglove's `mcap` package reads the file, `cantools` decodes the frames wi
     check_mcap.py RUN_DIR DBC [--mcap FILE] [--full]
 
 --full: the folder is a whole bench run: commands.jsonl and report.json must be there and the
-file must be on CLOCK_MONOTONIC (a realtime − monotonic offset measured from the run).
+file's log times must be UTC (the bench's CLOCK_MONOTONIC + a realtime − monotonic offset
+measured from the run, as the metadata says).
 
 Checked:
   * every frame of candump.log is on /can/raw, in order, with the same id and bytes and a
     publish time equal to candump's stamp (±1 µs);
-  * every frame's log time is its publish time minus the file's realtime − monotonic offset
-    (metadata `bench`), the same for every frame;
+  * with log times in UTC, every frame's log time is its publish time (candump's stamp) and
+    every other message's log time is its bench time plus the file's realtime − monotonic
+    offset (metadata `bench`); the checks below compare bench times (log time − offset), and
+    a frame's bench time is its publish time minus that offset, the same for every frame;
   * every frame of a DBC message is on /can/<name> with the same times, and each signal's value
     equals cantools' decode of the same bytes (scaled, no value-table names), and each
     value-table signal's schema names its values as cantools' choices do, and each schema
@@ -186,12 +189,21 @@ def main():
     if config.exists() and meta.get("ecu_config", {}).get("toml") != config.read_text():
         fail("metadata `ecu_config` is not the run folder's ecu-config.toml")
     offset = int(bench["realtime_minus_monotonic_ns"]) if bench.get("realtime_minus_monotonic_ns") else 0
+    utc = "UTC" in bench.get("log_time_clock", "")
     if a.full:
         for f in ("commands.jsonl", "report.json"):
             if not (a.run_dir / f).exists():
                 fail(f"--full: no {f} in {a.run_dir}")
-        if not bench.get("realtime_minus_monotonic_ns") or "MONOTONIC" not in bench.get("log_time_clock", ""):
-            fail(f"--full: log times are not on CLOCK_MONOTONIC ({bench.get('log_time_clock')})")
+        if not bench.get("realtime_minus_monotonic_ns") or not utc:
+            fail(f"--full: log times are not UTC with a measured offset ({bench.get('log_time_clock')})")
+    if utc:
+        # Every frame's log time is candump's own UTC stamp; then every message back on the
+        # bench's clock for the checks below.
+        for i, (log_t, pub_t, _, _) in enumerate(topics.get("/can/raw", [])):
+            if log_t != pub_t:
+                fail(f"frame {i}: UTC log time {log_t} is not candump's stamp {pub_t}")
+        topics = {t: [(lt - offset, pt, m, sc) for lt, pt, m, sc in msgs] for t, msgs in topics.items()}
+        print(f"check_mcap: log times in UTC: every frame at candump's stamp, every message at its bench time + {offset} ns")
     print(f"check_mcap: {mcap_path}: {sum(map(len, topics.values()))} messages, "
           f"route {bench.get('route')}, timing {bench.get('timing')}, offset {offset} ns")
 

@@ -33,7 +33,9 @@ def main():
         for _, ch, m in r.iter_messages():
             topics[ch.topic].append((m.log_time, json.loads(m.data)))
     bench = meta.get("bench", {})
-    t0 = int(bench.get("contact_ns") or 0) or (topics["/can/raw"][0][0] if topics["/can/raw"] else 0)
+    # The contact is a bench (CLOCK_MONOTONIC) time; log times are UTC where the file says so.
+    shift = int(bench.get("realtime_minus_monotonic_ns") or 0) if "UTC" in bench.get("log_time_clock", "") else 0
+    t0 = (int(bench.get("contact_ns") or 0) + shift if bench.get("contact_ns") not in (None, "", "0") else 0) or (topics["/can/raw"][0][0] if topics["/can/raw"] else 0)
     rel = "ms after the true contact" if bench.get("contact_ns") not in (None, "", "0") else "ms after the first frame"
     ms = lambda t: (t - t0) / 1e6  # noqa: E731
 

@@ -125,6 +125,9 @@ pub fn latency(path: &Path) -> Result<Latency> {
         })
         .map(|m| m.metadata)
         .unwrap_or_default();
+    // Log times back on the bench's clock, where the sample times inside the messages are.
+    let shift = crate::read::log_minus_bench_ns(&meta);
+    let bench_ns = |log: u64| log.saturating_add_signed(-shift);
     let mut known: Vec<(u64, u64)> = Vec::new();
     // Cycle count → the newest crash batch the cycle had read; batch sequence → its newest
     // sample's time.
@@ -138,7 +141,7 @@ pub fn latency(path: &Path) -> Result<Latency> {
         if topic == "/ecu/diagnostics" {
             let v: Value = serde_json::from_slice(&m.data)?;
             if let Some(c) = v["cycle_count"].as_u64() {
-                known.push((c, m.log_time));
+                known.push((c, bench_ns(m.log_time)));
                 if let Some(b) = v["last_accel_sequence"].as_u64() {
                     cycle_batch.insert(c, b);
                 }
@@ -147,14 +150,14 @@ pub fn latency(path: &Path) -> Result<Latency> {
             let v: Value = serde_json::from_slice(&m.data)?;
             if let (Some(seq), Some(t)) = (v["sequence"].as_u64(), v["newest_sample_ns"].as_u64()) {
                 batch_sample_ns.insert(seq, t);
-                last_batch_ns = last_batch_ns.max(m.log_time);
+                last_batch_ns = last_batch_ns.max(bench_ns(m.log_time));
             }
         } else if let Some(name) = topic.strip_prefix("/can/") {
             if name != "raw" {
                 frames
                     .entry(name.to_owned())
                     .or_default()
-                    .push((m.log_time, serde_json::from_slice(&m.data)?));
+                    .push((bench_ns(m.log_time), serde_json::from_slice(&m.data)?));
             }
         }
     }

@@ -14,14 +14,19 @@
 //! | `/sensors/object`, `/sensors/crash_accel`, `/sensors/safing_accel`, `/sensors/satellite_left`, `/sensors/satellite_right` | `feeds.postcard` (`sensor-feeds --log`) | publication |
 //! | `/truth/world` | the scenario file | ms of the scenario |
 //!
-//! **One clock.** Every message's `log_time` is CLOCK_MONOTONIC of the bench, ns — the clock
-//! of the ECU's cycles, the stubs' receive times and the diagnostics. candump stamps frames
-//! with the kernel's CLOCK_REALTIME arrival time; a frame's `publish_time` keeps that stamp
-//! exactly (µs → ns) and its `log_time` is it minus the realtime − monotonic offset, which
-//! is measured from the run itself: the stubs log the same kernel arrival time of every
-//! command frame on CLOCK_MONOTONIC (`commands.jsonl`), so the offset is the median of
-//! candump − stubs over the frames both saw. The file's `bench` metadata names the clock, the
-//! offset, the route and whether the timing is emulated.
+//! **One clock.** Every message's `log_time` is UTC (CLOCK_REALTIME, ns), as the same run's
+//! `run.mf4` is stamped: candump stamps frames with the kernel's CLOCK_REALTIME arrival time
+//! and a frame's `log_time` and `publish_time` are that stamp (µs → ns); everything the bench
+//! processes time — the ECU's cycles and diagnostics, the stubs' receive times, the feeds'
+//! publications, the truth — is on CLOCK_MONOTONIC, keeps that time as its `publish_time` and
+//! in its own fields, and is logged at it plus the run's realtime − monotonic offset. The
+//! offset is measured from the run itself: the stubs log the same kernel arrival time of every
+//! command frame on CLOCK_MONOTONIC (`commands.jsonl`), so it is the median of candump − stubs
+//! over the frames both saw. The file's `bench` metadata names the clock (`log_time_clock`),
+//! the offset (`realtime_minus_monotonic_ns`: a bench time is a log time less it), the route
+//! and whether the timing is emulated. A simulated run (the offline bench) has one clock and
+//! keeps it; a run whose offset could not be measured logs its frames at candump's stamps and
+//! everything else at its bench time, and says so.
 //!
 //! Message encoding is JSON; every schema is a JSON Schema, the CAN ones generated from the
 //! DBC's signal tables (`bus::signals_of`), never typed by hand.

@@ -49,6 +49,9 @@ struct Topic {
 /// The file being written: topics by name, schemas added on first use.
 struct Recording<W: std::io::Write + std::io::Seek> {
     w: Writer<W>,
+    /// What turns a bench time (CLOCK_MONOTONIC) into the file's log time, ns: the run's
+    /// realtime − monotonic offset (log times in UTC), or 0 (a simulated run, or no offset).
+    to_log_ns: i64,
     topics: HashMap<String, Topic>,
     counts: BTreeMap<String, u64>,
     buf: Vec<u8>,
@@ -96,7 +99,7 @@ impl<W: std::io::Write + std::io::Seek> Recording<W> {
             &MessageHeader {
                 channel_id,
                 sequence: t.sequence,
-                log_time,
+                log_time: log_time.saturating_add_signed(self.to_log_ns),
                 publish_time,
             },
             &self.buf,
@@ -136,8 +139,17 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
             .and_then(|s| world::Truth::new(&s).map(|t| (s, t)))
     });
     let file = std::fs::File::create(out).with_context(|| out.display().to_string())?;
+    // Log times in UTC where the run measured its realtime − monotonic offset (the MF4 of the
+    // same run is stamped in UTC too): every bench time below is CLOCK_MONOTONIC and moves by
+    // that offset; a simulated run keeps its one clock.
+    let to_log_ns = if meta.simulated_start_ns.is_some() {
+        0
+    } else {
+        offset.unwrap_or(0)
+    };
     let mut rec = Recording {
         w: Writer::new(BufWriter::new(file))?,
+        to_log_ns,
         topics: HashMap::new(),
         counts: BTreeMap::new(),
         buf: Vec::with_capacity(4096),
@@ -161,7 +173,8 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
                  frames at their cycle or tick without bus latency"
                     .to_owned()
             } else if offset.is_some() {
-                "CLOCK_MONOTONIC of the bench, ns".to_owned()
+                "CLOCK_REALTIME (UTC), ns: the bench's CLOCK_MONOTONIC + realtime_minus_monotonic_ns"
+                    .to_owned()
             } else {
                 "CLOCK_REALTIME (candump's stamps; no frame seen by both candump and the stubs)"
                     .to_owned()

@@ -1,15 +1,13 @@
 //! Scenario player library: plays the bench's world (the `world` crate: scenario files, the
 //! true world, the sensor models, the acceleration events) tick by tick ([`player`]). The
 //! `sensor-feeds` binary publishes it in real time over iceoryx2 and CAN; the offline bench
-//! hands the same records to the ECU core under a simulated clock. [`replay`] reads a
-//! recorded run back for the binary's `--replay`.
+//! hands the same records to the ECU core under a simulated clock.
 
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod player;
-pub mod replay;
 
 pub use player::{PlayCounts, Player, TickOutput};
 

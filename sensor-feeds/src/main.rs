@@ -14,8 +14,8 @@ use ipc::{
     AccelPublisher, BenchTruth, BenchTruthPublisher, ObjectPublisher, SafingPublisher,
     SatelliteLeftPublisher, SatelliteRightPublisher, ServiceNames,
 };
+use record::read::Item;
 use sensor_feeds::player::TICK_NS;
-use sensor_feeds::replay::Item;
 use sensor_feeds::{monotonic_ns, sleep_until_ns, Player, TickOutput};
 use signals::{FeedItem, FeedLogRecord};
 use std::path::PathBuf;
@@ -236,8 +236,8 @@ fn announce_epoch(start_ns: u64) {
 /// `--replay`: the recorded run's publications at their recorded times, moved to now.
 fn replay(cli: &Cli, path: &std::path::Path) -> Result<()> {
     let bytes = std::fs::read(path).with_context(|| format!("--replay {}", path.display()))?;
-    let rec = sensor_feeds::replay::read(&bytes)
-        .with_context(|| format!("--replay {}", path.display()))?;
+    let rec =
+        record::read::feeds(&bytes).with_context(|| format!("--replay {}", path.display()))?;
     let last_ns = rec.items.last().map_or(rec.start_ns, |(t, _)| *t);
     eprintln!(
         "sensor-feeds: replaying {}: scenario {}, {} messages over {:.3} s, {}",

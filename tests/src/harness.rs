@@ -18,7 +18,7 @@ pub fn python3() -> PathBuf {
 
 /// Runs `record/check_mcap.py` (Foxglove's `mcap` reader and cantools, no project code) on a
 /// run folder — with `full`, the folder of a whole bench run (the stubs' files there, log times
-/// on CLOCK_MONOTONIC, every path of `record/foxglove-layout.json` in the file); its report, or
+/// in UTC with a measured realtime − monotonic offset, every path of `record/foxglove-layout.json` in the file); its report, or
 /// what failed.
 pub fn check_recording(run_dir: &Path, full: bool) -> Result<String, String> {
     let root = crate::repo_root();

@@ -80,10 +80,10 @@ fn a_candump_log_is_recorded_frame_for_frame_and_decoded_as_cantools_decodes_it(
 }
 
 /// The stubs log command frames on CLOCK_MONOTONIC; candump on CLOCK_REALTIME. With a command log
-/// shifted by a known offset, the file's log times are candump's stamps minus exactly that
-/// offset, and every command record sits at its own monotonic time.
+/// shifted by a known offset, the file's log times are UTC, as the run's MF4 is: every frame at
+/// candump's own stamp, every command record at its monotonic time plus exactly that offset.
 #[test]
-fn log_times_are_on_the_monotonic_clock_the_stubs_measured() {
+fn log_times_are_utc_with_the_offset_the_stubs_measured() {
     const OFFSET_NS: i64 = 1_733_000_000_123_456_789;
     let dir = sample_dir("clock");
     let log = bus::candump::CandumpLog::read(&dir.join("candump.log")).unwrap();
@@ -110,7 +110,21 @@ fn log_times_are_on_the_monotonic_clock_the_stubs_measured() {
     assert_eq!(s.messages["/stubs/commands"], lines.lines().count() as u64);
     let text = python_check(&dir, false);
     assert!(text.contains(&format!("offset {OFFSET_NS} ns")), "{text}");
+    assert!(
+        text.contains("log times in UTC: every frame at candump's stamp"),
+        "{text}"
+    );
     assert!(text.contains("/stubs/commands: all"), "{text}");
+    // Read back here too: the first command's log time is its monotonic time + the offset.
+    let bytes = std::fs::read(dir.join("run.mcap")).unwrap();
+    let first = mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(Result::unwrap)
+        .find(|m| m.channel.topic == "/stubs/commands")
+        .expect("a command");
+    let v: serde_json::Value = serde_json::from_slice(&first.data).unwrap();
+    let mono = v["rx_mono_ns"].as_u64().unwrap();
+    assert_eq!(first.log_time, mono.saturating_add_signed(OFFSET_NS));
 }
 
 #[test]

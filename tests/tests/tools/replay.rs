@@ -3,7 +3,7 @@
 //! candump's log that the ECU did not send, in time order — from `run.mcap` alone, the file
 //! `record` wrote from that folder (here by `offline-bench --record`, on the simulated clock).
 
-use sensor_feeds::replay::{read, Item};
+use record::read::{feeds as read, Item};
 use signals::{FeedItem, FeedLogRecord};
 
 #[test]
