@@ -213,50 +213,60 @@ fn object(mut v: serde_json::Value) -> Result<ObjectState> {
     serde_json::from_value(v).context("/sensors/object")
 }
 
-fn accel(v: &serde_json::Value) -> Result<CrashAccelSample> {
-    let mut b = CrashAccelSample::EMPTY;
-    b.first_timestamp_ns = u64_of(v, "first_timestamp_ns")?;
-    b.sequence = u64_of(v, "sequence")?;
-    b.sample_period_ns = u32::try_from(u64_of(v, "sample_period_ns")?)?;
-    let samples = field(v, "accel_mps2")?
+/// A batch's header fields and its values into `slots` (at most their number), each read by
+/// `parse` (`None`: not a value of this batch, named `what`); returns (first time, sequence,
+/// sample period, count).
+fn batch<T>(
+    v: &serde_json::Value,
+    key: &str,
+    slots: &mut [T],
+    what: &str,
+    parse: impl Fn(&serde_json::Value) -> Option<T>,
+) -> Result<(u64, u64, u32, u32)> {
+    let values = field(v, key)?
         .as_array()
-        .context("`accel_mps2` is not an array")?;
-    if samples.len() > b.accel_mps2.len() {
+        .with_context(|| format!("`{key}` is not an array"))?;
+    if values.len() > slots.len() {
         bail!(
-            "{} samples in one batch, at most {}",
-            samples.len(),
-            b.accel_mps2.len()
+            "{} {key} in one batch, at most {}",
+            values.len(),
+            slots.len()
         );
     }
-    for (slot, s) in b.accel_mps2.iter_mut().zip(samples) {
-        *slot = s.as_f64().context("a sample is not a number")? as f32;
+    for (slot, x) in slots.iter_mut().zip(values) {
+        *slot = parse(x).with_context(|| format!("an entry of `{key}` is not {what}"))?;
     }
-    b.count = u32::try_from(u64_of(v, "count")?)?;
+    Ok((
+        u64_of(v, "first_timestamp_ns")?,
+        u64_of(v, "sequence")?,
+        u32::try_from(u64_of(v, "sample_period_ns")?)?,
+        u32::try_from(u64_of(v, "count")?)?,
+    ))
+}
+
+fn accel(v: &serde_json::Value) -> Result<CrashAccelSample> {
+    let mut b = CrashAccelSample::EMPTY;
+    (
+        b.first_timestamp_ns,
+        b.sequence,
+        b.sample_period_ns,
+        b.count,
+    ) = batch(v, "accel_mps2", &mut b.accel_mps2, "a number", |x| {
+        x.as_f64().map(|a| a as f32)
+    })?;
     Ok(b)
 }
 
 fn satellite(v: &serde_json::Value) -> Result<SatelliteFrames> {
     let mut b = SatelliteFrames::EMPTY;
-    b.first_timestamp_ns = u64_of(v, "first_timestamp_ns")?;
-    b.sequence = u64_of(v, "sequence")?;
-    b.sample_period_ns = u32::try_from(u64_of(v, "sample_period_ns")?)?;
-    let frames = field(v, "frames")?
-        .as_array()
-        .context("`frames` is not an array")?;
-    if frames.len() > b.frames.len() {
-        bail!(
-            "{} frames in one batch, at most {}",
-            frames.len(),
-            b.frames.len()
-        );
-    }
-    for (slot, f) in b.frames.iter_mut().zip(frames) {
-        *slot = f
-            .as_u64()
-            .and_then(|f| u16::try_from(f).ok())
-            .context("a frame is not a 16-bit word")?;
-    }
-    b.count = u32::try_from(u64_of(v, "count")?)?;
+    (
+        b.first_timestamp_ns,
+        b.sequence,
+        b.sample_period_ns,
+        b.count,
+    ) = batch(v, "frames", &mut b.frames, "a 16-bit word", |x| {
+        x.as_u64().and_then(|f| u16::try_from(f).ok())
+    })?;
     Ok(b)
 }
 

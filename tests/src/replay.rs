@@ -5,10 +5,12 @@
 
 use serde_json::Value;
 
-/// How far apart a replayed time may be from the recorded one, ms: one ECU cycle (the ECU's
-/// cycle phase against the feeds' ticks is a new one in every run, and a command goes out in
-/// the cycle nearest its time).
-pub const TOLERANCE_MS: f64 = 1.0;
+/// How far apart a replayed time may be from the recorded one, ms: one ECU cycle — a fire is
+/// decided in the cycle that reads the deciding sample, and the cycle's phase against the
+/// feeds' ticks is a new one in every run — plus the delivery jitter of the two runs' frames
+/// (the stubs stamp a command on arrival: 0.01–0.2 ms apart on the emulated route). A replay
+/// of the demo's run measured +0.01, −0.27, +0.73 and +1.00 ms.
+pub const TOLERANCE_MS: f64 = 1.25;
 
 /// What the replay did against the recording.
 #[derive(Debug, Clone, PartialEq)]
@@ -154,7 +156,7 @@ mod tests {
 
     #[test]
     fn a_later_fire_a_missing_action_or_other_modes_are_differences() {
-        let c = compare(&report(7.6, &MODES), &report(8.7, &MODES));
+        let c = compare(&report(7.6, &MODES), &report(8.9, &MODES));
         assert_eq!(c.differences.len(), 1, "{c:?}");
         assert!(c.differences[0].contains("airbag_fire"), "{c:?}");
         let mut fewer = report(7.6, &MODES);
