@@ -159,12 +159,7 @@ fn run(cli: &Cli) -> Result<()> {
     let keys = load_keys(cli)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let stop = host::install_stop_signals().context("installing signal handler")?;
-    // `--can`, else `$VCAN` (what `./vcan-setup.sh` exports), else vcan0.
-    let can = cli
-        .can
-        .clone()
-        .or_else(|| std::env::var("VCAN").ok().filter(|v| !v.is_empty()))
-        .unwrap_or_else(|| "vcan0".to_owned());
+    let can = bus::socket::interface(cli.can.as_deref());
     let mut sock = BusSocket::open(&can, &RX_IDS)
         .with_context(|| format!("CAN interface {can} (bring it up with ./vcan-setup.sh)"))?;
     // A deep receive queue: the stubs log every frame and may be descheduled for a while on a

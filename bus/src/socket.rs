@@ -24,6 +24,14 @@ const CAN_SFF_MASK: u32 = 0x7FF;
 /// Linux `CAN_RTR_FLAG`.
 const CAN_RTR_FLAG: u32 = 0x4000_0000;
 
+/// The CAN interface a bench process opens: `flag` (its `--can`), else `$VCAN` (what
+/// `./vcan-setup.sh` exports), else `vcan0`.
+pub fn interface(flag: Option<&str>) -> String {
+    flag.map(str::to_owned)
+        .or_else(|| std::env::var("VCAN").ok().filter(|v| !v.is_empty()))
+        .unwrap_or_else(|| "vcan0".to_owned())
+}
+
 /// A received data frame with its timestamps.
 #[derive(Debug, Clone, Copy)]
 pub struct RxFrame {

@@ -114,17 +114,8 @@ fn cycle_starts(known: &[(u64, u64)]) -> Vec<u64> {
 /// The file cannot be read, is no MCAP, or holds no diagnostics (no cycle times).
 pub fn latency(path: &Path) -> Result<Latency> {
     let bytes = std::fs::read(path).with_context(|| path.display().to_string())?;
-    let meta = mcap::Summary::read(&bytes)
-        .ok()
-        .flatten()
-        .and_then(|s| {
-            s.metadata_indexes
-                .iter()
-                .find(|i| i.name == "bench")
-                .and_then(|i| mcap::read::metadata(&bytes, i).ok())
-        })
-        .map(|m| m.metadata)
-        .unwrap_or_default();
+    // Read leniently: a file without the metadata has its log times on the bench's clock.
+    let meta = crate::read::bench_metadata(&bytes).unwrap_or_default();
     // Log times back on the bench's clock, where the sample times inside the messages are.
     let shift = crate::read::log_minus_bench_ns(&meta);
     let bench_ns = |log: u64| log.saturating_add_signed(-shift);

@@ -18,7 +18,7 @@
 use anyhow::{bail, Context, Result};
 use bus::RawFrame;
 use serde_json::Value;
-use signals::{CrashAccelSample, ObjectState, SatelliteFrames};
+use signals::{CrashAccelSample, FeedItem, ObjectState, SatelliteFrames};
 use std::collections::BTreeMap;
 
 /// The stubs' report of a recorded run.
@@ -68,48 +68,29 @@ pub fn log_minus_bench_ns(bench: &BTreeMap<String, String>) -> i64 {
 /// One thing to publish.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Item {
-    /// An object-list sample (`/sensors/object`).
-    Object(ObjectState),
-    /// A crash accelerometer batch (`/sensors/crash_accel`).
-    CrashAccel(CrashAccelSample),
-    /// A safing accelerometer batch (`/sensors/safing_accel`).
-    SafingAccel(CrashAccelSample),
-    /// The left satellite's frames (`/sensors/satellite_left`).
-    SatelliteLeft(SatelliteFrames),
-    /// The right satellite's frames (`/sensors/satellite_right`).
-    SatelliteRight(SatelliteFrames),
+    /// A feed's publication (`/sensors/*`), on its iceoryx2 service.
+    Feed(FeedItem),
     /// A CAN frame the ECU received (`/can/raw`).
     Can(RawFrame),
 }
 
 impl Item {
-    /// The item with its time stamps moved by `offset_ns` (frames carry none).
+    /// The item with its time stamp (a sample's or the first sample's) moved by `offset_ns`
+    /// (frames carry none).
     #[must_use]
-    pub fn shifted(self, offset_ns: i64) -> Self {
-        let s = |t: u64| t.saturating_add_signed(offset_ns);
-        match self {
-            Item::Object(mut o) => {
-                o.timestamp_ns = s(o.timestamp_ns);
-                Item::Object(o)
+    pub fn shifted(mut self, offset_ns: i64) -> Self {
+        let t = match &mut self {
+            Item::Feed(FeedItem::Object(o)) => &mut o.timestamp_ns,
+            Item::Feed(FeedItem::CrashAccel(b) | FeedItem::SafingAccel(b)) => {
+                &mut b.first_timestamp_ns
             }
-            Item::CrashAccel(mut b) => {
-                b.first_timestamp_ns = s(b.first_timestamp_ns);
-                Item::CrashAccel(b)
+            Item::Feed(FeedItem::SatelliteLeft(b) | FeedItem::SatelliteRight(b)) => {
+                &mut b.first_timestamp_ns
             }
-            Item::SafingAccel(mut b) => {
-                b.first_timestamp_ns = s(b.first_timestamp_ns);
-                Item::SafingAccel(b)
-            }
-            Item::SatelliteLeft(mut b) => {
-                b.first_timestamp_ns = s(b.first_timestamp_ns);
-                Item::SatelliteLeft(b)
-            }
-            Item::SatelliteRight(mut b) => {
-                b.first_timestamp_ns = s(b.first_timestamp_ns);
-                Item::SatelliteRight(b)
-            }
-            Item::Can(f) => Item::Can(f),
-        }
+            Item::Can(_) => return self,
+        };
+        *t = t.saturating_add_signed(offset_ns);
+        self
     }
 }
 
@@ -157,11 +138,13 @@ pub fn feeds(bytes: &[u8]) -> Result<Recording> {
                 .with_context(|| format!("{topic} at {} ns: not JSON", m.log_time))
         };
         let item = match topic {
-            "/sensors/object" => Item::Object(object(parse()?)?),
-            "/sensors/crash_accel" => Item::CrashAccel(accel(&parse()?)?),
-            "/sensors/safing_accel" => Item::SafingAccel(accel(&parse()?)?),
-            "/sensors/satellite_left" => Item::SatelliteLeft(satellite(&parse()?)?),
-            "/sensors/satellite_right" => Item::SatelliteRight(satellite(&parse()?)?),
+            "/sensors/object" => Item::Feed(FeedItem::Object(object(parse()?)?)),
+            "/sensors/crash_accel" => Item::Feed(FeedItem::CrashAccel(accel(&parse()?)?)),
+            "/sensors/safing_accel" => Item::Feed(FeedItem::SafingAccel(accel(&parse()?)?)),
+            "/sensors/satellite_left" => Item::Feed(FeedItem::SatelliteLeft(satellite(&parse()?)?)),
+            "/sensors/satellite_right" => {
+                Item::Feed(FeedItem::SatelliteRight(satellite(&parse()?)?))
+            }
             "/can/raw" => match can_input(&parse()?)? {
                 Some(f) => Item::Can(f),
                 None => continue,
@@ -183,7 +166,8 @@ pub fn feeds(bytes: &[u8]) -> Result<Recording> {
     })
 }
 
-fn bench_metadata(bytes: &[u8]) -> Result<BTreeMap<String, String>> {
+/// The file's `bench` metadata (`crate::write`'s run description: clock, offset, scenario …).
+pub(crate) fn bench_metadata(bytes: &[u8]) -> Result<BTreeMap<String, String>> {
     let summary = mcap::read::Summary::read(bytes)
         .context("reading the MCAP's summary")?
         .context("the MCAP has no summary section")?;

@@ -68,13 +68,6 @@ struct Cli {
 
 const TRUTH_PERIOD_TICKS: u64 = 10;
 
-/// The CAN interface: `--can`, else `$VCAN` (what `./vcan-setup.sh` exports), else vcan0.
-fn can_interface(flag: Option<&str>) -> String {
-    flag.map(str::to_owned)
-        .or_else(|| std::env::var("VCAN").ok().filter(|v| !v.is_empty()))
-        .unwrap_or_else(|| "vcan0".to_owned())
-}
-
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     host::exit_code("sensor-feeds", run(&cli))
@@ -155,15 +148,12 @@ impl Transports {
         let can = if cli.no_can {
             None
         } else {
-            Some(
-                bus::socket::BusSocket::open(&can_interface(cli.can.as_deref()), &[])
-                    .with_context(|| {
-                        format!(
-                            "CAN interface {} (bring it up with ./vcan-setup.sh, or pass --no-can)",
-                            can_interface(cli.can.as_deref())
-                        )
-                    })?,
-            )
+            let iface = bus::socket::interface(cli.can.as_deref());
+            Some(bus::socket::BusSocket::open(&iface, &[]).with_context(|| {
+                format!(
+                    "CAN interface {iface} (bring it up with ./vcan-setup.sh, or pass --no-can)"
+                )
+            })?)
         };
         Ok(Self {
             objects: ObjectPublisher::new(&node, &names)?,
@@ -279,11 +269,7 @@ fn replay(cli: &Cli, path: &std::path::Path) -> Result<()> {
         truth_due(&mut io, at_ns, &mut truth);
         sleep_until_ns(at_ns);
         match item.shifted(offset_ns) {
-            Item::Object(o) => io.publish(FeedItem::Object(o)),
-            Item::CrashAccel(b) => io.publish(FeedItem::CrashAccel(b)),
-            Item::SafingAccel(b) => io.publish(FeedItem::SafingAccel(b)),
-            Item::SatelliteLeft(b) => io.publish(FeedItem::SatelliteLeft(b)),
-            Item::SatelliteRight(b) => io.publish(FeedItem::SatelliteRight(b)),
+            Item::Feed(f) => io.publish(f),
             Item::Can(f) => io.send_can(&f),
         }
     }

@@ -128,9 +128,7 @@ fn run() -> Result<bool> {
             };
             let cfg = CampaignConfig {
                 out: out.clone(),
-                can: can
-                    .or_else(|| std::env::var("VCAN").ok())
-                    .unwrap_or_else(|| "vcan0".into()),
+                can: bus::socket::interface(can.as_deref()),
                 bin_dir,
                 repo: e2e_tests::repo_or_default(repo)?,
                 ecu_args: [e2e_tests::default_ecu_args(), ecu_arg].concat(),

@@ -205,11 +205,7 @@ fn run() -> Result<bool> {
             .map(PathBuf::from)
             .unwrap_or_default(),
     };
-    let can = cli
-        .can
-        .clone()
-        .or_else(|| std::env::var("VCAN").ok())
-        .unwrap_or_else(|| "vcan0".into());
+    let can = bus::socket::interface(cli.can.as_deref());
     // The output folder is checked before the runs, not after them.
     host::check_output_dir(&cli.out).with_context(|| format!("--out {}", cli.out.display()))?;
     if let Some(run) = &cli.replay {

@@ -35,16 +35,9 @@ fn a_recording_replays_every_feed_publication_and_every_can_input_in_order() {
     let replayed: Vec<(u64, FeedItem)> = rec
         .items
         .iter()
-        .filter_map(|(t, i)| {
-            let item = match *i {
-                Item::Object(o) => FeedItem::Object(o),
-                Item::CrashAccel(b) => FeedItem::CrashAccel(b),
-                Item::SafingAccel(b) => FeedItem::SafingAccel(b),
-                Item::SatelliteLeft(b) => FeedItem::SatelliteLeft(b),
-                Item::SatelliteRight(b) => FeedItem::SatelliteRight(b),
-                Item::Can(_) => return None,
-            };
-            Some((*t, item))
+        .filter_map(|(t, i)| match i {
+            Item::Feed(f) => Some((*t, *f)),
+            Item::Can(_) => None,
         })
         .collect();
     assert!(logged.len() > 1000, "{} records", logged.len());
@@ -88,12 +81,14 @@ fn a_recording_replays_every_feed_publication_and_every_can_input_in_order() {
         .items
         .iter()
         .find_map(|(_, i)| match i {
-            Item::Object(o) => Some(*o),
+            Item::Feed(FeedItem::Object(o)) => Some(*o),
             _ => None,
         })
         .expect("an object sample");
-    match Item::Object(first_object).shifted(-1_000) {
-        Item::Object(o) => assert_eq!(o.timestamp_ns + 1_000, first_object.timestamp_ns),
+    match Item::Feed(FeedItem::Object(first_object)).shifted(-1_000) {
+        Item::Feed(FeedItem::Object(o)) => {
+            assert_eq!(o.timestamp_ns + 1_000, first_object.timestamp_ns)
+        }
         other => panic!("{other:?}"),
     }
     let _ = std::fs::remove_dir_all(&dir);

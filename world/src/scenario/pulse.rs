@@ -60,11 +60,11 @@ impl MeasuredPulse {
                 path.display()
             ));
         }
-        let dv_mps: f64 = samples
-            .windows(2)
-            .map(|w| 0.5 * (w[0] + w[1]) * physics::defaults::STEP_S)
-            .sum();
-        if !(dv_mps < 0.0) {
+        let pulse = physics::CompartmentPulse {
+            step_s: physics::defaults::STEP_S,
+            accel_mps2: &samples,
+        };
+        if !(pulse.delta_v_mps() < 0.0) {
             return Err(format!(
                 "{}: the pulse does not slow the car (SAE J211: a frontal crash reads negative)",
                 path.display()
