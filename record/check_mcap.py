@@ -10,7 +10,8 @@ measured from the run, as the metadata says).
 
 Checked:
   * every frame of candump.log is on /can/raw, in order, with the same id and bytes and a
-    publish time equal to candump's stamp (±1 µs);
+    publish time equal to candump's stamp (±1 µs); every error frame on /can/error, with its
+    classes and detail bytes;
   * with log times in UTC, every frame's log time is its publish time (candump's stamp) and
     every other message's log time is its bench time plus the file's realtime − monotonic
     offset (metadata `bench`); the checks below compare bench times (log time − offset), and
@@ -53,13 +54,18 @@ def fail(msg):
     sys.exit(1)
 
 
+CAN_ERR_FLAG = 0x20000000  # linux/can.h: an eight-digit id with this bit is an error frame
+
+
 def candump_frames(path):
     frames = []
     for line in path.read_text().splitlines():
         m = LINE.match(line)
         if not m:
-            continue  # remote / error / FD frames: not data frames of this bus
+            continue  # remote / FD frames: not data frames of this bus
         sec, usec, iface, ident, data = m.groups()
+        if len(ident) == 8 and int(ident, 16) & CAN_ERR_FLAG:
+            continue  # an error frame (candump_error_frames)
         frames.append(
             {
                 "t_ns": (int(sec) * 1_000_000 + int(usec)) * 1000,
@@ -70,6 +76,28 @@ def candump_frames(path):
             }
         )
     return frames
+
+
+def candump_error_frames(path):
+    """candump's error frames: time, interface, the error classes (id without CAN_ERR_FLAG) and
+    the eight detail bytes (linux/can/error.h)."""
+    errors = []
+    for line in path.read_text().splitlines():
+        m = LINE.match(line)
+        if not m:
+            continue
+        sec, usec, iface, ident, data = m.groups()
+        if len(ident) != 8 or not int(ident, 16) & CAN_ERR_FLAG:
+            continue
+        errors.append(
+            {
+                "t_ns": (int(sec) * 1_000_000 + int(usec)) * 1000,
+                "iface": iface,
+                "class": int(ident, 16) & ~CAN_ERR_FLAG,
+                "data": bytes.fromhex(data).ljust(8, b"\0"),
+            }
+        )
+    return errors
 
 
 def frames_by_message(db, frames):
@@ -219,6 +247,18 @@ def main():
         if log_t != pub_t - offset:
             fail(f"frame {i}: log time {log_t} is not publish time − offset ({pub_t - offset})")
     print(f"check_mcap: /can/raw: all {len(frames)} frames of candump.log, bytes and times (±1 µs) equal")
+
+    errors = candump_error_frames(a.run_dir / "candump.log")
+    logged = topics.get("/can/error", [])
+    if len(logged) != len(errors):
+        fail(f"/can/error has {len(logged)} error frames, candump.log {len(errors)}")
+    for i, (e, (_, pub_t, msg, _)) in enumerate(zip(errors, logged)):
+        if msg["class"] != e["class"] or bytes(msg["data"]) != e["data"] or msg["interface"] != e["iface"]:
+            fail(f"error frame {i}: {msg} is not candump's {e['class']:x}#{e['data'].hex()}")
+        if abs(pub_t - e["t_ns"]) > 1000:
+            fail(f"error frame {i}: publish time {pub_t} vs candump {e['t_ns']} ns")
+    if errors:
+        print(f"check_mcap: /can/error: all {len(errors)} error frames of candump.log, classes, bytes and times equal")
 
     decoded = 0
     by_id = {m.name: [(fr, m) for fr in frs] for m, frs in frames_by_message(db, frames)}

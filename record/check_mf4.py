@@ -14,6 +14,8 @@ Checked:
     a time (header start + t) equal to candump's stamp (±1 µs);
   * asammdf's extract_bus_logging with the DBC yields every DBC message that is on the bus,
     each signal's samples and times equal to cantools' decode of the same frames;
+  * every error frame of candump.log in the CAN_ErrorFrame group (no group without one), same
+    classes, bytes and time, its ASAM ErrorType named;
   * the DBC is attached to CAN_DataFrame;
   * with run.mcap holding /ecu/diagnostics: the MF4's EcuDiagnostics group has one record per
     MCAP record, every numeric field a channel with the same value, and each record's time
@@ -35,7 +37,7 @@ from asammdf.blocks import v4_constants as v4c
 from mcap.reader import make_reader
 
 sys.path.insert(0, str(pathlib.Path(__file__).parent))
-from check_mcap import candump_frames, frames_by_message  # noqa: E402  (the same independent parsers)
+from check_mcap import candump_error_frames, candump_frames, frames_by_message  # noqa: E402  (the same independent parsers)
 
 PARTS = ["BusChannel", "ID", "IDE", "DLC", "DataLength", "DataBytes"]
 
@@ -62,6 +64,42 @@ def can_group(mdf):
     if len(found) != 1:
         fail(f"{len(found)} CAN bus-logging channel groups (bus event flag, CAN source), want 1")
     return found[0]
+
+
+def check_error_frames(mdf, t0, run_dir):
+    """The CAN_ErrorFrame group against candump's error frames: one record each, in order, same
+    classes and detail bytes, same time (±1 µs); the ASAM error type named, a protocol violation
+    in the CRC sequence or delimiter a CRC error (4). No group where candump logged none."""
+    errors = candump_error_frames(run_dir / "candump.log")
+    found = [
+        i
+        for i, g in enumerate(mdf.groups)
+        if g.channel_group.flags & v4c.FLAG_CG_BUS_EVENT
+        and "CAN_ErrorFrame" in [c.name for c in g.channels]
+    ]
+    if not errors:
+        if found:
+            fail("a CAN_ErrorFrame group, but candump.log has no error frame")
+        return
+    if len(found) != 1:
+        fail(f"{len(found)} CAN_ErrorFrame groups for {len(errors)} error frames, want 1")
+    gi = found[0]
+    got = {p: mdf.get(f"CAN_ErrorFrame.{p}", group=gi, raw=True) for p in ["ErrorClass", "DataBytes", "ErrorType"]}
+    times = got["ErrorClass"].timestamps
+    if len(times) != len(errors):
+        fail(f"the CAN_ErrorFrame group has {len(times)} records, candump.log {len(errors)} error frames")
+    for i, e in enumerate(errors):
+        if int(got["ErrorClass"].samples[i]) != e["class"] or bytes(got["DataBytes"].samples[i]) != e["data"]:
+            fail(f"error frame {i}: classes / bytes differ from candump's {e['class']:x}#{e['data'].hex()}")
+        if abs(t0 + round(float(times[i]) * 1e9) - e["t_ns"]) > 1000:
+            fail(f"error frame {i}: time differs from candump's {e['t_ns']} ns")
+        kind = int(got["ErrorType"].samples[i])
+        crc = e["class"] & 0x08 and e["data"][3] in (0x08, 0x18)  # CAN_ERR_PROT, LOC_CRC_SEQ / _DEL
+        if kind not in range(6) or (crc and kind != 4):
+            fail(f"error frame {i}: ErrorType {kind} for classes {e['class']:x}, location {e['data'][3]:#x}")
+    named = mdf.get("CAN_ErrorFrame.ErrorType", group=gi).samples
+    print(f"check_mf4: CAN_ErrorFrame: all {len(errors)} error frames of candump.log, classes, bytes and "
+          f"times (±1 µs) equal; types {sorted({x.decode() if isinstance(x, bytes) else str(x) for x in named})}")
 
 
 def main():
@@ -108,6 +146,8 @@ def check(run_dir, dbc, mf4, mcap):
         if abs(t - fr["t_ns"]) > 1000:
             fail(f"frame {i}: time {t} vs candump {fr['t_ns']} ns")
     print(f"check_mf4: CAN_DataFrame: all {len(frames)} frames of candump.log, bytes and times (±1 µs) equal")
+
+    check_error_frames(mdf, t0, run_dir)
 
     at = mdf.groups[gi].channels[names.index("CAN_DataFrame")].attachment
     if at is None:

@@ -20,19 +20,87 @@ pub struct LoggedFrame {
     pub frame: RawFrame,
 }
 
-/// A log: its data frames in order, and how many lines were no data frame (remote and error
+/// One error frame of a log: what a CAN controller reported (candump logs it when its error
+/// filter is set, `IFACE,0:0,#FFFFFFFF`).
+#[derive(Debug, Clone)]
+pub struct LoggedErrorFrame {
+    /// candump's time stamp, µs (CLOCK_REALTIME of the logging host).
+    pub t_us: u64,
+    /// Interface it was logged on.
+    pub device: String,
+    /// The error classes (`CAN_ERR_*` bits of the id, without `CAN_ERR_FLAG`).
+    pub class: u32,
+    /// The eight detail bytes (controller state, protocol violation and location, counters).
+    pub data: [u8; 8],
+    /// The report in words, every cause (socketcan's decoding of the classes and bytes).
+    pub text: String,
+}
+
+/// ASAM MDF bus logging's `CAN_ErrorFrame.ErrorType` values and names.
+pub const ASAM_ERROR_TYPES: [(u8, &str); 6] = [
+    (0, "Unknown"),
+    (1, "Bit Error"),
+    (2, "Form Error"),
+    (3, "Bit Stuffing Error"),
+    (4, "CRC Error"),
+    (5, "Acknowledgment Error"),
+];
+
+// linux/can/error.h: the classes and protocol details the ASAM error type is read from.
+const CAN_ERR_PROT: u32 = 0x0000_0008;
+const CAN_ERR_ACK: u32 = 0x0000_0020;
+const CAN_ERR_PROT_BIT: u8 = 0x01;
+const CAN_ERR_PROT_FORM: u8 = 0x02;
+const CAN_ERR_PROT_STUFF: u8 = 0x04;
+const CAN_ERR_PROT_BIT0: u8 = 0x08;
+const CAN_ERR_PROT_BIT1: u8 = 0x10;
+const CAN_ERR_PROT_LOC_CRC_SEQ: u8 = 0x08;
+const CAN_ERR_PROT_LOC_CRC_DEL: u8 = 0x18;
+
+impl LoggedErrorFrame {
+    /// The ASAM error type ([`ASAM_ERROR_TYPES`]) of this report: a protocol violation in the
+    /// CRC sequence or delimiter is a CRC error, else its violation type (bit, form, stuffing);
+    /// a missing acknowledgement an acknowledgment error; anything else (controller state,
+    /// bus-off, counters only) unknown.
+    #[must_use]
+    pub fn asam_error_type(&self) -> u8 {
+        let (types, location) = (self.data[2], self.data[3]);
+        if self.class & CAN_ERR_PROT != 0 {
+            if location == CAN_ERR_PROT_LOC_CRC_SEQ || location == CAN_ERR_PROT_LOC_CRC_DEL {
+                return 4;
+            }
+            if types & (CAN_ERR_PROT_BIT | CAN_ERR_PROT_BIT0 | CAN_ERR_PROT_BIT1) != 0 {
+                return 1;
+            }
+            if types & CAN_ERR_PROT_FORM != 0 {
+                return 2;
+            }
+            if types & CAN_ERR_PROT_STUFF != 0 {
+                return 3;
+            }
+        }
+        if self.class & CAN_ERR_ACK != 0 {
+            return 5;
+        }
+        0
+    }
+}
+
+/// A log: its data frames and error frames in order, and how many lines were neither (remote
 /// frames, CAN FD frames, lines candump did not write).
 #[derive(Debug, Clone, Default)]
 pub struct CandumpLog {
     /// The data frames.
     pub frames: Vec<LoggedFrame>,
+    /// The error frames.
+    pub errors: Vec<LoggedErrorFrame>,
     /// Lines skipped.
     pub skipped: usize,
 }
 
 impl CandumpLog {
-    /// Parses `candump -L` text; nothing in it is an error (a line that is no classic data frame
-    /// is counted in `skipped`).
+    /// Parses `candump -L` text; nothing in it is an error (a line that is neither a classic
+    /// data frame nor an error frame is counted in `skipped`).
     pub fn parse(text: &str) -> Self {
         let mut log = Self::default();
         for rec in socketcan::dump::Reader::from_reader(text.as_bytes()) {
@@ -48,6 +116,18 @@ impl CandumpLog {
                             t_us: r.t_us,
                             device: r.device,
                             frame: RawFrame::new(id, d.data()),
+                        });
+                    }
+                    CanAnyFrame::Error(e) => {
+                        let mut data = [0u8; 8];
+                        let bytes = e.data();
+                        data[..bytes.len().min(8)].copy_from_slice(&bytes[..bytes.len().min(8)]);
+                        log.errors.push(LoggedErrorFrame {
+                            t_us: r.t_us,
+                            device: r.device,
+                            class: e.error_bits(),
+                            data,
+                            text: e.into_error().to_string(),
                         });
                     }
                     _ => log.skipped += 1,
@@ -130,5 +210,28 @@ mod tests {
         assert_eq!(cansend_arg(&f.frame), "040#9F40B36400000000");
         assert_eq!(cansend_arg(&log.frames[1].frame), "12345678#0102");
         assert_eq!(log.frames[2].frame.payload(), &[] as &[u8]);
+    }
+
+    #[test]
+    fn an_error_frame_is_kept_with_its_classes_and_causes() {
+        // linux/can/error.h: CAN_ERR_FLAG | PROT 0x08 | BUSERROR 0x80 | CNT 0x200; data[2] =
+        // CAN_ERR_PROT_BIT 0x01, data[3] = CAN_ERR_PROT_LOC_CRC_SEQ 0x08, data[7] = rx count.
+        let text = "(1796387461.290112) vcan0 20000288#0000010800000007\n\
+                    (1796387461.290130) vcan0 12345678#0102\n";
+        let log = CandumpLog::parse(text);
+        assert_eq!((log.frames.len(), log.errors.len(), log.skipped), (1, 1, 0));
+        let e = &log.errors[0];
+        assert_eq!(
+            (e.t_us, e.device.as_str()),
+            (1_796_387_461_290_112, "vcan0")
+        );
+        assert_eq!(e.class, 0x288);
+        assert_eq!(e.data, [0, 0, 1, 8, 0, 0, 0, 7]);
+        for part in ["CRC sequence", "bus error", "rx=7"] {
+            assert!(e.text.contains(part), "{}", e.text);
+        }
+        assert_eq!(e.asam_error_type(), 4, "CRC Error");
+        // an extended data frame's eight digits stay a data frame
+        assert_eq!(cansend_arg(&log.frames[0].frame), "12345678#0102");
     }
 }

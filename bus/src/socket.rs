@@ -208,6 +208,16 @@ impl BusSocket {
         Ok(())
     }
 
+    /// Writes an error frame, as a CAN controller reports one to the hosts on its interface
+    /// (on vcan any sender can; receivers see it only with an error filter, as candump's
+    /// `#FFFFFFFF`).
+    pub fn send_error(&mut self, error: socketcan::CanError) -> io::Result<()> {
+        let frame = socketcan::CanErrorFrame::from(error);
+        self.sock.write_frame(&frame)?;
+        self.stats.frames_tx = self.stats.frames_tx.saturating_add(1);
+        Ok(())
+    }
+
     /// Writes a generated message as it is (E2E fields untouched; use
     /// [`crate::E2eProtector::seal`] for protected frames).
     pub fn send_message<F: embedded_can::Frame>(&mut self, msg: &F) -> io::Result<()> {

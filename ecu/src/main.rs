@@ -94,7 +94,7 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
         return Ok(());
     }
     // Every output path is checked before the run, not at its end.
-    if let Some(path) = cfg.report_json.as_ref().filter(|p| p.as_os_str() != "-") {
+    if let Some(path) = &cfg.report_json {
         host::check_output_file(path)
             .map_err(|e| anyhow::anyhow!("--json {}: {e}", path.display()))?;
     }
@@ -139,12 +139,9 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
         Some(&config),
     )?;
     print!("{}", outcome.text);
-    if cfg
-        .report_json
-        .as_ref()
-        .is_some_and(|p| p.as_os_str() == "-")
-    {
-        println!("{}", outcome.json);
+    if let Some(path) = &cfg.report_json {
+        host::results::write_json(path, &outcome.json)
+            .map_err(|e| anyhow::anyhow!("cannot write the report: {e}"))?;
     }
     Ok(())
 }

@@ -32,7 +32,11 @@ pub fn find_repo() -> Option<PathBuf> {
 /// Checks, before a run, that an output file can be written at its end: makes its folder and
 /// opens the file for writing (without truncating; a file the probe created is removed
 /// again). A run that would only fail at its end — after minutes — fails at once instead.
+/// `-` (stdout) is always writable.
 pub fn check_output_file(path: &Path) -> std::io::Result<()> {
+    if crate::results::is_stdout(path) {
+        return Ok(());
+    }
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)?;
     }

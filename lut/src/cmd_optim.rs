@@ -251,6 +251,6 @@ pub fn run_optimise(a: &OptimiseArgs) -> Result<()> {
             "occupant_simulations_per_s": opt.occupant_simulations as f64 * n / secs,
         },
     });
-    println!("{}", serde_json::to_string_pretty(&out)?);
+    println!("{}", lut::json_out::text(&out)?);
     Ok(())
 }

@@ -568,7 +568,7 @@ pub fn read_shard(origin: &str, bytes: &[u8]) -> Result<ShardFile<Samples>> {
 
 /// Write the result JSON atomically.
 pub fn write_result(r: &StudyResult, out: &Path) -> Result<()> {
-    let mut text = serde_json::to_string_pretty(r)?;
+    let mut text = crate::json_out::text(r)?;
     text.push('\n');
     Ok(diagram::write_atomically(out, text.as_bytes())?)
 }

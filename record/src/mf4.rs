@@ -12,6 +12,7 @@
 //! | group | source | channels |
 //! |---|---|---|
 //! | `CAN` (bus event, plain) | SI: bus, CAN, simulated (vcan) | `t`, `CAN_DataFrame` composed of `.BusChannel`, `.ID`, `.IDE`, `.DLC`, `.DataLength`, `.DataBytes` |
+//! | `CAN_ErrorFrame` (bus event, plain; only when candump logged error frames) | the same SI | `t`, `CAN_ErrorFrame` composed of `.BusChannel`, `.ErrorType` (ASAM's values, with names), `.ErrorClass` (Linux `CAN_ERR_*` bits), `.DataBytes` (the eight detail bytes) |
 //! | `EcuDiagnostics` | SI: ECU | `t` and one channel per numeric field of the diagnostics record (`mode` with its names) |
 //!
 //! `bus/restraint.dbc` is embedded as an attachment of `CAN_DataFrame`, so a tool that decodes
@@ -36,9 +37,14 @@ pub const RUN_MF4: &str = "run.mf4";
 /// The run summary's line for `path`.
 pub fn summary_line(path: &Path, s: &Mf4Summary) -> String {
     format!(
-        "recording (MDF 4.1): {} ({} CAN frames, {} diagnostics records, {:.0} kB; open in asammdf or CANape, docs/using.md \"Recordings\"){}",
+        "recording (MDF 4.1): {} ({} CAN frames, {}{} diagnostics records, {:.0} kB; open in asammdf or CANape, docs/using.md \"Recordings\"){}",
         path.display(),
         s.can_frames,
+        if s.error_frames > 0 {
+            format!("{} error frames, ", s.error_frames)
+        } else {
+            String::new()
+        },
         s.diagnostics,
         s.bytes as f64 / 1e3,
         s.diagnostics_left_out
@@ -52,6 +58,8 @@ pub fn summary_line(path: &Path, s: &Mf4Summary) -> String {
 pub struct Mf4Summary {
     /// Frames in the CAN group (= candump's data frames).
     pub can_frames: usize,
+    /// Records in the CAN_ErrorFrame group (= candump's error frames; no group when 0).
+    pub error_frames: usize,
     /// Records in the diagnostics group (0 when left out).
     pub diagnostics: usize,
     /// Why the diagnostics are left out, if they are.
@@ -312,6 +320,10 @@ impl MdfFile {
 /// length, 8 data bytes).
 const CAN_RECORD_BYTES: usize = 8 + 1 + 4 + 1 + 1 + 8;
 
+/// Bytes of one error record: t, then `CAN_ErrorFrame` (bus channel, ASAM error type, Linux
+/// error classes, 8 detail bytes).
+const ERROR_RECORD_BYTES: usize = 8 + 1 + 1 + 4 + 8;
+
 /// Writes `out` (normally `DIR/run.mf4`) from the run folder `dir` (`candump.log` required,
 /// the stubs' diagnostics log used when present).
 ///
@@ -334,10 +346,12 @@ pub fn write_run_mf4(dir: &Path, out: &Path) -> Result<Mf4Summary> {
                 .to_owned(),
         ),
     };
+    let errors = &run.log.errors;
     let start_ns: u64 = frames
         .first()
         .map(|f| i128::from(f.t_us) * 1_000)
         .into_iter()
+        .chain(errors.first().map(|e| i128::from(e.t_us) * 1_000))
         .chain(diags.first().and_then(diag_realtime))
         .min()
         // Whole µs: candump's resolution, and what a reader's date-time type holds exactly.
@@ -349,16 +363,19 @@ pub fn write_run_mf4(dir: &Path, out: &Path) -> Result<Mf4Summary> {
     let mut f = MdfFile::new();
 
     // Interfaces as bus channels 1, 2, … in order of appearance.
-    let mut interfaces: Vec<&str> = Vec::new();
-    let mut can = Vec::with_capacity(frames.len() * CAN_RECORD_BYTES);
-    for fr in frames {
-        let channel = match interfaces.iter().position(|i| *i == fr.device) {
+    let mut interfaces: Vec<String> = Vec::new();
+    let mut channel_of = |device: &str| -> usize {
+        match interfaces.iter().position(|i| i == device) {
             Some(i) => i + 1,
             None => {
-                interfaces.push(&fr.device);
+                interfaces.push(device.to_owned());
                 interfaces.len()
             }
-        };
+        }
+    };
+    let mut can = Vec::with_capacity(frames.len() * CAN_RECORD_BYTES);
+    for fr in frames {
+        let channel = channel_of(&fr.device);
         can.extend_from_slice(&seconds(i128::from(fr.t_us) * 1_000).to_le_bytes());
         can.push(u8::try_from(channel).unwrap_or(u8::MAX));
         // Linux can_id: bit 31 = extended, as the standard's ID with IDE in bit 31.
@@ -366,6 +383,15 @@ pub fn write_run_mf4(dir: &Path, out: &Path) -> Result<Mf4Summary> {
         let len = fr.frame.payload().len() as u8;
         can.extend_from_slice(&[len, len]);
         can.extend_from_slice(&fr.frame.data);
+    }
+    let mut err = Vec::with_capacity(errors.len() * ERROR_RECORD_BYTES);
+    for e in errors {
+        let channel = channel_of(&e.device);
+        err.extend_from_slice(&seconds(i128::from(e.t_us) * 1_000).to_le_bytes());
+        err.push(u8::try_from(channel).unwrap_or(u8::MAX));
+        err.push(e.asam_error_type());
+        err.extend_from_slice(&e.class.to_le_bytes());
+        err.extend_from_slice(&e.data);
     }
 
     // Diagnostics records: t, then the fields packed in order.
@@ -482,8 +508,56 @@ pub fn write_run_mf4(dir: &Path, out: &Path) -> Result<Mf4Summary> {
         SI_BUS_CAN,
         SI_FLAG_SIMULATED,
     );
+    let err_dg = if errors.is_empty() {
+        diag_dg
+    } else {
+        let names: Vec<(u8, &str)> = bus::candump::ASAM_ERROR_TYPES.to_vec();
+        let error_type_cc = f.value_to_text(&names);
+        let parts = [
+            Channel {
+                comment: "bus channel: 1 = the first interface in candump.log",
+                ..byte("CAN_ErrorFrame.BusChannel", 8, 8)
+            },
+            Channel {
+                conversion: error_type_cc,
+                comment: "ASAM error type, read from the Linux report's protocol violation",
+                ..byte("CAN_ErrorFrame.ErrorType", 9, 8)
+            },
+            Channel {
+                comment: "Linux error classes (CAN_ERR_* bits of the error frame's id)",
+                ..byte("CAN_ErrorFrame.ErrorClass", 10, 32)
+            },
+            Channel {
+                comment: "the report's eight detail bytes (linux/can/error.h)",
+                ..Channel::value("CAN_ErrorFrame.DataBytes", DT_BYTE_ARRAY, 14, 64)
+            },
+        ];
+        let composition = f.channels(&parts, NIL);
+        let frame = Channel {
+            flags: CN_FLAG_BUS_EVENT,
+            composition,
+            comment: "CAN error frames as candump logged them (the controller's reports)",
+            ..Channel::value(
+                "CAN_ErrorFrame",
+                DT_BYTE_ARRAY,
+                8,
+                (ERROR_RECORD_BYTES as u32 - 8) * 8,
+            )
+        };
+        let first = f.channels(&[Channel::time(), frame], NIL);
+        f.group(
+            diag_dg,
+            "CAN_ErrorFrame",
+            bus,
+            CG_FLAG_BUS_EVENT | CG_FLAG_PLAIN_BUS_EVENT,
+            first,
+            &err,
+            ERROR_RECORD_BYTES,
+            "",
+        )
+    };
     let can_dg = f.group(
-        diag_dg,
+        err_dg,
         "CAN",
         bus,
         CG_FLAG_BUS_EVENT | CG_FLAG_PLAIN_BUS_EVENT,
@@ -523,6 +597,7 @@ pub fn write_run_mf4(dir: &Path, out: &Path) -> Result<Mf4Summary> {
     std::fs::write(out, &f.buf).with_context(|| out.display().to_string())?;
     Ok(Mf4Summary {
         can_frames: frames.len(),
+        error_frames: errors.len(),
         diagnostics: if diag_dg == NIL { 0 } else { diags.len() },
         diagnostics_left_out,
         start_realtime_ns: start_ns,

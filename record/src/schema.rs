@@ -43,6 +43,41 @@ pub fn raw_frame(interface: &str, f: &RawFrame) -> Value {
     })
 }
 
+/// Schema name of `/can/error`.
+pub const ERROR_FRAME_SCHEMA: &str = "restraint_bench.CanErrorFrame";
+
+/// JSON Schema of an error frame on `/can/error`.
+pub fn error_frame_schema() -> Value {
+    let names: Vec<Value> = bus::candump::ASAM_ERROR_TYPES
+        .iter()
+        .map(|(v, n)| json!({ "const": v, "title": n }))
+        .collect();
+    json!({
+        "title": ERROR_FRAME_SCHEMA,
+        "description": "One CAN error frame as candump logged it: a controller's report of a bus error",
+        "type": "object",
+        "properties": {
+            "interface": { "type": "string", "description": "CAN interface it was logged on" },
+            "class": { "type": "integer", "description": "Linux error classes (CAN_ERR_* bits of the id, linux/can/error.h)" },
+            "data": { "type": "array", "items": { "type": "integer", "minimum": 0, "maximum": 255 }, "description": "the report's eight detail bytes" },
+            "error_type": { "type": "integer", "oneOf": names, "description": "ASAM MDF bus logging's ErrorType" },
+            "text": { "type": "string", "description": "every cause in words" }
+        },
+        "required": ["interface", "class", "data", "error_type", "text"]
+    })
+}
+
+/// An error frame as a `/can/error` message.
+pub fn error_frame(e: &bus::candump::LoggedErrorFrame) -> Value {
+    json!({
+        "interface": e.device,
+        "class": e.class,
+        "data": e.data,
+        "error_type": e.asam_error_type(),
+        "text": e.text,
+    })
+}
+
 /// Schema name of `/can/<message>`.
 pub fn message_schema_name(m: &MessageInfo) -> String {
     format!("restraint_bench.dbc.{}", m.name)

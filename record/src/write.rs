@@ -284,6 +284,19 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
         }
     }
 
+    let error_schema = schema::error_frame_schema();
+    for e in &log.errors {
+        let publish = e.t_us * 1_000;
+        rec.write(
+            "/can/error",
+            schema::ERROR_FRAME_SCHEMA,
+            &error_schema,
+            to_mono(publish),
+            publish,
+            &schema::error_frame(e),
+        )?;
+    }
+
     let diag_schema = schema::diagnostics_schema();
     let pulse_schema = schema::predicted_pulse_schema();
     let log_schema = schema::log_schema();

@@ -308,7 +308,9 @@ pub fn run_disturbed(cfg: &RunConfig, dist: &mut dyn Disturbance) -> Result<RunR
         // under the campaign's flood (it recorded ~ 1/4 of them), and its log is what the
         // flood and the recorded fire pair are counted from.
         Command::new("candump")
-            .args(["-L", "-r", "8388608", &cfg.can])
+            // Every frame (`0:0`) and every error class (`#FFFFFFFF`): the controller's error
+            // reports are part of the bus's record (run.mf4's CAN_ErrorFrame group).
+            .args(["-L", "-r", "8388608", &format!("{},0:0,#FFFFFFFF", cfg.can)])
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit()),
         "candump (install can-utils)",

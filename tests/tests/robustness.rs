@@ -179,6 +179,32 @@ fn forged_and_replayed_fire_commands_never_fire_the_airbag() {
     }
 }
 
+/// The error frames of the bus-fault case, as the field's readers see them: asammdf finds
+/// them in run.mf4's CAN_ErrorFrame group, Foxglove's `mcap` on /can/error of run.mcap, each
+/// against candump.log (record/check_mf4.py, record/check_mcap.py).
+#[test]
+fn the_error_frames_of_the_bus_fault_case_are_in_both_recordings() {
+    let c = campaign();
+    let r = c
+        .cases
+        .iter()
+        .find(|r| r.name == "can-errors")
+        .expect("can-errors");
+    assert!(
+        r.frames_injected > 10,
+        "{} error frames sent",
+        r.frames_injected
+    );
+    let dir = PathBuf::from(&r.dir);
+    let s = record::write_run_mf4(&dir, &dir.join(record::RUN_MF4)).expect("run.mf4");
+    assert_eq!(s.error_frames as u64, r.frames_injected);
+    let text = e2e_tests::harness::check_mf4(&[&dir]).unwrap_or_else(|e| panic!("{e}"));
+    let all = format!("all {} error frames", r.frames_injected);
+    assert!(text.contains(&format!("CAN_ErrorFrame: {all}")), "{text}");
+    let text = e2e_tests::harness::check_recording(&dir, false).unwrap_or_else(|e| panic!("{e}"));
+    assert!(text.contains(&format!("/can/error: {all}")), "{text}");
+}
+
 #[test]
 fn the_robustness_report_names_every_figure() {
     let c = campaign();

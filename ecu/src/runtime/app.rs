@@ -177,10 +177,6 @@ pub fn run_ecu(
     report.config = config;
     let text = report.to_text();
     let json = report.to_json()?;
-    if let Some(path) = cfg.report_json.as_ref().filter(|p| p.as_os_str() != "-") {
-        std::fs::write(path, &json)
-            .map_err(|e| anyhow::anyhow!("cannot write report {}: {e}", path.display()))?;
-    }
     drop(report);
     drop(rt_state);
     Ok(RunOutcome { text, json, stats })

@@ -65,6 +65,7 @@ fn show_config(args: &[&str], env: &[(&str, &str)]) -> (bool, String, String) {
     let out = Command::new(ECU)
         .arg("--show-config")
         .args(args)
+        .env_remove("VCAN")
         .envs(env.iter().copied())
         .output()
         .unwrap();
@@ -99,6 +100,34 @@ fn environment_overrides_the_file_and_flags_override_the_environment() {
     assert!(has("# cycles = (not set)"), "{out}");
     assert!(has("# sched_fifo_priority = (not set)"), "{out}");
     assert!(!out.contains("# cpu = (not set)"), "{out}");
+}
+
+#[test]
+fn vcan_names_the_interface_below_ecu_variables_and_flags() {
+    let line = |args: &[&str], env: &[(&str, &str)]| {
+        let (ok, out, err) = show_config(args, env);
+        assert!(ok, "{err}");
+        out.lines()
+            .find(|l| l.starts_with("interface = "))
+            .unwrap_or_default()
+            .to_owned()
+    };
+    assert_eq!(
+        line(&[], &[("VCAN", "vcan7")]),
+        "interface = \"vcan7\"  # environment variable VCAN"
+    );
+    assert_eq!(
+        line(&[], &[("VCAN", "")]),
+        "interface = \"vcan0\"  # defaults"
+    );
+    assert_eq!(
+        line(&[], &[("VCAN", "vcan7"), ("ECU_CAN__INTERFACE", "vcan8")]),
+        "interface = \"vcan8\"  # environment variable ECU_CAN__INTERFACE"
+    );
+    assert_eq!(
+        line(&["--can", "vcan9"], &[("VCAN", "vcan7")]),
+        "interface = \"vcan9\"  # command line"
+    );
 }
 
 #[test]

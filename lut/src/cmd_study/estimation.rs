@@ -69,7 +69,7 @@ pub fn run(a: &EstimationArgs) -> Result<()> {
     let pool = pool.build().context("cannot start the rayon thread pool")?;
     let r = pool.install(|| estimation::study(&scenarios, a.runs, a.seed, &|| progress.inc()))?;
     progress.finish();
-    let mut text = serde_json::to_string_pretty(&r)?;
+    let mut text = lut::json_out::text(&r)?;
     text.push('\n');
     diagram::write_atomically(&a.out, text.as_bytes())?;
     print!("{}", table_text(&r));

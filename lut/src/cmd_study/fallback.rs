@@ -202,7 +202,7 @@ pub fn run(args: &FallbackArgs) -> Result<()> {
                 })
             })
             .collect();
-        std::fs::write(path, serde_json::to_string_pretty(&cases)?)?;
+        lut::json_out::write(path, &cases)?;
     }
     if !bad.is_empty() {
         anyhow::bail!("{} requirement violation(s) on the sweep", bad.len());

@@ -7,7 +7,10 @@
 //!   - `counter`: the alive counter advanced by 5 and the CRC recomputed (a node whose counter
 //!     jumped: the CRC is right, the sequence is not);
 //!   - `replay`: the identical frame again right away (a replay: repeated counter);
-//!   - `delay`: the identical frame again `--delay-ms` later (a delayed / stale frame).
+//!   - `delay`: the identical frame again `--delay-ms` later (a delayed / stale frame);
+//!   - `errors`: an error frame instead of a copy — the controller's report of a transmission
+//!     attempt that failed in its CRC sequence (protocol violation, bus error, the receive
+//!     error counter), the genuine frame being the retransmission that got through.
 //!
 //!   It prints one JSON line `{"injected": n, "seen": m, "first_s": a, "last_s": b}` (scenario
 //!   times of the first and last injected frame) when the window is over.
@@ -118,6 +121,7 @@ enum Mode {
     Counter,
     Replay,
     Delay,
+    Errors,
 }
 
 /// A DBC message name (the bus's one source of truth) or a numeric id, to the message's id.
@@ -156,9 +160,29 @@ fn faulty_copy(mode: Mode, genuine: &RawFrame) -> RawFrame {
             let c = f.e2e_counter().unwrap_or(0).wrapping_add(5);
             f.set_e2e_counter(c);
         }
-        Mode::Replay | Mode::Delay => {}
+        Mode::Replay | Mode::Delay | Mode::Errors => {}
     }
     f
+}
+
+/// The controller's report of the `n`-th failed attempt (1, 2, …): a bit error in the CRC
+/// sequence, a bus error, and the receive error counter (which the retransmission that got
+/// through brings down again, so it stays low; capped below error-passive, 128).
+fn crc_error_report(n: u64) -> socketcan::CanError {
+    use socketcan::errors::{ErrorCause, Location, ViolationTypes};
+    socketcan::CanError::from_multiple(
+        ErrorCause::Protocol {
+            types: ViolationTypes::BIT,
+            location: Location::CrcSequence,
+        },
+        [
+            ErrorCause::BusError,
+            ErrorCause::Counters {
+                tx: 0,
+                rx: n.clamp(1, 127) as u8,
+            },
+        ],
+    )
 }
 
 /// A forged Armed+Fire `AirbagStageCmd` with a valid E2E CRC and alive counter `counter`, and
@@ -329,6 +353,20 @@ fn run(cli: Cli) -> Result<()> {
                         continue;
                     }
                     seen += 1;
+                    if mode == Mode::Errors {
+                        match sock.send_error(crc_error_report(injected + 1)) {
+                            Ok(()) => {
+                                injected += 1;
+                                let t_s = t.saturating_sub(epoch_ns) as f64 * 1e-9;
+                                if injected == 1 {
+                                    first_s = t_s;
+                                }
+                                last_s = t_s;
+                            }
+                            Err(e) => eprintln!("bus-inject: send error frame: {e}"),
+                        }
+                        continue;
+                    }
                     let due = if mode == Mode::Delay { t + delay_ns } else { t };
                     queue.push_back((due, faulty_copy(mode, &rx.frame)));
                 }

@@ -747,16 +747,21 @@ fn run_matrix() -> Result<()> {
     }
     writeln!(out, "{} variants in {:.1} s (seed {}); airbag! / pretens! = fired where none may (must be 0), missed = must-fire crashes without airbag (must be 0), late = must-fire airbags over {:.0} ms later than their clean twin's (must be 0), after = must-fire airbags after their \"127 mm − 30 ms\" time (must be 0 where gated in time), stuck = crash phases that fired nothing and never ended (must be 0)",
         results.len(), start.elapsed().as_secs_f64(), cli.seed, misuse::LATE_VS_CLEAN_MS)?;
-    print!("{out}");
+    // `--json -` keeps stdout for the JSON: the table goes to stderr then.
+    if cli.json.as_deref().is_some_and(host::results::is_stdout) {
+        eprint!("{out}");
+    } else {
+        print!("{out}");
+    }
     if let Some(path) = &cli.json {
-        std::fs::write(
+        host::results::write_json(
             path,
-            serde_json::to_string_pretty(&serde_json::json!({
+            &serde_json::to_string_pretty(&serde_json::json!({
                 "schema_version": misuse::SCHEMA_VERSION,
                 "seed": cli.seed, "families": json_rows, "failures": failures,
             }))?,
         )
-        .with_context(|| format!("writing {}", path.display()))?;
+        .with_context(|| format!("--json {}", path.display()))?;
     }
     if !failures.is_empty() {
         // --quiet: the table and this count only; every failing variant's scenario is in

@@ -106,7 +106,13 @@ fn run_all() -> Result<bool> {
         .iter()
         .filter_map(|(_, s)| s.as_ref().ok().map(|s| s.name.chars().count()))
         .fold(NAME_WIDTH, usize::max);
-    let mut out = std::io::stdout().lock();
+    // `--json -` keeps stdout for the JSON: the table goes to stderr then.
+    let json_to_stdout = cli.json.as_deref().is_some_and(host::results::is_stdout);
+    let mut out: Box<dyn std::io::Write> = if json_to_stdout {
+        Box::new(std::io::stderr().lock())
+    } else {
+        Box::new(std::io::stdout().lock())
+    };
     // A closed pipe (`| head`) ends the table quietly instead of a panic.
     let mut say = |line: &str| writeln!(out, "{line}").is_ok();
     say(&table_header(width));
@@ -173,8 +179,13 @@ fn run_all() -> Result<bool> {
         ));
     }
     if let Some(p) = &cli.json {
-        std::fs::write(p, serde_json::to_string_pretty(&json)?)
-            .with_context(|| format!("writing {}", p.display()))?;
+        // Every record names its layout, the runs and the files that did not run alike.
+        let doc = host::results::versioned_value(
+            e2e_tests::offline::RUN_SCHEMA_VERSION,
+            serde_json::Value::Array(json),
+        );
+        host::results::write_json(p, &serde_json::to_string_pretty(&doc)?)
+            .with_context(|| format!("--json {}", p.display()))?;
     }
     for m in &missed {
         eprintln!("offline-bench: {m}");

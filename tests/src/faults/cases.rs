@@ -42,7 +42,7 @@ pub enum Fault {
     },
     /// `bus-inject mirror --mode …` on EgoVehicleState in the window.
     Bus {
-        /// `crc` | `counter` | `replay` | `delay`.
+        /// `crc` | `counter` | `replay` | `delay` | `errors`.
         mode: &'static str,
         /// Window start [scenario s].
         from_s: f64,
@@ -192,6 +192,16 @@ pub fn cases() -> Vec<Case> {
                 to_s,
             },
             what: "every EgoVehicleState of 1.5–1.8 s sent again 200 ms late",
+        },
+        Case {
+            name: "can-errors",
+            scenario: CRASH_SCENARIO,
+            fault: Fault::Bus {
+                mode: "errors",
+                from_s,
+                to_s,
+            },
+            what: "an error frame (CRC-sequence bit error, bus error, rx error count) beside every EgoVehicleState, 1.5–1.8 s",
         },
         Case {
             name: "cangen-flood",

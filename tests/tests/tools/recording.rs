@@ -385,6 +385,51 @@ fn run_mf4_is_the_bus_logging_asammdf_decodes_with_the_dbc() {
     assert!(e.contains("frame 100: time"), "{e}");
 }
 
+/// Error frames (a controller's reports; candump logs them with its error filter) are in the
+/// MCAP on /can/error and in run.mf4's CAN_ErrorFrame group, as Python's readers see them: the
+/// classes and bytes linux/can/error.h gives, the time, a CRC-sequence violation typed as
+/// ASAM's CRC error; one changed class byte fails both checks.
+#[test]
+fn error_frames_are_recorded_in_both_files() {
+    let dir = std::env::temp_dir().join(format!("record-errors-{}", std::process::id()));
+    known_run(&dir);
+    let log = std::fs::read_to_string(dir.join("candump.log")).unwrap();
+    // After frames 10, 20, 30: CAN_ERR_PROT | BUSERROR | CNT, bit error in the CRC sequence,
+    // rx error counter 1, 2, 3 — as `bus-inject mirror --mode errors` sends them.
+    let mut lines: Vec<String> = log.lines().map(str::to_owned).collect();
+    for (k, at) in [(3u8, 30usize), (2, 20), (1, 10)] {
+        let stamp = lines[at].split_once(')').unwrap().0.to_owned();
+        lines.insert(
+            at + 1,
+            format!("{stamp}) vcan0 20000288#00000108000000{k:02X}"),
+        );
+    }
+    std::fs::write(dir.join("candump.log"), lines.join("\n") + "\n").unwrap();
+    let s = record::write_run(&dir, &dir.join("run.mcap"), &meta()).unwrap();
+    assert_eq!(s.messages.get("/can/error"), Some(&3));
+    let m = record::write_run_mf4(&dir, &dir.join(record::RUN_MF4)).unwrap();
+    assert_eq!(m.error_frames, 3);
+    let text = python_check(&dir, false);
+    assert!(text.contains("/can/error: all 3 error frames"), "{text}");
+    let text = check_mf4(&[&dir]).unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        text.contains("CAN_ErrorFrame: all 3 error frames"),
+        "{text}"
+    );
+    assert!(text.contains("CRC Error"), "{text}");
+    // The recordings are kept; the log changes under them.
+    let changed =
+        lines
+            .join("\n")
+            .replacen("20000288#0000010800000002", "20000288#0000010800000009", 1);
+    std::fs::write(dir.join("candump.log"), changed + "\n").unwrap();
+    let e = check_mf4(&[&dir]).unwrap_err();
+    assert!(e.contains("error frame 1"), "{e}");
+    let e = check_recording(&dir, false).unwrap_err();
+    assert!(e.contains("error frame 1"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Diagnostics whose clock cannot be placed (no command frame seen by both candump and the
 /// stubs) are left out and said so; the bus is still written and decodes.
 #[test]

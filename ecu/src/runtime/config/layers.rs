@@ -2,7 +2,8 @@
 //!
 //! 1. the defaults (`EcuConfig::default()`, shown in `ecu/ecu.toml`),
 //! 2. the `--config` file,
-//! 3. `ECU_*` environment variables (`ECU_PERIOD_US=500`; `__` between table and key:
+//! 3. `$VCAN`, the CAN interface every bench tool reads (what `./vcan-setup.sh` exports), then
+//!    `ECU_*` environment variables (`ECU_PERIOD_US=500`; `__` between table and key:
 //!    `ECU_RT__SCHED_FIFO_PRIORITY=80`, `ECU_CYCLE__LUT=my.lut`),
 //! 4. the command-line flags.
 //!
@@ -49,6 +50,9 @@ impl Layers {
             }
             None => None,
         };
+        if let Some(iface) = std::env::var("VCAN").ok().filter(|v| !v.is_empty()) {
+            figment = figment.merge(VcanEnv(iface));
+        }
         let figment = figment
             .merge(Env::prefixed(ENV_PREFIX).split(ENV_NESTING))
             .merge(command_line);
@@ -127,6 +131,7 @@ impl Layers {
                 None => path.display().to_string(),
             },
             _ if metadata.name == COMMAND_LINE => COMMAND_LINE.to_owned(),
+            _ if metadata.name == VCAN_ORIGIN => VCAN_ORIGIN.to_owned(),
             // figment names it "`ECU_` environment variable(s)".
             _ if metadata.name.contains("environment variable") => env_origin(key),
             _ => "defaults".to_owned(),
@@ -198,6 +203,25 @@ fn unset_keys(v: &serde_json::Value, table: &str, out: &mut Vec<(String, String)
             }
             _ => {}
         }
+    }
+}
+
+/// The origin `$VCAN` shows as.
+const VCAN_ORIGIN: &str = "environment variable VCAN";
+
+/// `$VCAN` as the `can.interface` layer: the one name for the bench's interface that
+/// `sensor-feeds`, `actuator-stubs` and the test tools read too.
+struct VcanEnv(String);
+
+impl Provider for VcanEnv {
+    fn metadata(&self) -> figment::Metadata {
+        figment::Metadata::named(VCAN_ORIGIN)
+    }
+
+    fn data(
+        &self,
+    ) -> Result<figment::value::Map<figment::Profile, figment::value::Dict>, figment::Error> {
+        Serialized::default("can.interface", &self.0).data()
     }
 }
 

@@ -269,7 +269,12 @@ pub fn judge(case: &Case, run: &RunResult, baseline: Option<&RunResult>) -> Case
         must_fire,
     );
     // Same decision as without the fault where the fault is over before the threat.
-    if window.is_some() || case.fault == Fault::StaleService {
+    if window.is_some()
+        || matches!(
+            case.fault,
+            Fault::StaleService | Fault::Bus { mode: "errors", .. }
+        )
+    {
         judge_same_plan(&mut checks, baseline, fire);
     }
 

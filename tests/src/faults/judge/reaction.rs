@@ -14,6 +14,8 @@ pub(super) fn fault_window(case: &Case, summary: Option<&serde_json::Value>) -> 
             from_s,
             to_s,
         } => (from_s + DELAY_MS * 1e-3, to_s + DELAY_MS * 1e-3),
+        // Error frames are the controller's reports, not inputs: nothing to react to.
+        Fault::Bus { mode: "errors", .. } => return None,
         Fault::Bus { from_s, to_s, .. } => (from_s, to_s),
         _ => return None,
     };
@@ -202,6 +204,32 @@ pub(super) fn judge_fault(
             }
         }
         Fault::Variant(v) => judge_variant(checks, v, &run.report),
+        Fault::Bus {
+            mode: "errors",
+            from_s,
+            to_s,
+        } => {
+            let logged = bus::candump::CandumpLog::read(&run.dir.join("candump.log"))
+                .map_or(0, |l| l.errors.len() as u64);
+            checks.check(
+                "error frames on the bus, each one in candump.log",
+                frames_injected > 0 && logged == frames_injected,
+                format!("{frames_injected} sent, {logged} logged (candump's error filter)"),
+            );
+            // The inputs themselves stay valid: degrading would drop the adaptive restraint
+            // for nothing. One input timeout after the window still counts as inside it.
+            let until_ms = to_s * 1e3 + E2E_HOLD_MS;
+            let degraded = modes
+                .iter()
+                .find(|(t, m)| *t >= from_s * 1e3 && *t <= until_ms && m == "ReferenceFallback");
+            checks.check(
+                "inputs kept: no degradation for the controller's error reports",
+                degraded.is_none(),
+                degraded.map_or("Normal throughout".into(), |(t, _)| {
+                    format!("ReferenceFallback at {t:.0} ms")
+                }),
+            );
+        }
         Fault::StaleService => {
             let cleaned = ecu
                 .and_then(|e| e.pointer("/ipc/stale_nodes_cleaned"))
