@@ -275,7 +275,7 @@ pub fn measure(
             roughness.floor_lift_mps(),
             restraint::satellites::Relief::NONE,
         );
-        algo.push(&p, s, now);
+        algo.push(&p, s, &now);
         match onset.push(&p, s) {
             OnsetStep::Reset => first_event = false,
             OnsetStep::Woke | OnsetStep::Awake if first_event => {

@@ -191,7 +191,7 @@ pub fn accel_only_fire_s(
             dt_s: ACCEL_PERIOD_S,
             decel_mps2,
         };
-        algo.push(&p, &s, now);
+        algo.push(&p, &s, &now);
         if let FallbackDecision::Fire { at_ns, .. } = algo.decision() {
             return at_ns as f64 * 1e-9 - LEAD_S;
         }

@@ -171,7 +171,7 @@ impl CrashMonitor {
             ..self.onset_params
         };
         for s in batch.iter() {
-            self.on_sample(&s, ctx, &generic, thresholds);
+            self.on_sample(&s, ctx, &generic, &thresholds);
         }
     }
 
@@ -231,7 +231,7 @@ impl CrashMonitor {
         s: &AccelSample,
         ctx: &FreezeContext<'_, '_>,
         generic: &ConfirmParams,
-        thresholds: Thresholds,
+        thresholds: &Thresholds,
     ) {
         self.matcher.push(s, &mut |slot| {
             let Some(sit) = ctx.situation.filter(|_| ctx.armed) else {

@@ -231,6 +231,8 @@ pub struct Thresholds {
     pub pretensioner_min_dv_mps: f64,
     /// The boundaries' values times this.
     pub boundary_scale: f64,
+    /// The loading rule is waived: the crush-zone satellites grant their whole relief.
+    pub loading_waived: bool,
 }
 
 /// A valley of the judged segment (`FallbackAlgorithm::follow_valley`).
@@ -439,12 +441,13 @@ impl FallbackAlgorithm {
             min_dv_mps: relief.floor_mps(self.airbag.min_dv_mps, floor_lift_mps),
             pretensioner_min_dv_mps: relief.floor_mps(self.pretensioner.min_dv_mps, floor_lift_mps),
             boundary_scale: relief.boundary_mps(1.0),
+            loading_waived: relief.fraction >= 1.0,
         }
     }
 
     /// Feeds one plausible sample (`p`: the wake threshold and quiet gap of the onset; `t`:
     /// [`Self::thresholds_now`]).
-    pub fn push(&mut self, p: &ConfirmParams, s: &AccelSample, t: Thresholds) {
+    pub fn push(&mut self, p: &ConfirmParams, s: &AccelSample, t: &Thresholds) {
         let before_dv = self.onset.delta_v_mps();
         match self.onset.push(p, s) {
             OnsetStep::Quiet => return,
@@ -517,7 +520,10 @@ impl FallbackAlgorithm {
             && self
                 .pretensioner
                 .reached(tau_ms, dv, scale, 0.0, t.pretensioner_min_dv_mps);
-        if (airbag || pretensioner) && self.run >= self.floor.samples && self.loading() {
+        if (airbag || pretensioner)
+            && self.run >= self.floor.samples
+            && (t.loading_waived || self.loading())
+        {
             if airbag {
                 self.airbag.decision = fire;
             }
@@ -695,7 +701,7 @@ mod tests {
                     dt_s: 1e-3,
                     decel_mps2: g * G_MPS2,
                 },
-                f.thresholds_now(0.0, Relief::NONE),
+                &f.thresholds_now(0.0, Relief::NONE),
             );
         }
     }
@@ -722,10 +728,11 @@ mod tests {
             min_dv_mps: 0.0,
             pretensioner_min_dv_mps: 0.0,
             boundary_scale: 1.0,
+            loading_waived: false,
         };
         let mut clean = FallbackAlgorithm::new(linear(), NO_FLOOR);
         for k in 20..80 {
-            clean.push(&params(), &sample(k, 5.0), th);
+            clean.push(&params(), &sample(k, 5.0), &th);
         }
         let g = |k: u64| if k < 20 { 2.0 } else { 5.0 };
         let (mut lobe, mut restarted) = (
@@ -733,8 +740,8 @@ mod tests {
             FallbackAlgorithm::new(linear(), NO_FLOOR),
         );
         for k in 0..80 {
-            lobe.push(&params(), &sample(k, g(k)), th);
-            restarted.push(&params(), &sample(k, g(k)), th);
+            lobe.push(&params(), &sample(k, g(k)), &th);
+            restarted.push(&params(), &sample(k, g(k)), &th);
             if k == 22 {
                 let since_dv_mps = 3.0 * 5.0 * G_MPS2 * 1e-3;
                 assert!(restarted.restart_at_crush(t0 + 19 * MS, since_dv_mps, 5.0 * G_MPS2));
@@ -754,7 +761,7 @@ mod tests {
         );
         // Not within 2 ms of the segment's start, not outside an event.
         let mut f = FallbackAlgorithm::new(linear(), NO_FLOOR);
-        f.push(&params(), &sample(0, 5.0), th);
+        f.push(&params(), &sample(0, 5.0), &th);
         assert!(!f.restart_at_crush(t0 + MS, 0.0, 5.0 * G_MPS2));
         let mut quiet = FallbackAlgorithm::new(linear(), NO_FLOOR);
         assert!(!quiet.restart_at_crush(t0 + 19 * MS, 0.0, 0.0));
@@ -928,7 +935,7 @@ mod tests {
                     dt_s: 1e-3,
                     decel_mps2: g(k) * G_MPS2,
                 },
-                f.thresholds_now(0.0, Relief::NONE),
+                &f.thresholds_now(0.0, Relief::NONE),
             );
         }
     }
@@ -955,6 +962,45 @@ mod tests {
         let mut f = FallbackAlgorithm::new([f64::INFINITY; KNOTS], floor());
         run_fn(&mut f, 40, |k| if k < 30 { 20.0 } else { 3.0 });
         assert!(f.loading());
+    }
+
+    /// A 30 g crest (three samples: the loading rule's median takes it) and then a 10 g
+    /// crash, under the loading rule's 85 % of that crest for good: with less than the whole
+    /// relief the decision waits for `LOADING_EXEMPT_DV_MPS` (≈ 45 ms); with the whole relief
+    /// it fires where the Δv meets the floor (1.0 m/s: 0.88 m/s of the crest plus 0.1 m/s per
+    /// ms), two samples after the crest.
+    #[test]
+    fn the_whole_relief_waives_the_loading_rule() {
+        let relief = |fraction: f64| Relief {
+            fraction,
+            floor_mps: 1.0,
+            boundary_scale: 1.0,
+            boundary_lift_mps: 0.0,
+            fold_scale: 1.0,
+        };
+        let fire_ms = |fraction: f64| {
+            let mut f = FallbackAlgorithm::new(linear(), floor());
+            for k in 0..60u64 {
+                f.push(
+                    &params(),
+                    &AccelSample {
+                        t_ns: 1_000_000_000 + k * 1_000_000,
+                        dt_s: 1e-3,
+                        decel_mps2: if k < 3 { 30.0 } else { 10.0 } * G_MPS2,
+                    },
+                    &f.thresholds_now(0.0, relief(fraction)),
+                );
+                if let FallbackDecision::Fire { at_ns, .. } = f.decision() {
+                    return Some((at_ns - 1_000_000_000) / 1_000_000);
+                }
+            }
+            None
+        };
+        let waived = fire_ms(1.0).expect("fires");
+        assert!((4..=5).contains(&waived), "{waived} ms");
+        let held = fire_ms(0.99).expect("fires past the exemption");
+        assert!(held >= 40, "{held} ms");
+        assert!(fire_ms(0.0).is_some_and(|t| t >= 40));
     }
 
     #[test]
@@ -999,7 +1045,7 @@ mod tests {
                     dt_s: 125e-6,
                     decel_mps2: g_at(k as f64 * 0.125) * G_MPS2,
                 },
-                f.thresholds_now(0.0, Relief::NONE),
+                &f.thresholds_now(0.0, Relief::NONE),
             );
         }
         f.decision()
