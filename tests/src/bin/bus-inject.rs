@@ -149,6 +149,36 @@ fn main() -> std::process::ExitCode {
 
 use bus::candump::cansend_arg;
 
+/// What a mirror put on the bus: how many frames, and the scenario times of the first and
+/// the last (NaN before the first).
+struct Injected {
+    count: u64,
+    first_s: f64,
+    last_s: f64,
+}
+
+impl Default for Injected {
+    fn default() -> Self {
+        Self {
+            count: 0,
+            first_s: f64::NAN,
+            last_s: f64::NAN,
+        }
+    }
+}
+
+impl Injected {
+    /// One more frame, sent `since_epoch_ns` after scenario t = 0.
+    fn add(&mut self, since_epoch_ns: u64) {
+        let t_s = since_epoch_ns as f64 * 1e-9;
+        self.count += 1;
+        if self.count == 1 {
+            self.first_s = t_s;
+        }
+        self.last_s = t_s;
+    }
+}
+
 /// The faulty copy of a genuine E2E frame for `mode` (`delay`/`replay`: the frame itself).
 fn faulty_copy(mode: Mode, genuine: &RawFrame) -> RawFrame {
     let mut f = *genuine;
@@ -342,9 +372,8 @@ fn run(cli: Cli) -> Result<()> {
             let (start, end) = (at(from_s), at(to_s));
             let delay_ns = (delay_ms * 1e6) as u64;
             let mut queue: VecDeque<(u64, RawFrame)> = VecDeque::new();
-            let (mut seen, mut injected) = (0u64, 0u64);
-            // Scenario times of the first and last injected frame.
-            let (mut first_s, mut last_s) = (f64::NAN, f64::NAN);
+            let mut seen = 0u64;
+            let mut injected = Injected::default();
             loop {
                 let now = sensor_feeds::monotonic_ns();
                 while let Some(rx) = sock.recv().context("CAN receive")? {
@@ -354,15 +383,8 @@ fn run(cli: Cli) -> Result<()> {
                     }
                     seen += 1;
                     if mode == Mode::Errors {
-                        match sock.send_error(crc_error_report(injected + 1)) {
-                            Ok(()) => {
-                                injected += 1;
-                                let t_s = t.saturating_sub(epoch_ns) as f64 * 1e-9;
-                                if injected == 1 {
-                                    first_s = t_s;
-                                }
-                                last_s = t_s;
-                            }
+                        match sock.send_error(crc_error_report(injected.count + 1)) {
+                            Ok(()) => injected.add(t.saturating_sub(epoch_ns)),
                             Err(e) => eprintln!("bus-inject: send error frame: {e}"),
                         }
                         continue;
@@ -373,14 +395,7 @@ fn run(cli: Cli) -> Result<()> {
                 while queue.front().is_some_and(|(due, _)| *due <= now) {
                     if let Some((_, f)) = queue.pop_front() {
                         match sock.send(&f) {
-                            Ok(()) => {
-                                injected += 1;
-                                let t_s = now.saturating_sub(epoch_ns) as f64 * 1e-9;
-                                if injected == 1 {
-                                    first_s = t_s;
-                                }
-                                last_s = t_s;
-                            }
+                            Ok(()) => injected.add(now.saturating_sub(epoch_ns)),
                             Err(e) => eprintln!("bus-inject: send: {e}"),
                         }
                     }
@@ -398,9 +413,10 @@ fn run(cli: Cli) -> Result<()> {
                 }
             };
             println!(
-                "{{\"injected\": {injected}, \"seen\": {seen}, \"first_s\": {}, \"last_s\": {}}}",
-                json_s(first_s),
-                json_s(last_s)
+                "{{\"injected\": {}, \"seen\": {seen}, \"first_s\": {}, \"last_s\": {}}}",
+                injected.count,
+                json_s(injected.first_s),
+                json_s(injected.last_s)
             );
             Ok(())
         }
