@@ -32,6 +32,8 @@ pub struct LoggedErrorFrame {
     pub class: u32,
     /// The eight detail bytes (controller state, protocol violation and location, counters).
     pub data: [u8; 8],
+    /// The ASAM error type ([`ASAM_ERROR_TYPES`]) the report amounts to.
+    pub error_type: u8,
     /// The report in words, every cause (socketcan's decoding of the classes and bytes).
     pub text: String,
 }
@@ -46,44 +48,30 @@ pub const ASAM_ERROR_TYPES: [(u8, &str); 6] = [
     (5, "Acknowledgment Error"),
 ];
 
-// linux/can/error.h: the classes and protocol details the ASAM error type is read from.
-const CAN_ERR_PROT: u32 = 0x0000_0008;
-const CAN_ERR_ACK: u32 = 0x0000_0020;
-const CAN_ERR_PROT_BIT: u8 = 0x01;
-const CAN_ERR_PROT_FORM: u8 = 0x02;
-const CAN_ERR_PROT_STUFF: u8 = 0x04;
-const CAN_ERR_PROT_BIT0: u8 = 0x08;
-const CAN_ERR_PROT_BIT1: u8 = 0x10;
-const CAN_ERR_PROT_LOC_CRC_SEQ: u8 = 0x08;
-const CAN_ERR_PROT_LOC_CRC_DEL: u8 = 0x18;
-
-impl LoggedErrorFrame {
-    /// The ASAM error type ([`ASAM_ERROR_TYPES`]) of this report: a protocol violation in the
-    /// CRC sequence or delimiter is a CRC error, else its violation type (bit, form, stuffing);
-    /// a missing acknowledgement an acknowledgment error; anything else (controller state,
-    /// bus-off, counters only) unknown.
-    #[must_use]
-    pub fn asam_error_type(&self) -> u8 {
-        let (types, location) = (self.data[2], self.data[3]);
-        if self.class & CAN_ERR_PROT != 0 {
-            if location == CAN_ERR_PROT_LOC_CRC_SEQ || location == CAN_ERR_PROT_LOC_CRC_DEL {
-                return 4;
-            }
-            if types & (CAN_ERR_PROT_BIT | CAN_ERR_PROT_BIT0 | CAN_ERR_PROT_BIT1) != 0 {
-                return 1;
-            }
-            if types & CAN_ERR_PROT_FORM != 0 {
-                return 2;
-            }
-            if types & CAN_ERR_PROT_STUFF != 0 {
-                return 3;
-            }
+/// The ASAM error type ([`ASAM_ERROR_TYPES`]) of a controller's report, from socketcan's
+/// decoding of it: a protocol violation in the CRC sequence or delimiter is a CRC error, else
+/// its violation type (bit, form, stuffing); a missing acknowledgement an acknowledgment error;
+/// anything else (controller state, bus-off, counters only) unknown.
+fn asam_error_type(e: &socketcan::CanError) -> u8 {
+    use socketcan::errors::{ErrorCause, Location, ViolationTypes};
+    if let Some((types, location)) = e.protocol() {
+        if matches!(location, Location::CrcSequence | Location::CrcDelimiter) {
+            return 4;
         }
-        if self.class & CAN_ERR_ACK != 0 {
-            return 5;
+        if types.intersects(ViolationTypes::BIT | ViolationTypes::BIT0 | ViolationTypes::BIT1) {
+            return 1;
         }
-        0
+        if types.contains(ViolationTypes::FORM) {
+            return 2;
+        }
+        if types.contains(ViolationTypes::STUFF) {
+            return 3;
+        }
     }
+    if e.causes().any(|c| matches!(c, ErrorCause::NoAck)) {
+        return 5;
+    }
+    0
 }
 
 /// A log: its data frames and error frames in order, and how many lines were neither (remote
@@ -120,14 +108,17 @@ impl CandumpLog {
                     }
                     CanAnyFrame::Error(e) => {
                         let mut data = [0u8; 8];
-                        let bytes = e.data();
-                        data[..bytes.len().min(8)].copy_from_slice(&bytes[..bytes.len().min(8)]);
+                        let n = e.data().len().min(data.len());
+                        data[..n].copy_from_slice(&e.data()[..n]);
+                        let class = e.error_bits();
+                        let report = e.into_error();
                         log.errors.push(LoggedErrorFrame {
                             t_us: r.t_us,
                             device: r.device,
-                            class: e.error_bits(),
+                            class,
                             data,
-                            text: e.into_error().to_string(),
+                            error_type: asam_error_type(&report),
+                            text: report.to_string(),
                         });
                     }
                     _ => log.skipped += 1,
@@ -230,7 +221,7 @@ mod tests {
         for part in ["CRC sequence", "bus error", "rx=7"] {
             assert!(e.text.contains(part), "{}", e.text);
         }
-        assert_eq!(e.asam_error_type(), 4, "CRC Error");
+        assert_eq!(e.error_type, 4, "CRC Error");
         // an extended data frame's eight digits stay a data frame
         assert_eq!(cansend_arg(&log.frames[0].frame), "12345678#0102");
     }

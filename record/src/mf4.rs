@@ -389,7 +389,7 @@ pub fn write_run_mf4(dir: &Path, out: &Path) -> Result<Mf4Summary> {
         let channel = channel_of(&e.device);
         err.extend_from_slice(&seconds(i128::from(e.t_us) * 1_000).to_le_bytes());
         err.push(u8::try_from(channel).unwrap_or(u8::MAX));
-        err.push(e.asam_error_type());
+        err.push(e.error_type);
         err.extend_from_slice(&e.class.to_le_bytes());
         err.extend_from_slice(&e.data);
     }
@@ -511,8 +511,7 @@ pub fn write_run_mf4(dir: &Path, out: &Path) -> Result<Mf4Summary> {
     let err_dg = if errors.is_empty() {
         diag_dg
     } else {
-        let names: Vec<(u8, &str)> = bus::candump::ASAM_ERROR_TYPES.to_vec();
-        let error_type_cc = f.value_to_text(&names);
+        let error_type_cc = f.value_to_text(&bus::candump::ASAM_ERROR_TYPES);
         let parts = [
             Channel {
                 comment: "bus channel: 1 = the first interface in candump.log",

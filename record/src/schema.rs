@@ -73,7 +73,7 @@ pub fn error_frame(e: &bus::candump::LoggedErrorFrame) -> Value {
         "interface": e.device,
         "class": e.class,
         "data": e.data,
-        "error_type": e.asam_error_type(),
+        "error_type": e.error_type,
         "text": e.text,
     })
 }

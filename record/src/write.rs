@@ -141,12 +141,8 @@ pub fn write_run(dir: &Path, out: &Path, meta: &RunMeta) -> Result<WriteSummary>
     let file = std::fs::File::create(out).with_context(|| out.display().to_string())?;
     // Log times in UTC where the run measured its realtime − monotonic offset (the MF4 of the
     // same run is stamped in UTC too): every bench time below is CLOCK_MONOTONIC and moves by
-    // that offset; a simulated run keeps its one clock.
-    let to_log_ns = if meta.simulated_start_ns.is_some() {
-        0
-    } else {
-        offset.unwrap_or(0)
-    };
+    // that offset; a simulated run (its offset 0, above) keeps its one clock.
+    let to_log_ns = offset.unwrap_or(0);
     let mut rec = Recording {
         w: Writer::new(BufWriter::new(file))?,
         to_log_ns,
