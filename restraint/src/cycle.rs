@@ -385,7 +385,10 @@ impl Activity for RestraintCycle<'_> {
             .reasons
             .intersects(Degraded::SAFING_STALE | Degraded::SAFING_INVALID);
         self.crash_sensor_faulty = accel_faulty;
-        let mut safing = self.safing.agrees(now, safing_faulty, vehicle);
+        let front_end_crushed = self.satellites.front_end_crushed(now);
+        let mut safing = self
+            .safing
+            .agrees(now, safing_faulty, vehicle, front_end_crushed);
         // With a healthy safing sensor, safing must also agree in severity on the confirmed
         // event (module `agreement`) — also once the crash sensor is found faulty (a stuck
         // sensor's first 20 ms were plausible); the backup path (confirmed by the vehicle

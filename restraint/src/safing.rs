@@ -18,11 +18,14 @@
 //!
 //! **A faulty safing channel** (stale, stuck, saturated, out of range, bad time stamps, port
 //! errors: the same [`crate::accel::AccelMonitor`] checks as the crash accelerometer) is on the
-//! bus (`EcuStatus.FaultSafingSensor`) and the vehicle-dynamics deceleration of the gateway's
-//! `EgoVehicleState` (a third sensor, fresh within `vehicle_timeout_ms`) stands in for it: a
-//! frame received within the hold window showing at least `safing_substitute_g` closes the
-//! channel. A real crash still fires — later, by up to one 10 ms vehicle frame — and a spike or
-//! stuck crash accelerometer still cannot fire alone. The pre-crash (reversible, motor-driven)
+//! bus (`EcuStatus.FaultSafingSensor`) and two other witnesses stand in for it: the crush-zone
+//! satellites' crushed front end ([`crate::satellites::Satellites::front_end_crushed`]: a
+//! frontal crash, seen within a millisecond or two of the contact, so the crash fires when it
+//! would with a healthy safing sensor), or the vehicle-dynamics deceleration of the gateway's
+//! `EgoVehicleState` (fresh within `vehicle_timeout_ms`): a frame received within the hold
+//! window showing at least `safing_substitute_g` closes the channel — for a crash the
+//! satellites do not see fold, later by up to one 10 ms vehicle frame. A spike or stuck crash
+//! accelerometer still cannot fire alone: neither witness is moved by it. The pre-crash (reversible, motor-driven)
 //! pretensioner needs no safing agreement: it fires on the prediction before any deceleration
 //! exists and is released when the crash does not come.
 
@@ -115,15 +118,23 @@ impl Safing {
     }
 
     /// Whether the safing function agrees at `now`: the safing sensor when it is healthy,
-    /// else the vehicle deceleration `vehicle` (m/s², receive time) received within the hold
-    /// time (module docs).
-    pub fn agrees(&self, now: u64, sensor_faulty: bool, vehicle: Option<(f64, u64)>) -> bool {
+    /// else the crush-zone satellites' crushed front end (`front_end_crushed`) or the vehicle
+    /// deceleration `vehicle` (m/s², receive time) received within the hold time (module docs).
+    pub fn agrees(
+        &self,
+        now: u64,
+        sensor_faulty: bool,
+        vehicle: Option<(f64, u64)>,
+        front_end_crushed: bool,
+    ) -> bool {
         if !sensor_faulty {
             return self.closed(now);
         }
-        vehicle.is_some_and(|(decel, rx_ns)| {
-            decel >= self.params.substitute_mps2 && now.saturating_sub(rx_ns) <= self.params.hold_ns
-        })
+        front_end_crushed
+            || vehicle.is_some_and(|(decel, rx_ns)| {
+                decel >= self.params.substitute_mps2
+                    && now.saturating_sub(rx_ns) <= self.params.hold_ns
+            })
     }
 
     /// Onset of the safing channel's event in progress, ns (`None` when quiet).
@@ -218,12 +229,15 @@ mod tests {
     fn a_faulty_safing_sensor_is_replaced_by_a_fresh_vehicle_deceleration() {
         let s = Safing::new(params());
         let now = 500 * MS;
-        assert!(!s.agrees(now, true, None));
-        assert!(!s.agrees(now, true, Some((1.0 * G_MPS2, now))));
-        assert!(s.agrees(now, true, Some((3.0 * G_MPS2, now - 5 * MS))));
+        assert!(!s.agrees(now, true, None, false));
+        assert!(!s.agrees(now, true, Some((1.0 * G_MPS2, now)), false));
+        assert!(s.agrees(now, true, Some((3.0 * G_MPS2, now - 5 * MS)), false));
         // Older than the hold: no longer.
-        assert!(!s.agrees(now, true, Some((3.0 * G_MPS2, now - 21 * MS))));
-        // A healthy but open sensor is not overruled by the vehicle signal.
-        assert!(!s.agrees(now, false, Some((3.0 * G_MPS2, now))));
+        assert!(!s.agrees(now, true, Some((3.0 * G_MPS2, now - 21 * MS)), false));
+        // A healthy but open sensor is not overruled by the vehicle signal, nor by the
+        // satellites.
+        assert!(!s.agrees(now, false, Some((3.0 * G_MPS2, now)), true));
+        // A crushed front end stands in as the vehicle frame does.
+        assert!(s.agrees(now, true, None, true));
     }
 }

@@ -612,6 +612,17 @@ impl Satellites {
         }
     }
 
+    /// Whether the usable satellites have seen the front end crush by at least the relief's
+    /// lower line (`satellite_relief_from_mps`) within the relief's hold at `now`: a frontal
+    /// crash, which no body motion of the envelope shows (≤ 0.41 m/s of crush) and no single
+    /// satellite can forge (the smaller of two usable ones counts). Read after the cycle's
+    /// batches (the relief is updated in each judged one).
+    pub fn front_end_crushed(&self, now: u64) -> bool {
+        self.params.enabled
+            && self.hold_until_ns.is_some_and(|t| now <= t)
+            && self.peak_mps >= self.params.relief_from_mps
+    }
+
     /// Where the front end began to fold ([`CrushOnset`], module docs "Crush onset"), when the
     /// relief began in this cycle (`now`): `None` in every other cycle, so the walk over the
     /// bins is made once a relief.

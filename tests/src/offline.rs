@@ -684,7 +684,6 @@ pub const ACCEPTED_COSTS: &[(&str, f64, &str)] = &[
 /// comes first in the safety order (no misuse may fire it); these are the cases where a plan
 /// made for a heavier opponent than the truth is earlier than the floor.
 pub const ACCEPTED_LATE_AIRBAGS: &[(&str, f64, &str)] = &[
-    ("fault-safing-sensor-dead", 1.5, LATE_SAFING_DEAD),
     (
         "taurus-31-31-abs-eba-true1300-rep1900-v2x",
         4.5,
@@ -696,11 +695,6 @@ pub const ACCEPTED_LATE_AIRBAGS: &[(&str, f64, &str)] = &[
         LATE_31_31_1300_KG,
     ),
 ];
-
-/// Why a crash with the safing sensor dead fires after its plan.
-const LATE_SAFING_DEAD: &str = "the safing sensor dead: the vehicle deceleration on CAN \
-     (10 ms frames) stands in for its agreement and holds the fire one cycle — +8.8 ms against \
-     the plan's +7.7 ms; −13.7 % against the reference, no bottoming-out";
 
 /// Why the 31 + 31 km/h cases against a 1 300 kg opponent with one source 600 kg heavy fire late.
 const LATE_31_31_1300_KG: &str = "at 31 + 31 km/h the pulse of a 1 300 kg (class 2) opponent \

@@ -178,6 +178,51 @@ fn a_real_crash_with_a_dead_safing_sensor_fires_when_the_vehicle_deceleration_ag
     assert!(b.ecu.vetoed_fires() > 0);
 }
 
+#[test]
+fn a_real_crash_with_a_dead_safing_sensor_fires_when_the_satellites_see_the_front_end_fold() {
+    // As above, but the vehicle frame shows only braking: the two crush-zone satellites stand
+    // in. Their rail tips slow at 100 g while the body slows at 20 g (80 g × 4 ms = 3.1 m/s
+    // of crush Δv, above the relief's 1 m/s line): the airbag fires in the cycle it fires with
+    // a healthy safing sensor. Satellites that move with the body (a body motion, no crush)
+    // stand in for nothing.
+    use restraint::signals::{psi5::code_of, SatelliteSide};
+    let run = |safing_live: bool, crushed: bool| {
+        let mut b = Bench::new(Some(test_lut()));
+        b.safing_live = safing_live;
+        b.ego_long_accel_mps2 = -G; // 1 g of braking: the vehicle frame never agrees
+        while b.now < C + 100 * MS {
+            let sat_g = match (b.now >= C, crushed) {
+                (false, _) => 0.0,
+                (true, true) => 100.0,
+                (true, false) => 20.0,
+            };
+            let code = code_of(sat_g * f64::from(G), 240.0 * f64::from(G));
+            for side in SatelliteSide::BOTH {
+                b.io.push_satellite(side, satellite_frames(b.now, code));
+            }
+            if (b.now - T0).is_multiple_of(10 * MS) {
+                b.push_object_none();
+            }
+            if b.now >= C {
+                b.push_accel(-20.0 * G);
+            }
+            b.step();
+        }
+        b
+    };
+    let healthy = run(true, true)
+        .first_airbag_fire()
+        .expect("healthy: the airbag fires");
+    let dead = run(false, true)
+        .first_airbag_fire()
+        .expect("dead: the airbag fires");
+    assert_eq!(dead.0, healthy.0);
+    assert!(healthy.0 < C + 10 * MS, "{}", healthy.0 - C);
+    let b = run(false, false);
+    assert!(!airbag_fired(&b) && !pretensioner_fired(&b));
+    assert!(b.ecu.vetoed_fires() > 0);
+}
+
 /// A crash-sensor fault inside a real misuse event that satisfies the safing
 /// sensor. `tolerance_dv_mps` = the severity agreement's absolute tolerance (5 m/s: off).
 fn fault_inside_event(case: &str, tolerance_dv_mps: f64) -> Bench {
