@@ -113,9 +113,9 @@ pub fn decode(msg: &Messages) -> Decoded {
             let n = bus::signal_values(msg, &mut values).unwrap_or(0);
             Decoded::Status {
                 mode: u8::from(m.ecu_mode()),
-                faults: crate::status::ecu_fault_signals()
+                faults: crate::status::ecu_fault_indices()
                     .enumerate()
-                    .filter(|(_, (i, _))| *i < n && values.get(*i).is_some_and(|v| *v != 0.0))
+                    .filter(|(_, i)| *i < n && values.get(*i).is_some_and(|v| *v != 0.0))
                     .fold(0, |bits, (k, _)| bits | (1 << k)),
             }
         }

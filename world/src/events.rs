@@ -184,6 +184,29 @@ impl AccelEvents {
         sum
     }
 
+    /// Whether no additive event reaching `sensor` is active anywhere in `[t0_s, t1_s]`
+    /// ([`Self::added_mps2`] is `None` throughout; a spike replaces a sample and is not read
+    /// through the filter).
+    pub fn quiet_over(&self, sensor: AccelSensor, t0_s: f64, t1_s: f64) -> bool {
+        // Each window with a margin beyond the edge tolerance `added_mps2` applies.
+        let overlaps = |a: f64, b: f64| a <= t1_s + 2.0 * EDGE_S && b >= t0_s - 2.0 * EDGE_S;
+        !self
+            .events
+            .iter()
+            .filter(|e| e.reach.reaches(sensor))
+            .any(|e| match &e.signal {
+                Signal::HalfSine {
+                    start_s,
+                    duration_s,
+                    ..
+                } => overlaps(*start_s, start_s + duration_s),
+                Signal::Ringing(r) => overlaps(r.start_s, r.start_s + r.duration_s),
+                Signal::RoughRoad { start_s, end_s, .. }
+                | Signal::Offset { start_s, end_s, .. } => overlaps(*start_s, *end_s),
+                Signal::Spike { .. } => false,
+            })
+    }
+
     /// The longest substep [s] that resolves what the additive events reaching `sensor` put
     /// into `[t0_s, t1_s]` for the accelerometers' anti-alias filter ([`crate::lowpass`]):
     /// a twentieth of a half-sine's or a ringing envelope's length, a twelfth of a ringing's
@@ -482,5 +505,44 @@ mod tests {
             assert_eq!(r.at(0.1 - 1e-6), None);
             assert_eq!(r.at(0.1 + ms * 1e-3 + 1e-6), None);
         }
+    }
+
+    #[test]
+    fn a_quiet_span_has_no_added_acceleration_anywhere_in_it() {
+        // One event of each additive kind on the crash sensor and a spike: wherever
+        // `quiet_over` says a 20 ms span is quiet, `added_mps2` is None at 10 µs steps in it,
+        // and the spans around each event are not quiet.
+        let s = Scenario::parse(
+            "t.toml",
+            "name = \"t\"\nduration_s = 1\n[ego]\nmass_kg = 1785\nspeed_kph = 0\n\
+             [opponent]\nkind = \"barrier\"\ninitial_distance_m = 100\n[sensor]\nmass_estimate_kg = 3000\n[occupant]\nmass_kg = 75\n\
+             [[accel_event]]\nkind = \"half_sine\"\nstart_s = 0.1\npeak_g = 5\nduration_ms = 10\n\
+             [[accel_event]]\nkind = \"rough_road\"\nstart_s = 0.3\nend_s = 0.4\nrms_g = 1\n\
+             [[accel_event]]\nkind = \"offset\"\nstart_s = 0.5\nend_s = 0.55\npeak_g = 2\nsensor = \"crash\"\n\
+             [[accel_event]]\nkind = \"ringing\"\nstart_s = 0.7\npeak_g = 20\nfrequency_hz = 200\nduration_ms = 30\n\
+             [[accel_event]]\nkind = \"spike\"\nstart_s = 0.9\npeak_g = 50\n",
+        )
+        .expect("valid");
+        let ev = AccelEvents::new(&s);
+        let mut quiet = 0;
+        for k in 0..1000 {
+            let t1 = k as f64 * 1e-3;
+            let t0 = t1 - 0.02;
+            if !ev.quiet_over(AccelSensor::Crash, t0, t1) {
+                continue;
+            }
+            quiet += 1;
+            for j in 0..=2000 {
+                let ts = t0 + (t1 - t0) * j as f64 / 2000.0;
+                assert_eq!(ev.added_mps2(AccelSensor::Crash, ts), None, "{ts}");
+            }
+        }
+        // 1 000 spans less those touching the four additive events (≈ 30 + 120 + 70 + 50).
+        assert!((600..=800).contains(&quiet), "{quiet}");
+        for t1 in [0.105, 0.35, 0.52, 0.715] {
+            assert!(!ev.quiet_over(AccelSensor::Crash, t1 - 0.02, t1), "{t1}");
+        }
+        // The offset is the crash sensor's alone.
+        assert!(ev.quiet_over(AccelSensor::Safing, 0.5, 0.52));
     }
 }

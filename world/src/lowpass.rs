@@ -119,6 +119,25 @@ impl AntiAlias {
         self.t_s = Some(t_s);
         self.x[0]
     }
+
+    /// [`Self::read`] for an input that holds `value` over everything the reading integrates
+    /// (the caller knows it: a quiet stretch of the scenario, over the last [`RESTART_GAP_S`]
+    /// at least) while the filter is settled on it: then every derivative is exactly zero, so
+    /// `read` would return the state unchanged, bit for bit, after its substeps — this returns
+    /// it without them. `None`: not settled on `value`, or a reading `read` restarts — read it.
+    /// Most of a drive is such a stretch (the car at constant speed before the event or the
+    /// contact, at rest after the pulse), and the substeps are most of a run's time.
+    pub fn read_settled(&mut self, t_s: f64, value: f64) -> Option<f64> {
+        if self.omega0 <= 0.0 {
+            return Some(value);
+        }
+        let t0 = self.t_s?;
+        if !(t0 <= t_s && t_s - t0 <= RESTART_GAP_S) || self.x != [value, 0.0, 0.0] {
+            return None;
+        }
+        self.t_s = Some(t_s);
+        Some(self.x[0])
+    }
 }
 
 /// States smaller than this are set to zero (see [`AntiAlias::read`]): 10⁻¹⁰⁰ m/s² is
@@ -223,5 +242,46 @@ mod tests {
         }
         // A third-order Bessel's step response overshoots 0.75 %.
         assert!(peak > 1.0 && peak < 1.01, "{peak}");
+    }
+
+    #[test]
+    fn a_settled_filter_on_a_quiet_input_reads_as_the_substeps_would_bit_for_bit() {
+        // At rest, a 50 g × 10 ms bump at 0.1 s, at rest again. One filter always substeps;
+        // the other skips the substeps whenever the last 20 ms were quiet. They read alike, bit
+        // for bit; the skip is taken before the bump and once the states have decayed to 0,
+        // never while they have not.
+        let bump = |t: f64| {
+            if (0.1..0.11).contains(&t) {
+                -490.0
+            } else {
+                0.0
+            }
+        };
+        let (mut slow, mut fast) = (AntiAlias::new(400.0), AntiAlias::new(400.0));
+        let (mut skipped_before, mut skipped_after, mut unsettled) = (0, 0, 0);
+        for k in 0..1600 {
+            let t = k as f64 * 5e-4;
+            let a = slow.read(t, DEFAULT_STEP_S, bump);
+            let quiet = t < 0.1 || t - RESTART_GAP_S > 0.11;
+            let b = match quiet.then(|| fast.read_settled(t, 0.0)).flatten() {
+                Some(b) => {
+                    if t < 0.1 {
+                        skipped_before += 1;
+                    } else {
+                        skipped_after += 1;
+                    }
+                    b
+                }
+                None => {
+                    unsettled += usize::from(quiet && k > 0);
+                    fast.read(t, DEFAULT_STEP_S, bump)
+                }
+            };
+            assert_eq!(a.to_bits(), b.to_bits(), "{t}: {a} vs {b}");
+        }
+        assert!(skipped_before >= 190, "{skipped_before}");
+        assert!(skipped_after >= 300, "{skipped_after}");
+        // Between the bump and the flush the quiet input found the filter unsettled.
+        assert!(unsettled > 0);
     }
 }

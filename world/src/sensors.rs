@@ -189,9 +189,14 @@ impl SensorModelSim {
                 None => a,
             }
         };
-        // What the input holds over the longest span this reading integrates.
-        let step_s = events.finest_step_s(sensor, t_s - crate::lowpass::RESTART_GAP_S, t_s);
-        let a = filter.read(t_s, step_s, input);
+        // The longest span this reading integrates: a quiet one (no acceleration, no event)
+        // leaves a settled filter as it is; else what the input holds over it sets the step.
+        let from_s = t_s - crate::lowpass::RESTART_GAP_S;
+        let quiet = truth.at_rest_over(from_s, t_s) && events.quiet_over(sensor, from_s, t_s);
+        let a = match quiet.then(|| filter.read_settled(t_s, 0.0)).flatten() {
+            Some(a) => a,
+            None => filter.read(t_s, events.finest_step_s(sensor, from_s, t_s), input),
+        };
         (a + noise).clamp(-full_scale, full_scale)
     }
 

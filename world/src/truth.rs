@@ -118,6 +118,9 @@ pub struct Truth {
     /// Each crush-zone satellite's acceleration relative to the body (left, right), on the
     /// pulse's grid ([`physics::crush_zone`]; empty without contact).
     satellite_rel_mps2: [Vec<f64>; 2],
+    /// From this long after the contact the pulse's body and satellite channels are exactly
+    /// 0 (separated, or the buffer's end) [s]; [`Self::at_rest_over`] reads it.
+    pulse_rest_s: f64,
 }
 
 impl Truth {
@@ -131,6 +134,7 @@ impl Truth {
             collision: None,
             pulse: Box::new(DefaultPulseBuffer::new()),
             satellite_rel_mps2: [Vec::new(), Vec::new()],
+            pulse_rest_s: 0.0,
         };
         // After an evasive manoeuvre the opponent is out of the path: no contact afterwards.
         let end = scenario
@@ -176,6 +180,17 @@ impl Truth {
                 scenario.sensor.satellite_depth_m,
             );
         }
+        // The last non-zero sample of any channel, and one more grid step, so that every
+        // interpolation from there on reads two zeros whatever the rounding of t / step.
+        let last = |ch: &[f64]| ch.iter().rposition(|a| *a != 0.0);
+        let [left, right] = &truth.satellite_rel_mps2;
+        let last_moving = [truth.pulse.ego_accel_mps2(), left, right]
+            .into_iter()
+            .filter_map(last)
+            .max();
+        let step = truth.pulse.step_s();
+        let buffer_s = truth.pulse.len() as f64 * step;
+        truth.pulse_rest_s = last_moving.map_or(0.0, |i| ((i + 2) as f64 * step).min(buffer_s));
         Ok(truth)
     }
 
@@ -306,6 +321,25 @@ impl Truth {
         }
     }
 
+    /// Whether the ego body and both crush-zone satellites feel exactly no acceleration all
+    /// over `[t0_s, t1_s]` ([`Self::ego_accel_mps2`] and [`Self::satellite_accel_mps2`]
+    /// return 0 at every instant there): before the contact and before any braking begins,
+    /// or after the pulse has come to rest. `false` where it cannot say so cheaply (braking,
+    /// the pulse). A braking plateau is steady too, but a filter never settles on it exactly,
+    /// so there is nothing to gain from saying so.
+    pub fn at_rest_over(&self, t0_s: f64, t1_s: f64) -> bool {
+        match self.contact_s {
+            Some(tc) if t0_s - tc >= self.pulse_rest_s => true,
+            Some(tc) if t1_s >= tc => false,
+            _ => self
+                .scenario
+                .ego
+                .braking
+                .as_ref()
+                .is_none_or(|b| t1_s <= b.start_s),
+        }
+    }
+
     /// What the crush-zone satellite on `side` feels at `t_s` [m/s²]: the body's acceleration
     /// and, from contact, the crush of the structure ahead of it ([`physics::crush_zone`]) as
     /// far as the crash mode reaches its rail tip ([`satellite_crush_m`]).
@@ -428,6 +462,48 @@ mod tests {
             (after.closing_speed_mps + 0.1 * v).abs() < 0.01 * v,
             "{after:?}"
         );
+    }
+
+    #[test]
+    fn at_rest_means_exactly_no_acceleration_on_body_and_satellites() {
+        // A braked 50 + 50 km/h crash and a 40 km/h offset crash (its pulse runs the whole
+        // buffer): every window the truth calls at rest reads exactly 0 at 10 µs steps, and
+        // the windows cover the drive before the braking and the run after the pulse.
+        let braked = "name = \"t\"\nduration_s = 1.5\n[ego]\nmass_kg = 1785\nspeed_kph = 50\n\
+             [ego.braking]\nstart_s = 0.2\ndecel_mps2 = 8\n\
+             [opponent]\nkind = \"vehicle\"\nmass_kg = 1785\nspeed_kph = 50\ninitial_distance_m = 20\n\
+             [occupant]\nmass_kg = 75\n";
+        let offset = "name = \"t\"\nduration_s = 1.5\n[ego]\nmass_kg = 1785\nspeed_kph = 40\n\
+             [opponent]\nkind = \"offset_barrier\"\noverlap_percent = 40\ninitial_distance_m = 5\n[sensor]\nmass_estimate_kg = 3000\n\
+             [occupant]\nmass_kg = 75\n";
+        for text in [braked, offset] {
+            let t = Truth::new(&parse(text)).expect("truth");
+            let tc = t.contact_s.expect("contact");
+            let (mut rest_before, mut rest_after) = (0, 0);
+            for k in 0..1500 {
+                let t1 = k as f64 * 1e-3;
+                let t0 = t1 - 0.02;
+                if !t.at_rest_over(t0, t1) {
+                    continue;
+                }
+                if t1 < tc {
+                    rest_before += 1;
+                } else {
+                    rest_after += 1;
+                }
+                for j in 0..=2000 {
+                    let ts = t0 + (t1 - t0) * j as f64 / 2000.0;
+                    assert_eq!(t.ego_accel_mps2(ts), 0.0, "{ts}");
+                    for side in [FrontSide::Left, FrontSide::Right] {
+                        assert_eq!(t.satellite_accel_mps2(side, ts), 0.0, "{ts}");
+                    }
+                }
+            }
+            assert!(
+                rest_before >= 100 && rest_after >= 100,
+                "{rest_before} {rest_after}"
+            );
+        }
     }
 
     #[test]
