@@ -383,6 +383,20 @@ impl CrashMonitor {
         }
     }
 
+    /// The crash sensor's own accelerometer-only decisions on its event, for the backup path
+    /// whose evidence dated the contact at `contact_ns`: whether the airbag's and the
+    /// pyrotechnic pretensioner's decisions are must-fire (used while the safing sensor reads
+    /// more than the crash sensor allows: the crash sensor's is then the smaller reading).
+    #[inline(never)]
+    pub(crate) fn own_severity(&self, contact_ns: u64) -> BackupSeverity {
+        let fires = |d: FallbackDecision| matches!(d, FallbackDecision::Fire { .. });
+        BackupSeverity {
+            contact_ns: Some(contact_ns),
+            airbag: fires(self.fallback()),
+            pretensioner: fires(self.pretensioner()),
+        }
+    }
+
     /// The latched confirmation.
     pub fn confirmation(&self) -> Option<Confirmation> {
         self.confirmation

@@ -417,17 +417,30 @@ impl Activity for RestraintCycle<'_> {
         // the safing sensor's is then the smaller reading) — never for a safing sensor that
         // reads more —, with the satellites' relief against it as the tunnel.
         let safing_measures = accel_faulty || crash_flagged || crash_reads_more;
-        let measured = if safing_measures && !safing_faulty && self.safing.onset_ns().is_some() {
+        let mut measured = if safing_measures && !safing_faulty && self.safing.onset_ns().is_some()
+        {
             let relief = self.satellites.relief(now, belted);
             Some(self.crash.backup_boundaries(&self.safing, relief))
         } else {
             None
         };
         let backup_for_disagreement = if pair_disagrees || crash_flagged {
-            self.estimate.situation.as_ref().and_then(|s| {
+            let evidence = self.estimate.situation.as_ref().and_then(|s| {
                 self.crash
                     .backup_evidence(now, s, &self.inputs, safing_onset_ns, measured)
-            })
+            });
+            // The safing sensor read more than the crash sensor allows (and the crash sensor
+            // never more): the crash sensor's is then the smaller reading whichever of the two
+            // is wrong, so its own accelerometer-only decisions time the backup's fires, as the
+            // safing sensor's measurement does the other way round. The decision stays the
+            // evidence's; this only brings its scheduled fires forward (and a healthy crash
+            // sensor's measurement confirms no backup: `CrashMonitor::end_cycle`).
+            if let (None, Some(e)) = (measured, evidence) {
+                if !crash_reads_more && !crash_flagged && !accel_faulty {
+                    measured = Some(self.crash.own_severity(e.contact_ns));
+                }
+            }
+            evidence
         } else {
             None
         };

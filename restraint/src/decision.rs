@@ -103,7 +103,8 @@ pub(crate) struct DecisionInputs<'d> {
     /// holds (`CrashMonitor::backup_evidence`).
     pub backup_for_disagreement: Option<BackupEvidence>,
     /// What the healthy safing sensor measures of the crash while the crash sensor is known
-    /// faulty or reads more than the safing sensor allows (`CrashMonitor::backup_boundaries`).
+    /// faulty or reads more than the safing sensor allows (`CrashMonitor::backup_boundaries`);
+    /// while the safing sensor reads more, the crash sensor's own accelerometer-only decisions.
     pub backup_severity: Option<BackupSeverity>,
     /// An accelerometer event is still in progress.
     pub event_in_progress: bool,

@@ -487,6 +487,24 @@ fn a_disagreeing_pair_in_a_predicted_crash_is_decided_by_the_vehicle_deceleratio
 }
 
 #[test]
+fn a_crash_sensor_reading_less_times_the_backup_by_its_own_decision() {
+    // The crash sensor reads 5 g low (15 g of the true 20 g), the safing sensor the truth: the
+    // pair disagrees with the safing sensor reading more, and the predicted crash with the
+    // vehicle frame's 15 g decides it for the backup. The crash sensor's is the smaller reading
+    // whichever of the two is wrong, so its own accelerometer-only decision times the backup's
+    // airbag: when 15 g has carried the floor, before the reference time (contact + 10 ms).
+    let b = crash_with_one_sensor_off(true, -5.0, 15.0);
+    let (t, cmd) = b.first_airbag_fire().expect("no airbag");
+    assert_eq!(
+        cmd.cmd_source(),
+        bus::codec::AirbagStageCmdCmdSource::Reference
+    );
+    assert_eq!(t, floor_reached_at(C, 15.0));
+    assert!(t < C + 10 * MS);
+    assert!(pretensioner_fired(&b));
+}
+
+#[test]
 fn a_safing_sensor_reading_more_never_measures_a_crash_for_the_backup() {
     // A predicted crash that does not come (a near miss at C) with an 8 g, 10 ms pothole on both
     // sensors; the safing sensor alone reads 25 g more from C (a fault) and the vehicle frame
