@@ -409,10 +409,11 @@ pub fn run_traced(
             v2x_lookups = n;
         }
     });
-    let truth = Truth::new(scenario).map_err(|e| anyhow!("{}: {e}", scenario.name))?;
+    // The truth the feeds played (solved once: the collision and its contact are not cheap).
+    let truth = player.model().truth();
     let contact_ns = contact_s.map_or(u64::MAX, |tc| START_NS + (tc * 1e9).round() as u64);
     let evaluated = match contact_s {
-        Some(_) => evaluate(scenario, &truth, &modules, contact_ns, &cfg.reference)
+        Some(_) => evaluate(scenario, truth, &modules, contact_ns, &cfg.reference)
             .map_err(|e| anyhow!("{}: judge: {e}", scenario.name))?,
         None => None,
     };
