@@ -439,7 +439,11 @@ pub const OPEN: &[&str] = &[
 /// Must-fire families gated on time: with `--gate`, every airbag must fire at or before its
 /// "127 mm − 30 ms" time (column `after`). The other must-fire families report the figure
 /// until they hold it.
-pub const IN_TIME: &[&str] = &["must-fire-crash", "must-fire-satellite-fault"];
+pub const IN_TIME: &[&str] = &[
+    "must-fire-crash",
+    "must-fire-satellite-fault",
+    "must-fire-safing-dead",
+];
 
 /// The family called `name`.
 pub fn family(name: &str) -> Option<&'static Family> {
