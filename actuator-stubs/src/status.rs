@@ -6,23 +6,22 @@ use heck::ToSnakeCase;
 /// The EcuStatus fault flags, in DBC order: every `EcuStatus` signal named `Fault…`, as
 /// (index in `EcuStatus::SIGNALS`, report name = the rest of the name in snake case).
 pub fn ecu_fault_signals() -> impl Iterator<Item = (usize, String)> {
-    ecu_fault_indices().map(|i| {
-        let name = bus::EcuStatus::SIGNALS.get(i).map_or("", |s| s.name);
-        (
-            i,
-            name.strip_prefix("Fault").unwrap_or(name).to_snake_case(),
-        )
-    })
+    fault_signals().map(|(i, name)| (i, name.to_snake_case()))
 }
 
 /// The index in `EcuStatus::SIGNALS` of every fault flag, in DBC order ([`ecu_fault_signals`]
 /// without the names: what decoding a status frame needs, every frame).
 pub fn ecu_fault_indices() -> impl Iterator<Item = usize> {
+    fault_signals().map(|(i, _)| i)
+}
+
+/// Every `EcuStatus` signal named `Fault…`: (index in `EcuStatus::SIGNALS`, the rest of its
+/// name as the DBC spells it).
+fn fault_signals() -> impl Iterator<Item = (usize, &'static str)> {
     bus::EcuStatus::SIGNALS
         .iter()
         .enumerate()
-        .filter(|(_, s)| s.name.starts_with("Fault"))
-        .map(|(i, _)| i)
+        .filter_map(|(i, s)| s.name.strip_prefix("Fault").map(|n| (i, n)))
 }
 
 /// The names of the fault flags set in `bits` (bit k = the k-th of [`ecu_fault_signals`]).

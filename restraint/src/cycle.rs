@@ -385,7 +385,8 @@ impl Activity for RestraintCycle<'_> {
             .reasons
             .intersects(Degraded::SAFING_STALE | Degraded::SAFING_INVALID);
         self.crash_sensor_faulty = accel_faulty;
-        let front_end_crushed = self.satellites.front_end_crushed(now);
+        // Asked only for a faulty safing sensor, which it stands in for.
+        let front_end_crushed = safing_faulty && self.satellites.front_end_crushed(now);
         let mut safing = self
             .safing
             .agrees(now, safing_faulty, vehicle, front_end_crushed);

@@ -25,9 +25,9 @@
 //! `EgoVehicleState` (fresh within `vehicle_timeout_ms`): a frame received within the hold
 //! window showing at least `safing_substitute_g` closes the channel — for a crash the
 //! satellites do not see fold, later by up to one 10 ms vehicle frame. A spike or stuck crash
-//! accelerometer still cannot fire alone: neither witness is moved by it. The pre-crash (reversible, motor-driven)
-//! pretensioner needs no safing agreement: it fires on the prediction before any deceleration
-//! exists and is released when the crash does not come.
+//! accelerometer still cannot fire alone: neither witness is moved by it. The pre-crash
+//! (reversible, motor-driven) pretensioner needs no safing agreement: it fires on the
+//! prediction before any deceleration exists and is released when the crash does not come.
 
 use crate::accel::PlausibleBatch;
 use crate::confirm::{ConfirmParams, Onset, OnsetStep};

@@ -94,6 +94,25 @@ struct Ringing {
     body_peak_mps2: f64,
 }
 
+impl Signal {
+    /// Where an additive signal acts: `[start, end]` [s] (`None`: a spike, which replaces a
+    /// sample instead of adding to the input).
+    fn additive_span_s(&self) -> Option<(f64, f64)> {
+        match self {
+            Signal::HalfSine {
+                start_s,
+                duration_s,
+                ..
+            } => Some((*start_s, start_s + duration_s)),
+            Signal::Ringing(r) => Some((r.start_s, r.start_s + r.duration_s)),
+            Signal::RoughRoad { start_s, end_s, .. } | Signal::Offset { start_s, end_s, .. } => {
+                Some((*start_s, *end_s))
+            }
+            Signal::Spike { .. } => None,
+        }
+    }
+}
+
 impl Ringing {
     fn at(&self, t_s: f64) -> Option<f64> {
         let tau = t_s - self.start_s;
@@ -189,22 +208,13 @@ impl AccelEvents {
     /// through the filter).
     pub fn quiet_over(&self, sensor: AccelSensor, t0_s: f64, t1_s: f64) -> bool {
         // Each window with a margin beyond the edge tolerance `added_mps2` applies.
-        let overlaps = |a: f64, b: f64| a <= t1_s + 2.0 * EDGE_S && b >= t0_s - 2.0 * EDGE_S;
+        let overlaps = |(a, b): (f64, f64)| a <= t1_s + 2.0 * EDGE_S && b >= t0_s - 2.0 * EDGE_S;
         !self
             .events
             .iter()
             .filter(|e| e.reach.reaches(sensor))
-            .any(|e| match &e.signal {
-                Signal::HalfSine {
-                    start_s,
-                    duration_s,
-                    ..
-                } => overlaps(*start_s, start_s + duration_s),
-                Signal::Ringing(r) => overlaps(r.start_s, r.start_s + r.duration_s),
-                Signal::RoughRoad { start_s, end_s, .. }
-                | Signal::Offset { start_s, end_s, .. } => overlaps(*start_s, *end_s),
-                Signal::Spike { .. } => false,
-            })
+            .filter_map(|e| e.signal.additive_span_s())
+            .any(overlaps)
     }
 
     /// The longest substep [s] that resolves what the additive events reaching `sensor` put
@@ -212,22 +222,20 @@ impl AccelEvents {
     /// a twentieth of a half-sine's or a ringing envelope's length, a twelfth of a ringing's
     /// period, a rough road's grid step; [`crate::lowpass::DEFAULT_STEP_S`] when none is active.
     pub fn finest_step_s(&self, sensor: AccelSensor, t0_s: f64, t1_s: f64) -> f64 {
-        let overlaps = |a: f64, b: f64| a <= t1_s + EDGE_S && b >= t0_s - EDGE_S;
+        let overlaps = |(a, b): (f64, f64)| a <= t1_s + EDGE_S && b >= t0_s - EDGE_S;
         let mut step = crate::lowpass::DEFAULT_STEP_S;
         for e in self.events.iter().filter(|e| e.reach.reaches(sensor)) {
+            if !e.signal.additive_span_s().is_some_and(overlaps) {
+                continue;
+            }
             let s = match &e.signal {
-                Signal::HalfSine {
-                    start_s,
-                    duration_s,
-                    ..
-                } if overlaps(*start_s, start_s + duration_s) => duration_s / 20.0,
-                Signal::Ringing(r) if overlaps(r.start_s, r.start_s + r.duration_s) => {
+                Signal::HalfSine { duration_s, .. } => duration_s / 20.0,
+                Signal::Ringing(r) => {
                     (r.duration_s / 20.0).min(std::f64::consts::TAU / (12.0 * r.omega_rad_s))
                 }
-                Signal::RoughRoad { start_s, end_s, .. } if overlaps(*start_s, *end_s) => {
-                    1.0 / ROUGH_ROAD_GRID_HZ
-                }
-                _ => continue,
+                Signal::RoughRoad { .. } => 1.0 / ROUGH_ROAD_GRID_HZ,
+                // An offset is a constant the default step resolves; a spike is no input.
+                Signal::Offset { .. } | Signal::Spike { .. } => continue,
             };
             step = step.min(s);
         }
