@@ -94,6 +94,15 @@ struct Ringing {
     body_peak_mps2: f64,
 }
 
+/// How a reading steps the anti-alias filter ([`AccelEvents::substeps`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Substeps {
+    /// The longest substep [s].
+    pub max_step_s: f64,
+    /// The input is linear over each substep ([`crate::lowpass::AntiAlias::read_linear`]).
+    pub linear: bool,
+}
+
 impl Signal {
     /// Where an additive signal acts: `[start, end]` [s] (`None`: a spike, which replaces a
     /// sample instead of adding to the input).
@@ -217,13 +226,18 @@ impl AccelEvents {
             .any(overlaps)
     }
 
-    /// The longest substep [s] that resolves what the additive events reaching `sensor` put
-    /// into `[t0_s, t1_s]` for the accelerometers' anti-alias filter ([`crate::lowpass`]):
-    /// a twentieth of a half-sine's or a ringing envelope's length, a twelfth of a ringing's
-    /// period, a rough road's grid step; [`crate::lowpass::DEFAULT_STEP_S`] when none is active.
-    pub fn finest_step_s(&self, sensor: AccelSensor, t0_s: f64, t1_s: f64) -> f64 {
+    /// How the accelerometers' anti-alias filter ([`crate::lowpass`]) steps through what the
+    /// additive events reaching `sensor` put into `[t0_s, t1_s]`: the longest substep that
+    /// resolves them — a twentieth of a half-sine's or a ringing envelope's length, a twelfth
+    /// of a ringing's period, a rough road's grid step; [`crate::lowpass::DEFAULT_STEP_S`] when
+    /// none is active — and whether the input is linear over each substep (no half-sine or
+    /// ringing: a rough road is linear between its grid points, an offset is a constant).
+    pub fn substeps(&self, sensor: AccelSensor, t0_s: f64, t1_s: f64) -> Substeps {
         let overlaps = |(a, b): (f64, f64)| a <= t1_s + EDGE_S && b >= t0_s - EDGE_S;
-        let mut step = crate::lowpass::DEFAULT_STEP_S;
+        let mut out = Substeps {
+            max_step_s: crate::lowpass::DEFAULT_STEP_S,
+            linear: true,
+        };
         for e in self.events.iter().filter(|e| e.reach.reaches(sensor)) {
             if !e.signal.additive_span_s().is_some_and(overlaps) {
                 continue;
@@ -233,13 +247,17 @@ impl AccelEvents {
                 Signal::Ringing(r) => {
                     (r.duration_s / 20.0).min(std::f64::consts::TAU / (12.0 * r.omega_rad_s))
                 }
-                Signal::RoughRoad { .. } => 1.0 / ROUGH_ROAD_GRID_HZ,
+                Signal::RoughRoad { .. } => {
+                    out.max_step_s = out.max_step_s.min(1.0 / ROUGH_ROAD_GRID_HZ);
+                    continue;
+                }
                 // An offset is a constant the default step resolves; a spike is no input.
                 Signal::Offset { .. } | Signal::Spike { .. } => continue,
             };
-            step = step.min(s);
+            out.max_step_s = out.max_step_s.min(s);
+            out.linear = false;
         }
-        step
+        out
     }
 
     /// The reading of a spike that replaces `sensor`'s sample at `t_s`, whose samples are
@@ -308,7 +326,9 @@ fn prepare(scenario: &Scenario, index: usize, e: &AccelEvent) -> Signal {
 
 /// Linear interpolation of `track` at fractional index `x ≥ 0` (the last point beyond it).
 fn interpolate(track: &[f64], x: f64) -> f64 {
-    let i = x.max(0.0).floor() as usize;
+    // `as` truncates, which is the floor for x ≥ 0 (NaN → 0) — without the libm call that a
+    // baseline x86-64 build makes of `floor`.
+    let i = x.max(0.0) as usize;
     match (track.get(i), track.get(i + 1)) {
         (Some(a), Some(b)) => a + (b - a) * (x - i as f64),
         (Some(a), None) => *a,

@@ -190,12 +190,16 @@ impl SensorModelSim {
             }
         };
         // The longest span this reading integrates: a quiet one (no acceleration, no event)
-        // leaves a settled filter as it is; else what the input holds over it sets the step.
+        // leaves a settled filter as it is; else what the input holds over it sets the step
+        // and whether it is linear over the substeps.
         let from_s = t_s - crate::lowpass::RESTART_GAP_S;
         let quiet = truth.at_rest_over(from_s, t_s) && events.quiet_over(sensor, from_s, t_s);
         let a = match quiet.then(|| filter.read_settled(t_s, 0.0)).flatten() {
             Some(a) => a,
-            None => filter.read(t_s, events.finest_step_s(sensor, from_s, t_s), input),
+            None => match events.substeps(sensor, from_s, t_s) {
+                s if s.linear => filter.read_linear(t_s, s.max_step_s, truth.contact_s, input),
+                s => filter.read(t_s, s.max_step_s, input),
+            },
         };
         (a + noise).clamp(-full_scale, full_scale)
     }

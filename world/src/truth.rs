@@ -281,7 +281,9 @@ impl Truth {
             return 0.0;
         }
         let x = t_since_contact_s / step;
-        let i = x.floor() as usize;
+        // The floor's index without a libm call: `as` truncates towards 0 and saturates, so
+        // every x < 1 (a negative one, NaN) gives 0 as `x.floor() as usize` does.
+        let i = x as usize;
         match (channel.get(i), channel.get(i + 1)) {
             (Some(a), Some(b)) => a + (b - a) * (x - i as f64),
             (Some(a), None) => *a,
