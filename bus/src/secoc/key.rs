@@ -1,7 +1,6 @@
 //! The 128-bit stream keys and their hex form.
 
-use aes::Aes128;
-use cmac::{digest::KeyInit, Cmac};
+use super::mac::KeyedCmac;
 
 /// A 128-bit AES key. `Debug` never prints the key material.
 #[derive(Clone, PartialEq, Eq)]
@@ -94,7 +93,7 @@ impl SecOcKey {
         &self.0
     }
 
-    pub(super) fn cmac(&self) -> Cmac<Aes128> {
-        <Cmac<Aes128> as KeyInit>::new(&self.0.into())
+    pub(super) fn cmac(&self) -> KeyedCmac {
+        KeyedCmac::new(&self.0)
     }
 }

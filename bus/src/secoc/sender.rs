@@ -1,9 +1,6 @@
 //! The sender side: freshness and authenticator of each command frame.
 
-use aes::Aes128;
-use cmac::Cmac;
-
-use super::mac::{auth_frame, mac40, payload8};
+use super::mac::{auth_frame, mac40, payload8, KeyedCmac};
 use super::{SecOcError, SecOcKey, SecOcStream};
 use crate::RawFrame;
 
@@ -11,7 +8,7 @@ use crate::RawFrame;
 #[derive(Clone)]
 pub struct SecOcSender {
     stream: SecOcStream,
-    mac: Cmac<Aes128>,
+    mac: KeyedCmac,
     last_freshness: u64,
 }
 
@@ -67,7 +64,7 @@ impl SecOcSender {
             .checked_add(1)
             .ok_or(SecOcError::FreshnessExhausted)?
             .max(sync_now_us);
-        let mac = mac40(self.mac.clone(), self.stream, &payload, fv);
+        let mac = mac40(&self.mac, self.stream, &payload, fv);
         let frame = auth_frame(self.stream, fv, mac)?;
         self.last_freshness = fv;
         Ok(frame)

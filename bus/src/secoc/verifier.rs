@@ -1,11 +1,8 @@
 //! The receiver side: holds a command until its authenticator verifies.
 
-use aes::Aes128;
-use cmac::Cmac;
-
 use strum::EnumCount;
 
-use super::mac::{auth_fields, mac40_ok, payload8};
+use super::mac::{auth_fields, mac40_ok, payload8, KeyedCmac};
 use super::{
     SecOcError, SecOcKey, SecOcReject, SecOcStream, FRESHNESS_TX_MASK, FRESHNESS_TX_SPAN,
     MAX_FRESHNESS_WINDOW_US,
@@ -99,7 +96,7 @@ struct Pending {
 #[derive(Clone)]
 pub struct SecOcVerifier {
     stream: SecOcStream,
-    mac: Cmac<Aes128>,
+    mac: KeyedCmac,
     config: SecOcConfig,
     last_accepted: u64,
     pending: Option<Pending>,
