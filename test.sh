@@ -42,7 +42,7 @@ log=$(mktemp); trap 'rm -f "$log"' EXIT
 cargo test --workspace --release --features bus/socket 2>&1 | tee "$log"
 totals=$(awk '/^test result:/ { p += $4; f += $6 } END { printf "%d passed, %d failed", p, f }' "$log")
 
-step "misuse matrix gate: 16 000 seeded misuse / single-fault / must-fire variants through the core (≈ 30 s on 2 cores)"
+step "misuse matrix gate: 16 000 seeded misuse / single-fault / must-fire variants through the core (≈ 10 s on 2 cores)"
 # Every family that holds must stay at 0 fires where none may, 0 misses, 0 stuck crash phases;
 # the families still open (e2e_tests::misuse::OPEN) and the beyond-physics sweep are printed.
 target/release/misuse-matrix --variants 16000 --seed 7 --gate --quiet
@@ -54,6 +54,9 @@ FUZZ_SECONDS=$FUZZ_SECONDS FUZZ_REPORT_JSON="$PWD/target/robustness/fuzz.json" t
 
 step "deterministic budget: instructions per worst-case ECU cycle (valgrind)"
 target/release/budget --no-criterion --prebuilt
+
+step "wall clock: the full-cycle rows beside a reference workload (a report, not judged)"
+target/release/cycle-timing --rounds 100000
 
 step "worst-case search: a short run from the committed seeds, no case above the budget"
 # Seconds; the long search that found the seeds is in benches/README.md ("Worst case, searched").
