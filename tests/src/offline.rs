@@ -313,6 +313,16 @@ pub fn run(scenario: &Scenario, cfg: &OfflineConfig) -> Result<OfflineRun> {
     run_traced(scenario, cfg, None)
 }
 
+/// [`run`] only as far as the airbag's fire: the cycles stop after the one that sent it, and
+/// nothing is evaluated (`evaluated` is `None`; modes, faults and actions end there). What a
+/// crash's airbag time — a clean twin's in the misuse matrix — needs, for about half a run.
+///
+/// # Errors
+/// As [`run`].
+pub fn run_until_airbag(scenario: &Scenario, cfg: &OfflineConfig) -> Result<OfflineRun> {
+    simulate(scenario, cfg, None, true)
+}
+
 /// [`run`], also recording into `trace` what the sensors read and the core's crash-phase state
 /// every cycle.
 ///
@@ -321,7 +331,18 @@ pub fn run(scenario: &Scenario, cfg: &OfflineConfig) -> Result<OfflineRun> {
 pub fn run_traced(
     scenario: &Scenario,
     cfg: &OfflineConfig,
+    trace: Option<&mut Trace>,
+) -> Result<OfflineRun> {
+    simulate(scenario, cfg, trace, false)
+}
+
+/// The run: every cycle of the scenario, or (`until_airbag`) up to the one that fired the
+/// airbag, without the evaluation.
+fn simulate(
+    scenario: &Scenario,
+    cfg: &OfflineConfig,
     mut trace: Option<&mut Trace>,
+    until_airbag: bool,
 ) -> Result<OfflineRun> {
     let truth = Truth::new(scenario).map_err(|e| anyhow!("{}: {e}", scenario.name))?;
     let contact_s = truth.contact_s;
@@ -400,6 +421,9 @@ pub fn run_traced(
         if crash_mode_ns.is_none() && crashed {
             crash_mode_ns = Some(now);
         }
+        if until_airbag && modules.action("airbag_fire").is_some() {
+            break;
+        }
     }
     let confirmed_by = ecu.crash_kind();
     let severity_excess_mps = ecu.agreement().worst_excess_mps();
@@ -413,6 +437,7 @@ pub fn run_traced(
     let truth = player.model().truth();
     let contact_ns = contact_s.map_or(u64::MAX, |tc| START_NS + (tc * 1e9).round() as u64);
     let evaluated = match contact_s {
+        Some(_) if until_airbag => None,
         Some(_) => evaluate(scenario, truth, &modules, contact_ns, &cfg.reference)
             .map_err(|e| anyhow!("{}: judge: {e}", scenario.name))?,
         None => None,

@@ -19,7 +19,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use anyhow::{Context, Result};
 use clap::Parser;
 use e2e_tests::misuse::{self, Family, Requirement};
-use e2e_tests::offline::{run, OfflineConfig};
+use e2e_tests::offline::{run, run_until_airbag, OfflineConfig};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
@@ -343,8 +343,12 @@ const UNFINISHED_MS: f64 = 150.0;
 fn run_variant(cfg: &OfflineConfig, text: &str, req: Requirement) -> Result<Outcome> {
     let mut outcome = run_one(cfg, text)?;
     if let Some(clean) = misuse::clean_twin(text) {
-        let twin = run_one(cfg, clean)?;
-        outcome.clean_margin_ms = twin.airbag_ms.zip(twin.required_ms).map(|(t, r)| t - r);
+        // Only its airbag time counts: the twin runs up to it.
+        let scenario =
+            world::Scenario::parse("matrix", clean).map_err(|e| anyhow::anyhow!("{e}\n{clean}"))?;
+        let twin = run_until_airbag(&scenario, cfg)?;
+        let airbag_ms = twin.action("airbag_fire").map(|a| a.0);
+        outcome.clean_margin_ms = airbag_ms.zip(twin.required_ms).map(|(t, r)| t - r);
     }
     if req == Requirement::ByOutcome {
         outcome.airbag_needed = Some(airbag_needed(cfg, text)?);

@@ -790,3 +790,43 @@ fn an_ecu_config_file_sets_what_the_ecu_reads_from_it() {
     assert!(err.contains("no_such_key"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A run stopped at the airbag (what the matrix's clean twins run) fires it when the whole run
+/// does, receives nothing after it (the whole run's adaptive belt commands go on), and
+/// evaluates nothing; a crash without an airbag runs to the end.
+#[test]
+fn a_run_until_the_airbag_fires_it_when_the_whole_run_does_and_stops_there() {
+    let cfg = cfg();
+    let mut cut_short = 0;
+    for name in [
+        "fmvss208-56-belted",
+        "taurus-48-48-abs",
+        "low-speed-no-fire",
+    ] {
+        let s = scenario(name);
+        let whole = e2e_tests::offline::run(&s, &cfg).expect("run");
+        let short = e2e_tests::offline::run_until_airbag(&s, &cfg).expect("run until the airbag");
+        assert_eq!(
+            short.action("airbag_fire").map(|a| a.0),
+            whole.action("airbag_fire").map(|a| a.0),
+            "{name}"
+        );
+        assert_eq!(short.required_ms, whole.required_ms, "{name}");
+        assert!(short.evaluated.is_none(), "{name}");
+        let belt = |r: &OfflineRun| r.modules.adaptive_belt_cmds.clone();
+        match whole.modules.action("airbag_fire").map(|a| a.t_ns) {
+            Some(fire_ns) => {
+                assert!(belt(&short).iter().all(|&t| t <= fire_ns), "{name}");
+                let after = belt(&whole).iter().filter(|&&t| t > fire_ns).count();
+                assert_eq!(belt(&short).len() + after, belt(&whole).len(), "{name}");
+                cut_short += usize::from(after > 0);
+            }
+            None => {
+                assert_eq!(short.modes, whole.modes, "{name}");
+                assert_eq!(belt(&short), belt(&whole), "{name}");
+            }
+        }
+    }
+    // The ECU keeps commanding the belt after the Taurus crash's airbag: the cut shows.
+    assert!(cut_short >= 1);
+}
