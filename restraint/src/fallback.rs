@@ -31,8 +31,10 @@
 //! (a kerb strike's ringing or a rough road's lobe running into the contact); it falls into a
 //! *valley*, under [`VALLEY_FRACTION`] of the segment's crest, and then rises past that crest —
 //! the pulse departs from the earlier event's severity. The segment then restarts at the
-//! valley's lowest sample (Δv and τ from there), if that sample reads under [`VALLEY_MAX_G`]:
-//! a higher trough is ringing on top of a crash already loading. A lobe that stays under the
+//! valley's lowest sample (Δv and τ from there), if that sample reads under [`VALLEY_MAX_G`]
+//! — under the wake threshold within [`RE_ONSET_EARLY_MS`] of the segment's start, where a
+//! kerb strike's ringing pulls a low-speed crash's first ramp down to a few g —: a higher
+//! trough is ringing on top of a crash already loading. A lobe that stays under the
 //! earlier crest (a kerb strike's ringing on top of a low-speed crash) keeps the segment it is
 //! in.
 //! The decision still belongs to the event ([`FallbackDecision::Fire`]'s `onset_ns`); what it
@@ -580,7 +582,11 @@ impl FallbackAlgorithm {
         }
         self.in_valley = false;
         if let Some(v) = self.valley {
-            if not_fired && crest > v.crest_before_mps2 && v.decel_mps2 <= VALLEY_MAX_MPS2 {
+            // Early in a segment the trough must reach the wake threshold, as a re-onset's dip
+            // must be longer there (`RE_ONSET_EARLY_MS`).
+            let early = v.t_ns.saturating_sub(self.segment_onset_ns) < RE_ONSET_EARLY_NS;
+            let trough_max = if early { p.wake_mps2 } else { VALLEY_MAX_MPS2 };
+            if not_fired && crest > v.crest_before_mps2 && v.decel_mps2 <= trough_max {
                 self.start_segment_at(v.t_ns, s, v.dv_mps);
             }
         }
@@ -1229,6 +1235,29 @@ mod tests {
                 1_000_000_000
             };
             assert_eq!(f.segment_onset_ns(), Some(expected), "trough {trough_g} g");
+        }
+        // Within RE_ONSET_EARLY_MS of the segment's start a valley's trough must reach the wake
+        // threshold: an 8 g crash ramp whose kerb ringing pulls it to 2.5 g for a sample at
+        // 8 ms, then a 40 g lobe, is the crash's plateau under the ringing (a 13.8 km/h barrier
+        // fired so); the same trough at 1 g (a dip too short for a re-onset) is rest the lobe
+        // rises out of, and at 2.5 g 12 ms in it restarts.
+        for (trough_ms, trough_g, restarts) in [(8, 2.5, false), (8, 1.0, true), (12, 2.5, true)] {
+            let mut f = FallbackAlgorithm::new([f64::INFINITY; KNOTS], floor());
+            run_fn(&mut f, trough_ms + 8, |k| match k {
+                k if k < trough_ms => 2.0 + k as f64 * 0.75,
+                k if k == trough_ms => trough_g,
+                _ => 40.0,
+            });
+            let expected = if restarts {
+                1_000_000_000 + trough_ms * 1_000_000
+            } else {
+                1_000_000_000
+            };
+            assert_eq!(
+                f.segment_onset_ns(),
+                Some(expected),
+                "trough {trough_g} g at {trough_ms} ms"
+            );
         }
     }
 
