@@ -421,7 +421,7 @@ fn simulate(
         if crash_mode_ns.is_none() && crashed {
             crash_mode_ns = Some(now);
         }
-        if until_airbag && modules.action("airbag_fire").is_some() {
+        if until_airbag && modules.airbag_fired {
             break;
         }
     }

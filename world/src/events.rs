@@ -242,20 +242,20 @@ impl AccelEvents {
             if !e.signal.additive_span_s().is_some_and(overlaps) {
                 continue;
             }
-            let s = match &e.signal {
-                Signal::HalfSine { duration_s, .. } => duration_s / 20.0,
-                Signal::Ringing(r) => {
-                    (r.duration_s / 20.0).min(std::f64::consts::TAU / (12.0 * r.omega_rad_s))
-                }
-                Signal::RoughRoad { .. } => {
-                    out.max_step_s = out.max_step_s.min(1.0 / ROUGH_ROAD_GRID_HZ);
-                    continue;
-                }
+            // The substep that resolves the event, and whether it is curved inside one.
+            let (step_s, curved) = match &e.signal {
+                Signal::HalfSine { duration_s, .. } => (duration_s / 20.0, true),
+                Signal::Ringing(r) => (
+                    (r.duration_s / 20.0).min(std::f64::consts::TAU / (12.0 * r.omega_rad_s)),
+                    true,
+                ),
+                // Linear between its grid points.
+                Signal::RoughRoad { .. } => (1.0 / ROUGH_ROAD_GRID_HZ, false),
                 // An offset is a constant the default step resolves; a spike is no input.
                 Signal::Offset { .. } | Signal::Spike { .. } => continue,
             };
-            out.max_step_s = out.max_step_s.min(s);
-            out.linear = false;
+            out.max_step_s = out.max_step_s.min(step_s);
+            out.linear &= !curved;
         }
         out
     }

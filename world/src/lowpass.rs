@@ -110,6 +110,20 @@ impl Hold {
         }
     }
 
+    /// The step for substeps of `h_s` from `holds` (the two latest lengths, the newer first),
+    /// derived and kept as the newer when neither serves it.
+    fn cached(holds: &mut [Option<Hold>; 2], omega0: f64, h_s: f64) -> &Hold {
+        let [newer, older] = holds;
+        if !newer.is_some_and(|hold| hold.serves(h_s)) {
+            if older.is_some_and(|hold| hold.serves(h_s)) {
+                core::mem::swap(newer, older);
+            } else {
+                *older = newer.take();
+            }
+        }
+        newer.get_or_insert_with(|| Hold::new(omega0, h_s))
+    }
+
     fn serves(&self, h_s: f64) -> bool {
         (self.h_s - h_s).abs() <= HOLD_REUSE_TOLERANCE * h_s
     }
@@ -197,13 +211,6 @@ impl AntiAlias {
         let Some((start, n, h)) = self.begin(t_s, max_step_s, &input) else {
             return self.x[0];
         };
-        if !self.holds[0].is_some_and(|hold| hold.serves(h)) {
-            if self.holds[1].is_some_and(|hold| hold.serves(h)) {
-                self.holds.swap(0, 1);
-            } else {
-                self.holds = [Some(Hold::new(self.omega0, h)), self.holds[0]];
-            }
-        }
         let Self {
             omega0,
             x,
@@ -212,9 +219,7 @@ impl AntiAlias {
             ..
         } = self;
         let omega0 = *omega0;
-        let Some(hold) = &holds[0] else {
-            return x[0];
-        };
+        let hold = Hold::cached(holds, omega0, h);
         // The substeps end at `start + k·h` and the last at `t_s` itself, so the input there is
         // the next reading's first, kept instead of read again.
         let mut u0 = match *end_input {

@@ -344,9 +344,7 @@ fn run_variant(cfg: &OfflineConfig, text: &str, req: Requirement) -> Result<Outc
     let mut outcome = run_one(cfg, text)?;
     if let Some(clean) = misuse::clean_twin(text) {
         // Only its airbag time counts: the twin runs up to it.
-        let scenario =
-            world::Scenario::parse("matrix", clean).map_err(|e| anyhow::anyhow!("{e}\n{clean}"))?;
-        let twin = run_until_airbag(&scenario, cfg)?;
+        let twin = run_until_airbag(&scenario_of(clean)?, cfg)?;
         let airbag_ms = twin.action("airbag_fire").map(|a| a.0);
         outcome.clean_margin_ms = airbag_ms.zip(twin.required_ms).map(|(t, r)| t - r);
     }
@@ -362,8 +360,7 @@ fn run_variant(cfg: &OfflineConfig, text: &str, req: Requirement) -> Result<Outc
 /// reference are the actuator stubs' (`actuator_stubs::outcome`), not the ECU's.
 fn airbag_needed(cfg: &OfflineConfig, text: &str) -> Result<bool> {
     use actuator_stubs::outcome::{judge, NEVER_S};
-    let scenario =
-        world::Scenario::parse("matrix", text).map_err(|e| anyhow::anyhow!("{e}\n{text}"))?;
+    let scenario = scenario_of(text)?;
     let truth = world::Truth::new(&scenario).map_err(anyhow::Error::msg)?;
     if truth.collision.is_none() {
         return Ok(false);
@@ -385,9 +382,13 @@ fn airbag_needed(cfg: &OfflineConfig, text: &str) -> Result<bool> {
     Ok(belt_only.0.bottomed_out && !with_airbag.0.bottomed_out)
 }
 
+/// A variant's scenario text parsed (the text beside the error: it is generated).
+fn scenario_of(text: &str) -> Result<world::Scenario> {
+    world::Scenario::parse("matrix", text).map_err(|e| anyhow::anyhow!("{e}\n{text}"))
+}
+
 fn run_one(cfg: &OfflineConfig, text: &str) -> Result<Outcome> {
-    let scenario =
-        world::Scenario::parse("matrix", text).map_err(|e| anyhow::anyhow!("{e}\n{text}"))?;
+    let scenario = scenario_of(text)?;
     let r = run(&scenario, cfg)?;
     let airbag_ms = r.action("airbag_fire").map(|a| a.0);
     let fired = r
