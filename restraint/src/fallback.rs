@@ -41,6 +41,18 @@
 //! adds is bounded by what it judges — one lobe of the signal, from rest or from a valley,
 //! against the same boundary and floors as a first event.
 //!
+//! **Early restarts.** A restart within [`RE_ONSET_EARLY_MS`] of its segment's start may sit
+//! inside one misuse event: a kerb strike's ringing that arrives in a low-speed crash first
+//! cancels the crash's ramp (the dip or valley) and then swings forward, and the restarted
+//! segment reads that forward swing without the backward one before it — more than the
+//! event's net Δv. The satellites' low-crush lift bounds what a misuse event adds over the
+//! whole event, so while it is on, the airbag must reach its lifted boundary read from the
+//! replaced segment (the *parent*: its start, its Δv) as well. A 15.6 km/h barrier with a
+//! 1.18 m/s kerb ringing 5 ms into it crossed the restarted segment's lifted boundary by
+//! 9 mm/s at τ = 7 ms, the parent's not at all (`low-speed-crash-and-kerb-untracked`, 22 223
+//! variants each of seeds 3, 11 and 13: 2 airbags → 0). Once the satellites see the front end
+//! crush the lift is off and the restarted segment decides alone, as does a later restart.
+//!
 //! **Crush onset.** A rough road's lobe can run into the contact with neither a dip nor a
 //! valley, and a severe crash's Δv rises as steeply as the boundary: read from the lobe's
 //! onset, a 55 km/h barrier crossed the boundary only where it levels off, 40 ms late, and a
@@ -250,6 +262,15 @@ struct Valley {
     crest_before_mps2: f64,
 }
 
+/// A judged segment that an early restart replaced ([`FallbackAlgorithm::parent`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Parent {
+    /// Its start, ns.
+    onset_ns: u64,
+    /// The event's Δv before its first interval, m/s.
+    base_dv_mps: f64,
+}
+
 /// One restraint's boundary and its decision on the current event.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Head {
@@ -283,9 +304,10 @@ impl Head {
         }
     }
 
-    /// Whether `dv` at `tau_ms` reaches the boundary (scaled, lifted) and the floor.
+    /// Whether `dv` at `tau_ms` reaches the boundary (scaled, lifted) and the floor (asked
+    /// first: under it, which most samples of an event are, the boundary is not read).
     fn reached(&self, tau_ms: f64, dv: f64, scale: f64, lift_mps: f64, floor_mps: f64) -> bool {
-        dv >= scale * threshold_mps(&self.thresholds, tau_ms) + lift_mps && dv >= floor_mps
+        dv >= floor_mps && dv >= scale * threshold_mps(&self.thresholds, tau_ms) + lift_mps
     }
 }
 
@@ -311,6 +333,10 @@ pub struct FallbackAlgorithm {
     /// The event's Δv before the segment's first interval, m/s: the segment's Δv is the
     /// event's less this (one integral for both).
     segment_base_dv_mps: f64,
+    /// The segment that a restart within [`RE_ONSET_EARLY_MS`] of its start replaced (the
+    /// earliest of a chain of such restarts): while the satellites' low-crush lift is on, the
+    /// airbag's boundary is read from it as well (module docs, "Early restarts").
+    parent: Option<Parent>,
     /// Since when the deceleration has been under the wake threshold inside the event, ns.
     dip_since_ns: Option<u64>,
     /// The latest valley of the segment: its lowest sample's time (ns) and the event's Δv
@@ -338,6 +364,7 @@ impl FallbackAlgorithm {
             run: 0,
             segment_onset_ns: 0,
             segment_base_dv_mps: 0.0,
+            parent: None,
             dip_since_ns: None,
             valley: None,
             in_valley: false,
@@ -419,6 +446,22 @@ impl FallbackAlgorithm {
         self.start_segment_from(onset_ns, s.decel_mps2, base_dv_mps);
     }
 
+    /// Restarts the judged segment inside the event (a re-onset or a valley at `onset_ns`):
+    /// a restart within [`RE_ONSET_EARLY_MS`] of the segment's start keeps that segment as the
+    /// parent, a later one judges alone.
+    fn restart_segment_at(&mut self, onset_ns: u64, s: &AccelSample, base_dv_mps: f64) {
+        let early = onset_ns.saturating_sub(self.segment_onset_ns) < RE_ONSET_EARLY_NS;
+        self.parent = if early {
+            self.parent.or(Some(Parent {
+                onset_ns: self.segment_onset_ns,
+                base_dv_mps: self.segment_base_dv_mps,
+            }))
+        } else {
+            None
+        };
+        self.start_segment_at(onset_ns, s, base_dv_mps);
+    }
+
     /// The judged segment from `onset_ns` with the event's Δv `base_dv_mps` there, the
     /// loading rule from `decel_mps2`; a decision not fired is pending again.
     fn start_segment_from(&mut self, onset_ns: u64, decel_mps2: f64, base_dv_mps: f64) {
@@ -466,6 +509,7 @@ impl FallbackAlgorithm {
                 self.airbag.decision = FallbackDecision::Pending;
                 self.pretensioner.decision = FallbackDecision::Pending;
                 self.run = 0;
+                self.parent = None;
                 self.start_segment(s, 0.0);
             }
             OnsetStep::Awake => {
@@ -477,7 +521,7 @@ impl FallbackAlgorithm {
                         .is_some_and(|d| s.t_ns.saturating_sub(d) >= self.re_onset_gap_ns(s.t_ns))
                     && not_fired;
                 if re_onset {
-                    self.start_segment(s, before_dv);
+                    self.restart_segment_at(s.t_ns, s, before_dv);
                 } else {
                     self.loading.push(s.decel_mps2, s.dt_s);
                     if above {
@@ -514,10 +558,16 @@ impl FallbackAlgorithm {
             onset_ns: onset,
         };
         let scale = t.boundary_scale;
+        let lift = self.boundary_lift_mps;
         let airbag = self.airbag.pending()
-            && self
-                .airbag
-                .reached(tau_ms, dv, scale, self.boundary_lift_mps, t.min_dv_mps);
+            && self.airbag.reached(tau_ms, dv, scale, lift, t.min_dv_mps)
+            && self.parent.is_none_or(|q| {
+                // The low-crush lift bounds what a misuse event adds over the whole event, not
+                // over the swing a segment restarted inside it reads (module docs).
+                let tau_ms = s.t_ns.saturating_sub(q.onset_ns) as f64 * 1e-6;
+                let dv = self.onset.delta_v_mps() - q.base_dv_mps;
+                lift <= 0.0 || self.airbag.reached(tau_ms, dv, scale, lift, t.min_dv_mps)
+            });
         let pretensioner = self.pretensioner.pending()
             && self
                 .pretensioner
@@ -587,7 +637,7 @@ impl FallbackAlgorithm {
             let early = v.t_ns.saturating_sub(self.segment_onset_ns) < RE_ONSET_EARLY_NS;
             let trough_max = if early { p.wake_mps2 } else { VALLEY_MAX_MPS2 };
             if not_fired && crest > v.crest_before_mps2 && v.decel_mps2 <= trough_max {
-                self.start_segment_at(v.t_ns, s, v.dv_mps);
+                self.restart_segment_at(v.t_ns, s, v.dv_mps);
             }
         }
     }
@@ -605,6 +655,7 @@ impl FallbackAlgorithm {
             return false;
         }
         let base = self.onset.delta_v_mps() - since_dv_mps;
+        self.parent = None;
         self.start_segment_from(at_ns, decel_mps2, base);
         true
     }
@@ -1200,6 +1251,36 @@ mod tests {
             _ => 10.0,
         });
         assert_eq!(f.segment_onset_ns(), Some(1_000_000_000));
+    }
+
+    /// A 3 g crash ramp whose kerb ringing pulls it under the wake threshold for 2 ms (a re-onset
+    /// inside RE_ONSET_EARLY_MS), then a 20 g ringing lobe for 16 ms, then 5 g. Against a
+    /// boundary of 0.1 m/s per ms with the 1.2 m/s low-crush lift, the restarted segment reads
+    /// the lobe alone over the lifted boundary at τ ≈ 12 ms; the whole event, read from its
+    /// onset, does not get there before the lobe ends: no airbag. Without the lift the restarted
+    /// segment decides alone (fires); after a 12 ms ramp the restart is no early one and decides
+    /// alone under the lift too.
+    #[test]
+    fn an_early_restart_under_the_low_crush_lift_is_judged_from_its_parent_too() {
+        let steep: [f64; KNOTS] = core::array::from_fn(|i| 0.1 + 0.4 * i as f64);
+        for (ramp_ms, lift_mps, fires) in [(5, 1.2, false), (5, 0.0, true), (12, 1.2, true)] {
+            let mut f = FallbackAlgorithm::new(steep, floor());
+            f.lift_boundary(lift_mps);
+            run_fn(&mut f, ramp_ms + 30, |k| match k {
+                k if k < ramp_ms => 3.0,
+                k if k < ramp_ms + 2 => 0.5,
+                k if k < ramp_ms + 18 => 20.0,
+                _ => 5.0,
+            });
+            let restart = 1_000_000_000 + (ramp_ms + 2) * 1_000_000;
+            assert_eq!(f.segment_onset_ns(), Some(restart), "ramp {ramp_ms} ms");
+            assert_eq!(
+                matches!(f.decision(), FallbackDecision::Fire { .. }),
+                fires,
+                "ramp {ramp_ms} ms, lift {lift_mps} m/s: {:?}",
+                f.decision()
+            );
+        }
     }
 
     #[test]
