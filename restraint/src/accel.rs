@@ -340,6 +340,17 @@ impl AccelMonitor {
         }
     }
 
+    /// How long the reading at sample time `t_ns` has been bit-identical, ns (0 before any
+    /// reading, and at a sample that changed it): what a stuck sensor shows long before it is
+    /// flagged (`accel_stuck_ms`).
+    pub fn unchanged_for_ns(&self, t_ns: u64) -> u64 {
+        if self.last_bits.is_none() {
+            0
+        } else {
+            t_ns.saturating_sub(self.same_since_ns)
+        }
+    }
+
     /// No batch received within the timeout (none at all = stale).
     pub fn stale(&self, now: u64) -> bool {
         self.rx_ns
@@ -375,6 +386,20 @@ mod tests {
         let mut out = PlausibleBatch::new();
         m.feed(now, now - 750_000, 250_000, &v, &mut out);
         out.iter().collect()
+    }
+
+    #[test]
+    fn a_reading_unchanged_since_its_last_change_is_timed_from_that_change() {
+        let mut m = monitor();
+        assert_eq!(m.unchanged_for_ns(5 * MS), 0, "no reading yet");
+        // Samples at 9.25, 9.5, 9.75, 10 ms; the reading last changes at 9.5 ms.
+        feed(&mut m, 10 * MS, [-1.0, -2.0, -2.0, -2.0]);
+        assert_eq!(m.unchanged_for_ns(10 * MS), 500_000);
+        feed(&mut m, 11 * MS, [-2.0, -2.0, -2.0, -2.0]);
+        assert_eq!(m.unchanged_for_ns(11 * MS), 1_500_000);
+        // A live batch: every reading differs, the newest changed it.
+        feed(&mut m, 12 * MS, [-1.0, -2.0, -3.0, -4.0]);
+        assert_eq!(m.unchanged_for_ns(12 * MS), 0);
     }
 
     #[test]

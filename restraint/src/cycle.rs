@@ -21,7 +21,7 @@ use crate::outputs::{publish_diagnostics, Outputs};
 use crate::pair_monitor::{CycleMean, PairMonitor};
 use crate::plan::{ReferenceSettings, RestraintPlan};
 use crate::safing::Safing;
-use crate::satellites::{Relief, Satellites};
+use crate::satellites::{Relief, Satellites, TUNNEL_FROZEN_MS};
 use crate::settings::ConfigError;
 use crate::settings::G_MPS2;
 use crate::signals::{Degraded, SatelliteSide};
@@ -66,6 +66,8 @@ pub struct RestraintCycle<'lut> {
 }
 
 /// Report-counter names of the E2E rejections, in [`RejectReason::VARIANTS`] order.
+const TUNNEL_FROZEN_NS: u64 = (TUNNEL_FROZEN_MS * 1e6) as u64;
+
 const E2E_COUNTER_NAMES: [&str; RejectReason::COUNT] = [
     "can_rejected_unknown_id",
     "can_rejected_wrong_dlc",
@@ -284,7 +286,15 @@ impl Activity for RestraintCycle<'_> {
                 satellites.on_tunnel_dv(dv_mps);
             }
             plausible.remove_decel(braking);
+            let accel = &inputs.accel;
             crash.on_batch(&plausible, &freeze, belted, || {
+                // A frozen crash sensor is no reference for the satellites' crush
+                // (`satellites::TUNNEL_FROZEN_MS`); asked of a judged batch only.
+                let frozen = !tunnel_is_safing
+                    && plausible
+                        .last_sample()
+                        .is_some_and(|(t, _)| accel.unchanged_for_ns(t) >= TUNNEL_FROZEN_NS);
+                satellites.set_tunnel_frozen(frozen);
                 *relief = satellites.relief(now, belted);
                 *relief
             });

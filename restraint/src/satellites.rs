@@ -89,6 +89,16 @@
 //! accelerometer-only algorithm restarts its judged segment there when a road lobe or kerb
 //! strike began it earlier (`fallback`, "Crush onset").
 //!
+//! **A frozen tunnel.** The crush is the satellites' slowing *less the tunnel's*: a body motion
+//! that every sensor sees alike (a door slam's or kerb's ringing, up to ±90 g) cancels in it.
+//! A tunnel accelerometer stuck at one reading no longer cancels it, and is flagged only after
+//! `accel_stuck_ms` (20 ms): a door slam's ringing lobe then reads as 1.0–1.3 m/s of crush at
+//! both rail tips — an unbelted occupant's whole relief — while the stuck reading carries the
+//! relieved floor (a standing car, a 59 g slam, the crash sensor stuck at 6 g: the pyrotechnic
+//! pretensioner fired; `stuck-crash-sensor-in-door-slam`, seed 17). A live sensor's noise
+//! changes its reading every sample, so while the tunnel's newest reading has been
+//! bit-identical for [`TUNNEL_FROZEN_MS`] there is no relief: the central-only logic decides.
+//!
 //! Every Fire still needs the tunnel's own event to cross the lowered boundary and floor, the
 //! persistence and loading rules, and the safing channel's agreement: **the satellites alone
 //! never fire.** With both satellites out of the fusion the tunnel's central-only logic
@@ -104,6 +114,12 @@ use crate::signals::{SatelliteFrames, SatelliteSide};
 /// them with the evidence its first milliseconds gave. In the late window past them
 /// (`fallback::LATE_WINDOW_MS`) a relief holds only while the severity keeps reaching the line.
 pub const RELIEF_HOLD_MS: f64 = 60.0;
+
+/// A tunnel accelerometer whose reading has been bit-identical for this long is frozen, ms: no
+/// reference for the crush (module docs, "A frozen tunnel"). A live sensor's noise (≥ 1 LSB)
+/// changes its reading every sample; 1 ms is 8 samples at 8 kHz, and a sensor stuck at one
+/// reading is flagged only after `accel_stuck_ms` (20 ms).
+pub const TUNNEL_FROZEN_MS: f64 = 1.0;
 
 /// How long a satellite's status or corrupt frame, or an implausible crush, keeps it out of
 /// the fusion, ms (as an accelerometer's implausible reading: `accel::INVALID_HOLD_MS`).
@@ -371,6 +387,8 @@ pub struct Satellites {
     /// This cycle's tracked prediction allows a fold to scale the boundary
     /// ([`Self::allow_fold`]).
     fold_allowed: bool,
+    /// The tunnel accelerometer's reading is frozen ([`Self::set_tunnel_frozen`]).
+    tunnel_frozen: bool,
     /// When the current relief began (the cycle, ns; 0: none yet), and the satellites usable
     /// then.
     relief_began_ns: u64,
@@ -422,6 +440,7 @@ impl Satellites {
             hold_until_ns: None,
             fold_until_ns: None,
             fold_allowed: false,
+            tunnel_frozen: false,
             relief_began_ns: 0,
             relief_began_usable: [false; 2],
             faults: SatelliteFaults::default(),
@@ -478,6 +497,13 @@ impl Satellites {
         ch.rx_ns = Some(now);
         self.bins.open(self.now_ns);
         self.bins.add(side as usize, dv);
+    }
+
+    /// Whether the tunnel accelerometer's newest reading has been bit-identical for
+    /// [`TUNNEL_FROZEN_MS`] or longer (module docs, "A frozen tunnel"): while it has, there is
+    /// no relief.
+    pub fn set_tunnel_frozen(&mut self, frozen: bool) {
+        self.tunnel_frozen = frozen;
     }
 
     /// The tunnel accelerometer's velocity change over its plausible samples of this cycle
@@ -539,7 +565,7 @@ impl Satellites {
     /// is known to be belted; else the low-crush lift ends at `unbelted_crush_mps`).
     pub fn relief(&mut self, now: u64, belted: bool) -> Relief {
         let p = self.params;
-        if !p.enabled {
+        if !p.enabled || self.tunnel_frozen {
             return Relief::NONE;
         }
         if self.hold_until_ns.is_some_and(|t| now > t) {

@@ -830,3 +830,46 @@ fn a_run_until_the_airbag_fires_it_when_the_whole_run_does_and_stops_there() {
     // The ECU keeps commanding the belt after the Taurus crash's airbag: the cut shows.
     assert!(cut_short >= 1);
 }
+
+/// A standing car's door slammed (a 59 g ringing at 131 Hz that every sensor sees) while the
+/// crash sensor sticks at 6 g on one of its lobes for 100 ms (flagged after 20 ms), an
+/// unbelted occupant: one fault inside one misuse event. The satellites' crush is measured
+/// against that frozen tunnel, which no longer cancels the slam's ringing at the rail tips, and
+/// read 1.0–1.3 m/s of crush: an unbelted occupant's whole relief, whose 0.5 m/s floor the
+/// stuck 6 g carried in 9 ms — the pyrotechnic pretensioner fired. Nothing may fire.
+#[test]
+fn a_door_slam_with_the_crash_sensor_stuck_on_a_lobe_fires_nothing() {
+    let text = r#"
+name = "stuck-crash-sensor-in-door-slam-regression"
+seed = 12651
+duration_s = 0.8
+[ego]
+mass_kg = 1785
+class = 4
+speed_kph = 0
+[opponent]
+kind = "barrier"
+initial_distance_m = 900.0
+[sensor]
+mass_estimate_kg = 3000
+accel_faults = [{ start_s = 0.383294328, end_s = 0.483294328, kind = "stuck", sensor = "crash" }]
+[occupant]
+mass_kg = 75
+chest_to_wheel_mm = 300
+belted = false
+[[accel_event]]
+kind = "ringing"
+start_s = 0.365988229
+peak_g = 59.13
+frequency_hz = 131.086
+duration_ms = 38.744
+net_dv_mps = 0.0145
+phase_deg = 217.124
+sensor = "all"
+"#;
+    let s = Scenario::parse("door-slam-stuck.toml", text).expect("scenario");
+    let r = run(&s, &cfg()).expect("run");
+    for what in ["airbag_fire", "pretensioner_fire"] {
+        assert!(r.action(what).is_none(), "{what}: {:?}", r.action(what));
+    }
+}
