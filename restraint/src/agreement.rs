@@ -10,7 +10,9 @@
 //! is the faulty one of the pair — or the pair cannot tell, which is reason enough not to fire.
 //!
 //! **Rule.** Both sensors' plausible samples are integrated to a velocity trace while either
-//! is in an event (a sample ≥ the wake threshold, then `reset_gap` of quiet): a quiet sensor's
+//! is in an event (a sample ≥ the wake threshold, then `reset_gap` of quiet) — each trace
+//! records every sample while the other's event runs, so a plateau at the wake threshold that
+//! one sensor reads just above it and the other just below counts on both —: a quiet sensor's
 //! velocity does not change. For the confirmed event (onset `t₀`) and the newest instant both
 //! sensors have measured (`t₁`): with Δv_c and Δv_s the crash and safing sensors' velocity
 //! change over [t₀, t₁], the pair **disagrees** when
@@ -91,24 +93,32 @@ impl VelocityTrace {
         }
     }
 
-    /// One batch of plausible samples. A quiet batch outside an event only keeps its newest
-    /// sample (every cycle of a drive: what the integration needs for its next trapezoid).
-    pub fn on_batch(&mut self, batch: &PlausibleBatch) {
-        if !self.recording && batch.all_below(self.wake_mps2) {
+    /// One batch of plausible samples; `beside`: the other sensor's trace is recording, so
+    /// this one records every sample too (module docs, "Rule"). A quiet batch outside an event
+    /// only keeps its newest sample (every cycle of a drive: what the integration needs for its
+    /// next trapezoid).
+    pub fn on_batch(&mut self, batch: &PlausibleBatch, beside: bool) {
+        if !(self.recording || beside) && batch.all_below(self.wake_mps2) {
             if let Some((t, d)) = batch.last_sample() {
                 (self.last_ns, self.last_decel_mps2, self.seen) = (t, d, true);
             }
             return;
         }
         for s in batch.iter() {
-            self.push(s.t_ns, s.decel_mps2);
+            self.push(s.t_ns, s.decel_mps2, beside);
         }
     }
 
-    /// One sample (a trapezoid from the previous one, across any dropped sample).
+    /// Samples are being integrated: an event of this sensor, or of the other one, in progress.
+    pub fn recording(&self) -> bool {
+        self.recording
+    }
+
+    /// One sample (a trapezoid from the previous one, across any dropped sample); `beside`:
+    /// the other sensor's event keeps this one's going.
     #[inline]
-    fn push(&mut self, t_ns: u64, d: f64) {
-        if d >= self.wake_mps2 {
+    fn push(&mut self, t_ns: u64, d: f64, beside: bool) {
+        if beside || d >= self.wake_mps2 {
             self.active_until_ns = t_ns.saturating_add(self.gap_ns);
         }
         if self.seen {
@@ -381,7 +391,7 @@ mod tests {
                 &samples,
                 &mut b,
             );
-            trace.on_batch(&b);
+            trace.on_batch(&b, false);
             t += 1_000;
         }
     }
@@ -420,6 +430,57 @@ mod tests {
             let worst = a.worst_excess_mps().unwrap();
             assert!(worst.abs() < 0.03, "{peak} g: {worst}");
         }
+    }
+
+    /// Two healthy sensors on a plateau at the wake threshold (a truck bed's hood: the crash
+    /// sensor reads 1.55 g, the safing sensor 1.45 g) for 50 ms, then 6 g for 20 ms, fed as the
+    /// cycle feeds them (each 1 ms: the crash sensor's batch, then the safing sensor's). The
+    /// safing sensor's samples count while the crash sensor's event runs: the pair agrees.
+    /// Each trace on its own events, the crash sensor's 0.76 m/s of plateau had no counterpart
+    /// and the pair disagreed (an underride with the object list dead was missed).
+    #[test]
+    fn a_plateau_at_the_wake_threshold_counts_on_both_sensors() {
+        let limits = AccelLimits {
+            timeout_ns: 50 * MS,
+            stuck_ns: 20 * MS,
+            full_scale_mps2: 200.0 * G_MPS2,
+        };
+        let (mut crash, mut safing) = (AccelMonitor::new(limits), AccelMonitor::new(limits));
+        let level = |t_us: u64, plateau_g: f64| match t_us {
+            0..=9_999 => 0.0,
+            10_000..=59_999 => plateau_g,
+            60_000..=79_999 => 6.0,
+            _ => 0.0,
+        };
+        let batch = |mon: &mut AccelMonitor, t: u64, period_us: u64, g: f64| {
+            let n = (1_000 / period_us) as usize;
+            let samples: heapless::Vec<f32, 16> = (0..n)
+                .map(|k| -(g * G_MPS2) as f32 + if k % 2 == 0 { 0.01 } else { -0.01 })
+                .collect();
+            let mut b = PlausibleBatch::new();
+            mon.feed(
+                t * US + MS,
+                t * US,
+                (period_us * US) as u32,
+                &samples,
+                &mut b,
+            );
+            b
+        };
+        let mut a = agreement();
+        let mut t = 0;
+        while t < 100_000 {
+            let b = batch(&mut crash, t, 250, level(t, 1.55));
+            let beside = a.safing.recording();
+            a.crash.on_batch(&b, beside);
+            let b = batch(&mut safing, t, 500, level(t, 1.45));
+            let beside = a.crash.recording();
+            a.safing.on_batch(&b, beside);
+            t += 1_000;
+        }
+        assert!(a.agrees(10 * MS), "excess {:?}", a.worst_excess_mps());
+        let excess = a.worst_excess_mps().unwrap();
+        assert!((excess - 0.1 * G_MPS2 * 0.050).abs() < 0.02, "{excess}");
     }
 
     #[test]

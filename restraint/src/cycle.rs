@@ -279,7 +279,8 @@ impl Activity for RestraintCycle<'_> {
             crash_mean.add(&plausible);
             // The agreement, the road's roughness and the satellites' crush Δv take the
             // readings as they are.
-            agreement.crash.on_batch(&plausible);
+            let beside = agreement.safing.recording();
+            agreement.crash.on_batch(&plausible, beside);
             let (dv_mps, span_s) = plausible.decel_integral_mps();
             crash.on_raw_batch(dv_mps, span_s);
             if !tunnel_is_safing {
@@ -327,7 +328,8 @@ impl Activity for RestraintCycle<'_> {
                 crash.end_safing_roughness(now);
             }
             safing.on_batch(&safing_batch);
-            agreement.safing.on_batch(&safing_batch);
+            let beside = agreement.crash.recording();
+            agreement.safing.on_batch(&safing_batch, beside);
         });
         inputs.on_receive_errors(io.receive_errors(), now);
         // The fresh vehicle frame's deceleration: the pair check's reference and, for a faulty
