@@ -365,34 +365,46 @@ mod tests {
         SeverityAgreement::new(params(), 1.5 * G_MPS2, 10 * MS)
     }
 
-    /// Feeds `g(t_us)` (deceleration, g) sampled every `period_us` over `[t0, t1)` µs, in 1 ms
-    /// batches through a real monitor.
-    fn feed(trace: &mut VelocityTrace, period_us: u64, t1_us: u64, g: impl Fn(u64) -> f64) {
-        let mut mon = AccelMonitor::new(AccelLimits {
+    /// A monitor with the crash sensor's limits.
+    fn monitor() -> AccelMonitor {
+        AccelMonitor::new(AccelLimits {
             timeout_ns: 50 * MS,
             stuck_ns: 20 * MS,
             full_scale_mps2: 200.0 * G_MPS2,
-        });
-        let per_batch = (1_000 / period_us) as usize;
+        })
+    }
+
+    /// The 1 ms batch from `t_us` of `g(t_us)` (deceleration, g) sampled every `period_us`,
+    /// through `mon`.
+    fn batch(
+        mon: &mut AccelMonitor,
+        t: u64,
+        period_us: u64,
+        g: &impl Fn(u64) -> f64,
+    ) -> PlausibleBatch {
+        let samples: heapless::Vec<f32, 16> = (0..1_000 / period_us)
+            .map(|k| {
+                // A tiny alternating noise keeps the stuck check quiet.
+                -(g(t + k * period_us) * G_MPS2) as f32 + if k % 2 == 0 { 0.01 } else { -0.01 }
+            })
+            .collect();
         let mut b = PlausibleBatch::new();
-        let mut t = 0;
-        while t < t1_us {
-            let samples: heapless::Vec<f32, 16> = (0..per_batch)
-                .map(|k| {
-                    let tk = t + k as u64 * period_us;
-                    // A tiny alternating noise keeps the stuck check quiet.
-                    -(g(tk) * G_MPS2) as f32 + if k % 2 == 0 { 0.01 } else { -0.01 }
-                })
-                .collect();
-            mon.feed(
-                t * US + MS,
-                t * US,
-                (period_us * US) as u32,
-                &samples,
-                &mut b,
-            );
-            trace.on_batch(&b, false);
-            t += 1_000;
+        mon.feed(
+            t * US + MS,
+            t * US,
+            (period_us * US) as u32,
+            &samples,
+            &mut b,
+        );
+        b
+    }
+
+    /// Feeds `g(t_us)` (deceleration, g) sampled every `period_us` over `[0, t1)` µs, in 1 ms
+    /// batches through a real monitor.
+    fn feed(trace: &mut VelocityTrace, period_us: u64, t1_us: u64, g: impl Fn(u64) -> f64) {
+        let mut mon = monitor();
+        for t in (0..t1_us).step_by(1_000) {
+            trace.on_batch(&batch(&mut mon, t, period_us, &g), false);
         }
     }
 
@@ -440,43 +452,23 @@ mod tests {
     /// and the pair disagreed (an underride with the object list dead was missed).
     #[test]
     fn a_plateau_at_the_wake_threshold_counts_on_both_sensors() {
-        let limits = AccelLimits {
-            timeout_ns: 50 * MS,
-            stuck_ns: 20 * MS,
-            full_scale_mps2: 200.0 * G_MPS2,
+        let (mut crash, mut safing) = (monitor(), monitor());
+        let level = |plateau_g: f64| {
+            move |t_us: u64| match t_us {
+                10_000..=59_999 => plateau_g,
+                60_000..=79_999 => 6.0,
+                _ => 0.0,
+            }
         };
-        let (mut crash, mut safing) = (AccelMonitor::new(limits), AccelMonitor::new(limits));
-        let level = |t_us: u64, plateau_g: f64| match t_us {
-            0..=9_999 => 0.0,
-            10_000..=59_999 => plateau_g,
-            60_000..=79_999 => 6.0,
-            _ => 0.0,
-        };
-        let batch = |mon: &mut AccelMonitor, t: u64, period_us: u64, g: f64| {
-            let n = (1_000 / period_us) as usize;
-            let samples: heapless::Vec<f32, 16> = (0..n)
-                .map(|k| -(g * G_MPS2) as f32 + if k % 2 == 0 { 0.01 } else { -0.01 })
-                .collect();
-            let mut b = PlausibleBatch::new();
-            mon.feed(
-                t * US + MS,
-                t * US,
-                (period_us * US) as u32,
-                &samples,
-                &mut b,
-            );
-            b
-        };
+        let (crash_g, safing_g) = (level(1.55), level(1.45));
         let mut a = agreement();
-        let mut t = 0;
-        while t < 100_000 {
-            let b = batch(&mut crash, t, 250, level(t, 1.55));
+        for t in (0..100_000).step_by(1_000) {
             let beside = a.safing.recording();
-            a.crash.on_batch(&b, beside);
-            let b = batch(&mut safing, t, 500, level(t, 1.45));
+            a.crash
+                .on_batch(&batch(&mut crash, t, 250, &crash_g), beside);
             let beside = a.crash.recording();
-            a.safing.on_batch(&b, beside);
-            t += 1_000;
+            a.safing
+                .on_batch(&batch(&mut safing, t, 500, &safing_g), beside);
         }
         assert!(a.agrees(10 * MS), "excess {:?}", a.worst_excess_mps());
         let excess = a.worst_excess_mps().unwrap();
