@@ -21,7 +21,7 @@ use crate::outputs::{publish_diagnostics, Outputs};
 use crate::pair_monitor::{CycleMean, PairMonitor};
 use crate::plan::{ReferenceSettings, RestraintPlan};
 use crate::safing::Safing;
-use crate::satellites::{Relief, Satellites, TUNNEL_FROZEN_MS};
+use crate::satellites::{Relief, Satellites, TUNNEL_FROZEN_NS};
 use crate::settings::ConfigError;
 use crate::settings::G_MPS2;
 use crate::signals::{Degraded, SatelliteSide};
@@ -66,8 +66,6 @@ pub struct RestraintCycle<'lut> {
 }
 
 /// Report-counter names of the E2E rejections, in [`RejectReason::VARIANTS`] order.
-const TUNNEL_FROZEN_NS: u64 = (TUNNEL_FROZEN_MS * 1e6) as u64;
-
 const E2E_COUNTER_NAMES: [&str; RejectReason::COUNT] = [
     "can_rejected_unknown_id",
     "can_rejected_wrong_dlc",

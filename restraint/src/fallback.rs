@@ -450,8 +450,7 @@ impl FallbackAlgorithm {
     /// a restart within [`RE_ONSET_EARLY_MS`] of the segment's start keeps that segment as the
     /// parent, a later one judges alone.
     fn restart_segment_at(&mut self, onset_ns: u64, s: &AccelSample, base_dv_mps: f64) {
-        let early = onset_ns.saturating_sub(self.segment_onset_ns) < RE_ONSET_EARLY_NS;
-        self.parent = if early {
+        self.parent = if self.early_in_segment(onset_ns) {
             self.parent.or(Some(Parent {
                 onset_ns: self.segment_onset_ns,
                 base_dv_mps: self.segment_base_dv_mps,
@@ -588,11 +587,17 @@ impl FallbackAlgorithm {
     /// The dip under the wake threshold a re-onset at `t_ns` needs, ns: twice
     /// [`RE_ONSET_GAP_MS`] within [`RE_ONSET_EARLY_MS`] of the segment's start.
     fn re_onset_gap_ns(&self, t_ns: u64) -> u64 {
-        if t_ns.saturating_sub(self.segment_onset_ns) >= RE_ONSET_EARLY_NS {
-            RE_ONSET_GAP_NS
-        } else {
+        if self.early_in_segment(t_ns) {
             2 * RE_ONSET_GAP_NS
+        } else {
+            RE_ONSET_GAP_NS
         }
+    }
+
+    /// `t_ns` lies within [`RE_ONSET_EARLY_MS`] of the judged segment's start.
+    #[inline]
+    fn early_in_segment(&self, t_ns: u64) -> bool {
+        t_ns.saturating_sub(self.segment_onset_ns) < RE_ONSET_EARLY_NS
     }
 
     /// Follows the segment's valleys (module docs, "Re-onset"): the lowest sample of the latest
@@ -634,8 +639,11 @@ impl FallbackAlgorithm {
         if let Some(v) = self.valley {
             // Early in a segment the trough must reach the wake threshold, as a re-onset's dip
             // must be longer there (`RE_ONSET_EARLY_MS`).
-            let early = v.t_ns.saturating_sub(self.segment_onset_ns) < RE_ONSET_EARLY_NS;
-            let trough_max = if early { p.wake_mps2 } else { VALLEY_MAX_MPS2 };
+            let trough_max = if self.early_in_segment(v.t_ns) {
+                p.wake_mps2
+            } else {
+                VALLEY_MAX_MPS2
+            };
             if not_fired && crest > v.crest_before_mps2 && v.decel_mps2 <= trough_max {
                 self.restart_segment_at(v.t_ns, s, v.dv_mps);
             }

@@ -120,6 +120,8 @@ pub const RELIEF_HOLD_MS: f64 = 60.0;
 /// changes its reading every sample; 1 ms is 8 samples at 8 kHz, and a sensor stuck at one
 /// reading is flagged only after `accel_stuck_ms` (20 ms).
 pub const TUNNEL_FROZEN_MS: f64 = 1.0;
+/// [`TUNNEL_FROZEN_MS`] in ns.
+pub const TUNNEL_FROZEN_NS: u64 = (TUNNEL_FROZEN_MS * 1e6) as u64;
 
 /// How long a satellite's status or corrupt frame, or an implausible crush, keeps it out of
 /// the fusion, ms (as an accelerometer's implausible reading: `accel::INVALID_HOLD_MS`).
