@@ -333,6 +333,11 @@ struct Outcome {
     /// The occupant bottomed out under what the ECU fired (`None`: no contact).
     #[serde(default)]
     bottomed_out: Option<bool>,
+    /// A needed airbag fired by its required time and the occupant still bottomed out:
+    /// whether the reference restraint, its airbag fired at the ECU's airbag time, bottoms
+    /// out too (`None`: not asked).
+    #[serde(default)]
+    reference_bottomed_at_fire: Option<bool>,
 }
 
 /// A crash phase entered less than this before the run's end is unfinished, not stuck, ms: the
@@ -349,9 +354,62 @@ fn run_variant(cfg: &OfflineConfig, text: &str, req: Requirement) -> Result<Outc
         outcome.clean_margin_ms = airbag_ms.zip(twin.required_ms).map(|(t, r)| t - r);
     }
     if req == Requirement::ByOutcome {
-        outcome.airbag_needed = Some(airbag_needed(cfg, text)?);
+        let needed = airbag_needed(cfg, text)?;
+        outcome.airbag_needed = Some(needed);
+        if let (true, Some(true), Some(t), Some(r)) = (
+            needed,
+            outcome.bottomed_out,
+            outcome.airbag_ms,
+            outcome.required_ms,
+        ) {
+            if t <= r {
+                outcome.reference_bottomed_at_fire = Some(reference_bottoms_at(cfg, text, t)?);
+            }
+        }
     }
     Ok(outcome)
+}
+
+/// The variant's occupant, its true pulse and the reference restraint's settings: what the
+/// judge of a family by outcome simulates.
+fn reference_case(
+    cfg: &OfflineConfig,
+    text: &str,
+) -> Result<
+    Option<(
+        world::Truth,
+        physics::OccupantInput,
+        physics::RestraintSettings,
+    )>,
+> {
+    let scenario = scenario_of(text)?;
+    let truth = world::Truth::new(&scenario).map_err(anyhow::Error::msg)?;
+    if truth.collision.is_none() {
+        return Ok(None);
+    }
+    let occ = physics::OccupantInput {
+        mass_kg: scenario.occupant.mass_kg,
+        chest_to_wheel_m: scenario.occupant.chest_to_wheel_mm * 1e-3,
+        belted: scenario.occupant.belted,
+    };
+    Ok(Some((truth, occ, cfg.reference.settings())))
+}
+
+/// Whether the reference restraint with its airbag fired `airbag_ms` after the true contact
+/// lets the occupant bottom out. The ECU fires on its own cycle, up to one cycle after the
+/// reference's ideal instant: where the reference itself bottoms out when fired then, the
+/// bottoming out is the restraint's margin at that instant, not the ECU's decision.
+fn reference_bottoms_at(cfg: &OfflineConfig, text: &str, airbag_ms: f64) -> Result<bool> {
+    let Some((truth, occ, full)) = reference_case(cfg, text)? else {
+        return Ok(false);
+    };
+    let set = physics::RestraintSettings {
+        airbag_time_s: airbag_ms * 1e-3,
+        ..full
+    };
+    let judged = actuator_stubs::outcome::judge(&truth.pulse.ego_pulse(), &occ, &set)
+        .map_err(anyhow::Error::msg)?;
+    Ok(judged.0.bottomed_out)
 }
 
 /// Whether the reference restraint's airbag is what keeps the occupant from bottoming out in
@@ -360,18 +418,10 @@ fn run_variant(cfg: &OfflineConfig, text: &str, req: Requirement) -> Result<Outc
 /// reference are the actuator stubs' (`actuator_stubs::outcome`), not the ECU's.
 fn airbag_needed(cfg: &OfflineConfig, text: &str) -> Result<bool> {
     use actuator_stubs::outcome::{judge, NEVER_S};
-    let scenario = scenario_of(text)?;
-    let truth = world::Truth::new(&scenario).map_err(anyhow::Error::msg)?;
-    if truth.collision.is_none() {
+    let Some((truth, occ, full)) = reference_case(cfg, text)? else {
         return Ok(false);
-    }
-    let pulse = truth.pulse.ego_pulse();
-    let occ = physics::OccupantInput {
-        mass_kg: scenario.occupant.mass_kg,
-        chest_to_wheel_m: scenario.occupant.chest_to_wheel_mm * 1e-3,
-        belted: scenario.occupant.belted,
     };
-    let full = cfg.reference.settings();
+    let pulse = truth.pulse.ego_pulse();
     let belt = physics::RestraintSettings {
         airbag_force_n: 0.0,
         airbag_time_s: NEVER_S,
@@ -415,6 +465,7 @@ fn run_one(cfg: &OfflineConfig, text: &str) -> Result<Outcome> {
         severity_excess_mps: r.severity_excess_mps,
         clean_margin_ms: None,
         airbag_needed: None,
+        reference_bottomed_at_fire: None,
         bottomed_out: r
             .evaluated
             .as_ref()
@@ -558,6 +609,9 @@ fn run_matrix() -> Result<()> {
         let (mut bad_bag, mut bad_pt, mut missed, mut errors, mut stuck) = (0, 0, 0, 0, 0);
         // Judged by outcome: variants whose airbag is needed, and airbags fired in the others.
         let (mut needed, mut fired_unneeded) = (0, 0);
+        // Of those, airbags fired in time whose occupant the reference bottoms out as well
+        // when fired at the ECU's instant (the cycle's grid against the ideal one).
+        let mut at_margin = 0;
         let mut margins = Vec::new();
         // Fire − required less the clean twin's, where the family has twins.
         let (mut late, mut vs_clean) = (0, f64::NEG_INFINITY);
@@ -656,11 +710,16 @@ fn run_matrix() -> Result<()> {
                         margins.push(t - req);
                         after += usize::from(t > req);
                     }
-                    if o.bottomed_out == Some(true) {
+                    if o.bottomed_out == Some(true) && o.reference_bottomed_at_fire == Some(true) {
+                        at_margin += 1;
+                    } else if o.bottomed_out == Some(true) {
                         missed += 1;
                         fail(&match o.airbag_ms {
                             None => "the reference airbag keeps this occupant from bottoming out; no airbag, bottomed out".to_owned(),
-                            Some(t) => format!("the reference airbag keeps this occupant from bottoming out; airbag at {t:+.1} ms, bottomed out"),
+                            Some(t) => match o.required_ms {
+                                Some(r) if t > r => format!("the reference airbag keeps this occupant from bottoming out; airbag at {t:+.1} ms, after its required {r:+.1} ms, bottomed out"),
+                                _ => format!("the reference airbag keeps this occupant from bottoming out; airbag at {t:+.1} ms, bottomed out where the reference restraint fired then does not"),
+                            },
                         });
                     }
                 }
@@ -677,7 +736,7 @@ fn run_matrix() -> Result<()> {
                     margins[margins.len() - 1]
                 )
             };
-            format!("{m} (airbag needed in {needed}; fired in {fired_unneeded} of the others)")
+            format!("{m} (airbag needed in {needed}, {at_margin} of them fired in time and bottomed out as the reference fired then does; fired in {fired_unneeded} of the others)")
         } else if margins.is_empty() {
             "—".to_owned()
         } else {
@@ -739,6 +798,7 @@ fn run_matrix() -> Result<()> {
             "fire_minus_required_ms_worst": margins.last(),
             "airbag_needed": (req == Requirement::ByOutcome).then_some(needed),
             "airbag_fired_where_not_needed": (req == Requirement::ByOutcome).then_some(fired_unneeded),
+            "bottomed_out_as_reference_at_fire": (req == Requirement::ByOutcome).then_some(at_margin),
         }));
     }
     if healthy_excess.is_finite() {

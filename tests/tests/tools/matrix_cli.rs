@@ -56,6 +56,42 @@ fn quiet_prints_the_table_only() {
     );
 }
 
+/// The grey zone's margin, judged apart from a miss: an unbelted occupant in a 25 + 25 km/h
+/// car crash whom the reference restraint's airbag at its ideal +10.000 ms stops short of the
+/// wheel by 0.015 mm. The ECU fires the same plan on its cycle, 0.014 ms later and 4.5 ms
+/// before "127 mm − 30 ms"; the occupant reaches the wheel, as under the reference fired at
+/// that instant.
+#[test]
+fn a_grey_zone_airbag_in_time_is_judged_against_the_reference_at_its_instant() {
+    let out = std::env::temp_dir().join(format!("grey-margin-{}.json", std::process::id()));
+    let (code, _, stderr) = matrix(&[
+        "--family",
+        "grey-zone",
+        "--variants",
+        "22223",
+        "--seed",
+        "17",
+        "--shard",
+        "9560/22223",
+        "--outcomes",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let rows: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let _ = std::fs::remove_file(&out);
+    assert_eq!(rows.as_array().map(Vec::len), Some(1), "{rows}");
+    let o = &rows[0]["outcome"];
+    assert_eq!(o["airbag_needed"], true, "{o}");
+    assert_eq!(o["bottomed_out"], true, "{o}");
+    let (fire, required) = (o["airbag_ms"].as_f64(), o["required_ms"].as_f64());
+    assert!(
+        matches!((fire, required), (Some(t), Some(r)) if t > 10.0 && t < 10.5 && t < r),
+        "{o}"
+    );
+    assert_eq!(o["reference_bottomed_at_fire"], true, "{o}");
+}
+
 /// Runs `bin args`, reads one line of its output and closes the pipe: how `| head -1` ends it.
 fn closed_pipe(bin: &str, args: &[&str]) -> (std::process::ExitStatus, String) {
     use std::io::{BufRead, BufReader, Read};
