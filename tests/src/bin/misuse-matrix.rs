@@ -338,6 +338,16 @@ struct Outcome {
     /// out too (`None`: not asked).
     #[serde(default)]
     reference_bottomed_at_fire: Option<bool>,
+    /// The occupant bottomed out under the reference restraint in the true pulse (`None`: no
+    /// contact).
+    #[serde(default)]
+    reference_bottomed_out: Option<bool>,
+}
+
+/// Families whose crashes the report also weighs by the occupant's outcome against the
+/// reference restraint's: every crash in them needs a restraint.
+fn judged_by_occupant(req: Requirement) -> bool {
+    matches!(req, Requirement::MustFire | Requirement::ByOutcome)
 }
 
 /// A crash phase entered less than this before the run's end is unfinished, not stuck, ms: the
@@ -470,6 +480,10 @@ fn run_one(cfg: &OfflineConfig, text: &str) -> Result<Outcome> {
             .evaluated
             .as_ref()
             .map(|e| e.outcome.adaptive.bottomed_out),
+        reference_bottomed_out: r
+            .evaluated
+            .as_ref()
+            .map(|e| e.outcome.reference.bottomed_out),
     })
 }
 
@@ -600,6 +614,9 @@ fn run_matrix() -> Result<()> {
     let mut json_rows = Vec::new();
     // Two healthy sensors on real crashes: the must-fire families' largest crash − safing Δv.
     let mut healthy_excess = f64::NEG_INFINITY;
+    // Per must-fire family: occupants bottomed out where the reference restraint's would not
+    // (a report: the fire time is the family's requirement, this is what it costs).
+    let mut worse_than_reference = Vec::new();
     for (f, family) in families.iter().enumerate() {
         let (name, req) = (family.name, family.requirement);
         let open = cli.gate && misuse::OPEN.contains(&name);
@@ -617,6 +634,8 @@ fn run_matrix() -> Result<()> {
         let (mut late, mut vs_clean) = (0, f64::NEG_INFINITY);
         // Airbags after their required time.
         let mut after = 0;
+        // Occupants bottomed out where the reference restraint's would not.
+        let mut bottomed_vs_reference = 0;
         for (_, i, o) in &rows {
             let o = match o {
                 Ok(o) => o,
@@ -642,6 +661,12 @@ fn run_matrix() -> Result<()> {
                 if let Some(x) = o.severity_excess_mps {
                     healthy_excess = healthy_excess.max(x);
                 }
+            }
+            if judged_by_occupant(req)
+                && o.bottomed_out == Some(true)
+                && o.reference_bottomed_out == Some(false)
+            {
+                bottomed_vs_reference += 1;
             }
             match req {
                 Requirement::NoFire => {
@@ -799,7 +824,18 @@ fn run_matrix() -> Result<()> {
             "airbag_needed": (req == Requirement::ByOutcome).then_some(needed),
             "airbag_fired_where_not_needed": (req == Requirement::ByOutcome).then_some(fired_unneeded),
             "bottomed_out_as_reference_at_fire": (req == Requirement::ByOutcome).then_some(at_margin),
+            "bottomed_out_where_reference_does_not": judged_by_occupant(req).then_some(bottomed_vs_reference),
         }));
+        if bottomed_vs_reference > 0 {
+            worse_than_reference.push(format!("{name} {bottomed_vs_reference} of {}", rows.len()));
+        }
+    }
+    if !worse_than_reference.is_empty() {
+        writeln!(
+            out,
+            "occupant bottomed out where the reference restraint's does not (a report, not judged): {}",
+            worse_than_reference.join(", ")
+        )?;
     }
     if healthy_excess.is_finite() {
         let c = &cfg.cycle;

@@ -92,6 +92,62 @@ fn a_grey_zone_airbag_in_time_is_judged_against_the_reference_at_its_instant() {
     assert_eq!(o["reference_bottomed_at_fire"], true, "{o}");
 }
 
+/// The occupant report: a must-fire family's count of occupants bottomed out where the
+/// reference restraint's are not is the same in the table's line, the JSON and the variants'
+/// own outcomes (one shard holding them all).
+#[test]
+fn the_occupant_report_counts_what_the_outcomes_say() {
+    let dir = std::env::temp_dir().join(format!("occupant-report-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (json, outcomes) = (dir.join("m.json"), dir.join("o.json"));
+    let family = [
+        "--family",
+        "must-fire-heavy-opponent",
+        "--variants",
+        "60",
+        "--seed",
+        "11",
+    ];
+    let (code, stdout, stderr) =
+        matrix(&[&family[..], &["--quiet", "--json", json.to_str().unwrap()]].concat());
+    assert!(code == 0 || code == 1, "{stderr}");
+    let (code, _, stderr) = matrix(
+        &[
+            &family[..],
+            &["--shard", "0/1", "--outcomes", outcomes.to_str().unwrap()],
+        ]
+        .concat(),
+    );
+    assert_eq!(code, 0, "{stderr}");
+    let read = |p: &std::path::Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+    };
+    let (report, rows) = (read(&json), read(&outcomes));
+    let _ = std::fs::remove_dir_all(&dir);
+    let worse = rows
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|r| {
+            r["outcome"]["bottomed_out"] == true && r["outcome"]["reference_bottomed_out"] == false
+        })
+        .count();
+    let counted = report["families"][0]["bottomed_out_where_reference_does_not"].as_u64();
+    assert_eq!(counted, Some(worse as u64), "{report}");
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("occupant bottomed out where"));
+    if worse > 0 {
+        let line = line.unwrap_or_else(|| panic!("no report line:\n{stdout}"));
+        assert!(
+            line.contains(&format!("must-fire-heavy-opponent {worse} of 60")),
+            "{line}"
+        );
+    } else {
+        assert!(line.is_none(), "{stdout}");
+    }
+}
+
 /// Runs `bin args`, reads one line of its output and closes the pipe: how `| head -1` ends it.
 fn closed_pipe(bin: &str, args: &[&str]) -> (std::process::ExitStatus, String) {
     use std::io::{BufRead, BufReader, Read};
