@@ -364,82 +364,86 @@ fn run_variant(cfg: &OfflineConfig, text: &str, req: Requirement) -> Result<Outc
         outcome.clean_margin_ms = airbag_ms.zip(twin.required_ms).map(|(t, r)| t - r);
     }
     if req == Requirement::ByOutcome {
-        let needed = airbag_needed(cfg, text)?;
+        // A variant without a collision needs no airbag.
+        let case = ReferenceCase::new(cfg, text)?;
+        let needed = case
+            .as_ref()
+            .map_or(Ok(false), ReferenceCase::airbag_needed)?;
         outcome.airbag_needed = Some(needed);
-        if let (true, Some(true), Some(t), Some(r)) = (
+        if let (Some(case), true, Some(true), Some(t), Some(r)) = (
+            &case,
             needed,
             outcome.bottomed_out,
             outcome.airbag_ms,
             outcome.required_ms,
         ) {
             if t <= r {
-                outcome.reference_bottomed_at_fire = Some(reference_bottoms_at(cfg, text, t)?);
+                outcome.reference_bottomed_at_fire = Some(case.bottoms_out_with_airbag_at(t)?);
             }
         }
     }
     Ok(outcome)
 }
 
-/// The variant's occupant, its true pulse and the reference restraint's settings: what the
-/// judge of a family by outcome simulates.
-fn reference_case(
-    cfg: &OfflineConfig,
-    text: &str,
-) -> Result<
-    Option<(
-        world::Truth,
-        physics::OccupantInput,
-        physics::RestraintSettings,
-    )>,
-> {
-    let scenario = scenario_of(text)?;
-    let truth = world::Truth::new(&scenario).map_err(anyhow::Error::msg)?;
-    if truth.collision.is_none() {
-        return Ok(None);
+/// What the judge of a family by outcome simulates: the variant's true pulse, its occupant and
+/// the reference restraint. The occupant model and the reference are the actuator stubs'
+/// (`actuator_stubs::outcome`), not the ECU's.
+struct ReferenceCase {
+    truth: world::Truth,
+    occupant: physics::OccupantInput,
+    reference: physics::RestraintSettings,
+}
+
+impl ReferenceCase {
+    /// The variant's case (`None`: no collision in its true world).
+    fn new(cfg: &OfflineConfig, text: &str) -> Result<Option<Self>> {
+        let scenario = scenario_of(text)?;
+        let truth = world::Truth::new(&scenario).map_err(anyhow::Error::msg)?;
+        if truth.collision.is_none() {
+            return Ok(None);
+        }
+        let occupant = physics::OccupantInput {
+            mass_kg: scenario.occupant.mass_kg,
+            chest_to_wheel_m: scenario.occupant.chest_to_wheel_mm * 1e-3,
+            belted: scenario.occupant.belted,
+        };
+        Ok(Some(Self {
+            truth,
+            occupant,
+            reference: cfg.reference.settings(),
+        }))
     }
-    let occ = physics::OccupantInput {
-        mass_kg: scenario.occupant.mass_kg,
-        chest_to_wheel_m: scenario.occupant.chest_to_wheel_mm * 1e-3,
-        belted: scenario.occupant.belted,
-    };
-    Ok(Some((truth, occ, cfg.reference.settings())))
-}
 
-/// Whether the reference restraint with its airbag fired `airbag_ms` after the true contact
-/// lets the occupant bottom out. The ECU fires on its own cycle, up to one cycle after the
-/// reference's ideal instant: where the reference itself bottoms out when fired then, the
-/// bottoming out is the restraint's margin at that instant, not the ECU's decision.
-fn reference_bottoms_at(cfg: &OfflineConfig, text: &str, airbag_ms: f64) -> Result<bool> {
-    let Some((truth, occ, full)) = reference_case(cfg, text)? else {
-        return Ok(false);
-    };
-    let set = physics::RestraintSettings {
-        airbag_time_s: airbag_ms * 1e-3,
-        ..full
-    };
-    let judged = actuator_stubs::outcome::judge(&truth.pulse.ego_pulse(), &occ, &set)
-        .map_err(anyhow::Error::msg)?;
-    Ok(judged.0.bottomed_out)
-}
+    /// Whether the occupant bottoms out under `set` in the true pulse.
+    fn bottoms_out(&self, set: &physics::RestraintSettings) -> Result<bool> {
+        let judged =
+            actuator_stubs::outcome::judge(&self.truth.pulse.ego_pulse(), &self.occupant, set)
+                .map_err(anyhow::Error::msg)?;
+        Ok(judged.0.bottomed_out)
+    }
 
-/// Whether the reference restraint's airbag is what keeps the occupant from bottoming out in
-/// the variant's true pulse: its belt alone (the airbag never fired) bottoms out, the whole
-/// reference restraint (the airbag at its time) does not. The occupant model and the
-/// reference are the actuator stubs' (`actuator_stubs::outcome`), not the ECU's.
-fn airbag_needed(cfg: &OfflineConfig, text: &str) -> Result<bool> {
-    use actuator_stubs::outcome::{judge, NEVER_S};
-    let Some((truth, occ, full)) = reference_case(cfg, text)? else {
-        return Ok(false);
-    };
-    let pulse = truth.pulse.ego_pulse();
-    let belt = physics::RestraintSettings {
-        airbag_force_n: 0.0,
-        airbag_time_s: NEVER_S,
-        ..full
-    };
-    let with_airbag = judge(&pulse, &occ, &full).map_err(anyhow::Error::msg)?;
-    let belt_only = judge(&pulse, &occ, &belt).map_err(anyhow::Error::msg)?;
-    Ok(belt_only.0.bottomed_out && !with_airbag.0.bottomed_out)
+    /// Whether the reference restraint's airbag is what keeps the occupant from bottoming out:
+    /// its belt alone (the airbag never fired) bottoms out, the whole reference restraint (the
+    /// airbag at its time) does not.
+    fn airbag_needed(&self) -> Result<bool> {
+        let belt = physics::RestraintSettings {
+            airbag_force_n: 0.0,
+            airbag_time_s: actuator_stubs::outcome::NEVER_S,
+            ..self.reference
+        };
+        Ok(self.bottoms_out(&belt)? && !self.bottoms_out(&self.reference)?)
+    }
+
+    /// Whether the reference restraint with its airbag fired `airbag_ms` after the true contact
+    /// lets the occupant bottom out. The ECU fires on its own cycle, up to one cycle after the
+    /// reference's ideal instant: where the reference itself bottoms out when fired then, the
+    /// bottoming out is the restraint's margin at that instant, not the ECU's decision.
+    fn bottoms_out_with_airbag_at(&self, airbag_ms: f64) -> Result<bool> {
+        self.bottoms_out(&physics::RestraintSettings {
+            airbag_time_s: airbag_ms * 1e-3,
+            ..self.reference
+        })
+    }
 }
 
 /// A variant's scenario text parsed (the text beside the error: it is generated).
